@@ -1,0 +1,1 @@
+"""Policies: scripted expert, frontier baselines and learned agents. They see observations only."""

@@ -1,0 +1,61 @@
+"""The interface every policy implements: scripted expert, baselines and learned agents."""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class StepStats:
+    """Compute time a policy spent on one ``act`` call, by stage, in milliseconds.
+
+    ``map_generation_ms`` covers building the policy's map representation (the semantic
+    topometric map, or frontier detection for the frontier baselines); ``global_planning_ms``
+    covers goal selection and the global path search; ``local_planning_ms`` the local planner.
+    A stage that did not run in this step reports 0.
+    """
+
+    map_generation_ms: float = 0.0
+    global_planning_ms: float = 0.0
+    local_planning_ms: float = 0.0
+    replanned: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+class Policy(abc.ABC):
+    """A controller from observations to actions.
+
+    A policy sees what a robot sees: the observation dict and the ``info`` dict the env returns
+    (including ``info["map_geometry"]`` and the robot limits), never the simulator.
+
+    Lifecycle: ``reset(obs, info, seed=...)`` at the start of an episode, then
+    ``act(obs, info)`` each step. ``done`` turns True when the policy considers the mission
+    over (``stop_reason`` says why); ``last_stats`` holds the compute times of the last step.
+    """
+
+    name: str = "policy"
+
+    def __init__(self) -> None:
+        self.done: bool = False
+        self.stop_reason: str = ""
+        self.last_stats: StepStats = StepStats()
+        self.rng: np.random.Generator = np.random.default_rng()
+
+    def reset(self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None) -> None:
+        """Start a new episode. All randomness of the policy flows from ``seed``."""
+        self.done = False
+        self.stop_reason = ""
+        self.last_stats = StepStats()
+        self.rng = np.random.default_rng(seed)
+
+    @abc.abstractmethod
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        """Return the action for this step: float32 ``(2,)`` in ``[-1, 1]`` (scaled v, omega)."""
+
+    def overlay(self) -> dict[str, Any]:
+        """Drawing hints for the renderer (see :mod:`semexplore_gym.rendering`); empty by default."""
+        return {}

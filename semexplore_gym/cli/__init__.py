@@ -1,0 +1,61 @@
+"""The ``semexplore`` command: one entry point, one module per subcommand.
+
+Each subcommand module defines ``add_parser(subparsers)`` (registering its parser with
+``set_defaults(func=run)``-style dispatch handled here) and ``run(args) -> int``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+#: Subcommand name -> module under ``semexplore_gym.cli``.
+SUBCOMMANDS: dict[str, str] = {
+    "show-world": "show_world",
+    "segment": "segment",
+    "explore": "explore",
+    "benchmark": "benchmark",
+    "train": "train",
+    "compare-weights": "compare_weights",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="semexplore",
+        description="SemanticExplore: semantic topometric exploration with a simulated TurtleBot3.",
+    )
+    from semexplore_gym import __version__
+
+    parser.add_argument("--version", action="version", version=f"semexplore {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, module_name in SUBCOMMANDS.items():
+        try:
+            module = importlib.import_module(f"semexplore_gym.cli.{module_name}")
+        except ModuleNotFoundError as e:
+            if e.name == f"semexplore_gym.cli.{module_name}":
+                continue  # subcommand not part of this build
+            raise
+        p = module.add_parser(sub)
+        p.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the process exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "_run", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args._run(args) or 0)
+    except (ValueError, FileNotFoundError, KeyError) as e:
+        print(f"semexplore {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,434 @@
+"""Goal selection over the semantic topometric map: the paper's Algorithm 1 and frontier cost.
+
+The cost of a frontier ``F_i`` (paper, Eq. 1-2) is::
+
+    C(F_i) = d / L_path + w_v * v  -  (w_p * p_l(F_i) + w_I * (O(I) + P_u(I)))
+
+with ``d`` the length of the path from the robot to ``F_i`` along the map's paths, ``v`` the
+angle between the robot's heading and the start of that path, ``L_path`` the mean length of the
+paths between adjacent intersections, ``p_l`` the path length from the frontier to its
+intersection ``I``, ``O(I)`` the number of openings of ``I`` and ``P_u(I)`` the number of its
+pathways that lead directly to a frontier. The goal is ``F* = argmin C``.
+
+Algorithm 1 finds the paths to all frontiers in one search:
+
+* The graph's nodes are the map's **openings**; inside each area every pair of openings is
+  joined by the area's path (:class:`~semexplore_gym.core.topometric.types.GraphEdge`).
+* The search starts in the robot's area. Each opening of that area is a first neighbour; it is
+  seeded with the cost ``w_v * v`` of the angle between the robot's heading and the start of
+  the path to it, plus that first leg's length over ``L_path`` (the paper's line 3 names only
+  ``w_v * v``; adding the leg keeps the seeds comparable with each other).
+* Paths never re-enter the robot's area (as if ``A_cost`` of the start area were 0): the first
+  legs already cover every way through it, and re-entering would let a path start straight
+  ahead, turn round behind the robot and so dodge the angle cost.
+* The search list is a stack: the **last** element is expanded first.
+* A path is discontinued when it reaches a node already reached at a lower or equal cost (the
+  ``A_cost`` array). By default ``A_cost`` has one slot per *opening*: an area is entered through
+  one of its openings, and the cost of leaving it depends on which one, so per-opening pruning
+  keeps the search exact (it returns the cheapest path to every frontier). ``prune_by="area"``
+  keeps one slot per area as the paper's pseudocode reads; it prunes more and can lose the
+  cheapest path when an area is entered through two different openings.
+* When the popped path ends at a frontier opening it is scored with ``C`` (the semantic gain is
+  a property of the frontier, so it is subtracted once the path is complete).
+
+The accumulated search cost is the metric part of ``C`` in the same normalised units
+(``d / L_path + w_v * v``), so the pruning compares exactly what goal selection minimises.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from semexplore_gym.core.topometric.types import Frontier, TopometricMap
+
+
+@dataclass(frozen=True)
+class FrontierCostWeights:
+    """Weights of the frontier cost ``C`` (defaults: the paper's table).
+
+    Attributes:
+        w_v: Weight of the heading angle ``v`` (per radian).
+        w_p: Weight of the frontier's path length ``p_l`` to its intersection (per metre).
+        w_i: Weight of the intersection's ``O(I) + P_u(I)`` (per opening / pathway).
+        fallback_path_length_m: ``L_path`` to use while the map has fewer than two connected
+            intersections (its ``mean_intersection_path_m`` is nan).
+        heading_lookahead_m: ``v`` is the angle between the robot's heading and the direction
+            from the robot to the point this far along the path (the "start of the path").
+    """
+
+    w_v: float = 4.0
+    w_p: float = 0.2
+    w_i: float = 0.1
+    fallback_path_length_m: float = 2.0
+    heading_lookahead_m: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("w_v", "w_p", "w_i", "heading_lookahead_m"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        if not (math.isfinite(self.fallback_path_length_m) and self.fallback_path_length_m > 0.0):
+            raise ValueError(f"fallback_path_length_m must be a positive finite number, got {self.fallback_path_length_m!r}")
+
+
+@dataclass(frozen=True)
+class FrontierCandidate:
+    """The cheapest path found to one frontier, with every term of its cost.
+
+    Attributes:
+        frontier: The frontier (its pathway, opening and intersection).
+        goal_xy_m: The exploration target, the frontier opening's midpoint.
+        path_m: ``(K, 2)`` metric polyline from the robot's position to ``goal_xy_m``.
+        opening_ids: The graph nodes (openings) along the path, first to last.
+        d_m: Path length ``d``.
+        v_rad: Angle ``v`` in ``[0, pi]`` between the heading and the start of the path.
+        p_l_m: ``p_l(F)``.
+        n_openings: ``O(I)`` (0 without an intersection).
+        n_frontier_pathways: ``P_u(I)`` (0 without an intersection).
+        l_path_m: The ``L_path`` used for normalisation.
+        metric_cost: ``d / L_path + w_v * v``.
+        semantic_gain: ``w_p * p_l + w_I * (O + P_u)``.
+        cost: ``C = metric_cost - semantic_gain``.
+    """
+
+    frontier: Frontier
+    goal_xy_m: tuple[float, float]
+    path_m: np.ndarray
+    opening_ids: tuple[int, ...]
+    d_m: float
+    v_rad: float
+    p_l_m: float
+    n_openings: int
+    n_frontier_pathways: int
+    l_path_m: float
+    metric_cost: float
+    semantic_gain: float
+    cost: float
+
+
+@dataclass(frozen=True)
+class SearchStats:
+    """Work done by one run of Algorithm 1.
+
+    Attributes:
+        robot_area_id: The area the search started in (-1: robot not in any area).
+        n_seeds: First neighbours seeded.
+        n_popped: Paths taken off the search list.
+        n_pushed: Paths added to the search list (seeds included).
+        n_pruned: Extensions discontinued by the ``A_cost`` condition (at push or at pop).
+    """
+
+    robot_area_id: int
+    n_seeds: int
+    n_pushed: int
+    n_popped: int
+    n_pruned: int
+
+
+@dataclass(frozen=True)
+class _Partial:
+    nodes: tuple[int, ...]
+    edges: tuple[int, ...]
+    cost: float
+    length_m: float
+
+
+def resolve_path_length_m(tmap: TopometricMap, weights: FrontierCostWeights) -> float:
+    """``L_path``: the map's mean intersection-to-intersection path length, or the fallback."""
+    value = float(tmap.mean_intersection_path_m)
+    if math.isfinite(value) and value > 0.0:
+        return value
+    return weights.fallback_path_length_m
+
+
+def semantic_terms(tmap: TopometricMap, frontier: Frontier) -> tuple[float, int, int]:
+    """``(p_l, O(I), P_u(I))`` of a frontier; ``O`` and ``P_u`` are 0 when it has no intersection."""
+    iid = frontier.intersection_id
+    if iid is None or iid not in tmap.areas:
+        return float(frontier.path_length_m), 0, 0
+    return float(frontier.path_length_m), tmap.n_openings(iid), tmap.n_frontier_pathways(iid)
+
+
+def find_frontier_paths(
+    tmap: TopometricMap,
+    robot_xy_m: tuple[float, float],
+    robot_yaw_rad: float,
+    weights: FrontierCostWeights | None = None,
+    *,
+    prune_by: Literal["opening", "area"] = "opening",
+    min_frontier_width_m: float = 0.0,
+) -> list[FrontierCandidate]:
+    """Run Algorithm 1 and return one candidate per reachable frontier, cheapest first.
+
+    The first element (if any) is ``F*``. See :func:`search_frontier_paths` for the arguments.
+    """
+    candidates, _ = search_frontier_paths(
+        tmap, robot_xy_m, robot_yaw_rad, weights, prune_by=prune_by, min_frontier_width_m=min_frontier_width_m
+    )
+    return candidates
+
+
+def search_frontier_paths(
+    tmap: TopometricMap,
+    robot_xy_m: tuple[float, float],
+    robot_yaw_rad: float,
+    weights: FrontierCostWeights | None = None,
+    *,
+    prune_by: Literal["opening", "area"] = "opening",
+    min_frontier_width_m: float = 0.0,
+) -> tuple[list[FrontierCandidate], SearchStats]:
+    """Algorithm 1: paths from the robot to all frontiers of ``tmap``, scored with ``C``.
+
+    Args:
+        tmap: The semantic topometric map.
+        robot_xy_m: Robot position in the map frame.
+        robot_yaw_rad: Robot heading in the map frame.
+        weights: Cost weights (default: the paper's).
+        prune_by: ``"opening"`` (exact, default) or ``"area"``: what ``A_cost`` is indexed by.
+        min_frontier_width_m: Frontiers narrower than this are ignored (too narrow to enter).
+
+    Returns:
+        ``(candidates, stats)``: one :class:`FrontierCandidate` per reachable frontier, sorted by
+        cost (ties by path length), and the search's :class:`SearchStats`.
+
+    Raises:
+        ValueError: on a non-finite pose or an unknown ``prune_by``.
+    """
+    w = weights if weights is not None else FrontierCostWeights()
+    if prune_by not in ("opening", "area"):
+        raise ValueError(f"prune_by must be 'opening' or 'area', got {prune_by!r}")
+    rx, ry = float(robot_xy_m[0]), float(robot_xy_m[1])
+    yaw = float(robot_yaw_rad)
+    if not (math.isfinite(rx) and math.isfinite(ry) and math.isfinite(yaw)):
+        raise ValueError(f"robot pose must be finite, got xy={robot_xy_m!r}, yaw={robot_yaw_rad!r}")
+
+    robot_area = tmap.area_at(rx, ry) if tmap.areas else -1
+    if robot_area < 0 or robot_area not in tmap.areas:
+        return [], SearchStats(-1, 0, 0, 0, 0)
+    l_path = resolve_path_length_m(tmap, w)
+
+    frontier_at: dict[int, Frontier] = {}
+    for f in tmap.frontiers:
+        if f.width_m >= min_frontier_width_m:
+            frontier_at[f.opening_id] = f
+
+    adjacency: dict[int, list[tuple[int, int]]] = {}
+    for k, e in enumerate(tmap.edges):
+        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k))
+        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k))
+
+    def slot(node: int, via_edge: int | None) -> tuple[str, int]:
+        # Which A_cost entry a path ending at `node` competes for.
+        if prune_by == "opening":
+            return ("o", node)
+        here = tmap.edges[via_edge].area_id if via_edge is not None else robot_area
+        ids = tmap.openings[node].area_ids if 0 <= node < len(tmap.openings) else (here,)
+        beyond = [a for a in ids if a >= 0 and a != here]
+        # A frontier opening leads into unknown space: it keeps its own slot.
+        return ("a", beyond[0]) if beyond else ("o", node)
+
+    first_legs = _first_legs(tmap, robot_area, (rx, ry))
+    a_cost: dict[tuple[str, int], float] = {}
+    search_list: list[_Partial] = []
+    n_pushed = n_popped = n_pruned = 0
+    leg_start_angle: dict[int, float] = {}
+    for node, leg in first_legs.items():
+        v = _heading_angle(leg, (rx, ry), yaw, w.heading_lookahead_m)
+        leg_start_angle[node] = v
+        leg_m = _polyline_length(leg)
+        cost = w.w_v * v + leg_m / l_path
+        key = slot(node, None)
+        if a_cost.get(key, math.inf) <= cost:
+            n_pruned += 1
+            continue
+        a_cost[key] = cost
+        search_list.append(_Partial((node,), (), cost, leg_m))
+        n_pushed += 1
+    n_seeds = n_pushed
+
+    best: dict[int, tuple[float, _Partial]] = {}
+    while search_list:
+        path = search_list.pop()
+        n_popped += 1
+        last = path.nodes[-1]
+        if a_cost.get(slot(last, path.edges[-1] if path.edges else None), math.inf) < path.cost:
+            # Reached more cheaply since it was pushed: the A_cost condition, applied at pop.
+            n_pruned += 1
+            continue
+        if last in frontier_at:
+            prev = best.get(last)
+            if prev is None or path.cost < prev[0]:
+                best[last] = (path.cost, path)
+        for nbr, k in adjacency.get(last, ()):
+            if nbr in path.nodes or tmap.edges[k].area_id == robot_area:
+                continue
+            d_m = float(tmap.edges[k].length_m)
+            new_cost = path.cost + d_m / l_path
+            key = slot(nbr, k)
+            if a_cost.get(key, math.inf) <= new_cost:
+                n_pruned += 1
+                continue
+            a_cost[key] = new_cost
+            search_list.append(_Partial(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m))
+            n_pushed += 1
+
+    candidates: list[FrontierCandidate] = []
+    for node, (metric, path) in best.items():
+        f = frontier_at[node]
+        p_l, n_open, n_fp = semantic_terms(tmap, f)
+        gain = w.w_p * p_l + w.w_i * (n_open + n_fp)
+        poly = _assemble(tmap, path, first_legs[path.nodes[0]], f.midpoint_m)
+        candidates.append(
+            FrontierCandidate(
+                frontier=f,
+                goal_xy_m=(float(f.midpoint_m[0]), float(f.midpoint_m[1])),
+                path_m=poly,
+                opening_ids=path.nodes,
+                d_m=path.length_m,
+                v_rad=leg_start_angle[path.nodes[0]],
+                p_l_m=p_l,
+                n_openings=n_open,
+                n_frontier_pathways=n_fp,
+                l_path_m=l_path,
+                metric_cost=metric,
+                semantic_gain=gain,
+                cost=metric - gain,
+            )
+        )
+    candidates.sort(key=lambda c: (c.cost, c.d_m))
+    return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+
+
+# --- metric helpers -------------------------------------------------------------------------
+
+
+def _polyline_length(poly: np.ndarray) -> float:
+    if len(poly) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(poly, axis=0).T).sum())
+
+
+def _wrap_angle(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _heading_angle(poly: np.ndarray, robot_xy: tuple[float, float], yaw: float, lookahead_m: float) -> float:
+    """Angle in [0, pi] between the heading and the direction to the point ``lookahead_m`` along ``poly``."""
+    target = point_along(poly, lookahead_m)
+    dx, dy = target[0] - robot_xy[0], target[1] - robot_xy[1]
+    if math.hypot(dx, dy) < 1e-9:
+        # The leg has no length: the path starts where the robot is, along its first segment
+        # beyond the robot, or (none) straight ahead.
+        rest = poly[np.hypot(poly[:, 0] - robot_xy[0], poly[:, 1] - robot_xy[1]) > 1e-9]
+        if len(rest) == 0:
+            return 0.0
+        dx, dy = rest[0, 0] - robot_xy[0], rest[0, 1] - robot_xy[1]
+    return abs(_wrap_angle(math.atan2(dy, dx) - yaw))
+
+
+def point_along(poly: np.ndarray, s_m: float) -> np.ndarray:
+    """The point at arc length ``s_m`` along a polyline (clamped to its ends)."""
+    if len(poly) == 1 or s_m <= 0.0:
+        return poly[0].copy()
+    seg = np.hypot(*np.diff(poly, axis=0).T)
+    cum = np.concatenate(([0.0], np.cumsum(seg)))
+    if s_m >= cum[-1]:
+        return poly[-1].copy()
+    i = int(np.searchsorted(cum, s_m, side="right") - 1)
+    t = (s_m - cum[i]) / seg[i] if seg[i] > 0 else 0.0
+    return poly[i] + t * (poly[i + 1] - poly[i])
+
+
+def project_onto_polyline(poly: np.ndarray, xy: tuple[float, float]) -> tuple[float, np.ndarray, int, float]:
+    """Nearest point of a polyline to ``xy``.
+
+    Returns:
+        ``(distance, point, segment_index, arc_length)`` where the point lies on segment
+        ``segment_index`` (from vertex ``i`` to ``i + 1``) at ``arc_length`` from the start.
+    """
+    p = np.asarray(xy, dtype=np.float64)
+    if len(poly) == 1:
+        return float(np.hypot(*(poly[0] - p))), poly[0].copy(), 0, 0.0
+    a = poly[:-1]
+    b = poly[1:]
+    ab = b - a
+    den = np.einsum("ij,ij->i", ab, ab)
+    t = np.where(den > 0, np.einsum("ij,ij->i", p - a, ab) / np.where(den > 0, den, 1.0), 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    q = a + t[:, None] * ab
+    dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
+    i = int(np.argmin(dist))
+    seg = np.sqrt(den)
+    s = float(seg[:i].sum() + t[i] * seg[i])
+    return float(dist[i]), q[i], i, s
+
+
+def _dedupe(poly: np.ndarray, tol_m: float = 1e-6) -> np.ndarray:
+    if len(poly) < 2:
+        return poly
+    keep = np.ones(len(poly), dtype=bool)
+    keep[1:] = np.hypot(*np.diff(poly, axis=0).T) > tol_m
+    return poly[keep]
+
+
+def _oriented(path_m: np.ndarray, start_xy: tuple[float, float], end_xy: tuple[float, float]) -> np.ndarray:
+    """``path_m`` ordered so that it starts at the end nearer ``start_xy`` (ties: ``end_xy`` decides)."""
+    p = np.asarray(path_m, dtype=np.float64).reshape(-1, 2)
+    d_fwd = math.hypot(*(p[0] - start_xy)) + math.hypot(*(p[-1] - end_xy))
+    d_rev = math.hypot(*(p[-1] - start_xy)) + math.hypot(*(p[0] - end_xy))
+    return p if d_fwd <= d_rev else p[::-1].copy()
+
+
+def _edge_polyline(tmap: TopometricMap, k: int, from_node: int) -> np.ndarray:
+    e = tmap.edges[k]
+    to_node = e.opening_b if from_node == e.opening_a else e.opening_a
+    return _oriented(e.path_m, tmap.openings[from_node].midpoint_m, tmap.openings[to_node].midpoint_m)
+
+
+def _first_legs(tmap: TopometricMap, area_id: int, robot_xy: tuple[float, float]) -> dict[int, np.ndarray]:
+    """Polylines from the robot to every opening of its area, along the area's own paths.
+
+    The robot joins the nearest point of each path of its area in a straight line, then follows
+    that path to the opening. Openings no path reaches are joined in a straight line.
+    """
+    area = tmap.areas[area_id]
+    r = np.asarray(robot_xy, dtype=np.float64)
+    best: dict[int, tuple[float, np.ndarray]] = {}
+
+    def offer(node: int, dist: float, q: np.ndarray, rest: np.ndarray) -> None:
+        poly = _dedupe(np.vstack([r, q, rest]))
+        length = dist + _polyline_length(np.vstack([q, rest]))
+        if node not in best or length < best[node][0]:
+            best[node] = (length, poly)
+
+    for k, e in enumerate(tmap.edges):
+        if e.area_id != area_id:
+            continue
+        poly = _edge_polyline(tmap, k, e.opening_a)
+        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
+        offer(e.opening_a, dist, q, poly[: i + 1][::-1])
+        offer(e.opening_b, dist, q, poly[i + 1 :])
+    for oid, path in area.paths_m.items():
+        if oid in best or oid not in area.opening_ids:
+            continue
+        # Single-opening areas (dead ends) have no edges; their path starts at the opening.
+        poly = _oriented(path, tmap.openings[oid].midpoint_m, tuple(np.asarray(path)[-1]))
+        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
+        offer(oid, dist, q, poly[: i + 1][::-1])
+    for oid in area.opening_ids:
+        if oid not in best and 0 <= oid < len(tmap.openings):
+            m = np.asarray(tmap.openings[oid].midpoint_m, dtype=np.float64)
+            offer(oid, float(np.hypot(*(m - r))), m, np.empty((0, 2)))
+    return {node: poly for node, (_, poly) in best.items()}
+
+
+def _assemble(tmap: TopometricMap, path: _Partial, first_leg: np.ndarray, goal_xy: tuple[float, float]) -> np.ndarray:
+    parts = [first_leg]
+    for j, k in enumerate(path.edges):
+        parts.append(_edge_polyline(tmap, k, path.nodes[j]))
+    parts.append(np.asarray([goal_xy], dtype=np.float64))
+    return _dedupe(np.vstack(parts))

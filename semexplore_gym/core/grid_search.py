@@ -1,0 +1,516 @@
+"""Costmap inflation and grid search: a Navfn-like global planner and geodesic distance fields.
+
+**Costmap** (like ROS ``costmap_2d`` with a static layer and an ``InflationLayer``): values are
+uint8 with the ROS meanings
+
+==================  =====  ===================================================================
+name                value  meaning
+==================  =====  ===================================================================
+FREE_COST           0      free and farther than ``inflation_radius_m`` from any obstacle
+(decay)             1-252  ``252 * exp(-cost_scaling_factor * (d - inscribed_radius_m))``
+INSCRIBED_COST      253    the robot centre here would make the robot touch an obstacle
+LETHAL_COST         254    an occupied cell
+NO_INFORMATION      255    unknown (only with ``track_unknown_space``; else unknown is free)
+==================  =====  ===================================================================
+
+where ``d`` is the distance between cell centres to the nearest occupied cell (from
+``scipy.ndimage.distance_transform_edt``). As in ROS, unknown cells keep 255 unless they are
+within the inscribed radius of an obstacle (then 253/254), or ``inflate_unknown`` is set.
+
+**Navfn-like planner**: ROS ``navfn`` turns the costmap into per-cell traversal costs
+``neutral_cost + cost_factor * cost`` (50 + 0.8 c), makes INSCRIBED and LETHAL impassable and
+unknown cells passable at the highest cost (253) when ``allow_unknown``. It then propagates a
+potential from the goal and descends its gradient. We keep the cost model and solve it exactly
+with an 8-connected Dijkstra / A* (step lengths 1 and sqrt(2) times the cost of the entered
+cell; no diagonal step between two impassable cells), so paths are the optimal 8-connected
+paths of the same cost field rather than navfn's interpolated ones.
+
+**Geodesic distance** (:func:`geodesic_distance_m`): a plain Dijkstra over a boolean mask with
+unit cell cost, giving the 8-connected path length in metres from the robot to every cell; used
+to pick the nearest frontier by path length (Yamauchi).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+from scipy import ndimage
+
+from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
+
+__all__ = [
+    "FREE_COST",
+    "INSCRIBED_COST",
+    "LETHAL_COST",
+    "NO_INFORMATION",
+    "CostmapParams",
+    "GridPath",
+    "NavfnParams",
+    "distance_field",
+    "extract_path",
+    "geodesic_distance_m",
+    "inflate_costmap",
+    "inflation_cost",
+    "navfn_cell_costs",
+    "plan_path",
+    "shortest_path_cells",
+]
+
+FREE_COST: int = 0
+INSCRIBED_COST: int = 253
+LETHAL_COST: int = 254
+NO_INFORMATION: int = 255
+
+
+@dataclass(frozen=True)
+class CostmapParams:
+    """How an occupancy grid becomes a costmap (ROS ``costmap_2d`` inflation).
+
+    Attributes:
+        inscribed_radius_m: Robot radius; cells closer than this to an obstacle are INSCRIBED.
+        inflation_radius_m: Costs decay to this distance; farther cells are FREE_COST.
+        cost_scaling_factor: Exponential decay rate of the cost beyond the inscribed radius, 1/m
+            (ROS default 10).
+        track_unknown_space: Keep unknown cells as NO_INFORMATION (255); if False they are free.
+        inflate_unknown: Let inflation raise unknown cells too (ROS ``inflate_unknown``).
+    """
+
+    inscribed_radius_m: float = 0.105
+    inflation_radius_m: float = 0.2
+    cost_scaling_factor: float = 10.0
+    track_unknown_space: bool = True
+    inflate_unknown: bool = False
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.inscribed_radius_m) and self.inscribed_radius_m >= 0):
+            raise ValueError(f"inscribed_radius_m must be >= 0, got {self.inscribed_radius_m!r}")
+        if not (math.isfinite(self.inflation_radius_m) and self.inflation_radius_m >= self.inscribed_radius_m):
+            raise ValueError(
+                f"inflation_radius_m must be >= inscribed_radius_m ({self.inscribed_radius_m}), got {self.inflation_radius_m!r}"
+            )
+        if not (math.isfinite(self.cost_scaling_factor) and self.cost_scaling_factor >= 0):
+            raise ValueError(f"cost_scaling_factor must be >= 0, got {self.cost_scaling_factor!r}")
+
+
+@dataclass(frozen=True)
+class NavfnParams:
+    """Cost model of the Navfn-like planner.
+
+    Attributes:
+        neutral_cost: Cost of a free cell (navfn ``COST_NEUTRAL`` 50).
+        cost_factor: Weight of the costmap value (navfn ``COST_FACTOR`` 0.8).
+        allow_unknown: Plan through unknown cells (at cost 253), as navfn does by default.
+        goal_tolerance_m: If the goal cell cannot be reached, accept the reachable cell nearest
+            to it within this distance (navfn ``default_tolerance``, 0 = exact goal only).
+        escape_radius_m: Inscribed (not lethal) cells within this distance of the start are
+            passable, so a robot that grazed a wall can still plan its way out. ROS navfn clears
+            only the robot's own cell (0 here) and leaves the rest to recovery behaviours.
+        use_astar: Stop at the goal with an octile heuristic (same optimal path, less work).
+    """
+
+    neutral_cost: float = 50.0
+    cost_factor: float = 0.8
+    allow_unknown: bool = True
+    goal_tolerance_m: float = 0.0
+    escape_radius_m: float = 0.0
+    use_astar: bool = True
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.neutral_cost) and self.neutral_cost > 0):
+            raise ValueError(f"neutral_cost must be > 0, got {self.neutral_cost!r}")
+        if not (math.isfinite(self.cost_factor) and self.cost_factor >= 0):
+            raise ValueError(f"cost_factor must be >= 0, got {self.cost_factor!r}")
+        if not (math.isfinite(self.goal_tolerance_m) and self.goal_tolerance_m >= 0):
+            raise ValueError(f"goal_tolerance_m must be >= 0, got {self.goal_tolerance_m!r}")
+        if not (math.isfinite(self.escape_radius_m) and self.escape_radius_m >= 0):
+            raise ValueError(f"escape_radius_m must be >= 0, got {self.escape_radius_m!r}")
+
+
+@dataclass(frozen=True)
+class GridPath:
+    """A planned path.
+
+    Attributes:
+        cells: ``(K, 2)`` int64 ``(row, col)`` from start to goal.
+        points_m: ``(K, 2)`` float64 world ``(x, y)`` of the cell centres, except that the first
+            point is the exact start position.
+        length_m: Polyline length of ``points_m``.
+        cost: Accumulated planner cost (sum of step length in cells times entered cell cost).
+    """
+
+    cells: np.ndarray
+    points_m: np.ndarray
+    length_m: float
+    cost: float
+
+
+def inflation_cost(distance_m: npt.ArrayLike, params: CostmapParams) -> np.ndarray:
+    """ROS inflation cost (uint8) of cells at ``distance_m`` from the nearest obstacle cell."""
+    d = np.asarray(distance_m, dtype=np.float64)
+    factor = np.exp(-params.cost_scaling_factor * (d - params.inscribed_radius_m))
+    decay = np.floor((INSCRIBED_COST - 1) * factor)
+    cost = np.where(d <= params.inflation_radius_m, decay, FREE_COST)
+    cost = np.where(d <= params.inscribed_radius_m, INSCRIBED_COST, cost)
+    cost = np.where(d <= 0.0, LETHAL_COST, cost)
+    return cost.astype(np.uint8)
+
+
+def inflate_costmap(grid: npt.ArrayLike, resolution_m: float, params: CostmapParams = CostmapParams()) -> np.ndarray:
+    """Costmap (uint8, ROS values) of an encoded occupancy grid.
+
+    Args:
+        grid: Encoded occupancy grid ``(H, W)`` uint8.
+        resolution_m: Cell size in metres.
+        params: Inflation parameters.
+
+    Returns:
+        ``(H, W)`` uint8 costmap; see the module docstring for the values.
+    """
+    a = validate_encoded_grid(grid)
+    if not (math.isfinite(resolution_m) and resolution_m > 0):
+        raise ValueError(f"resolution_m must be a positive number, got {resolution_m!r}")
+    occupied = a == OCCUPIED
+    if occupied.any():
+        dist_m = ndimage.distance_transform_edt(~occupied) * resolution_m
+    else:
+        dist_m = np.full(a.shape, np.inf)
+    cost = inflation_cost(dist_m, params)
+    if params.track_unknown_space:
+        unknown = a == UNKNOWN
+        # ROS keeps NO_INFORMATION unless inflation makes the cell (nearly) lethal.
+        keep = unknown & ((cost == FREE_COST) if params.inflate_unknown else (cost < INSCRIBED_COST))
+        cost[keep] = NO_INFORMATION
+    return cost
+
+
+def navfn_cell_costs(costmap: npt.ArrayLike, params: NavfnParams = NavfnParams()) -> np.ndarray:
+    """Per-cell traversal cost for the planner (float64, ``inf`` = impassable)."""
+    c = np.asarray(costmap)
+    if c.ndim != 2 or c.dtype != np.uint8:
+        raise TypeError(f"costmap must be a 2-D uint8 array, got dtype {c.dtype} shape {c.shape}")
+    out = params.neutral_cost + params.cost_factor * c.astype(np.float64)
+    out = np.minimum(out, float(INSCRIBED_COST))
+    out[(c == INSCRIBED_COST) | (c == LETHAL_COST)] = np.inf
+    out[c == NO_INFORMATION] = float(INSCRIBED_COST) if params.allow_unknown else np.inf
+    return out
+
+
+def plan_path(
+    costmap: npt.ArrayLike,
+    geometry: GridGeometry,
+    start_xy_m: npt.ArrayLike,
+    goal_xy_m: npt.ArrayLike,
+    params: NavfnParams = NavfnParams(),
+) -> GridPath | None:
+    """Plan a path on a costmap like ROS navfn (see the module docstring).
+
+    Args:
+        costmap: ``(H, W)`` uint8 costmap from :func:`inflate_costmap`.
+        geometry: Frame of the costmap.
+        start_xy_m: Start ``(x, y)`` in metres (the robot).
+        goal_xy_m: Goal ``(x, y)`` in metres.
+        params: Planner parameters.
+
+    Returns:
+        The path, or ``None`` if start or goal lie outside the grid or the goal (within
+        ``goal_tolerance_m``) cannot be reached.
+    """
+    c = np.asarray(costmap)
+    if c.shape != geometry.shape:
+        raise ValueError(f"costmap shape {c.shape} does not match geometry shape {geometry.shape}")
+    sx, sy = _xy(start_xy_m, "start_xy_m")
+    gx, gy = _xy(goal_xy_m, "goal_xy_m")
+    sr, sc = (int(v) for v in geometry.world_to_grid(sx, sy))
+    gr, gc = (int(v) for v in geometry.world_to_grid(gx, gy))
+    if not (geometry.contains(sr, sc) and geometry.contains(gr, gc)):
+        return None
+    cost = navfn_cell_costs(c, params)
+    _open_start(cost, c, sr, sc, params, geometry.resolution_m)
+    res = geometry.resolution_m
+    tol_cells = params.goal_tolerance_m / res
+    if np.isfinite(cost[gr, gc]) or tol_cells <= 0:
+        found = shortest_path_cells(cost, (sr, sc), (gr, gc), use_astar=params.use_astar)
+        if found is None and tol_cells <= 0:
+            return None
+    else:
+        found = None
+    if found is None:
+        dist, parent = distance_field(cost, (sr, sc))
+        goal = _nearest_reached(dist, gr, gc, tol_cells)
+        if goal is None:
+            return None
+        found = (extract_path(parent, goal), float(dist[goal]))
+    cells, total = found
+    xs, ys = geometry.grid_to_world(cells[:, 0], cells[:, 1])
+    pts = np.column_stack([xs, ys])
+    pts[0] = (sx, sy)
+    length = float(np.hypot(*np.diff(pts, axis=0).T).sum()) if len(pts) > 1 else 0.0
+    return GridPath(cells=cells, points_m=pts, length_m=length, cost=total)
+
+
+def shortest_path_cells(
+    cell_cost: npt.ArrayLike,
+    start_rc: tuple[int, int],
+    goal_rc: tuple[int, int],
+    use_astar: bool = True,
+) -> tuple[np.ndarray, float] | None:
+    """Least-cost 8-connected path between two cells.
+
+    Args:
+        cell_cost: ``(H, W)`` float cost of entering each cell; ``inf`` (or NaN) = impassable.
+            The start cell may be impassable (the robot is already there).
+        start_rc: ``(row, col)`` start.
+        goal_rc: ``(row, col)`` goal.
+        use_astar: Use an octile heuristic scaled by the smallest finite cell cost.
+
+    Returns:
+        ``(cells (K, 2) int64 from start to goal, total cost)``, or ``None`` if unreachable.
+    """
+    cost = _cost_array(cell_cost)
+    h, w = cost.shape
+    (sr, sc), (gr, gc) = _rc(start_rc, cost.shape, "start_rc"), _rc(goal_rc, cost.shape, "goal_rc")
+    if not np.isfinite(cost[gr, gc]) and (sr, sc) != (gr, gc):
+        return None
+    finite = cost[np.isfinite(cost)]
+    h_weight = float(finite.min()) if (use_astar and finite.size) else 0.0
+    dist = np.full(h * w, np.inf)
+    parent = np.full(h * w, -1, dtype=np.int64)
+    _search(cost, sr * w + sc, gr * w + gc, h_weight, dist, parent)
+    total = dist[gr * w + gc]
+    if not np.isfinite(total):
+        return None
+    return extract_path(parent.reshape(h, w), (gr, gc)), float(total)
+
+
+def distance_field(cell_cost: npt.ArrayLike, start_rc: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Dijkstra from one cell to all cells.
+
+    Args:
+        cell_cost: ``(H, W)`` float cost of entering each cell; ``inf``/NaN = impassable.
+        start_rc: ``(row, col)`` source (may itself be impassable).
+
+    Returns:
+        ``(dist, parent)``: ``(H, W)`` float64 least cost (``inf`` unreachable) and ``(H, W)``
+        int64 flat index of each cell's predecessor (-1 for the start and unreached cells).
+    """
+    cost = _cost_array(cell_cost)
+    h, w = cost.shape
+    sr, sc = _rc(start_rc, cost.shape, "start_rc")
+    dist = np.full(h * w, np.inf)
+    parent = np.full(h * w, -1, dtype=np.int64)
+    _search(cost, sr * w + sc, -1, 0.0, dist, parent)
+    return dist.reshape(h, w), parent.reshape(h, w)
+
+
+def geodesic_distance_m(
+    traversable: npt.ArrayLike, geometry: GridGeometry, start_xy_m: npt.ArrayLike
+) -> np.ndarray:
+    """8-connected path length in metres from a point to every cell through ``traversable``.
+
+    Args:
+        traversable: ``(H, W)`` bool, True where a path may go. The start cell always counts as
+            traversable.
+        geometry: Frame of the mask.
+        start_xy_m: Source ``(x, y)`` in metres; must lie inside the grid.
+
+    Returns:
+        ``(H, W)`` float64 distances, ``inf`` where unreachable.
+    """
+    m = np.asarray(traversable)
+    if m.dtype != np.bool_ or m.shape != geometry.shape:
+        raise ValueError(f"traversable must be a bool array of shape {geometry.shape}, got {m.dtype} {m.shape}")
+    sx, sy = _xy(start_xy_m, "start_xy_m")
+    sr, sc = (int(v) for v in geometry.world_to_grid(sx, sy))
+    if not geometry.contains(sr, sc):
+        raise ValueError(f"start ({sx:.3f}, {sy:.3f}) m is outside the grid")
+    cost = np.where(m, geometry.resolution_m, np.inf)
+    dist, _ = distance_field(cost, (sr, sc))
+    return dist
+
+
+def extract_path(parent: np.ndarray, goal_rc: tuple[int, int]) -> np.ndarray:
+    """Follow predecessor links back from ``goal_rc``; returns ``(K, 2)`` cells start-to-goal."""
+    h, w = parent.shape
+    cells = _backtrack(parent.ravel(), int(goal_rc[0]) * w + int(goal_rc[1]))
+    return np.column_stack([cells // w, cells % w])
+
+
+def _open_start(cost: np.ndarray, costmap: np.ndarray, sr: int, sc: int, params: NavfnParams, res: float) -> None:
+    # The robot's own cell is always passable (navfn's clearRobotCell).
+    if not np.isfinite(cost[sr, sc]):
+        cost[sr, sc] = float(INSCRIBED_COST)
+    k = int(params.escape_radius_m / res)
+    if k <= 0:
+        return
+    h, w = cost.shape
+    r0, r1, c0, c1 = max(sr - k, 0), min(sr + k + 1, h), max(sc - k, 0), min(sc + k + 1, w)
+    rr, cc = np.mgrid[r0:r1, c0:c1]
+    near = (rr - sr) ** 2 + (cc - sc) ** 2 <= k * k
+    win = costmap[r0:r1, c0:c1]
+    sub = cost[r0:r1, c0:c1]
+    sub[near & (win == INSCRIBED_COST)] = float(INSCRIBED_COST)
+
+
+def _nearest_reached(dist: np.ndarray, gr: int, gc: int, tol_cells: float) -> tuple[int, int] | None:
+    if tol_cells <= 0:
+        return (gr, gc) if np.isfinite(dist[gr, gc]) else None
+    k = int(math.floor(tol_cells))
+    h, w = dist.shape
+    r0, r1, c0, c1 = max(gr - k, 0), min(gr + k + 1, h), max(gc - k, 0), min(gc + k + 1, w)
+    rr, cc = np.mgrid[r0:r1, c0:c1]
+    d2 = ((rr - gr) ** 2 + (cc - gc) ** 2).astype(np.float64)
+    ok = np.isfinite(dist[r0:r1, c0:c1]) & (d2 <= tol_cells * tol_cells)
+    if not ok.any():
+        return None
+    d2[~ok] = np.inf
+    i = int(np.argmin(d2))
+    return (int(rr.ravel()[i]), int(cc.ravel()[i]))
+
+
+def _cost_array(cell_cost: npt.ArrayLike) -> np.ndarray:
+    cost = np.asarray(cell_cost, dtype=np.float64)
+    if cost.ndim != 2 or cost.size == 0:
+        raise ValueError(f"cell_cost must be a non-empty 2-D array, got shape {cost.shape}")
+    if (cost[np.isfinite(cost)] <= 0).any():
+        raise ValueError("cell_cost must be > 0 wherever it is finite")
+    cost = np.where(np.isnan(cost), np.inf, cost)
+    return np.ascontiguousarray(cost)
+
+
+def _rc(rc: tuple[int, int], shape: tuple[int, ...], name: str) -> tuple[int, int]:
+    try:
+        r, c = int(rc[0]), int(rc[1])
+    except (TypeError, ValueError, IndexError):
+        raise ValueError(f"{name} must be a (row, col) pair, got {rc!r}") from None
+    if not (0 <= r < shape[0] and 0 <= c < shape[1]):
+        raise ValueError(f"{name} {(r, c)} is outside the grid of shape {tuple(shape)}")
+    return r, c
+
+
+def _xy(p: npt.ArrayLike, name: str) -> tuple[float, float]:
+    arr = np.asarray(p, dtype=np.float64).ravel()
+    if arr.shape[0] < 2 or not np.isfinite(arr[:2]).all():
+        raise ValueError(f"{name} must be a finite (x, y), got {p!r}")
+    return float(arr[0]), float(arr[1])
+
+
+@njit(cache=True)
+def _heap_push(keys, vals, size, key, val):  # pragma: no cover - numba
+    if size == keys.shape[0]:
+        nk = np.empty(2 * size, dtype=keys.dtype)
+        nv = np.empty(2 * size, dtype=vals.dtype)
+        nk[:size] = keys
+        nv[:size] = vals
+        keys = nk
+        vals = nv
+    i = size
+    keys[i] = key
+    vals[i] = val
+    while i > 0:
+        p = (i - 1) >> 1
+        if keys[p] <= keys[i]:
+            break
+        keys[p], keys[i] = keys[i], keys[p]
+        vals[p], vals[i] = vals[i], vals[p]
+        i = p
+    return keys, vals, size + 1
+
+
+@njit(cache=True)
+def _heap_pop(keys, vals, size):  # pragma: no cover - numba
+    key = keys[0]
+    val = vals[0]
+    size -= 1
+    keys[0] = keys[size]
+    vals[0] = vals[size]
+    i = 0
+    while True:
+        left = 2 * i + 1
+        if left >= size:
+            break
+        m = left
+        if left + 1 < size and keys[left + 1] < keys[left]:
+            m = left + 1
+        if keys[i] <= keys[m]:
+            break
+        keys[m], keys[i] = keys[i], keys[m]
+        vals[m], vals[i] = vals[i], vals[m]
+        i = m
+    return key, val, size
+
+
+@njit(cache=True)
+def _search(cost, start, goal, h_weight, dist, parent):  # pragma: no cover - numba
+    """Dijkstra (h_weight = 0) or A* (octile heuristic * h_weight) with lazy deletion.
+
+    Fills dist/parent (flat) in place; stops when ``goal`` (flat index, -1 = none) is settled.
+    """
+    h, w = cost.shape
+    sqrt2 = math.sqrt(2.0)
+    dr = np.array([1, -1, 0, 0, 1, 1, -1, -1])
+    dc = np.array([0, 0, 1, -1, 1, -1, 1, -1])
+    step = np.array([1.0, 1.0, 1.0, 1.0, sqrt2, sqrt2, sqrt2, sqrt2])
+    gr = goal // w if goal >= 0 else 0
+    gc = goal - gr * w if goal >= 0 else 0
+    closed = np.zeros(h * w, dtype=np.uint8)
+    keys = np.empty(1024, dtype=np.float64)
+    vals = np.empty(1024, dtype=np.int64)
+    size = 0
+    dist[start] = 0.0
+    keys, vals, size = _heap_push(keys, vals, size, 0.0, start)
+    while size > 0:
+        _, u, size = _heap_pop(keys, vals, size)
+        if closed[u]:
+            continue
+        closed[u] = 1
+        if u == goal:
+            break
+        ur = u // w
+        uc = u - ur * w
+        du = dist[u]
+        for k in range(8):
+            nr = ur + dr[k]
+            nc = uc + dc[k]
+            if nr < 0 or nr >= h or nc < 0 or nc >= w:
+                continue
+            cv = cost[nr, nc]
+            if not cv < np.inf:
+                continue
+            if k >= 4:
+                # No corner cutting: both orthogonal cells of a diagonal step must be passable.
+                if not (cost[ur, nc] < np.inf and cost[nr, uc] < np.inf):
+                    continue
+            v = nr * w + nc
+            if closed[v]:
+                continue
+            nd = du + step[k] * cv
+            if nd < dist[v]:
+                dist[v] = nd
+                parent[v] = u
+                pri = nd
+                if h_weight > 0.0:
+                    ddr = abs(nr - gr)
+                    ddc = abs(nc - gc)
+                    lo = min(ddr, ddc)
+                    hi = max(ddr, ddc)
+                    pri = nd + h_weight * ((hi - lo) + sqrt2 * lo)
+                keys, vals, size = _heap_push(keys, vals, size, pri, v)
+
+
+@njit(cache=True)
+def _backtrack(parent, goal):  # pragma: no cover - numba
+    n = 0
+    v = goal
+    while v >= 0:
+        n += 1
+        v = parent[v]
+    out = np.empty(n, dtype=np.int64)
+    v = goal
+    for i in range(n - 1, -1, -1):
+        out[i] = v
+        v = parent[v]
+    return out

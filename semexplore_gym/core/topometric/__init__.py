@@ -1,0 +1,1 @@
+"""Semantic topometric segmentation of occupancy grids (see segment_map)."""

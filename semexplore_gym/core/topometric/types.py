@@ -1,0 +1,172 @@
+"""Data types of the semantic topometric map (the output of :func:`segment_map`).
+
+These types are the contract between the segmentation and every planner that reads it.
+Coordinates are world metres unless a name says ``cells``; grids follow the (row, col)
+convention of :mod:`semexplore_gym.core`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+import numpy as np
+
+from semexplore_gym.core.grid import GridGeometry
+
+
+class AreaType(IntEnum):
+    """Semantic type of an area. The values follow GRID-FAST's type codes."""
+
+    INTERSECTION = 0
+    PATHWAY = 10
+    DEAD_END = 20
+    FRONTIER_PATHWAY = 30
+
+
+@dataclass(frozen=True)
+class Opening:
+    """A cut across free space between two areas, or between an area and unknown space.
+
+    Attributes:
+        id: Index into :attr:`TopometricMap.openings`.
+        endpoints_m: ``(2, 2)`` array, the two wall-side ends ``[[x0, y0], [x1, y1]]``.
+        midpoint_m: ``(x, y)`` centre of the opening.
+        width_m: Free width of the opening.
+        area_ids: The ids of the areas on its two sides; ``-1`` stands for unknown space.
+        is_frontier: True when one side is unknown space (the opening *is* a frontier).
+    """
+
+    id: int
+    endpoints_m: np.ndarray
+    midpoint_m: tuple[float, float]
+    width_m: float
+    area_ids: tuple[int, int]
+    is_frontier: bool
+
+
+@dataclass(frozen=True)
+class Area:
+    """One semantic region of free space.
+
+    Attributes:
+        id: Identifier, stable across successive segmentations of a growing map (areas are
+            matched by position), so planners can remember visited areas.
+        type: :class:`AreaType`.
+        centre_m: ``(x, y)`` a point inside the area, far from its walls.
+        opening_ids: Ids of the openings on its border.
+        paths_m: Polylines ``(K, 2)`` through the area, keyed by opening id: for an intersection
+            the path from that opening to the centre; for a pathway the path from that opening to
+            the other opening; for a dead end the path from its opening to its far end. A robot
+            of the segmentation's clearance can follow every path.
+        n_cells: Number of grid cells in the area.
+    """
+
+    id: int
+    type: AreaType
+    centre_m: tuple[float, float]
+    opening_ids: tuple[int, ...]
+    paths_m: dict[int, np.ndarray]
+    n_cells: int
+
+
+@dataclass(frozen=True)
+class Frontier:
+    """The frontier at the far end of a frontier pathway.
+
+    Attributes:
+        area_id: The frontier pathway it belongs to.
+        opening_id: The opening to unknown space.
+        midpoint_m: ``(x, y)`` of that opening, the exploration target.
+        width_m: Width of the opening.
+        intersection_id: The nearest intersection leading to it (``I`` in the paper), or
+            ``None`` when the map has no intersection connected to it yet.
+        path_length_m: ``p_l``: path length from the frontier to that intersection (to the
+            pathway's other end when ``intersection_id`` is None).
+    """
+
+    area_id: int
+    opening_id: int
+    midpoint_m: tuple[float, float]
+    width_m: float
+    intersection_id: int | None
+    path_length_m: float
+
+
+@dataclass(frozen=True)
+class GraphEdge:
+    """An edge of the topometric graph, whose nodes are openings (see :class:`TopometricMap`)."""
+
+    opening_a: int
+    opening_b: int
+    area_id: int
+    length_m: float
+    path_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class TopometricMap:
+    """A semantic topometric map of an explored occupancy grid.
+
+    Attributes:
+        geometry: The grid frame the map was computed on.
+        area_ids: ``(H, W)`` int32 raster, the area id of every reachable free cell, -1 elsewhere.
+        areas: Areas by id.
+        openings: Openings, ``openings[i].id == i``.
+        frontiers: One per frontier pathway.
+        edges: Graph edges. Nodes are openings; inside each area every pair of its openings is
+            joined (through the centre for intersections) with the metric length of the path.
+        mean_intersection_path_m: ``L_path``: mean length of the paths between adjacent
+            intersections; ``nan`` when fewer than two intersections are connected.
+        clearance_m: The robot clearance (radius + margin) used.
+        time_ms: Wall time the segmentation took.
+    """
+
+    geometry: GridGeometry
+    area_ids: np.ndarray
+    areas: dict[int, Area]
+    openings: list[Opening]
+    frontiers: list[Frontier]
+    edges: list[GraphEdge]
+    mean_intersection_path_m: float
+    clearance_m: float
+    time_ms: float = 0.0
+    extras: dict = field(default_factory=dict)
+
+    def areas_of_type(self, area_type: AreaType) -> list[Area]:
+        return [a for a in self.areas.values() if a.type == area_type]
+
+    def n_openings(self, intersection_id: int) -> int:
+        """``O(I)``: the number of openings of an intersection."""
+        return len(self.areas[intersection_id].opening_ids)
+
+    def n_frontier_pathways(self, intersection_id: int) -> int:
+        """``P_u(I)``: the number of the intersection's pathways that lead directly to a frontier."""
+        n = 0
+        for oid in self.areas[intersection_id].opening_ids:
+            for aid in self.openings[oid].area_ids:
+                if aid >= 0 and aid != intersection_id and self.areas[aid].type == AreaType.FRONTIER_PATHWAY:
+                    n += 1
+        return n
+
+    def area_at(self, x_m: float, y_m: float) -> int:
+        """Id of the area containing a point, or of the nearest area cell; -1 if the map has none."""
+        g = self.geometry
+        row, col = g.world_to_grid(x_m, y_m)
+        r, c = int(row), int(col)
+        if 0 <= r < g.height and 0 <= c < g.width and self.area_ids[r, c] >= 0:
+            return int(self.area_ids[r, c])
+        cells = np.argwhere(self.area_ids >= 0)
+        if len(cells) == 0:
+            return -1
+        d2 = (cells[:, 0] - r) ** 2 + (cells[:, 1] - c) ** 2
+        rr, cc = cells[int(np.argmin(d2))]
+        return int(self.area_ids[rr, cc])
+
+    def counts(self) -> dict[str, int]:
+        return {
+            "intersections": len(self.areas_of_type(AreaType.INTERSECTION)),
+            "pathways": len(self.areas_of_type(AreaType.PATHWAY)),
+            "dead_ends": len(self.areas_of_type(AreaType.DEAD_END)),
+            "frontier_pathways": len(self.areas_of_type(AreaType.FRONTIER_PATHWAY)),
+        }

@@ -1,0 +1,1 @@
+"""Worlds: wall geometry, bounds, start pose and ground-truth free space."""

@@ -1,0 +1,191 @@
+"""Raster <-> wall geometry.
+
+:func:`raster_to_segments` turns a free-space raster into wall segments: a wall runs along every
+cell edge between a free cell and a non-free one (occupied *or unknown*, and everything outside
+the raster counts as non-free), so a map always comes out closed. Unit edges on one grid line
+are merged into maximal axis-aligned segments. A wall one pixel thick yields a segment on each
+of its faces, so it stays a wall however thin it is.
+
+:func:`rasterize_free` goes the other way: the ground-truth free mask of a world on any grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from scipy import ndimage
+
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.worlds.geometry import (
+    as_segments,
+    crossed_links,
+    flood_fill_links,
+    segment_distance_field,
+)
+from semexplore_gym.core.worlds.world import World
+
+# A cell centre exactly on half a cell from a wall (the wall lies on the cell's edge, as for
+# every raster-derived wall) must count as free despite rounding.
+_HALF_CELL_TOLERANCE = 1e-5
+
+_FOUR_CONNECTED = ndimage.generate_binary_structure(2, 1)
+
+
+def remove_small_free_components(free_mask: np.ndarray, min_free_cells: int) -> np.ndarray:
+    """Drop 4-connected free components smaller than ``min_free_cells`` cells.
+
+    Such specks (isolated free pixels in SLAM maps, anti-aliasing dots) are too small for a
+    robot and would only add tiny closed walls.
+    """
+    free = np.asarray(free_mask, dtype=bool)
+    if min_free_cells <= 1:
+        return free.copy()
+    labels, n = ndimage.label(free, structure=_FOUR_CONNECTED)
+    if n == 0:
+        return free.copy()
+    sizes = np.bincount(labels.ravel(), minlength=n + 1)
+    keep = sizes >= min_free_cells
+    keep[0] = False
+    return keep[labels]
+
+
+def _runs_along_rows(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Maximal runs of True along axis 1: ``(row, first_col, end_col_exclusive)`` for each run."""
+    h, w = edges.shape
+    padded = np.zeros((h, w + 2), dtype=np.int8)
+    padded[:, 1:-1] = edges
+    d = np.diff(padded, axis=1)
+    start_r, start_c = np.nonzero(d == 1)
+    _, end_c = np.nonzero(d == -1)
+    # np.nonzero walks row-major, so the k-th start and k-th end belong to the same run.
+    return start_r, start_c, end_c
+
+
+def raster_to_segments(free_mask: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:
+    """Wall segments along the boundary between free and non-free cells.
+
+    Args:
+        free_mask: ``(H, W)`` bool, True = free. Cells outside the raster count as non-free.
+        geometry: Frame of ``free_mask``.
+
+    Returns:
+        ``(N, 4)`` float64 segments ``x0, y0, x1, y1`` in metres, axis-aligned and maximal:
+        collinear touching unit edges are merged (a straight 10-cell wall face is one segment).
+        Horizontal segments come first, ordered by y then x; then vertical ones by x then y.
+    """
+    free = np.asarray(free_mask, dtype=bool)
+    if free.shape != geometry.shape:
+        raise ValueError(f"free_mask shape {free.shape} != geometry shape {geometry.shape}")
+    h, w = free.shape
+    padded = np.zeros((h + 2, w + 2), dtype=bool)
+    padded[1:-1, 1:-1] = free
+    res = float(geometry.resolution_m)
+    ox = float(geometry.origin_x_m)
+    oy = float(geometry.origin_y_m)
+
+    # Edge on grid line y = oy + k * res between padded rows k and k+1, for columns 0..w-1.
+    horizontal = padded[:-1, 1:-1] != padded[1:, 1:-1]  # (h + 1, w)
+    k, c0, c1 = _runs_along_rows(horizontal)
+    yh = oy + k * res
+    seg_h = np.column_stack([ox + c0 * res, yh, ox + c1 * res, yh])
+
+    # Edge on grid line x = ox + k * res between padded columns k and k+1, for rows 0..h-1.
+    vertical = padded[1:-1, :-1] != padded[1:-1, 1:]  # (h, w + 1)
+    k, r0, r1 = _runs_along_rows(vertical.T)
+    xv = ox + k * res
+    seg_v = np.column_stack([xv, oy + r0 * res, xv, oy + r1 * res])
+    return np.ascontiguousarray(np.vstack([seg_h, seg_v]).astype(np.float64))
+
+
+def _blocked_by_walls(segments_m: np.ndarray, geometry: GridGeometry) -> np.ndarray:
+    """Cells whose centre lies strictly within half a cell of some wall."""
+    half = 0.5 * geometry.resolution_m
+    dist = segment_distance_field(segments_m, geometry, max_distance_m=2.0 * half)
+    return dist < half * (1.0 - _HALF_CELL_TOLERANCE)
+
+
+def sample_mask(mask: np.ndarray, mask_geometry: GridGeometry, geometry: GridGeometry) -> np.ndarray:
+    """Nearest-cell resampling: the value of ``mask`` at each cell centre of ``geometry``.
+
+    Centres outside ``mask_geometry`` read False.
+    """
+    h, w = geometry.shape
+    xs, _ = geometry.grid_to_world(0, np.arange(w))
+    _, ys = geometry.grid_to_world(np.arange(h), 0)
+    _, cols = mask_geometry.world_to_grid(xs, 0.0)
+    rows, _ = mask_geometry.world_to_grid(0.0, ys)
+    col_ok = (cols >= 0) & (cols < mask_geometry.width)
+    row_ok = (rows >= 0) & (rows < mask_geometry.height)
+    out = np.zeros((h, w), dtype=bool)
+    if col_ok.any() and row_ok.any():
+        sub = mask[np.ix_(rows[row_ok], cols[col_ok])]
+        out[np.ix_(row_ok, col_ok)] = sub
+    return out
+
+
+def rasterize_free(
+    world_or_segments: World | npt.ArrayLike,
+    geometry: GridGeometry,
+    *,
+    interior_points_m: npt.ArrayLike | None = None,
+) -> np.ndarray:
+    """Ground-truth free mask of a world on any grid.
+
+    A cell is free when its centre lies inside the world's free space and no wall passes
+    within half a cell of it (strictly: a wall on the cell's edge leaves it free, so a raster
+    world resampled on its own grid gives back exactly its mask).
+
+    "Inside" is decided by the world's ``free_space_source``:
+
+    - ``"raster"``: the world's exact ``free_mask`` is read at the cell centre.
+    - ``"vector"``: a 4-connected flood fill over cells not blocked by a wall, never crossing a
+      wall between two cell centres, seeded from cells whose centre lies inside the world's
+      ``free_mask`` and farther than one native cell from any wall (so a seed cannot sit on the
+      wrong side of a wall).
+
+    Args:
+        world_or_segments: A :class:`World`, or bare ``(N, 4)`` wall segments; then
+            ``interior_points_m`` must say where the inside is.
+        geometry: The target grid.
+        interior_points_m: ``(K, 2)`` points inside free space, the flood-fill seeds for bare
+            segments (ignored for a world).
+
+    Returns:
+        ``geometry.shape`` bool mask, True = free.
+    """
+    if isinstance(world_or_segments, World):
+        world = world_or_segments
+        segments = world.segments_m
+        blocked = _blocked_by_walls(segments, geometry)
+        inside = sample_mask(world.free_mask, world.free_geometry, geometry)
+        if world.free_space_source == "raster":
+            return inside & ~blocked
+        # One native cell of margin: a native cell that straddles a wall can only be sampled
+        # from within one native diagonal of that wall.
+        seed_margin_m = max(world.free_geometry.resolution_m, geometry.resolution_m)
+        dist = segment_distance_field(segments, geometry, max_distance_m=2.0 * seed_margin_m)
+        seeds = inside & (dist > seed_margin_m)
+        if not seeds.any():
+            # The grid is too coarse for deep seeds: accept any unblocked inside cell.
+            seeds = inside & ~blocked
+        return _flood_fill_inside(segments, geometry, ~blocked, seeds)
+
+    segments = as_segments(world_or_segments)
+    if interior_points_m is None:
+        raise ValueError("rasterize_free needs interior_points_m when given bare segments (where is the inside?)")
+    pts = np.atleast_2d(np.asarray(interior_points_m, dtype=np.float64))
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
+        raise ValueError(f"interior_points_m must be finite (K, 2) points, got shape {pts.shape}")
+    blocked = _blocked_by_walls(segments, geometry)
+    seeds = np.zeros(geometry.shape, dtype=bool)
+    rows, cols = geometry.world_to_grid(pts[:, 0], pts[:, 1])
+    ok = geometry.contains(rows, cols)
+    seeds[rows[ok], cols[ok]] = True
+    return _flood_fill_inside(segments, geometry, ~blocked, seeds)
+
+
+def _flood_fill_inside(
+    segments_m: np.ndarray, geometry: GridGeometry, passable: np.ndarray, seeds: np.ndarray
+) -> np.ndarray:
+    cut_x, cut_y = crossed_links(segments_m, geometry)
+    return flood_fill_links(passable, cut_x, cut_y, seeds)

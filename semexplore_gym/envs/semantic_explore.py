@@ -1,0 +1,339 @@
+"""``SemanticExplore-v0``: explore an unknown building with a simulated TurtleBot3 and LiDAR."""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.occupancy_grid import OccupancyGrid
+from semexplore_gym.core.odometry import OdometryDrift
+from semexplore_gym.core.raycast import SegmentIndex
+from semexplore_gym.core.worlds import make_world
+from semexplore_gym.core.worlds.start import reachable_free_mask, sample_start_pose, validate_start_pose
+from semexplore_gym.core.worlds.world import World
+from semexplore_gym.envs.config import EnvConfig, load_env_config
+from semexplore_gym.sim.lidar import Lidar
+from semexplore_gym.sim.robot import RobotSim
+
+
+PROCEDURAL_FAMILIES = ("maze", "office", "cave")
+
+
+def _is_unseeded_procedural(spec: Any) -> bool:
+    if not isinstance(spec, str):
+        return False
+    family, _, params = spec.partition(":")
+    return family in PROCEDURAL_FAMILIES and "seed=" not in params
+
+
+class SemanticExploreEnv(gym.Env):
+    """Explore an unknown building with a TurtleBot3 Burger and a 2D LiDAR.
+
+    ## Description
+    A disc robot (TurtleBot3 Burger, radius 0.105 m) drives in a 2D world of walls simulated
+    with pymunk. Each control step (0.2 s) a 360-beam LiDAR scans the walls and the scan is
+    fused into a log-odds occupancy grid. The task is to map the reachable free space; the
+    scripted expert (``policies.semantic_expert``) does it with the semantic topometric method
+    of Fredriksson, Saradagi and Nikolakopoulos.
+
+    ## Action Space
+    ``Box(-1, 1, (2,), float32)``: ``[v, omega]`` scaled by ``robot.max_linear_speed_mps``
+    (0.22 m/s) and ``robot.max_angular_speed_radps`` (2.84 rad/s). Values outside [-1, 1] are
+    clipped; NaN or inf raise ``ValueError``.
+
+    ## Observation Space
+    ``Dict``:
+
+    =======  ==============  =======  =================  ===================================
+    key      shape           dtype    range              unit / meaning
+    =======  ==============  =======  =================  ===================================
+    map      (H, W)          uint8    {0, 128, 255}      OCCUPIED=0, UNKNOWN=128, FREE=255;
+                                                         row 0 = lowest y (see ``core``)
+    pose     (3,)            float32  x, y, yaw          metres, metres, radians (map frame)
+    scan     (n_beams,)      float32  [0, max_range_m]   metres; 0 = invalid, max = no return
+    =======  ==============  =======  =================  ===================================
+
+    The map frame is the world frame; ``info["map_geometry"]`` (and ``self.map_geometry``)
+    give the grid's resolution, origin and shape. ``pose`` is the pose the map was built with:
+    ground truth, or the odometry estimate when ``odometry`` noise is configured. Beam ``i`` of
+    ``scan`` points ``i * 2*pi/n_beams`` counter-clockwise from the heading.
+
+    ## Rewards
+    ``reward = sum(weight * term)`` over named terms (weights in ``RewardParams``):
+    ``new_area`` (m^2 of free space newly mapped this step, weight 1), ``time`` (the control
+    period in s, weight -0.01) and ``collision`` (1 when a wall contact begins, weight -1).
+    ``info["reward_terms"]`` holds each weighted term.
+
+    ## Starting State
+    The world's start pose, ``episode.start_pose``, ``reset(options={"start_pose": ...})``, or
+    (``episode.random_start`` or none given) a pose sampled uniformly in free space at least
+    ``radius + start_clearance_margin_m`` from walls, yaw uniform, from the env's RNG. The first
+    scan is fused before the first observation.
+
+    ## Episode End
+    Terminated when ``coverage >= episode.coverage_goal`` (0.99). Truncated when the simulated
+    time reaches ``episode.max_time_s`` (1200 s). ``coverage`` = mapped free cells inside the
+    reachable mask / cells of the reachable mask, where the reachable mask is the free area the
+    robot's body can sweep from the start, less a one-cell band along walls.
+
+    ## Arguments
+    - ``world``: ``"maze1"``, ``"maze2"``, ``"maze:seed=3,size_m=10"``, ``"office:..."``,
+      ``"cave:..."``, a ROS map ``.yaml`` or a HouseExpo ``.json``. A procedural spelling without
+      ``seed`` draws a new world from the env's RNG at every reset (same grid shape).
+    - ``config``: None, a preset name (``"default"``, ``"paper"``), a YAML path, a dict or an
+      :class:`EnvConfig`.
+    - ``overrides``: list of ``"section.key=value"`` strings applied on top of ``config``.
+    - ``render_mode``: None, ``"rgb_array"`` or ``"human"``.
+
+    ## Info
+    ``map_geometry``, ``robot``, ``lidar``, ``dt_s``, ``coverage``, ``explored_area_m2`` (free
+    area in the map), ``collisions`` (count so far), ``sim_time_s``, ``path_length_m``,
+    ``reward_terms``, ``true_pose`` is *not* given (policies must not see ground truth).
+
+    ## Notes
+    Rendering overlays: ``env.unwrapped.set_overlay(dict)`` draws a policy's semantic areas,
+    paths and goal on the next frames (keys in :mod:`semexplore_gym.rendering.renderer`).
+
+    ## Version History
+    - v0: initial version.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
+
+    def __init__(
+        self,
+        world: str | os.PathLike | World = "maze1",
+        config: EnvConfig | str | os.PathLike | dict | None = None,
+        overrides: list[str] | None = None,
+        render_mode: str | None = None,
+    ) -> None:
+        super().__init__()
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}")
+        self.render_mode = render_mode
+        self.config: EnvConfig = load_env_config(config, overrides)
+        cfg = self.config
+        self.world_spec = world
+        self._randomise_world = _is_unseeded_procedural(world)
+        self.world: World = world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
+        self.map_geometry: GridGeometry = GridGeometry.covering(*self.world.bounds_m, cfg.mapping.resolution_m, cfg.mapping.margin_m)
+        n_cells = self.map_geometry.height * self.map_geometry.width
+        if n_cells > 40_000_000:
+            raise ValueError(
+                f"world {self.world.name!r} needs a {self.map_geometry.height}x{self.map_geometry.width} map at "
+                f"mapping.resolution_m={cfg.mapping.resolution_m}; raise mapping.resolution_m"
+            )
+        self._build_world_state()
+
+        h, w = self.map_geometry.shape
+        big = np.float32(1e6)
+        self.observation_space = spaces.Dict(
+            {
+                "map": spaces.Box(0, 255, shape=(h, w), dtype=np.uint8),
+                "pose": spaces.Box(np.array([-big, -big, -np.pi], dtype=np.float32), np.array([big, big, np.pi], dtype=np.float32), dtype=np.float32),
+                "scan": spaces.Box(0.0, cfg.lidar.max_range_m, shape=(cfg.lidar.n_beams,), dtype=np.float32),
+            }
+        )
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        self._static_info = {
+            "map_geometry": self.map_geometry.to_dict(),
+            "robot": {
+                "radius_m": cfg.robot.radius_m,
+                "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
+                "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
+            },
+            "lidar": {
+                "n_beams": cfg.lidar.n_beams,
+                "min_range_m": cfg.lidar.min_range_m,
+                "max_range_m": cfg.lidar.max_range_m,
+                "angle_increment_rad": cfg.lidar.angle_increment_rad,
+                "mount_x_m": cfg.lidar.mount_x_m,
+                "mount_y_m": cfg.lidar.mount_y_m,
+            },
+            "dt_s": cfg.episode.dt_s,
+        }
+        self._overlay: dict[str, Any] = {}
+        self._renderer: Any = None
+        self._started = False
+
+    # ----------------------------------------------------------------- set-up
+    def _build_world_state(self) -> None:
+        cfg = self.config
+        self.sim = RobotSim(self.world, cfg.robot, cfg.physics)
+        self.lidar = Lidar(cfg.lidar, SegmentIndex(self.world.segments_m))
+        self.grid = OccupancyGrid(self.map_geometry, cfg.mapping)
+        self.odometry = OdometryDrift(cfg.odometry)
+
+    def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
+        cfg = self.config
+        clearance = cfg.robot.radius_m + cfg.episode.start_clearance_margin_m
+        pose = None
+        if options and options.get("start_pose") is not None:
+            pose = options["start_pose"]
+        elif cfg.episode.start_pose is not None:
+            pose = cfg.episode.start_pose
+        elif self.world.start_pose is not None and not cfg.episode.random_start:
+            pose = self.world.start_pose
+        if pose is None:
+            return tuple(float(v) for v in sample_start_pose(self.world, self.np_random, clearance))  # type: ignore[return-value]
+        try:
+            pose_t = tuple(float(v) for v in pose)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"start_pose must be (x_m, y_m, yaw_rad), got {pose!r}") from e
+        if len(pose_t) != 3:
+            raise ValueError(f"start_pose must be (x_m, y_m, yaw_rad), got {pose!r}")
+        validate_start_pose(self.world, pose_t, cfg.robot.radius_m)
+        return pose_t  # type: ignore[return-value]
+
+    # ------------------------------------------------------------------- API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        if self._randomise_world and (self._started or seed is not None):
+            world_seed = int(self.np_random.integers(0, 2**31 - 1))
+            family, _, params = str(self.world_spec).partition(":")
+            params = f"{params},seed={world_seed}" if params.strip() else f"seed={world_seed}"
+            self.world = make_world(f"{family}:{params}")
+            self._build_world_state()
+        self._started = True
+        pose = self._choose_start(options)
+        cfg = self.config
+        self.sim.reset(pose)
+        reach = reachable_free_mask(self.world, self.map_geometry, pose[:2], cfg.robot.radius_m, cfg.robot.radius_m + 0.01)
+        self._n_reachable = max(1, int(reach.sum()))
+        self.grid = OccupancyGrid(self.map_geometry, cfg.mapping, count_mask=reach)
+        self.odometry.reset(pose)
+        self._est_pose = pose
+        self.sim_time_s = 0.0
+        self.path_length_m = 0.0
+        self._trajectory: list[tuple[float, float]] = [(pose[0], pose[1])]
+        self._overlay = {}
+        self._scan = self._sense_and_map()
+        info = self._info({"new_area": 0.0, "time": 0.0, "collision": 0.0})
+        if self.render_mode == "human":
+            self.render()
+        return self._obs(), info
+
+    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        v_mps, w_radps = self._scale_action(action)
+        cfg = self.config
+        before = self.sim.pose
+        new_collision = self.sim.step(v_mps, w_radps, cfg.episode.dt_s)
+        after = self.sim.pose
+        self.sim_time_s += cfg.episode.dt_s
+        self.path_length_m += math.hypot(after[0] - before[0], after[1] - before[1])
+        self._trajectory.append((after[0], after[1]))
+        self._est_pose = self.odometry.update(before, after, self.np_random)
+        n_free_before = self.grid.n_free_cells
+        self._scan = self._sense_and_map()
+        new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
+        rw = cfg.reward
+        terms = {
+            "new_area": rw.new_area_weight * new_area_m2,
+            "time": rw.time_weight * cfg.episode.dt_s,
+            "collision": rw.collision_weight * float(new_collision),
+        }
+        reward = float(sum(terms.values()))
+        info = self._info(terms)
+        terminated = bool(info["coverage"] >= cfg.episode.coverage_goal)
+        truncated = bool(self.sim_time_s >= cfg.episode.max_time_s - 1e-9)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs(), reward, terminated, truncated, info
+
+    def _scale_action(self, action: Any) -> tuple[float, float]:
+        try:
+            a = np.asarray(action, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}") from e
+        if a.shape != (2,):
+            raise ValueError(f"action must have shape (2,), got shape {np.shape(action)}: {action!r}")
+        if not np.isfinite(a).all():
+            raise ValueError(f"action contains NaN or inf: {action!r}")
+        a = np.clip(a, -1.0, 1.0)
+        rp = self.config.robot
+        v = float(a[0]) * rp.max_linear_speed_mps
+        if not rp.allow_reverse:
+            v = max(v, 0.0)
+        return v, float(a[1]) * rp.max_angular_speed_radps
+
+    def _sense_and_map(self) -> np.ndarray:
+        x, y, yaw = self.sim.pose
+        scan = self.lidar.scan(x, y, yaw, self.np_random)
+        ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
+        self.grid.integrate_scan(ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m)
+        return scan
+
+    def _obs(self) -> dict[str, np.ndarray]:
+        x, y, yaw = self._est_pose
+        yaw = (yaw + math.pi) % (2 * math.pi) - math.pi
+        return {
+            "map": self.grid.encoded.copy(),
+            "pose": np.array([x, y, yaw], dtype=np.float32),
+            "scan": self._scan,
+        }
+
+    def _info(self, terms: dict[str, float]) -> dict[str, Any]:
+        info = dict(self._static_info)
+        info.update(
+            coverage=self.grid.n_free_in_mask / self._n_reachable,
+            explored_area_m2=self.grid.n_free_cells * self.config.mapping.resolution_m**2,
+            collisions=self.sim.collisions,
+            sim_time_s=self.sim_time_s,
+            path_length_m=self.path_length_m,
+            reward_terms=terms,
+        )
+        return info
+
+    # ------------------------------------------------------------- rendering
+    def set_overlay(self, overlay: dict[str, Any] | None) -> None:
+        """Draw a policy's overlay (semantic areas, paths, goal) on subsequent frames."""
+        self._overlay = dict(overlay or {})
+
+    def render_snapshot(self) -> Any:
+        from semexplore_gym.rendering.renderer import RenderSnapshot
+
+        x, y, yaw = self.sim.pose
+        return RenderSnapshot(
+            map=self.grid.encoded.copy(),
+            geometry=self.map_geometry,
+            segments_m=self.world.segments_m,
+            pose=(x, y, yaw),
+            radius_m=self.config.robot.radius_m,
+            scan=self._scan.copy(),
+            beam_angles_rad=self.lidar.beam_angles_rad,
+            sensor_pose=self.lidar.sensor_pose(x, y, yaw),
+            max_range_m=self.config.lidar.max_range_m,
+            trajectory_m=np.asarray(self._trajectory, dtype=np.float64),
+            overlay=self._overlay,
+            text=f"t={self.sim_time_s:6.1f} s  coverage={self.grid.n_free_in_mask / self._n_reachable:5.1%}",
+        )
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human' to gym.make")
+            return None
+        from semexplore_gym.rendering.renderer import Renderer
+
+        if self._renderer is None:
+            self._renderer = Renderer(self.map_geometry)
+        frame = self._renderer.draw(self.render_snapshot())
+        if self.render_mode == "rgb_array":
+            return frame
+        self._renderer.show(frame, fps=self.metadata["render_fps"])
+        return None
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_renderer"] = None
+        return state

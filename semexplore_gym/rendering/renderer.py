@@ -1,0 +1,185 @@
+"""Drawing an env state for people: a read-only snapshot in, an RGB array out.
+
+The renderer never touches simulator state: the env hands it a :class:`RenderSnapshot`.
+Layers, bottom to top: the occupancy map (white free, grey unknown, black occupied), the
+ground-truth walls (faint blue), a policy overlay, LiDAR rays, the trajectory and the robot.
+
+Overlay keys (all optional), set with ``env.unwrapped.set_overlay(policy.overlay())``:
+
+=================  =========================================================
+``area_types``     (H, W) int raster of ``AreaType`` values, -1 where none
+``paths_m``        list of (K, 2) polylines in world metres (the chosen path)
+``goal_m``         (x, y) the chosen goal
+``frontiers_m``    list of (x, y) frontier targets
+``points_m``       list of (x, y) extra markers
+``text``           a line of text drawn under the status line
+=================  =========================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+
+#: Colours of semantic area types (GRID-FAST codes 0/10/20/30).
+AREA_COLOURS: dict[int, tuple[int, int, int]] = {
+    0: (230, 85, 60),  # intersection: red
+    10: (90, 160, 230),  # pathway: blue
+    20: (150, 150, 150),  # dead end: grey
+    30: (70, 190, 90),  # frontier pathway: green
+}
+
+
+@dataclass(frozen=True)
+class RenderSnapshot:
+    """Everything one frame shows, copied out of the env."""
+
+    map: np.ndarray
+    geometry: GridGeometry
+    segments_m: np.ndarray
+    pose: tuple[float, float, float]
+    radius_m: float
+    scan: np.ndarray | None = None
+    beam_angles_rad: np.ndarray | None = None
+    sensor_pose: tuple[float, float, float] | None = None
+    max_range_m: float = 3.5
+    trajectory_m: np.ndarray | None = None
+    overlay: dict[str, Any] = field(default_factory=dict)
+    text: str = ""
+
+
+class Renderer:
+    """Turns snapshots into RGB frames (and shows them in a window for ``human`` mode).
+
+    Args:
+        geometry: Frame of the maps that will be drawn.
+        max_size_px: Longest side of the frame; the map is scaled to fit.
+    """
+
+    def __init__(self, geometry: GridGeometry, max_size_px: int = 720) -> None:
+        self.geometry = geometry
+        h, w = geometry.shape
+        self.px_per_cell = max(1.0, min(8.0, max_size_px / max(h, w))) if max(h, w) <= max_size_px else max_size_px / max(h, w)
+        self.size_px = (max(1, int(round(w * self.px_per_cell))), max(1, int(round(h * self.px_per_cell))))
+        self._window: Any = None
+        self._clock: Any = None
+
+    def world_to_px(self, xy_m: np.ndarray) -> np.ndarray:
+        """World metres -> image pixel (u right, v down) for (N, 2) points."""
+        g = self.geometry
+        xy = np.asarray(xy_m, dtype=np.float64).reshape(-1, 2)
+        u = (xy[:, 0] - g.origin_x_m) / g.resolution_m * self.px_per_cell
+        v = self.size_px[1] - (xy[:, 1] - g.origin_y_m) / g.resolution_m * self.px_per_cell
+        return np.stack([u, v], axis=1)
+
+    def _base_image(self, grid: np.ndarray, area_types: np.ndarray | None) -> np.ndarray:
+        rgb = np.empty(grid.shape + (3,), dtype=np.uint8)
+        rgb[grid == FREE] = (255, 255, 255)
+        rgb[grid == UNKNOWN] = (200, 200, 200)
+        rgb[grid == OCCUPIED] = (20, 20, 20)
+        if area_types is not None and area_types.shape == grid.shape:
+            for code, colour in AREA_COLOURS.items():
+                m = area_types == code
+                if m.any():
+                    rgb[m] = (0.45 * rgb[m] + 0.55 * np.array(colour)).astype(np.uint8)
+        rgb = rgb[::-1]  # row 0 is the lowest y: flip so that y points up
+        h, w = grid.shape
+        rows = np.minimum((np.arange(self.size_px[1]) / self.px_per_cell).astype(np.int64), h - 1)
+        cols = np.minimum((np.arange(self.size_px[0]) / self.px_per_cell).astype(np.int64), w - 1)
+        return rgb[rows][:, cols]
+
+    def draw(self, snap: RenderSnapshot) -> np.ndarray:
+        """Return an (H_px, W_px, 3) uint8 frame."""
+        from PIL import Image, ImageDraw
+
+        ov = snap.overlay or {}
+        img = Image.fromarray(self._base_image(snap.map, ov.get("area_types")))
+        draw = ImageDraw.Draw(img, "RGBA")
+        lw = max(1, int(round(self.px_per_cell * 0.4)))
+        if len(snap.segments_m):
+            a = self.world_to_px(snap.segments_m[:, 0:2])
+            b = self.world_to_px(snap.segments_m[:, 2:4])
+            for (u0, v0), (u1, v1) in zip(a, b):
+                draw.line([(u0, v0), (u1, v1)], fill=(60, 90, 220, 90), width=lw)
+        if snap.scan is not None and snap.beam_angles_rad is not None and snap.sensor_pose is not None:
+            sx, sy, syaw = snap.sensor_pose
+            r = np.where(snap.scan > 0, snap.scan, np.nan)
+            ang = syaw + snap.beam_angles_rad
+            ends = np.stack([sx + r * np.cos(ang), sy + r * np.sin(ang)], axis=1)
+            ok = np.isfinite(ends).all(axis=1)
+            origin = self.world_to_px(np.array([[sx, sy]]))[0]
+            hit = ok & (snap.scan < snap.max_range_m)
+            for (u, v), is_hit in zip(self.world_to_px(ends[ok]), hit[ok]):
+                draw.line([tuple(origin), (u, v)], fill=(255, 140, 0, 40), width=1)
+                if is_hit:
+                    draw.point((u, v), fill=(230, 60, 0, 255))
+        for path in ov.get("paths_m", []) or []:
+            p = np.asarray(path, dtype=np.float64)
+            if p.ndim == 2 and len(p) >= 2:
+                draw.line([tuple(q) for q in self.world_to_px(p)], fill=(160, 40, 200, 230), width=max(2, lw + 1))
+        marker = max(3.0, self.px_per_cell * 1.5)
+        for pt in ov.get("frontiers_m", []) or []:
+            u, v = self.world_to_px(np.asarray(pt, dtype=np.float64)[:2])[0]
+            draw.ellipse([u - marker, v - marker, u + marker, v + marker], outline=(0, 140, 60, 255), width=2)
+        for pt in ov.get("points_m", []) or []:
+            u, v = self.world_to_px(np.asarray(pt, dtype=np.float64)[:2])[0]
+            draw.rectangle([u - marker / 2, v - marker / 2, u + marker / 2, v + marker / 2], fill=(40, 40, 200, 200))
+        if ov.get("goal_m") is not None:
+            u, v = self.world_to_px(np.asarray(ov["goal_m"], dtype=np.float64)[:2])[0]
+            m = marker * 1.5
+            draw.line([(u - m, v - m), (u + m, v + m)], fill=(200, 0, 160, 255), width=3)
+            draw.line([(u - m, v + m), (u + m, v - m)], fill=(200, 0, 160, 255), width=3)
+        if snap.trajectory_m is not None and len(snap.trajectory_m) >= 2:
+            draw.line([tuple(q) for q in self.world_to_px(snap.trajectory_m)], fill=(0, 120, 255, 200), width=max(1, lw))
+        x, y, yaw = snap.pose
+        (u, v), = self.world_to_px(np.array([[x, y]]))
+        rpx = snap.radius_m / self.geometry.resolution_m * self.px_per_cell
+        draw.ellipse([u - rpx, v - rpx, u + rpx, v + rpx], fill=(0, 90, 200, 220), outline=(0, 0, 0, 255))
+        draw.line([(u, v), (u + rpx * 1.6 * math.cos(yaw), v - rpx * 1.6 * math.sin(yaw))], fill=(255, 255, 255, 255), width=2)
+        lines = [t for t in (snap.text, ov.get("text", "")) if t]
+        for i, t in enumerate(lines):
+            draw.text((4, 4 + 12 * i), t, fill=(0, 0, 0, 255))
+        return np.asarray(img, dtype=np.uint8)
+
+    def show(self, frame: np.ndarray, fps: float) -> None:
+        """Show a frame in a pygame window (``human`` render mode)."""
+        try:
+            import pygame
+        except ImportError as e:  # pragma: no cover - depends on the optional extra
+            from gymnasium.error import DependencyNotInstalled
+
+            raise DependencyNotInstalled('render_mode="human" needs pygame: pip install "semexplore-gym[render]"') from e
+        if self._window is None:
+            pygame.init()
+            pygame.display.init()
+            self._window = pygame.display.set_mode((frame.shape[1], frame.shape[0]))
+            pygame.display.set_caption("SemanticExplore")
+            self._clock = pygame.time.Clock()
+        surf = pygame.surfarray.make_surface(np.transpose(frame, (1, 0, 2)))
+        self._window.blit(surf, (0, 0))
+        pygame.event.pump()
+        pygame.display.flip()
+        self._clock.tick(fps)
+
+    def close(self) -> None:
+        if self._window is not None:
+            import pygame
+
+            pygame.display.quit()
+            pygame.quit()
+            self._window = None
+
+
+def save_gif(frames: list[np.ndarray], path: str, fps: float = 10.0) -> None:
+    """Write frames as an animated GIF with Pillow."""
+    from PIL import Image
+
+    if not frames:
+        raise ValueError(f"no frames to write to {path!r}")
+    images = [Image.fromarray(f) for f in frames]
+    images[0].save(path, save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0, optimize=False)
