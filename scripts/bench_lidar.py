@@ -73,7 +73,9 @@ def maze_segments(
     for k in cells:
         cx = (k % n_cells + 0.5) * cell_m
         cy = (k // n_cells + 0.5) * cell_m
-        segs.append((cx + 0.25 * cell_m, cy + 0.38 * cell_m, cx + 0.38 * cell_m, cy + 0.22 * cell_m))
+        segs.append(
+            (cx + 0.25 * cell_m, cy + 0.38 * cell_m, cx + 0.38 * cell_m, cy + 0.22 * cell_m)
+        )
     return np.asarray(segs, dtype=np.float64)
 
 
@@ -109,13 +111,15 @@ def make_worlds(rng: np.random.Generator) -> dict[str, tuple[np.ndarray, int, fl
 
 
 def pymunk_scan(space, x, y, angles, max_range_m, out):  # noqa: ANN001 - pymunk only here
+    """Reference scan: one ``segment_query_first`` per beam (end points precomputed)."""
     import pymunk
 
     flt = pymunk.ShapeFilter()
-    for j, th in enumerate(angles):
-        q = space.segment_query_first(
-            (x, y), (x + max_range_m * np.cos(th), y + max_range_m * np.sin(th)), 0.0, flt
-        )
+    query = space.segment_query_first
+    start = (float(x), float(y))
+    ends = np.c_[x + max_range_m * np.cos(angles), y + max_range_m * np.sin(angles)].tolist()
+    for j, end in enumerate(ends):
+        q = query(start, end, 0.0, flt)
         out[j] = np.inf if q is None else q.alpha * max_range_m
     return out
 
@@ -124,7 +128,9 @@ def pymunk_space(segments_m: np.ndarray):  # noqa: ANN201
     import pymunk
 
     space = pymunk.Space()
-    space.add(*[pymunk.Segment(space.static_body, (a, b), (c, d), 0.0) for a, b, c, d in segments_m])
+    space.add(
+        *[pymunk.Segment(space.static_body, (a, b), (c, d), 0.0) for a, b, c, d in segments_m]
+    )
     return space
 
 
@@ -142,7 +148,9 @@ def first_call_s(cold: bool) -> float:
     with tempfile.TemporaryDirectory() as tmp:
         if cold:
             env["NUMBA_CACHE_DIR"] = tmp
-        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+        out = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
     return float(out.stdout.strip())
 
 
@@ -153,12 +161,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--beams", type=int, default=360, help="beams per scan")
     ap.add_argument("--max-range-m", type=float, default=3.5, help="LiDAR max range in metres")
     ap.add_argument("--seed", type=int, default=0, help="seed for worlds and poses")
-    ap.add_argument("--skip-pymunk-above", type=int, default=100_000, help="skip pymunk above this many segments")
+    ap.add_argument(
+        "--skip-pymunk-above",
+        type=int,
+        default=100_000,
+        help="skip pymunk above this many segments",
+    )
     args = ap.parse_args(argv)
 
     rng = np.random.default_rng(args.seed)
     beams = np.arange(args.beams) * (2 * np.pi / args.beams)
     rows = []
+    SegmentIndex(np.array([[0.0, 0.0, 1.0, 1.0]]))  # load the compiled builder before timing it
     for name, (segs, n_cells, cell_m) in make_worlds(rng).items():
         poses = corridor_poses(n_cells, cell_m, args.poses, rng)
         t = time.perf_counter()
@@ -197,16 +211,22 @@ def main(argv: list[str] | None = None) -> int:
         pm = float(np.median(pm_ms)) if use_pm else float("nan")
         rows.append((name, len(segs), index, build_ms, pm, ours, max_err))
 
-    print(f"LiDAR scan: {args.beams} beams, max range {args.max_range_m} m, {args.poses} poses, median of {args.repeats}\n")
-    print("| world | segments | index build ms | pymunk ms/scan | ours ms/scan | ours scans/s | x vs pymunk | max abs err vs pymunk (m) |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    print(
+        f"LiDAR scan: {args.beams} beams, max range {args.max_range_m} m, {args.poses} poses, median of {args.repeats}\n"
+    )
+    print(
+        "| world | segments | bucket m | index build ms | pymunk ms/scan | ours ms/scan | ours scans/s | x vs pymunk | max abs err vs pymunk (m) |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, n, index, build_ms, pm, ours, err in rows:
         print(
-            f"| {name} | {n} | {build_ms:.2f} | {pm:.3f} | {ours:.4f} | {1e3 / ours:,.0f} | {pm / ours:.1f} | {err:.1e} |"
+            f"| {name} | {n} | {index.cell_size_m:.2f} | {build_ms:.2f} | {pm:.3f} | {ours:.4f} | {1e3 / ours:,.0f} | {pm / ours:.1f} | {err:.1e} |"
         )
     print()
-    print(f"first call (import + one scan, fresh process): warm cache {first_call_s(False):.2f} s, "
-          f"cold cache (compile) {first_call_s(True):.2f} s")
+    print(
+        f"first call (import + one scan, fresh process): warm cache {first_call_s(False):.2f} s, "
+        f"cold cache (compile) {first_call_s(True):.2f} s"
+    )
     return 0
 
 

@@ -70,7 +70,11 @@ class GridFrontier:
 
     def cell_xy_m(self, geometry: GridGeometry, which: str) -> tuple[float, float]:
         """World ``(x, y)`` of ``"initial"``, ``"nearest"`` or ``"middle"`` cell centre."""
-        cells = {"initial": self.initial_cell, "nearest": self.nearest_cell, "middle": self.middle_cell}
+        cells = {
+            "initial": self.initial_cell,
+            "nearest": self.nearest_cell,
+            "middle": self.middle_cell,
+        }
         if which not in cells:
             raise ValueError(f"which must be one of {sorted(cells)}, got {which!r}")
         r, c = cells[which]

@@ -72,7 +72,9 @@ class FrontierCostWeights:
             if not (math.isfinite(value) and value >= 0.0):
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
         if not (math.isfinite(self.fallback_path_length_m) and self.fallback_path_length_m > 0.0):
-            raise ValueError(f"fallback_path_length_m must be a positive finite number, got {self.fallback_path_length_m!r}")
+            raise ValueError(
+                f"fallback_path_length_m must be a positive finite number, got {self.fallback_path_length_m!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -167,7 +169,12 @@ def find_frontier_paths(
     The first element (if any) is ``F*``. See :func:`search_frontier_paths` for the arguments.
     """
     candidates, _ = search_frontier_paths(
-        tmap, robot_xy_m, robot_yaw_rad, weights, prune_by=prune_by, min_frontier_width_m=min_frontier_width_m
+        tmap,
+        robot_xy_m,
+        robot_yaw_rad,
+        weights,
+        prune_by=prune_by,
+        min_frontier_width_m=min_frontier_width_m,
     )
     return candidates
 
@@ -273,7 +280,9 @@ def search_frontier_paths(
                 n_pruned += 1
                 continue
             a_cost[key] = new_cost
-            search_list.append(_Partial(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m))
+            search_list.append(
+                _Partial(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m)
+            )
             n_pushed += 1
 
     candidates: list[FrontierCandidate] = []
@@ -316,7 +325,9 @@ def _wrap_angle(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def _heading_angle(poly: np.ndarray, robot_xy: tuple[float, float], yaw: float, lookahead_m: float) -> float:
+def _heading_angle(
+    poly: np.ndarray, robot_xy: tuple[float, float], yaw: float, lookahead_m: float
+) -> float:
     """Angle in [0, pi] between the heading and the direction to the point ``lookahead_m`` along ``poly``."""
     target = point_along(poly, lookahead_m)
     dx, dy = target[0] - robot_xy[0], target[1] - robot_xy[1]
@@ -343,7 +354,9 @@ def point_along(poly: np.ndarray, s_m: float) -> np.ndarray:
     return poly[i] + t * (poly[i + 1] - poly[i])
 
 
-def project_onto_polyline(poly: np.ndarray, xy: tuple[float, float]) -> tuple[float, np.ndarray, int, float]:
+def project_onto_polyline(
+    poly: np.ndarray, xy: tuple[float, float]
+) -> tuple[float, np.ndarray, int, float]:
     """Nearest point of a polyline to ``xy``.
 
     Returns:
@@ -375,7 +388,9 @@ def _dedupe(poly: np.ndarray, tol_m: float = 1e-6) -> np.ndarray:
     return poly[keep]
 
 
-def _oriented(path_m: np.ndarray, start_xy: tuple[float, float], end_xy: tuple[float, float]) -> np.ndarray:
+def _oriented(
+    path_m: np.ndarray, start_xy: tuple[float, float], end_xy: tuple[float, float]
+) -> np.ndarray:
     """``path_m`` ordered so that it starts at the end nearer ``start_xy`` (ties: ``end_xy`` decides)."""
     p = np.asarray(path_m, dtype=np.float64).reshape(-1, 2)
     d_fwd = math.hypot(*(p[0] - start_xy)) + math.hypot(*(p[-1] - end_xy))
@@ -386,10 +401,14 @@ def _oriented(path_m: np.ndarray, start_xy: tuple[float, float], end_xy: tuple[f
 def _edge_polyline(tmap: TopometricMap, k: int, from_node: int) -> np.ndarray:
     e = tmap.edges[k]
     to_node = e.opening_b if from_node == e.opening_a else e.opening_a
-    return _oriented(e.path_m, tmap.openings[from_node].midpoint_m, tmap.openings[to_node].midpoint_m)
+    return _oriented(
+        e.path_m, tmap.openings[from_node].midpoint_m, tmap.openings[to_node].midpoint_m
+    )
 
 
-def _first_legs(tmap: TopometricMap, area_id: int, robot_xy: tuple[float, float]) -> dict[int, np.ndarray]:
+def _first_legs(
+    tmap: TopometricMap, area_id: int, robot_xy: tuple[float, float]
+) -> dict[int, np.ndarray]:
     """Polylines from the robot to every opening of its area, along the area's own paths.
 
     The robot joins the nearest point of each path of its area in a straight line, then follows
@@ -426,7 +445,9 @@ def _first_legs(tmap: TopometricMap, area_id: int, robot_xy: tuple[float, float]
     return {node: poly for node, (_, poly) in best.items()}
 
 
-def _assemble(tmap: TopometricMap, path: _Partial, first_leg: np.ndarray, goal_xy: tuple[float, float]) -> np.ndarray:
+def _assemble(
+    tmap: TopometricMap, path: _Partial, first_leg: np.ndarray, goal_xy: tuple[float, float]
+) -> np.ndarray:
     parts = [first_leg]
     for j, k in enumerate(path.edges):
         parts.append(_edge_polyline(tmap, k, path.nodes[j]))

@@ -88,7 +88,10 @@ class CostmapParams:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.inscribed_radius_m) and self.inscribed_radius_m >= 0):
             raise ValueError(f"inscribed_radius_m must be >= 0, got {self.inscribed_radius_m!r}")
-        if not (math.isfinite(self.inflation_radius_m) and self.inflation_radius_m >= self.inscribed_radius_m):
+        if not (
+            math.isfinite(self.inflation_radius_m)
+            and self.inflation_radius_m >= self.inscribed_radius_m
+        ):
             raise ValueError(
                 f"inflation_radius_m must be >= inscribed_radius_m ({self.inscribed_radius_m}), got {self.inflation_radius_m!r}"
             )
@@ -159,7 +162,9 @@ def inflation_cost(distance_m: npt.ArrayLike, params: CostmapParams) -> np.ndarr
     return cost.astype(np.uint8)
 
 
-def inflate_costmap(grid: npt.ArrayLike, resolution_m: float, params: CostmapParams = CostmapParams()) -> np.ndarray:
+def inflate_costmap(
+    grid: npt.ArrayLike, resolution_m: float, params: CostmapParams = CostmapParams()
+) -> np.ndarray:
     """Costmap (uint8, ROS values) of an encoded occupancy grid.
 
     Args:
@@ -182,7 +187,9 @@ def inflate_costmap(grid: npt.ArrayLike, resolution_m: float, params: CostmapPar
     if params.track_unknown_space:
         unknown = a == UNKNOWN
         # ROS keeps NO_INFORMATION unless inflation makes the cell (nearly) lethal.
-        keep = unknown & ((cost == FREE_COST) if params.inflate_unknown else (cost < INSCRIBED_COST))
+        keep = unknown & (
+            (cost == FREE_COST) if params.inflate_unknown else (cost < INSCRIBED_COST)
+        )
         cost[keep] = NO_INFORMATION
     return cost
 
@@ -279,30 +286,40 @@ def shortest_path_cells(
     h_weight = float(finite.min()) if (use_astar and finite.size) else 0.0
     dist = np.full(h * w, np.inf)
     parent = np.full(h * w, -1, dtype=np.int64)
-    _search(cost, sr * w + sc, gr * w + gc, h_weight, dist, parent)
+    _search(cost, np.array([sr * w + sc], dtype=np.int64), gr * w + gc, h_weight, dist, parent)
     total = dist[gr * w + gc]
     if not np.isfinite(total):
         return None
     return extract_path(parent.reshape(h, w), (gr, gc)), float(total)
 
 
-def distance_field(cell_cost: npt.ArrayLike, start_rc: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Dijkstra from one cell to all cells.
+def distance_field(
+    cell_cost: npt.ArrayLike, start_rc: tuple[int, int] | npt.ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """Dijkstra from one cell (or several, all at distance 0) to all cells.
 
     Args:
         cell_cost: ``(H, W)`` float cost of entering each cell; ``inf``/NaN = impassable.
-        start_rc: ``(row, col)`` source (may itself be impassable).
+        start_rc: ``(row, col)`` source, or a ``(K, 2)`` array of sources (K >= 1). Sources may
+            themselves be impassable.
 
     Returns:
         ``(dist, parent)``: ``(H, W)`` float64 least cost (``inf`` unreachable) and ``(H, W)``
-        int64 flat index of each cell's predecessor (-1 for the start and unreached cells).
+        int64 flat index of each cell's predecessor (-1 for sources and unreached cells).
     """
     cost = _cost_array(cell_cost)
     h, w = cost.shape
-    sr, sc = _rc(start_rc, cost.shape, "start_rc")
+    src = np.asarray(start_rc)
+    if src.ndim == 2:
+        if src.shape[0] < 1 or src.shape[1] != 2:
+            raise ValueError(f"start_rc must be (row, col) or a (K, 2) array, got shape {src.shape}")
+        rcs = [_rc(tuple(p), cost.shape, "start_rc") for p in src.tolist()]
+    else:
+        rcs = [_rc(start_rc, cost.shape, "start_rc")]  # type: ignore[arg-type]
+    starts = np.array([r * w + c for r, c in rcs], dtype=np.int64)
     dist = np.full(h * w, np.inf)
     parent = np.full(h * w, -1, dtype=np.int64)
-    _search(cost, sr * w + sc, -1, 0.0, dist, parent)
+    _search(cost, starts, -1, 0.0, dist, parent)
     return dist.reshape(h, w), parent.reshape(h, w)
 
 
@@ -322,7 +339,9 @@ def geodesic_distance_m(
     """
     m = np.asarray(traversable)
     if m.dtype != np.bool_ or m.shape != geometry.shape:
-        raise ValueError(f"traversable must be a bool array of shape {geometry.shape}, got {m.dtype} {m.shape}")
+        raise ValueError(
+            f"traversable must be a bool array of shape {geometry.shape}, got {m.dtype} {m.shape}"
+        )
     sx, sy = _xy(start_xy_m, "start_xy_m")
     sr, sc = (int(v) for v in geometry.world_to_grid(sx, sy))
     if not geometry.contains(sr, sc):
@@ -339,7 +358,9 @@ def extract_path(parent: np.ndarray, goal_rc: tuple[int, int]) -> np.ndarray:
     return np.column_stack([cells // w, cells % w])
 
 
-def _open_start(cost: np.ndarray, costmap: np.ndarray, sr: int, sc: int, params: NavfnParams, res: float) -> None:
+def _open_start(
+    cost: np.ndarray, costmap: np.ndarray, sr: int, sc: int, params: NavfnParams, res: float
+) -> None:
     # The robot's own cell is always passable (navfn's clearRobotCell).
     if not np.isfinite(cost[sr, sc]):
         cost[sr, sc] = float(INSCRIBED_COST)
@@ -355,7 +376,9 @@ def _open_start(cost: np.ndarray, costmap: np.ndarray, sr: int, sc: int, params:
     sub[near & (win == INSCRIBED_COST)] = float(INSCRIBED_COST)
 
 
-def _nearest_reached(dist: np.ndarray, gr: int, gc: int, tol_cells: float) -> tuple[int, int] | None:
+def _nearest_reached(
+    dist: np.ndarray, gr: int, gc: int, tol_cells: float
+) -> tuple[int, int] | None:
     if tol_cells <= 0:
         return (gr, gc) if np.isfinite(dist[gr, gc]) else None
     k = int(math.floor(tol_cells))
@@ -444,10 +467,11 @@ def _heap_pop(keys, vals, size):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def _search(cost, start, goal, h_weight, dist, parent):  # pragma: no cover - numba
+def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - numba
     """Dijkstra (h_weight = 0) or A* (octile heuristic * h_weight) with lazy deletion.
 
-    Fills dist/parent (flat) in place; stops when ``goal`` (flat index, -1 = none) is settled.
+    ``starts`` are flat source indices (all at distance 0). Fills dist/parent (flat) in place;
+    stops when ``goal`` (flat index, -1 = none) is settled.
     """
     h, w = cost.shape
     sqrt2 = math.sqrt(2.0)
@@ -460,8 +484,11 @@ def _search(cost, start, goal, h_weight, dist, parent):  # pragma: no cover - nu
     keys = np.empty(1024, dtype=np.float64)
     vals = np.empty(1024, dtype=np.int64)
     size = 0
-    dist[start] = 0.0
-    keys, vals, size = _heap_push(keys, vals, size, 0.0, start)
+    for i in range(starts.shape[0]):
+        st = starts[i]
+        if dist[st] > 0.0:
+            dist[st] = 0.0
+            keys, vals, size = _heap_push(keys, vals, size, 0.0, st)
     while size > 0:
         _, u, size = _heap_pop(keys, vals, size)
         if closed[u]:

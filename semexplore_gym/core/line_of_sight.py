@@ -84,7 +84,9 @@ def farthest_visible_index(
     pts = np.ascontiguousarray(points_m, dtype=np.float64)
     mask = np.ascontiguousarray(candidate_mask, dtype=np.bool_)
     if pts.ndim != 2 or pts.shape[1] != 2 or mask.shape != (pts.shape[0],):
-        raise ValueError(f"points_m must be (K, 2) with a (K,) mask, got {pts.shape} and {mask.shape}")
+        raise ValueError(
+            f"points_m must be (K, 2) with a (K,) mask, got {pts.shape} and {mask.shape}"
+        )
     return int(
         _farthest_visible(
             grid,
@@ -113,7 +115,9 @@ def _blocked_cell(grid, r, c, unknown_blocks):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def _segment_clear(grid, ox, oy, res, x0, y0, x1, y1, clearance_m, unknown_blocks):  # pragma: no cover - numba
+def _segment_clear(
+    grid, ox, oy, res, x0, y0, x1, y1, clearance_m, unknown_blocks
+):  # pragma: no cover - numba
     # Sample at a quarter cell so that no crossed cell is skipped; with a clearance, check
     # the disk of cells whose centres lie within it of every sample.
     length = math.hypot(x1 - x0, y1 - y0)
@@ -136,7 +140,9 @@ def _segment_clear(grid, ox, oy, res, x0, y0, x1, y1, clearance_m, unknown_block
             # A diagonal step may slip between two cells that share only a corner (a
             # rasterised diagonal wall); both of them must be free.
             if k > 0 and r != last_r and c != last_c:
-                if _blocked_cell(grid, last_r, c, unknown_blocks) or _blocked_cell(grid, r, last_c, unknown_blocks):
+                if _blocked_cell(grid, last_r, c, unknown_blocks) or _blocked_cell(
+                    grid, r, last_c, unknown_blocks
+                ):
                     return False
             last_r = r
             last_c = c
@@ -153,10 +159,14 @@ def _segment_clear(grid, ox, oy, res, x0, y0, x1, y1, clearance_m, unknown_block
 
 
 @njit(cache=True)
-def _farthest_visible(grid, ox, oy, res, x0, y0, pts, mask, clearance_m, unknown_blocks):  # pragma: no cover - numba
+def _farthest_visible(
+    grid, ox, oy, res, x0, y0, pts, mask, clearance_m, unknown_blocks
+):  # pragma: no cover - numba
     for i in range(pts.shape[0] - 1, -1, -1):
         if not mask[i]:
             continue
-        if _segment_clear(grid, ox, oy, res, x0, y0, pts[i, 0], pts[i, 1], clearance_m, unknown_blocks):
+        if _segment_clear(
+            grid, ox, oy, res, x0, y0, pts[i, 0], pts[i, 1], clearance_m, unknown_blocks
+        ):
             return i
     return -1

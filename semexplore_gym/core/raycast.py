@@ -36,7 +36,7 @@ _MAX_BUCKETS = 1 << 20
 # Angular bins per scan; about one per beam of a 360-beam LiDAR.
 _N_ANGLE_BINS = 360
 # Below this many candidate segments, binning costs more than it saves.
-_MIN_CANDIDATES_FOR_BINS = 24
+_MIN_CANDIDATES_FOR_BINS = 8
 
 
 class SegmentIndex:
@@ -88,7 +88,9 @@ class SegmentIndex:
         else:
             cell = float(cell_size_m)
             if not (math.isfinite(cell) and cell > 0):
-                raise ValueError(f"cell_size_m must be a positive finite number, got {cell_size_m!r}")
+                raise ValueError(
+                    f"cell_size_m must be a positive finite number, got {cell_size_m!r}"
+                )
         cell = max(cell, math.sqrt(span_x * span_y / _MAX_BUCKETS))
 
         n_cols = int(math.floor(span_x / cell)) + 1
@@ -248,7 +250,7 @@ def _check_out(out: np.ndarray | None, n: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _build_buckets(seg, x0, y0, cell, n_rows, n_cols):  # pragma: no cover - numba
     """CSR bucket lists: every bucket a segment passes through, padded by a small tolerance."""
     n = seg.shape[0]
@@ -296,9 +298,22 @@ def _build_buckets(seg, x0, y0, cell, n_rows, n_cols):  # pragma: no cover - num
     return start, items
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _cast_kernel(
-    seg, bucket_start, bucket_items, x0, y0, cell, n_rows, n_cols, ox, oy, yaw, angles, max_range, out
+    seg,
+    bucket_start,
+    bucket_items,
+    x0,
+    y0,
+    cell,
+    n_rows,
+    n_cols,
+    ox,
+    oy,
+    yaw,
+    angles,
+    max_range,
+    out,
 ):  # pragma: no cover - numba
     n_rays = angles.shape[0]
     n_seg = seg.shape[0]
@@ -375,9 +390,12 @@ def _cast_kernel(
         return
 
     if m < _MIN_CANDIDATES_FOR_BINS:
+        every = np.arange(m)
         for j in range(n_rays):
             th = angles[j] + yaw
-            out[j] = _first_hit(math.cos(th), math.sin(th), cax, cay, cbx, cby, ck, 0, m, None, max_range)
+            out[j] = _first_hit(
+                math.cos(th), math.sin(th), cax, cay, cbx, cby, ck, 0, m, every, max_range
+            )
         return
 
     # Angular bins: each candidate goes into every bin its angular extent touches, padded by
@@ -409,18 +427,24 @@ def _cast_kernel(
             b0 += nb
         first[q] = b0
         nspan[q] = cnt
-        for b in range(b0, b0 + cnt):
-            counts[(b % nb) + 1] += 1
+        # bins b0 .. b0 + cnt - 1, wrapping past nb (no modulo in the hot loop)
+        for b in range(b0, min(b0 + cnt, nb)):
+            counts[b + 1] += 1
+        for b in range(0, b0 + cnt - nb):
+            counts[b + 1] += 1
     for b in range(nb):
         counts[b + 1] += counts[b]
     cursor = counts[:nb].copy()
     items = np.empty(counts[nb], dtype=np.int64)
     for q in range(m):
         b0 = first[q]
-        for b in range(b0, b0 + nspan[q]):
-            bb = b % nb
-            items[cursor[bb]] = q
-            cursor[bb] += 1
+        cnt = nspan[q]
+        for b in range(b0, min(b0 + cnt, nb)):
+            items[cursor[b]] = q
+            cursor[b] += 1
+        for b in range(0, b0 + cnt - nb):
+            items[cursor[b]] = q
+            cursor[b] += 1
     for j in range(n_rays):
         th = angles[j] + yaw
         dx = math.cos(th)
@@ -428,10 +452,12 @@ def _cast_kernel(
         b = int(_pseudo_angle(dx, dy) / w)
         if b >= nb:
             b = nb - 1
-        out[j] = _first_hit(dx, dy, cax, cay, cbx, cby, ck, counts[b], counts[b + 1], items, max_range)
+        out[j] = _first_hit(
+            dx, dy, cax, cay, cbx, cby, ck, counts[b], counts[b + 1], items, max_range
+        )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _pseudo_angle(x, y):  # pragma: no cover - numba
     """A value in [0, 4) that grows monotonically with atan2(y, x) taken in [0, 2 pi)."""
     p = y / (abs(x) + abs(y))
@@ -442,19 +468,15 @@ def _pseudo_angle(x, y):  # pragma: no cover - numba
     return p
 
 
-@njit(cache=True, inline="always")
-def _first_hit(dx, dy, cax, cay, cbx, cby, ck, lo, hi, items, max_range):  # pragma: no cover - numba
-    """Nearest crossing ``0 < t < max_range`` of ray ``t * (dx, dy)`` with candidates ``lo:hi``.
-
-    ``items`` maps positions to candidate ids (``None``: positions are the ids).
-    """
+@njit(cache=True, inline="always", error_model="numpy")
+def _first_hit(
+    dx, dy, cax, cay, cbx, cby, ck, lo, hi, items, max_range
+):  # pragma: no cover - numba
+    """Nearest crossing ``0 < t < max_range`` of ray ``t * (dx, dy)`` with candidates ``items[lo:hi]``."""
     best = max_range
     hit = False
     for p in range(lo, hi):
-        if items is None:
-            q = p
-        else:
-            q = items[p]
+        q = items[p]
         # Signed sides of the two end points w.r.t. the ray line; the ray line crosses the
         # segment when they differ in sign (an end point on the line counts).
         ca = dx * cay[q] - dy * cax[q]

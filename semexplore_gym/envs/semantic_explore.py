@@ -169,6 +169,8 @@ class SemanticExploreEnv(gym.Env):
         self.lidar = Lidar(cfg.lidar, SegmentIndex(self.world.segments_m))
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping)
         self.odometry = OdometryDrift(cfg.odometry)
+        o = cfg.odometry
+        self._odometry_noisy = any(v != 0 for v in (o.rot_from_rot, o.rot_from_trans, o.trans_from_trans, o.trans_from_rot))
 
     def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         cfg = self.config
@@ -228,7 +230,7 @@ class SemanticExploreEnv(gym.Env):
         self.sim_time_s += cfg.episode.dt_s
         self.path_length_m += math.hypot(after[0] - before[0], after[1] - before[1])
         self._trajectory.append((after[0], after[1]))
-        self._est_pose = self.odometry.update(before, after, self.np_random)
+        self._est_pose = self.odometry.update(before, after, self.np_random) if self._odometry_noisy else after
         n_free_before = self.grid.n_free_cells
         self._scan = self._sense_and_map()
         new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
@@ -247,20 +249,23 @@ class SemanticExploreEnv(gym.Env):
         return self._obs(), reward, terminated, truncated, info
 
     def _scale_action(self, action: Any) -> tuple[float, float]:
-        try:
-            a = np.asarray(action, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError) as e:
-            raise ValueError(f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}") from e
-        if a.shape != (2,):
-            raise ValueError(f"action must have shape (2,), got shape {np.shape(action)}: {action!r}")
-        if not np.isfinite(a).all():
+        if isinstance(action, np.ndarray) and action.shape == (2,):
+            a0, a1 = float(action[0]), float(action[1])
+        else:
+            try:
+                a = np.asarray(action, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError) as e:
+                raise ValueError(f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}") from e
+            if a.shape != (2,):
+                raise ValueError(f"action must have shape (2,), got shape {np.shape(action)}: {action!r}")
+            a0, a1 = float(a[0]), float(a[1])
+        if not (math.isfinite(a0) and math.isfinite(a1)):
             raise ValueError(f"action contains NaN or inf: {action!r}")
-        a = np.clip(a, -1.0, 1.0)
         rp = self.config.robot
-        v = float(a[0]) * rp.max_linear_speed_mps
+        v = min(1.0, max(-1.0, a0)) * rp.max_linear_speed_mps
         if not rp.allow_reverse:
             v = max(v, 0.0)
-        return v, float(a[1]) * rp.max_angular_speed_radps
+        return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
     def _sense_and_map(self) -> np.ndarray:
         x, y, yaw = self.sim.pose
@@ -279,7 +284,8 @@ class SemanticExploreEnv(gym.Env):
         }
 
     def _info(self, terms: dict[str, float]) -> dict[str, Any]:
-        info = dict(self._static_info)
+        # Fresh nested dicts each call: callers may keep and mutate what they are given.
+        info = {k: dict(v) if isinstance(v, dict) else v for k, v in self._static_info.items()}
         info.update(
             coverage=self.grid.n_free_in_mask / self._n_reachable,
             explored_area_m2=self.grid.n_free_cells * self.config.mapping.resolution_m**2,

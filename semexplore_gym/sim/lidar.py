@@ -78,10 +78,11 @@ class Lidar:
         p = self.params
         sx, sy, syaw = self.sensor_pose(x_m, y_m, yaw_rad)
         ranges = cast_scan(self.index, sx, sy, syaw, self.beam_angles_rad, p.max_range_m)
-        no_return = ~np.isfinite(ranges)
         if p.range_noise_std_m > 0:
+            no_return = ~np.isfinite(ranges)
             ranges = ranges + rng.normal(0.0, p.range_noise_std_m, size=ranges.shape)
-        ranges = np.where(no_return, p.max_range_m, np.minimum(ranges, p.max_range_m))
+            ranges[no_return] = np.inf
+        np.minimum(ranges, p.max_range_m, out=ranges)  # no return (inf) -> max_range_m
         invalid = ranges < p.min_range_m
         if p.dropout_prob > 0:
             invalid |= rng.random(ranges.shape) < p.dropout_prob

@@ -139,16 +139,21 @@ class RobotSim:
         gear.max_force = r.max_turn_torque_nm
         space.add(body, shape, control, pivot, gear)
 
-        self._contact_this_step = False
-        self._contact_was = False
+        self._touching = 0
+        self._began = False
+        self._suppress_begin = False
 
+        # begin/separate fire only when a contact starts or ends, so they cost nothing while the
+        # robot drives in free space; a pre-solve callback would run every substep.
         def _begin(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
-            self._contact_this_step = True
+            if self._touching == 0 and not self._suppress_begin:
+                self._began = True
+            self._touching += 1
 
-        def _pre(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
-            self._contact_this_step = True
+        def _separate(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
+            self._touching = max(0, self._touching - 1)
 
-        space.on_collision(ROBOT_COLLISION_TYPE, WALL_COLLISION_TYPE, begin=_begin, pre_solve=_pre)
+        space.on_collision(ROBOT_COLLISION_TYPE, WALL_COLLISION_TYPE, begin=_begin, separate=_separate)
         self.space = space
         self.body = body
         self.control = control
@@ -168,7 +173,8 @@ class RobotSim:
         self.space.reindex_shapes_for_body(self.body)
         self.collisions = 0
         self.in_contact = False
-        self._contact_was = False
+        self._began = False
+        self._touching = 0
 
     @property
     def pose(self) -> tuple[float, float, float]:
@@ -188,27 +194,26 @@ class RobotSim:
         n = self._substeps_for(dt_s)
         reach = rp.radius_m + rp.max_linear_speed_mps * dt_s + 0.01
         near = self.space.point_query_nearest(self.body.position, reach, self._wall_filter)
-        if near is None and not self._contact_was:
+        if near is None and self._touching == 0:
             self._drive_free(linear_mps, angular_radps, dt_s)
             self.in_contact = False
             return False
         h = dt_s / n
-        touching = False
+        self._began = False
+        body, control = self.body, self.control
+        # The pivot and gear joints have no positional bias: only the control body's velocities
+        # matter; keeping it on the robot avoids a large lever arm in the pivot constraint.
+        control.position = body.position
         for _ in range(n):
-            yaw = self.body.angle
-            # Keep the control body on the robot; the pivot joint only matches velocities.
-            self.control.position = self.body.position
-            self.control.angle = yaw
-            self.control.velocity = (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw))
-            self.control.angular_velocity = angular_radps
-            self._contact_this_step = False
+            yaw = body.angle
+            control.velocity = (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw))
+            control.angular_velocity = angular_radps
             self.space.step(h)
-            touching = touching or self._contact_this_step
-        new_collision = touching and not self._contact_was
+        self._suppress_begin = False
+        new_collision = self._began
         if new_collision:
             self.collisions += 1
-        self._contact_was = touching
-        self.in_contact = touching
+        self.in_contact = self._touching > 0
         return new_collision
 
     def _substeps_for(self, dt_s: float) -> int:
@@ -230,14 +235,12 @@ class RobotSim:
             yaw2 = yaw
             x += v * dt_s * math.cos(yaw)
             y += v * dt_s * math.sin(yaw)
-        vel = (v * math.cos(yaw2), v * math.sin(yaw2))
-        for b in (self.body, self.control):
-            b.position = (x, y)
-            b.angle = yaw2
-            b.velocity = vel
-            b.angular_velocity = w
-        self.space.reindex_shapes_for_body(self.body)
-        self._contact_was = False
+        body = self.body
+        body.position = (x, y)
+        body.angle = yaw2
+        body.velocity = (v * math.cos(yaw2), v * math.sin(yaw2))
+        body.angular_velocity = w
+        self.space.reindex_shapes_for_body(body)
 
     # Pymunk objects hold C pointers: pickle the inputs and rebuild.
     def __getstate__(self) -> dict:
@@ -249,7 +252,7 @@ class RobotSim:
             "velocity": tuple(self.body.velocity),
             "angular_velocity": float(self.body.angular_velocity),
             "collisions": self.collisions,
-            "contact_was": self._contact_was,
+            "touching": self._touching > 0,
         }
 
     def __setstate__(self, state: dict) -> None:
@@ -261,7 +264,8 @@ class RobotSim:
         self.body.velocity = state["velocity"]
         self.body.angular_velocity = state["angular_velocity"]
         self.collisions = state["collisions"]
-        self._contact_was = state["contact_was"]
+        # The rebuilt space re-detects a contact that was already counted: do not count it again.
+        self._suppress_begin = bool(state["touching"])
 
 
 def nearest_wall_distance_m(segments_m: np.ndarray, x_m: float, y_m: float) -> float:

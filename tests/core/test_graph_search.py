@@ -15,9 +15,16 @@ from semexplore_gym.core.graph_search import (
     search_frontier_paths,
 )
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.topometric.types import Area, AreaType, Frontier, GraphEdge, Opening, TopometricMap
+from semexplore_gym.core.topometric.types import (
+    Area,
+    AreaType,
+    Frontier,
+    GraphEdge,
+    Opening,
+    TopometricMap,
+)
 
-I, P, D, F = AreaType.INTERSECTION, AreaType.PATHWAY, AreaType.DEAD_END, AreaType.FRONTIER_PATHWAY
+INT, P, D, F = AreaType.INTERSECTION, AreaType.PATHWAY, AreaType.DEAD_END, AreaType.FRONTIER_PATHWAY
 
 
 def build_map(
@@ -41,7 +48,9 @@ def build_map(
     for o, xy in enumerate(openings_xy):
         sides = owners[o] + [-1] * (2 - len(owners[o]))
         frontier = len(owners[o]) == 1 and types[owners[o][0]] == F
-        openings.append(Opening(o, np.array([xy, xy], float), xy, 0.8, (sides[0], sides[1]), frontier))
+        openings.append(
+            Opening(o, np.array([xy, xy], float), xy, 0.8, (sides[0], sides[1]), frontier)
+        )
 
     edges: list[GraphEdge] = []
     area_objs: dict[int, Area] = {}
@@ -50,7 +59,7 @@ def build_map(
         c = np.asarray(centre, float)
         paths = {}
         segs = []
-        if t == I:
+        if t == INT:
             for o in oids:
                 paths[o] = np.array([openings_xy[o], centre], float)
                 segs.append(paths[o])
@@ -64,7 +73,9 @@ def build_map(
             paths[oids[0]] = poly
             paths[oids[1]] = poly[::-1].copy()
             segs.append(poly)
-            edges.append(GraphEdge(oids[0], oids[1], aid, float(np.hypot(*(poly[1] - poly[0]))), poly))
+            edges.append(
+                GraphEdge(oids[0], oids[1], aid, float(np.hypot(*(poly[1] - poly[0]))), poly)
+            )
         else:
             poly = np.array([openings_xy[oids[0]], centre], float)
             paths[oids[0]] = poly
@@ -79,7 +90,7 @@ def build_map(
     ids = np.full((160, 160), -1, np.int32)
     for aid, segs in segments.items():
         for poly in segs:
-            for a, b in zip(poly[:-1], poly[1:]):
+            for a, b in zip(poly[:-1], poly[1:], strict=True):
                 ab = b - a
                 den = max(float(ab @ ab), 1e-12)
                 t = np.clip(((xs - a[0]) * ab[0] + (ys - a[1]) * ab[1]) / den, 0, 1)
@@ -97,19 +108,30 @@ def build_map(
         inner = [o for o in oids if o != fo]
         iid = None
         if inner:
-            iid = next((a for a in owners[inner[0]] if types[a] == I), None)
-        length = float(np.hypot(*(np.subtract(openings_xy[fo], openings_xy[inner[0]])))) if inner else 0.0
+            iid = next((a for a in owners[inner[0]] if types[a] == INT), None)
+        length = (
+            float(np.hypot(*(np.subtract(openings_xy[fo], openings_xy[inner[0]]))))
+            if inner
+            else 0.0
+        )
         frontiers.append(Frontier(aid, fo, openings_xy[fo], widths.get(fo, 0.8), iid, length))
     return TopometricMap(geom, ids, area_objs, openings, frontiers, edges, l_path_m, 0.15)
 
 
-def brute_force_costs(tmap: TopometricMap, robot_xy, yaw: float, w: FrontierCostWeights) -> dict[int, float]:
+def brute_force_costs(
+    tmap: TopometricMap, robot_xy, yaw: float, w: FrontierCostWeights
+) -> dict[int, float]:
     """C of every frontier by enumerating every simple path (independent of Algorithm 1).
 
     Uses the same first legs (robot to each opening of its area), so only the graph part is
     recomputed here.
     """
-    from semexplore_gym.core.graph_search import _first_legs, _heading_angle, _polyline_length, resolve_path_length_m
+    from semexplore_gym.core.graph_search import (
+        _first_legs,
+        _heading_angle,
+        _polyline_length,
+        resolve_path_length_m,
+    )
 
     l_path = resolve_path_length_m(tmap, w)
     start_area = tmap.area_at(*robot_xy)
@@ -123,7 +145,10 @@ def brute_force_costs(tmap: TopometricMap, robot_xy, yaw: float, w: FrontierCost
     for f in tmap.frontiers:
         best = math.inf
         for start, leg in legs.items():
-            seed = w.w_v * _heading_angle(leg, robot_xy, yaw, w.heading_lookahead_m) + _polyline_length(leg) / l_path
+            seed = (
+                w.w_v * _heading_angle(leg, robot_xy, yaw, w.heading_lookahead_m)
+                + _polyline_length(leg) / l_path
+            )
             if start == f.opening_id:
                 best = min(best, seed)
                 continue
@@ -133,7 +158,11 @@ def brute_force_costs(tmap: TopometricMap, robot_xy, yaw: float, w: FrontierCost
                 best = min(best, seed + sum(g.edges[u, v, k]["weight"] for u, v, k in p) / l_path)
         if math.isfinite(best):
             iid = f.intersection_id
-            gain = w.w_p * f.path_length_m + (w.w_i * (tmap.n_openings(iid) + tmap.n_frontier_pathways(iid)) if iid is not None else 0.0)
+            gain = w.w_p * f.path_length_m + (
+                w.w_i * (tmap.n_openings(iid) + tmap.n_frontier_pathways(iid))
+                if iid is not None
+                else 0.0
+            )
             out[f.opening_id] = best - gain
     return out
 
@@ -151,11 +180,11 @@ OPENINGS = [
     (-4.0, 5.0),  # 7: north frontier of I1
 ]
 AREAS = [
-    (0, I, (0.0, 0.0), (0, 1, 2)),
+    (0, INT, (0.0, 0.0), (0, 1, 2)),
     (1, F, (1.5, 0.0), (0, 3)),
     (2, P, (-2.0, 0.0), (1, 4)),
     (3, D, (0.0, 2.0), (2,)),
-    (4, I, (-4.0, 0.0), (4, 5, 6)),
+    (4, INT, (-4.0, 0.0), (4, 5, 6)),
     (5, F, (-4.0, 3.0), (5, 7)),
     (6, D, (-4.0, -2.0), (6,)),
 ]
@@ -187,7 +216,9 @@ def test_candidate_terms_and_polyline():
     assert west.metric_cost == pytest.approx(9.0 / 4.0)
     assert west.semantic_gain == pytest.approx(0.2 * 4.0 + 0.1 * 4)
     assert west.cost == pytest.approx(west.metric_cost - west.semantic_gain)
-    np.testing.assert_allclose(west.path_m, [[0, 0], [-1, 0], [-3, 0], [-4, 0], [-4, 1], [-4, 5]], atol=1e-9)
+    np.testing.assert_allclose(
+        west.path_m, [[0, 0], [-1, 0], [-3, 0], [-4, 0], [-4, 1], [-4, 5]], atol=1e-9
+    )
     assert west.goal_xy_m == (-4.0, 5.0)
     east = cands[3]
     assert east.v_rad == pytest.approx(math.pi)
@@ -209,8 +240,18 @@ def test_semantic_gain_can_outweigh_distance():
     # Facing north (both frontiers need a turn of pi/2): with a large w_p the long western
     # frontier pathway (p_l = 4 m vs 1 m) is preferred despite being farther away.
     tmap = build_map(OPENINGS, AREAS, l_path_m=4.0)
-    assert find_frontier_paths(tmap, (0.0, 0.0), math.pi / 2, FrontierCostWeights(w_p=0.0, w_i=0.0))[0].frontier.opening_id == 3
-    assert find_frontier_paths(tmap, (0.0, 0.0), math.pi / 2, FrontierCostWeights(w_p=1.0, w_i=0.0))[0].frontier.opening_id == 7
+    assert (
+        find_frontier_paths(tmap, (0.0, 0.0), math.pi / 2, FrontierCostWeights(w_p=0.0, w_i=0.0))[
+            0
+        ].frontier.opening_id
+        == 3
+    )
+    assert (
+        find_frontier_paths(tmap, (0.0, 0.0), math.pi / 2, FrontierCostWeights(w_p=1.0, w_i=0.0))[
+            0
+        ].frontier.opening_id
+        == 7
+    )
 
 
 def test_zero_weights_pick_the_nearest_frontier_by_path_length():
@@ -218,7 +259,7 @@ def test_zero_weights_pick_the_nearest_frontier_by_path_length():
     # 3.2 m away in a straight line and 4 m along the paths.
     openings = [(1.0, 0.0), (-1.0, 0.0), (1.0, 3.0), (-1.0, 3.0), (0.0, 1.5)]
     areas = [
-        (0, I, (0.0, 0.0), (0, 1)),  # two-opening "intersection" keeps the example small
+        (0, INT, (0.0, 0.0), (0, 1)),  # two-opening "intersection" keeps the example small
         (1, P, (1.0, 1.5), (0, 2)),
         (2, F, (-1.0, 1.5), (1, 3)),
         (3, F, (0.5, 2.0), (2, 4)),
@@ -243,11 +284,11 @@ def loop_map() -> TopometricMap:
         (7.0, 0.0),  # 6 frontier
     ]
     areas = [
-        (0, I, (0.0, 0.0), (0, 1, 2)),
+        (0, INT, (0.0, 0.0), (0, 1, 2)),
         (1, P, (2.0, 0.0), (0, 3)),
         (2, P, (2.0, 4.0), (1, 4)),
         (3, D, (-2.0, 0.0), (2,)),
-        (4, I, (4.0, 0.0), (3, 4, 5)),
+        (4, INT, (4.0, 0.0), (3, 4, 5)),
         (5, F, (6.0, 0.0), (5, 6)),
     ]
     return build_map(openings, areas, l_path_m=3.0)
@@ -296,8 +337,13 @@ def test_area_pruning_is_available_and_agrees_on_simple_maps():
 def test_robot_inside_a_pathway_joins_its_path():
     tmap = build_map(OPENINGS, AREAS, l_path_m=4.0)
     # In the west pathway (area 2), 0.2 m off its centre line.
-    cands = {c.frontier.opening_id: c for c in find_frontier_paths(tmap, (-2.0, 0.2), math.pi, FrontierCostWeights())}
-    np.testing.assert_allclose(cands[7].path_m[:3], [[-2.0, 0.2], [-2.0, 0.0], [-3.0, 0.0]], atol=1e-9)
+    cands = {
+        c.frontier.opening_id: c
+        for c in find_frontier_paths(tmap, (-2.0, 0.2), math.pi, FrontierCostWeights())
+    }
+    np.testing.assert_allclose(
+        cands[7].path_m[:3], [[-2.0, 0.2], [-2.0, 0.0], [-3.0, 0.0]], atol=1e-9
+    )
     assert cands[7].d_m == pytest.approx(0.2 + 1.0 + 1.0 + 1.0 + 4.0)
     assert cands[3].opening_ids[:2] == (1, 0)
 
@@ -306,8 +352,13 @@ def test_narrow_frontiers_are_skipped_and_no_area_gives_nothing():
     tmap = build_map(OPENINGS, AREAS, l_path_m=4.0, frontier_widths_m={3: 0.15})
     cands = find_frontier_paths(tmap, (0.0, 0.0), 0.0, min_frontier_width_m=0.3)
     assert [c.frontier.opening_id for c in cands] == [7]
-    assert find_frontier_paths(tmap, (7.5, 7.5), 0.0)[0].frontier.opening_id in (3, 7)  # nearest area
-    empty = TopometricMap(tmap.geometry, np.full((160, 160), -1, np.int32), {}, [], [], [], float("nan"), 0.15)
+    assert find_frontier_paths(tmap, (7.5, 7.5), 0.0)[0].frontier.opening_id in (
+        3,
+        7,
+    )  # nearest area
+    empty = TopometricMap(
+        tmap.geometry, np.full((160, 160), -1, np.int32), {}, [], [], [], float("nan"), 0.15
+    )
     cands, stats = search_frontier_paths(empty, (0.0, 0.0), 0.0)
     assert cands == [] and stats.robot_area_id == -1
     with pytest.raises(ValueError, match="finite"):

@@ -1,1 +1,7 @@
-"""Semantic topometric segmentation of occupancy grids (see segment_map)."""
+"""Semantic topometric segmentation of occupancy grids (see :func:`segment_map`)."""
+
+from semexplore_gym.core.topometric.params import SegmentationParams
+from semexplore_gym.core.topometric.segmentation import segment_map
+from semexplore_gym.core.topometric.types import Area, AreaType, Frontier, GraphEdge, Opening, TopometricMap
+
+__all__ = ["Area", "AreaType", "Frontier", "GraphEdge", "Opening", "SegmentationParams", "TopometricMap", "segment_map"]

@@ -35,6 +35,10 @@ class Opening:
         width_m: Free width of the opening.
         area_ids: The ids of the areas on its two sides; ``-1`` stands for unknown space.
         is_frontier: True when one side is unknown space (the opening *is* a frontier).
+        anchor_m: ``(x, y)`` where the robot crosses the opening: a point at least the
+            clearance away from walls and unknown space, where the areas' paths start and end
+            (the skeleton point of a doorway; for a frontier, the frontier's target). ``None``
+            when not computed.
     """
 
     id: int
@@ -43,6 +47,7 @@ class Opening:
     width_m: float
     area_ids: tuple[int, int]
     is_frontier: bool
+    anchor_m: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -74,10 +79,16 @@ class Area:
 class Frontier:
     """The frontier at the far end of a frontier pathway.
 
+    A frontier pathway usually has one frontier; a lone corridor open at both ends (no
+    intersection yet) is one frontier pathway with two.
+
     Attributes:
         area_id: The frontier pathway it belongs to.
-        opening_id: The opening to unknown space.
-        midpoint_m: ``(x, y)`` of that opening, the exploration target.
+        opening_id: The opening to unknown space (its geometric middle is
+            ``openings[opening_id].midpoint_m``).
+        midpoint_m: ``(x, y)`` the exploration target: where the robot can stand next to the
+            opening (free, at least the clearance from walls and unknown space); the frontier
+            pathway's path ends there.
         width_m: Width of the opening.
         intersection_id: The nearest intersection leading to it (``I`` in the paper), or
             ``None`` when the map has no intersection connected to it yet.
@@ -113,7 +124,8 @@ class TopometricMap:
         area_ids: ``(H, W)`` int32 raster, the area id of every reachable free cell, -1 elsewhere.
         areas: Areas by id.
         openings: Openings, ``openings[i].id == i``.
-        frontiers: One per frontier pathway.
+        frontiers: One per frontier opening (one per frontier pathway, two for a lone corridor
+            open at both ends).
         edges: Graph edges. Nodes are openings; inside each area every pair of its openings is
             joined (through the centre for intersections) with the metric length of the path.
         mean_intersection_path_m: ``L_path``: mean length of the paths between adjacent

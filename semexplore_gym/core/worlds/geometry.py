@@ -331,3 +331,52 @@ def merge_polyline_edges(vertices_xy_m: npt.ArrayLike, closed: bool = True, tol_
         a = v[:-1]
         b = v[1:]
     return np.ascontiguousarray(np.hstack([a, b]))
+
+
+def polygon_inside_mask(vertices_xy_m: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:
+    """Cells whose centre lies inside a polygon (even-odd rule, scanline crossings).
+
+    Args:
+        vertices_xy_m: ``(K, 2)`` polygon vertices; the polygon is closed implicitly.
+        geometry: The grid.
+
+    Returns:
+        ``geometry.shape`` bool mask.
+    """
+    v = np.asarray(vertices_xy_m, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3:
+        raise ValueError(f"a polygon needs (K >= 3, 2) vertices, got shape {v.shape}")
+    if not np.isfinite(v).all():
+        raise ValueError("polygon vertices contain NaN or inf")
+    h, w = geometry.shape
+    toggles = np.zeros((h, w + 1), dtype=np.int32)
+    _polygon_crossings_kernel(
+        np.ascontiguousarray(v), float(geometry.origin_x_m), float(geometry.origin_y_m), float(geometry.resolution_m), toggles
+    )
+    return (np.cumsum(toggles, axis=1)[:, :w] & 1).astype(bool)
+
+
+@njit(cache=True)
+def _polygon_crossings_kernel(v: np.ndarray, ox: float, oy: float, res: float, toggles: np.ndarray) -> None:
+    h = toggles.shape[0]
+    w = toggles.shape[1] - 1
+    n = v.shape[0]
+    for i in range(n):
+        x0 = v[i, 0]
+        y0 = v[i, 1]
+        x1 = v[(i + 1) % n, 0]
+        y1 = v[(i + 1) % n, 1]
+        if y0 == y1:
+            continue
+        # Half-open in y so a scanline through a vertex counts each crossing once.
+        ylo = min(y0, y1)
+        yhi = max(y0, y1)
+        r_lo = max(0, int(np.ceil((ylo - oy) / res - 0.5)))
+        r_hi = min(h - 1, int(np.ceil((yhi - oy) / res - 0.5)) - 1)
+        for r in range(r_lo, r_hi + 1):
+            yc = oy + (r + 0.5) * res
+            x = x0 + (yc - y0) * (x1 - x0) / (y1 - y0)
+            # Cells with centre x > crossing are on the far side of it.
+            c = int(np.floor((x - ox) / res - 0.5)) + 1
+            c = min(max(c, 0), w)
+            toggles[r, c] += 1

@@ -97,8 +97,9 @@ def raster_to_segments(free_mask: npt.ArrayLike, geometry: GridGeometry) -> np.n
     return np.ascontiguousarray(np.vstack([seg_h, seg_v]).astype(np.float64))
 
 
-def _blocked_by_walls(segments_m: np.ndarray, geometry: GridGeometry) -> np.ndarray:
-    """Cells whose centre lies strictly within half a cell of some wall."""
+def cells_near_walls(segments_m: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:
+    """Cells whose centre lies strictly within half a cell of some wall (a wall on the cell's
+    edge does not count)."""
     half = 0.5 * geometry.resolution_m
     dist = segment_distance_field(segments_m, geometry, max_distance_m=2.0 * half)
     return dist < half * (1.0 - _HALF_CELL_TOLERANCE)
@@ -132,16 +133,19 @@ def rasterize_free(
     """Ground-truth free mask of a world on any grid.
 
     A cell is free when its centre lies inside the world's free space and no wall passes
-    within half a cell of it (strictly: a wall on the cell's edge leaves it free, so a raster
-    world resampled on its own grid gives back exactly its mask).
+    within half a cell of that centre. A wall lying exactly on the edge between two cells
+    (half a cell from both centres) marks just one of them, the one on the +x / +y side as
+    :meth:`GridGeometry.world_to_grid` would, so a thin wall always shows as a line one cell
+    thick and never disappears, while a raster world resampled on its own grid gives back
+    exactly its mask (there every wall already has a non-free cell on one side).
 
     "Inside" is decided by the world's ``free_space_source``:
 
     - ``"raster"``: the world's exact ``free_mask`` is read at the cell centre.
-    - ``"vector"``: a 4-connected flood fill over cells not blocked by a wall, never crossing a
-      wall between two cell centres, seeded from cells whose centre lies inside the world's
-      ``free_mask`` and farther than one native cell from any wall (so a seed cannot sit on the
-      wrong side of a wall).
+    - ``"vector"``: a 4-connected flood fill over cells no wall passes within half a cell of,
+      never crossing a wall between two cell centres, seeded from cells whose centre lies
+      inside the world's ``free_mask`` and more than a native cell from any wall (so a seed
+      cannot sit on the wrong side of a wall).
 
     Args:
         world_or_segments: A :class:`World`, or bare ``(N, 4)`` wall segments; then
@@ -156,19 +160,18 @@ def rasterize_free(
     if isinstance(world_or_segments, World):
         world = world_or_segments
         segments = world.segments_m
-        blocked = _blocked_by_walls(segments, geometry)
+        blocked = cells_near_walls(segments, geometry)
+        cut_x, cut_y = crossed_links(segments, geometry)
         inside = sample_mask(world.free_mask, world.free_geometry, geometry)
-        if world.free_space_source == "raster":
-            return inside & ~blocked
-        # One native cell of margin: a native cell that straddles a wall can only be sampled
-        # from within one native diagonal of that wall.
-        seed_margin_m = max(world.free_geometry.resolution_m, geometry.resolution_m)
-        dist = segment_distance_field(segments, geometry, max_distance_m=2.0 * seed_margin_m)
-        seeds = inside & (dist > seed_margin_m)
-        if not seeds.any():
-            # The grid is too coarse for deep seeds: accept any unblocked inside cell.
-            seeds = inside & ~blocked
-        return _flood_fill_inside(segments, geometry, ~blocked, seeds)
+        if world.free_space_source == "vector":
+            seed_margin_m = max(world.free_geometry.resolution_m, geometry.resolution_m)
+            dist = segment_distance_field(segments, geometry, max_distance_m=2.0 * seed_margin_m)
+            seeds = inside & (dist > seed_margin_m)
+            if not seeds.any():
+                # The grid is too coarse for deep seeds: accept any unblocked inside cell.
+                seeds = inside & ~blocked
+            inside = flood_fill_links(~blocked, cut_x, cut_y, seeds)
+        return mark_walls(inside & ~blocked, cut_x, cut_y)
 
     segments = as_segments(world_or_segments)
     if interior_points_m is None:
@@ -176,16 +179,27 @@ def rasterize_free(
     pts = np.atleast_2d(np.asarray(interior_points_m, dtype=np.float64))
     if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
         raise ValueError(f"interior_points_m must be finite (K, 2) points, got shape {pts.shape}")
-    blocked = _blocked_by_walls(segments, geometry)
+    blocked = cells_near_walls(segments, geometry)
+    cut_x, cut_y = crossed_links(segments, geometry)
     seeds = np.zeros(geometry.shape, dtype=bool)
     rows, cols = geometry.world_to_grid(pts[:, 0], pts[:, 1])
     ok = geometry.contains(rows, cols)
     seeds[rows[ok], cols[ok]] = True
-    return _flood_fill_inside(segments, geometry, ~blocked, seeds)
+    inside = flood_fill_links(~blocked, cut_x, cut_y, seeds)
+    return mark_walls(inside, cut_x, cut_y)
 
 
-def _flood_fill_inside(
-    segments_m: np.ndarray, geometry: GridGeometry, passable: np.ndarray, seeds: np.ndarray
-) -> np.ndarray:
-    cut_x, cut_y = crossed_links(segments_m, geometry)
-    return flood_fill_links(passable, cut_x, cut_y, seeds)
+def mark_walls(free: np.ndarray, cut_x: np.ndarray, cut_y: np.ndarray) -> np.ndarray:
+    """Make every wall visible: where a wall crosses the link between two free cells, the cell
+    on the +x (or +y) side becomes non-free.
+
+    Args:
+        free: ``(H, W)`` bool free cells (already without cells within half a cell of a wall).
+        cut_x: ``(H, W-1)`` crossed links along x from
+            :func:`~semexplore_gym.core.worlds.geometry.crossed_links`.
+        cut_y: ``(H-1, W)`` crossed links along y.
+    """
+    out = free.copy()
+    out[:, 1:] &= ~(cut_x & free[:, :-1] & free[:, 1:])
+    out[1:, :] &= ~(cut_y & free[:-1, :] & free[1:, :])
+    return out

@@ -1,0 +1,830 @@
+"""Frontier-exploration baselines: ROS ``frontier_exploration`` (FE) and Yamauchi's nearest frontier.
+
+Both drive with the same move_base-like navigator (:class:`MoveBaseParams`): a Navfn-like
+global planner on an inflated costmap (:mod:`semexplore_gym.core.grid_search`) and a DWA local
+planner (:mod:`semexplore_gym.core.dwa`), with move_base's failure handling:
+
+* a new goal is planned once (``planner_frequency_hz = 0``, the TurtleBot3 setting); the path is
+  replanned when the local planner fails (no admissible trajectory, or it can only stand still);
+* while planning fails the robot stands still; after ``planner_patience_s`` (5 s), or when
+  the local planner has failed for ``controller_patience_s`` (15 s), or the robot has not
+  moved ``oscillation_distance_m`` (0.2 m) for ``oscillation_timeout_s`` (10 s), a recovery
+  runs: rotate in place once round (``recovery_rotation_rad`` at
+  ``recovery_angular_speed_radps``; move_base's ``rotate_recovery``), then plan again;
+* after ``max_recoveries`` (2, the two rotations of move_base's default recovery list) the
+  goal is **aborted**.
+
+:class:`FrontierExplorationPolicy` (``"frontier"``) follows ``frontier_exploration``
+(``explore_server`` + ``BoundedExploreLayer``, indigo; blacklist of the melodic plugin):
+
+* every ``1 / frequency_hz`` (2 Hz in its ``global_map.launch``) it runs the wavefront
+  frontier search (:func:`~semexplore_gym.core.frontiers.detect_frontiers`) **on its explore
+  costmap** (``search_on_costmap``): only cells of cost 0 are free, so frontiers hide within
+  ``explore_costmap.inflation_radius_m`` (0.15 m) of walls, exactly as FE's search on its
+  layered costmap;
+* it picks the frontier with the smallest Euclidean ``min_distance`` (``selection="euclidean"``,
+  indigo) or the first in BFS discovery order (``"bfs_order"``, the melodic plugin), and sends
+  its travel point (``"closest"`` = first-contact cell, FE's default; ``"middle"``, which in
+  FE's code is the Euclidean-nearest cell; or ``"centroid"``);
+* the goal is re-sent only when it moved farther than ``0.9 * goal_aliasing_m`` (1 m) from the
+  current one, or when the robot is not moving;
+* **it does not check reachability before committing** (the paper names this as one reason FE
+  is slow): an unreachable travel point costs planner patience plus recoveries before it is
+  aborted. ``check_reachability=True`` skips frontiers whose travel point the planner cannot
+  reach (one Dijkstra from the robot per selection);
+* aborted goals are blacklisted (travel points within ``blacklist_box_m`` are skipped); the
+  blacklist is cleared when a goal succeeds (melodic ``FrontierPlugin``);
+* exploration is complete when no frontier is found ``no_frontier_retries + 1`` times in a row.
+
+:class:`NearestFrontierPolicy` (``"nearest"``, Yamauchi 1997) picks the frontier closest by
+**grid path length** through known free cells the robot fits in (geodesic Dijkstra from the
+robot) and drives to its nearest such cell. It re-selects when that cell stops being a frontier
+cell (it has been seen), when the goal is reached or aborted, and every ``replan_period_s`` only
+if the current target is gone. Aborted targets stay blacklisted for the mission.
+
+Both policies are honest: they read ``obs`` (``map``, ``pose``, ``scan``) and the static facts of
+``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``). Time is the policy's own clock
+(steps times ``dt_s``). ``last_stats.map_generation_ms`` is the frontier search (and the explore
+costmap it runs on), ``global_planning_ms`` the goal selection and Navfn, and
+``local_planning_ms`` the DWA.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from policies.base import Policy, StepStats
+from semexplore_gym.core.dwa import DWAParams, DWAPlanner, scan_points_m
+from semexplore_gym.core.frontiers import GridFrontier, detect_frontiers
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.grid_search import (
+    INSCRIBED_COST,
+    NO_INFORMATION,
+    CostmapParams,
+    GridPath,
+    NavfnParams,
+    distance_field,
+    geodesic_distance_m,
+    inflate_costmap,
+    navfn_cell_costs,
+    plan_path,
+)
+
+__all__ = [
+    "FrontierExplorationParams",
+    "FrontierExplorationPolicy",
+    "MoveBaseParams",
+    "NavStatus",
+    "Navigator",
+    "NearestFrontierParams",
+    "NearestFrontierPolicy",
+]
+
+
+def _check_positive(obj: Any, names: tuple[str, ...], allow_zero: bool = False) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        ok = isinstance(v, (int, float)) and math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
+        if not ok:
+            bound = ">= 0" if allow_zero else "> 0"
+            raise ValueError(
+                f"{type(obj).__name__}.{name} must be a finite number {bound}, got {v!r}"
+            )
+
+
+@dataclass(frozen=True)
+class MoveBaseParams:
+    """The move_base-like navigator shared by both baselines.
+
+    Attributes:
+        costmap: Global costmap (TurtleBot3 burger: inflation 0.2 m; ``track_unknown_space``).
+            Its ``inscribed_radius_m`` is replaced by the robot radius from ``info``.
+        navfn: Global planner cost model. ``escape_radius_m`` lets a robot that touched the
+            inscribed band plan out of it (ROS relies on recoveries for that).
+        dwa: Local planner (TurtleBot3 DWA settings). Speed limits are capped by the env's,
+            ``control_period_s`` and ``robot_radius_m`` are taken from ``info``.
+        planner_frequency_hz: Periodic global replanning; 0 = only for a new goal or after a
+            local-planner failure (TurtleBot3 ``planner_frequency: 0.0``).
+        planner_patience_s: How long planning may fail before a recovery.
+        controller_patience_s: How long the local planner may fail before a recovery.
+        oscillation_timeout_s: Time without moving ``oscillation_distance_m`` before a recovery.
+        oscillation_distance_m: See ``oscillation_timeout_s``.
+        recovery_rotation_rad: Angle of one in-place rotation recovery.
+        recovery_angular_speed_radps: Its angular speed (``rotate_recovery`` default 1.0).
+        max_recoveries: Recoveries per goal before the goal is aborted.
+        stand_still_speed_mps: A local-planner command slower than this in both v and
+            ``stand_still_speed_mps / radius`` in omega counts as a failure (ROS DWA never
+            samples such commands: TurtleBot3 ``min_trans_vel`` 0.11, ``min_rot_vel`` 1.37).
+    """
+
+    costmap: CostmapParams = field(
+        default_factory=lambda: CostmapParams(
+            inscribed_radius_m=0.105, inflation_radius_m=0.2, cost_scaling_factor=10.0
+        )
+    )
+    navfn: NavfnParams = field(default_factory=lambda: NavfnParams(escape_radius_m=0.15))
+    dwa: DWAParams = field(default_factory=DWAParams)
+    planner_frequency_hz: float = 0.0
+    planner_patience_s: float = 5.0
+    controller_patience_s: float = 15.0
+    oscillation_timeout_s: float = 10.0
+    oscillation_distance_m: float = 0.2
+    recovery_rotation_rad: float = 2.0 * math.pi
+    recovery_angular_speed_radps: float = 1.0
+    max_recoveries: int = 2
+    stand_still_speed_mps: float = 0.005
+
+    def __post_init__(self) -> None:
+        _check_positive(
+            self,
+            (
+                "planner_patience_s",
+                "controller_patience_s",
+                "oscillation_timeout_s",
+                "recovery_angular_speed_radps",
+            ),
+        )
+        _check_positive(
+            self,
+            (
+                "planner_frequency_hz",
+                "oscillation_distance_m",
+                "recovery_rotation_rad",
+                "stand_still_speed_mps",
+            ),
+            allow_zero=True,
+        )
+        if not (isinstance(self.max_recoveries, int) and self.max_recoveries >= 0):
+            raise ValueError(
+                f"MoveBaseParams.max_recoveries must be an integer >= 0, got {self.max_recoveries!r}"
+            )
+
+
+class NavStatus:
+    """Navigator states (strings, so they show up readably in stats)."""
+
+    IDLE = "idle"
+    ACTIVE = "active"
+    RECOVERING = "recovering"
+    SUCCEEDED = "succeeded"
+    ABORTED = "aborted"
+
+
+class Navigator:
+    """move_base emulation: Navfn global plan, DWA local control, patience and recoveries."""
+
+    def __init__(
+        self,
+        params: MoveBaseParams,
+        robot_radius_m: float,
+        limits: tuple[float, float],
+        dt_s: float,
+    ) -> None:
+        radius = float(robot_radius_m)
+        cm = params.costmap
+        self.costmap_params = dataclasses.replace(
+            cm, inscribed_radius_m=radius, inflation_radius_m=max(cm.inflation_radius_m, radius)
+        )
+        dwa = dataclasses.replace(
+            params.dwa,
+            robot_radius_m=radius,
+            control_period_s=dt_s,
+            inflation_radius_m=max(params.dwa.inflation_radius_m, radius),
+        )
+        self.params = params
+        self.dwa = DWAPlanner(dwa)
+        self.limits = (float(limits[0]), float(limits[1]))
+        self.dt_s = float(dt_s)
+        self.radius_m = radius
+        self.status = NavStatus.IDLE
+        self.goal_xy_m: tuple[float, float] | None = None
+        self.path: GridPath | None = None
+        self.velocity = (0.0, 0.0)
+        self.trajectory_m = np.zeros((0, 2))
+        self.counters = {
+            "plans": 0,
+            "plan_failures": 0,
+            "recoveries": 0,
+            "aborts": 0,
+            "successes": 0,
+        }
+        self._reset_goal_state(0.0)
+
+    def _reset_goal_state(self, now_s: float) -> None:
+        self._need_plan = True
+        self._plan_fail_since: float | None = None
+        self._ctrl_fail_since: float | None = None
+        self._last_plan_s = -math.inf
+        self._osc_anchor: tuple[float, float] | None = None
+        self._osc_since = now_s
+        self._recoveries = 0
+        self._recovery_left_rad = 0.0
+
+    def set_goal(self, goal_xy_m: tuple[float, float], now_s: float) -> None:
+        """Start navigating to a new goal (move_base ``sendGoal``)."""
+        self.goal_xy_m = (float(goal_xy_m[0]), float(goal_xy_m[1]))
+        self.status = NavStatus.ACTIVE
+        self.path = None
+        self.dwa.clear()
+        self._reset_goal_state(now_s)
+
+    def cancel(self) -> None:
+        self.goal_xy_m = None
+        self.path = None
+        self.dwa.clear()
+        self.status = NavStatus.IDLE
+
+    def step(
+        self,
+        now_s: float,
+        pose: np.ndarray,
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        scan_pts: np.ndarray | None,
+        stats: StepStats,
+    ) -> tuple[float, float]:
+        """One control period; returns ``(v_mps, omega_radps)`` and updates ``status``."""
+        if self.status not in (NavStatus.ACTIVE, NavStatus.RECOVERING) or self.goal_xy_m is None:
+            return self._command(0.0, 0.0)
+        prm = self.params
+        if self.status == NavStatus.RECOVERING:
+            if self._recovery_left_rad > 0.0:
+                w = min(prm.recovery_angular_speed_radps, self.limits[1])
+                self._recovery_left_rad -= w * self.dt_s
+                return self._command(0.0, w)
+            # Recovery over: plan again (move_base goes back to PLANNING).
+            self.status = NavStatus.ACTIVE
+            self._need_plan = True
+            self._plan_fail_since = None
+            self._ctrl_fail_since = None
+            self._osc_anchor = None
+            self._osc_since = now_s
+
+        if (
+            prm.planner_frequency_hz > 0
+            and now_s - self._last_plan_s >= 1.0 / prm.planner_frequency_hz
+        ):
+            self._need_plan = True
+        if self._need_plan:
+            t0 = time.perf_counter()
+            path = self._plan(pose, grid, geometry)
+            stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
+            stats.replanned = True
+            self._last_plan_s = now_s
+            self.counters["plans"] += 1
+            if path is None:
+                self.counters["plan_failures"] += 1
+                if self._plan_fail_since is None:
+                    self._plan_fail_since = now_s
+                if now_s - self._plan_fail_since >= prm.planner_patience_s:
+                    return self._recover(now_s)
+                return self._command(0.0, 0.0)
+            self.path = path
+            self.dwa.set_path(path.points_m)
+            self._need_plan = False
+            self._plan_fail_since = None
+
+        if self._oscillating(now_s, pose):
+            return self._recover(now_s)
+
+        t0 = time.perf_counter()
+        cmd = self.dwa.compute(
+            pose, self.velocity, grid, geometry, obstacle_points_m=scan_pts, limits=self.limits
+        )
+        stats.local_planning_ms += (time.perf_counter() - t0) * 1e3
+        self.trajectory_m = cmd.trajectory_m
+        if cmd.goal_reached:
+            self.status = NavStatus.SUCCEEDED
+            self.counters["successes"] += 1
+            return self._command(0.0, 0.0)
+        still = (
+            abs(cmd.v_mps) < prm.stand_still_speed_mps
+            and abs(cmd.omega_radps) * self.radius_m < prm.stand_still_speed_mps
+        )
+        if not cmd.valid or still:
+            # Local planner failure: replan next step; recover after controller patience.
+            if self._ctrl_fail_since is None:
+                self._ctrl_fail_since = now_s
+            self._need_plan = True
+            if now_s - self._ctrl_fail_since >= prm.controller_patience_s:
+                return self._recover(now_s)
+            return self._command(0.0, 0.0)
+        self._ctrl_fail_since = None
+        return self._command(cmd.v_mps, cmd.omega_radps)
+
+    def _plan(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> GridPath | None:
+        costmap = inflate_costmap(grid, geometry.resolution_m, self.costmap_params)
+        assert self.goal_xy_m is not None
+        return plan_path(costmap, geometry, pose[:2], self.goal_xy_m, self.params.navfn)
+
+    def _oscillating(self, now_s: float, pose: np.ndarray) -> bool:
+        p = (float(pose[0]), float(pose[1]))
+        if (
+            self._osc_anchor is None
+            or math.dist(p, self._osc_anchor) >= self.params.oscillation_distance_m
+        ):
+            self._osc_anchor = p
+            self._osc_since = now_s
+            return False
+        return now_s - self._osc_since >= self.params.oscillation_timeout_s
+
+    def _recover(self, now_s: float) -> tuple[float, float]:
+        if self._recoveries >= self.params.max_recoveries:
+            self.status = NavStatus.ABORTED
+            self.counters["aborts"] += 1
+            self.path = None
+            self.dwa.clear()
+            return self._command(0.0, 0.0)
+        self._recoveries += 1
+        self.counters["recoveries"] += 1
+        self.status = NavStatus.RECOVERING
+        self._recovery_left_rad = self.params.recovery_rotation_rad
+        self._osc_anchor = None
+        self._osc_since = now_s
+        if self._recovery_left_rad <= 0.0:
+            return self._command(0.0, 0.0)
+        w = min(self.params.recovery_angular_speed_radps, self.limits[1])
+        self._recovery_left_rad -= w * self.dt_s
+        return self._command(0.0, w)
+
+    def _command(self, v: float, w: float) -> tuple[float, float]:
+        self.velocity = (float(v), float(w))
+        return self.velocity
+
+
+class _FrontierBaseline(Policy):
+    """Shared plumbing: reading obs/info, the navigator, actions, stats and overlay."""
+
+    def __init__(self, navigation: MoveBaseParams) -> None:
+        super().__init__()
+        self._nav_params = navigation
+        self.nav: Navigator | None = None
+        self.frontiers: list[GridFrontier] = []
+        self.blacklist: list[tuple[float, float]] = []
+        self.counters: dict[str, int] = {}
+
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
+        super().reset(obs, info, seed=seed)
+        try:
+            self.geometry = GridGeometry.from_dict(info["map_geometry"])
+            robot = info["robot"]
+            self.radius_m = float(robot["radius_m"])
+            self.max_v = float(robot["max_linear_speed_mps"])
+            self.max_w = float(robot["max_angular_speed_radps"])
+            lidar = info["lidar"]
+            self.max_range_m = float(lidar["max_range_m"])
+            self.min_range_m = float(lidar.get("min_range_m", 0.0))
+            self.dt_s = float(info["dt_s"])
+        except (KeyError, TypeError) as e:
+            raise ValueError(
+                f"{type(self).__name__}.reset needs info with map_geometry, robot, lidar and dt_s: {e!r}"
+            ) from None
+        if not (self.max_v > 0 and self.max_w > 0 and self.dt_s > 0):
+            raise ValueError(
+                f"robot limits and dt_s must be positive, got {self.max_v}, {self.max_w}, {self.dt_s}"
+            )
+        self.nav = Navigator(self._nav_params, self.radius_m, (self.max_v, self.max_w), self.dt_s)
+        self.now_s = 0.0
+        self.frontiers = []
+        self.blacklist = []
+        self.counters = {"selections": 0, "goals_sent": 0, "blacklisted": 0}
+        self._no_frontier_count = 0
+
+    def _read(self, obs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        grid = np.asarray(obs["map"])
+        if grid.shape != self.geometry.shape:
+            raise ValueError(
+                f"obs['map'] shape {grid.shape} differs from info map_geometry {self.geometry.shape}"
+            )
+        pose = np.asarray(obs["pose"], dtype=np.float64).ravel()[:3]
+        scan = scan_points_m(pose, obs["scan"], self.max_range_m, self.min_range_m)
+        return grid, pose, scan
+
+    def _action(self, v: float, w: float) -> np.ndarray:
+        a = np.array([v / self.max_v, w / self.max_w], dtype=np.float32)
+        return np.clip(a, -1.0, 1.0)
+
+    def _blacklisted(self, xy: tuple[float, float], half_box_m: float) -> bool:
+        return any(
+            abs(xy[0] - bx) <= half_box_m and abs(xy[1] - by) <= half_box_m
+            for bx, by in self.blacklist
+        )
+
+    def _finish(self, reason: str) -> np.ndarray:
+        self.done = True
+        self.stop_reason = reason
+        if self.nav is not None:
+            self.nav.cancel()
+        return self._action(0.0, 0.0)
+
+    def overlay(self) -> dict[str, Any]:
+        if self.nav is None:
+            return {}
+        out: dict[str, Any] = {
+            "frontiers_m": [f.centroid_m for f in self.frontiers],
+            "points_m": list(self.blacklist),
+        }
+        paths = []
+        if self.nav.path is not None:
+            paths.append(self.nav.path.points_m)
+        if self.nav.trajectory_m.shape[0] > 1:
+            paths.append(self.nav.trajectory_m)
+        out["paths_m"] = paths
+        if self.nav.goal_xy_m is not None:
+            out["goal_m"] = self.nav.goal_xy_m
+        out["text"] = f"{self.name}: {self.nav.status}, {len(self.frontiers)} frontiers"
+        return out
+
+
+@dataclass(frozen=True)
+class FrontierExplorationParams:
+    """ROS ``frontier_exploration`` (indigo explore_server + BoundedExploreLayer).
+
+    Attributes:
+        frequency_hz: Frontier search / goal update rate (``frequency``, 2.0 in
+            ``global_map.launch``); 0 = wait until each goal ends before choosing the next.
+        goal_aliasing_m: A new travel point is sent only if farther than 0.9 times this from
+            the current goal (``goal_aliasing``, the launch sets it to the sensor range, 1.0).
+        travel_point: ``"closest"`` (first-contact cell, FE's default), ``"middle"`` (FE's
+            ``middle`` field, the Euclidean-nearest cell) or ``"centroid"``.
+        selection: ``"euclidean"`` (smallest ``min_distance``, indigo) or ``"bfs_order"``
+            (first frontier found, the melodic plugin).
+        min_frontier_cells: Smallest frontier kept (FE indigo: more than one cell).
+        search_on_costmap: Search on the explore costmap (free = cost 0), as FE does, rather
+            than on the raw occupancy grid.
+        explore_costmap: The explore costmap's inflation (``global_map.launch``: 0.15 m; ROS
+            default ``cost_scaling_factor`` 10). Its inscribed radius becomes the robot radius.
+        check_reachability: Skip frontiers the global planner cannot reach (not in FE).
+        blacklist_box_m: Travel points within this box half-size of an aborted goal are skipped
+            (melodic ``blacklist_box_size`` 0.5).
+        no_frontier_retries: Searches without a frontier tolerated before stopping (FE: 5).
+        navigation: The move_base-like navigator.
+    """
+
+    frequency_hz: float = 2.0
+    goal_aliasing_m: float = 1.0
+    travel_point: Literal["closest", "middle", "centroid"] = "closest"
+    selection: Literal["euclidean", "bfs_order"] = "euclidean"
+    min_frontier_cells: int = 2
+    search_on_costmap: bool = True
+    explore_costmap: CostmapParams = field(
+        default_factory=lambda: CostmapParams(
+            inscribed_radius_m=0.105, inflation_radius_m=0.15, cost_scaling_factor=10.0
+        )
+    )
+    check_reachability: bool = False
+    blacklist_box_m: float = 0.5
+    no_frontier_retries: int = 5
+    navigation: MoveBaseParams = field(default_factory=MoveBaseParams)
+
+    def __post_init__(self) -> None:
+        _check_positive(
+            self, ("frequency_hz", "goal_aliasing_m", "blacklist_box_m"), allow_zero=True
+        )
+        if self.travel_point not in ("closest", "middle", "centroid"):
+            raise ValueError(
+                f"travel_point must be 'closest', 'middle' or 'centroid', got {self.travel_point!r}"
+            )
+        if self.selection not in ("euclidean", "bfs_order"):
+            raise ValueError(
+                f"selection must be 'euclidean' or 'bfs_order', got {self.selection!r}"
+            )
+        if not (isinstance(self.min_frontier_cells, int) and self.min_frontier_cells >= 1):
+            raise ValueError(
+                f"min_frontier_cells must be an integer >= 1, got {self.min_frontier_cells!r}"
+            )
+        if not (isinstance(self.no_frontier_retries, int) and self.no_frontier_retries >= 0):
+            raise ValueError(
+                f"no_frontier_retries must be an integer >= 0, got {self.no_frontier_retries!r}"
+            )
+
+
+class FrontierExplorationPolicy(_FrontierBaseline):
+    """ROS ``frontier_exploration`` with Navfn + DWA (the paper's FE baseline).
+
+    Args:
+        params: Parameters; ``None`` = FE's defaults. Keyword overrides (e.g.
+            ``check_reachability=True``) are applied on top.
+    """
+
+    name = "frontier"
+
+    def __init__(self, params: FrontierExplorationParams | None = None, **overrides: Any) -> None:
+        p = params if params is not None else FrontierExplorationParams()
+        if overrides:
+            p = dataclasses.replace(p, **overrides)
+        self.params = p
+        super().__init__(p.navigation)
+
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
+        super().reset(obs, info, seed=seed)
+        ec = self.params.explore_costmap
+        self._explore_costmap = dataclasses.replace(
+            ec,
+            inscribed_radius_m=self.radius_m,
+            inflation_radius_m=max(ec.inflation_radius_m, self.radius_m),
+        )
+        self._last_search_s = -math.inf
+        self._moving = False
+
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        if self.nav is None:
+            raise RuntimeError("call reset() before act()")
+        stats = StepStats()
+        self.last_stats = stats
+        if self.done:
+            return self._action(0.0, 0.0)
+        grid, pose, scan = self._read(obs)
+        nav = self.nav
+        prm = self.params
+
+        if nav.status == NavStatus.SUCCEEDED:
+            self.blacklist.clear()  # melodic FrontierPlugin clears the blacklist on success
+            self._moving = False
+        elif nav.status == NavStatus.ABORTED:
+            if nav.goal_xy_m is not None:
+                self.blacklist.append(nav.goal_xy_m)
+                self.counters["blacklisted"] += 1
+            nav.cancel()
+            self._moving = False
+
+        due = (
+            prm.frequency_hz > 0
+            and self.now_s - self._last_search_s >= 1.0 / prm.frequency_hz - 1e-9
+        )
+        if not self._moving or due:
+            self._last_search_s = self.now_s
+            goal = self._next_goal(grid, pose, stats)
+            if goal is None:
+                self._no_frontier_count += 1
+                if self._no_frontier_count > prm.no_frontier_retries:
+                    return self._finish(
+                        "no frontiers left"
+                        if not self.frontiers
+                        else "all frontiers blacklisted or unreachable"
+                    )
+            else:
+                self._no_frontier_count = 0
+                far = (
+                    nav.goal_xy_m is None
+                    or math.dist(goal, nav.goal_xy_m) > 0.9 * prm.goal_aliasing_m
+                )
+                if not self._moving or far:
+                    nav.set_goal(goal, self.now_s)
+                    self._moving = True
+                    self.counters["goals_sent"] += 1
+
+        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
+        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
+        self.now_s += self.dt_s
+        return self._action(v, w)
+
+    def _next_goal(
+        self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
+    ) -> tuple[float, float] | None:
+        prm = self.params
+        t0 = time.perf_counter()
+        search_grid = grid
+        if prm.search_on_costmap:
+            cost = inflate_costmap(grid, self.geometry.resolution_m, self._explore_costmap)
+            search_grid = np.full(grid.shape, OCCUPIED, dtype=np.uint8)
+            search_grid[cost == 0] = FREE
+            search_grid[cost == NO_INFORMATION] = UNKNOWN
+        self.frontiers = detect_frontiers(
+            search_grid, self.geometry, pose[:2], min_frontier_cells=prm.min_frontier_cells
+        )
+        stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
+
+        t0 = time.perf_counter()
+        self.counters["selections"] += 1
+        candidates = [(f, self._travel_point(f)) for f in self.frontiers]
+        candidates = [
+            (f, p) for f, p in candidates if not self._blacklisted(p, prm.blacklist_box_m)
+        ]
+        if prm.selection == "euclidean":
+            candidates.sort(key=lambda fp: fp[0].min_distance_m)
+        if prm.check_reachability and candidates:
+            reach = self._reachable_mask(grid, pose)
+            kept = []
+            for f, p in candidates:
+                r, c = self.geometry.world_to_grid(p[0], p[1])
+                if self.geometry.contains(r, c) and reach[int(r), int(c)]:
+                    kept.append((f, p))
+            candidates = kept
+        stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
+        return candidates[0][1] if candidates else None
+
+    def _travel_point(self, f: GridFrontier) -> tuple[float, float]:
+        tp = self.params.travel_point
+        if tp == "centroid":
+            return f.centroid_m
+        return f.cell_xy_m(self.geometry, "initial" if tp == "closest" else "nearest")
+
+    def _reachable_mask(self, grid: np.ndarray, pose: np.ndarray) -> np.ndarray:
+        assert self.nav is not None
+        costmap = inflate_costmap(grid, self.geometry.resolution_m, self.nav.costmap_params)
+        cost = navfn_cell_costs(costmap, self.nav.params.navfn)
+        r, c = self.geometry.world_to_grid(pose[0], pose[1])
+        if not self.geometry.contains(r, c):
+            return np.zeros(grid.shape, dtype=bool)
+        r, c = int(r), int(c)
+        # Same start handling as the planner (robot cell and escape radius are passable).
+        if not np.isfinite(cost[r, c]):
+            cost[r, c] = float(INSCRIBED_COST)
+        k = int(self.nav.params.navfn.escape_radius_m / self.geometry.resolution_m)
+        if k > 0:
+            r0, r1 = max(r - k, 0), min(r + k + 1, grid.shape[0])
+            c0, c1 = max(c - k, 0), min(c + k + 1, grid.shape[1])
+            rr, cc = np.mgrid[r0:r1, c0:c1]
+            near = ((rr - r) ** 2 + (cc - c) ** 2 <= k * k) & (
+                costmap[r0:r1, c0:c1] == INSCRIBED_COST
+            )
+            cost[r0:r1, c0:c1][near] = float(INSCRIBED_COST)
+        dist, _ = distance_field(cost, (r, c))
+        return np.isfinite(dist)
+
+
+@dataclass(frozen=True)
+class NearestFrontierParams:
+    """Yamauchi's nearest-frontier exploration.
+
+    Attributes:
+        replan_period_s: How often the frontier search runs while a target is pursued.
+        min_frontier_cells: Smallest frontier kept, in cells.
+        cell_convention: Frontier cells are ``"free"`` cells next to unknown (Yamauchi) or
+            ``"unknown"`` cells next to free (FE).
+        blacklist_radius_m: Targets within this distance of an aborted target are skipped for
+            the rest of the mission.
+        no_frontier_retries: Searches without a reachable frontier tolerated before stopping.
+        navigation: The move_base-like navigator.
+    """
+
+    replan_period_s: float = 0.5
+    min_frontier_cells: int = 2
+    cell_convention: Literal["free", "unknown"] = "free"
+    blacklist_radius_m: float = 0.5
+    no_frontier_retries: int = 2
+    navigation: MoveBaseParams = field(default_factory=MoveBaseParams)
+
+    def __post_init__(self) -> None:
+        _check_positive(self, ("replan_period_s",))
+        _check_positive(self, ("blacklist_radius_m",), allow_zero=True)
+        if self.cell_convention not in ("free", "unknown"):
+            raise ValueError(
+                f"cell_convention must be 'free' or 'unknown', got {self.cell_convention!r}"
+            )
+        if not (isinstance(self.min_frontier_cells, int) and self.min_frontier_cells >= 1):
+            raise ValueError(
+                f"min_frontier_cells must be an integer >= 1, got {self.min_frontier_cells!r}"
+            )
+        if not (isinstance(self.no_frontier_retries, int) and self.no_frontier_retries >= 0):
+            raise ValueError(
+                f"no_frontier_retries must be an integer >= 0, got {self.no_frontier_retries!r}"
+            )
+
+
+class NearestFrontierPolicy(_FrontierBaseline):
+    """Yamauchi (1997): go to the frontier nearest by path length, with Navfn + DWA.
+
+    Args:
+        params: Parameters; ``None`` = defaults. Keyword overrides are applied on top.
+    """
+
+    name = "nearest"
+
+    def __init__(self, params: NearestFrontierParams | None = None, **overrides: Any) -> None:
+        p = params if params is not None else NearestFrontierParams()
+        if overrides:
+            p = dataclasses.replace(p, **overrides)
+        self.params = p
+        super().__init__(p.navigation)
+
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
+        super().reset(obs, info, seed=seed)
+        self._last_search_s = -math.inf
+        self._target_cell: tuple[int, int] | None = None
+        self.path_length_m = math.inf
+
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        if self.nav is None:
+            raise RuntimeError("call reset() before act()")
+        stats = StepStats()
+        self.last_stats = stats
+        if self.done:
+            return self._action(0.0, 0.0)
+        grid, pose, scan = self._read(obs)
+        nav = self.nav
+        prm = self.params
+
+        if nav.status == NavStatus.ABORTED and nav.goal_xy_m is not None:
+            self.blacklist.append(nav.goal_xy_m)
+            self.counters["blacklisted"] += 1
+        need_target = nav.status in (
+            NavStatus.IDLE,
+            NavStatus.SUCCEEDED,
+            NavStatus.ABORTED,
+        ) or not self._target_still_frontier(grid)
+        due = self.now_s - self._last_search_s >= prm.replan_period_s - 1e-9
+        if need_target:
+            self._last_search_s = self.now_s
+            goal = self._select(grid, pose, stats)
+            if goal is None:
+                self._no_frontier_count += 1
+                nav.cancel()
+                if self._no_frontier_count > prm.no_frontier_retries:
+                    return self._finish(
+                        "no reachable frontier left"
+                        if not self.frontiers
+                        else "all frontiers blacklisted"
+                    )
+            else:
+                self._no_frontier_count = 0
+                nav.set_goal(goal, self.now_s)
+                self.counters["goals_sent"] += 1
+        elif due:
+            # The target is still a frontier: keep it (no goal switching), but keep the frontier
+            # list current for the overlay and the timing statistics.
+            self._last_search_s = self.now_s
+            t0 = time.perf_counter()
+            self.frontiers = self._detect(grid, pose)
+            stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
+
+        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
+        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
+        self.now_s += self.dt_s
+        return self._action(v, w)
+
+    def _detect(self, grid: np.ndarray, pose: np.ndarray) -> list[GridFrontier]:
+        prm = self.params
+        return detect_frontiers(
+            grid, self.geometry, pose[:2], prm.min_frontier_cells, prm.cell_convention
+        )
+
+    def _target_still_frontier(self, grid: np.ndarray) -> bool:
+        if self._target_cell is None:
+            return False
+        r, c = self._target_cell
+        own = FREE if self.params.cell_convention == "free" else UNKNOWN
+        other = UNKNOWN if own == FREE else FREE
+        if grid[r, c] != own:
+            return False
+        h, w = grid.shape
+        return any(
+            0 <= r + dr < h and 0 <= c + dc < w and grid[r + dr, c + dc] == other
+            for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1))
+        )
+
+    def _select(
+        self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
+    ) -> tuple[float, float] | None:
+        assert self.nav is not None
+        t0 = time.perf_counter()
+        self.frontiers = self._detect(grid, pose)
+        stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
+        self._target_cell = None
+        if not self.frontiers:
+            return None
+        t0 = time.perf_counter()
+        self.counters["selections"] += 1
+        costmap = inflate_costmap(grid, self.geometry.resolution_m, self.nav.costmap_params)
+        # Known free cells the robot fits in; unknown frontier cells count as enterable targets.
+        traversable = (costmap < INSCRIBED_COST) & (grid == FREE)
+        fmask = np.zeros(grid.shape, dtype=bool)
+        for f in self.frontiers:
+            fmask[f.cells[:, 0], f.cells[:, 1]] = True
+        traversable |= fmask & ((costmap < INSCRIBED_COST) | (costmap == NO_INFORMATION))
+        dist = geodesic_distance_m(traversable, self.geometry, pose[:2])
+        best: tuple[float, tuple[int, int]] | None = None
+        for f in self.frontiers:
+            d = dist[f.cells[:, 0], f.cells[:, 1]]
+            i = int(np.argmin(d))
+            if not np.isfinite(d[i]):
+                continue
+            cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
+            x, y = self.geometry.grid_to_world(*cell)
+            if any(
+                math.dist((float(x), float(y)), b) <= self.params.blacklist_radius_m
+                for b in self.blacklist
+            ):
+                continue
+            if best is None or d[i] < best[0]:
+                best = (float(d[i]), cell)
+        stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
+        if best is None:
+            return None
+        self.path_length_m = best[0]
+        self._target_cell = best[1]
+        x, y = self.geometry.grid_to_world(*best[1])
+        return (float(x), float(y))

@@ -1,0 +1,624 @@
+"""Imitation learning without the ``imitation`` package: expert datasets, BC and DAgger.
+
+The learner is an SB3 actor-critic policy (``MultiInputActorCriticPolicy`` for the Dict
+observation of :class:`semexplore_gym.wrappers.egocentric.EgocentricObservation`), so a
+behaviour-cloned model can be fine-tuned with PPO. The expert is any :class:`policies.base.Policy`
+(normally the scripted semantic expert); it sees the raw observation, the learner the
+egocentric features computed from that same observation (:class:`EgocentricEncoder`).
+
+Datasets are ``.npz`` files holding the egocentric observations (``obs__<key>``), the expert's
+actions, an episode id per sample and a JSON ``meta`` record; :class:`DatasetWriter` rewrites
+the file atomically after every episode, so an interrupted recording keeps its finished
+episodes.
+
+torch and stable-baselines3 (the ``rl`` extra) are imported inside the functions that need them.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import time
+import zipfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from policies.base import Policy
+from semexplore_gym.wrappers.egocentric import EgocentricEncoder, EgocentricParams
+
+#: Name of the JSON record stored inside model zips: policy class and feature parameters.
+MODEL_META_NAME = "semexplore.json"
+
+
+# --------------------------------------------------------------------------- dataset
+@dataclass
+class ImitationDataset:
+    """Egocentric observations with the expert's action for each.
+
+    Attributes:
+        obs: Observation arrays by key, each with the sample axis first.
+        actions: ``(N, 2)`` float32 expert actions.
+        episode_ids: ``(N,)`` int64 episode index of each sample.
+        meta: JSON-safe facts (egocentric parameters, expert, world ...).
+    """
+
+    obs: dict[str, np.ndarray]
+    actions: np.ndarray
+    episode_ids: np.ndarray
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        n = len(self.actions)
+        if self.actions.ndim != 2:
+            raise ValueError(f"actions must be (N, action_dim), got shape {self.actions.shape}")
+        if self.episode_ids.shape != (n,):
+            raise ValueError(f"episode_ids must have shape ({n},), got {self.episode_ids.shape}")
+        for k, v in self.obs.items():
+            if len(v) != n:
+                raise ValueError(f"obs[{k!r}] has {len(v)} samples but there are {n} actions")
+
+    def __len__(self) -> int:
+        return len(self.actions)
+
+    @property
+    def n_episodes(self) -> int:
+        return len(np.unique(self.episode_ids))
+
+    @classmethod
+    def empty(cls, meta: dict[str, Any] | None = None) -> ImitationDataset:
+        return cls({}, np.zeros((0, 2), np.float32), np.zeros(0, np.int64), dict(meta or {}))
+
+    def concatenate(self, other: ImitationDataset) -> ImitationDataset:
+        """Both datasets' samples; ``other``'s episode ids are shifted past this one's."""
+        if len(self) == 0:
+            return ImitationDataset(
+                dict(other.obs), other.actions, other.episode_ids, {**other.meta, **self.meta}
+            )
+        if len(other) == 0:
+            return self
+        if set(self.obs) != set(other.obs):
+            raise ValueError(f"observation keys differ: {sorted(self.obs)} vs {sorted(other.obs)}")
+        shift = int(self.episode_ids.max()) + 1 - int(other.episode_ids.min())
+        return ImitationDataset(
+            {k: np.concatenate([self.obs[k], other.obs[k]]) for k in self.obs},
+            np.concatenate([self.actions, other.actions]),
+            np.concatenate([self.episode_ids, other.episode_ids + shift]),
+            dict(self.meta),
+        )
+
+    def subset(self, mask: np.ndarray) -> ImitationDataset:
+        return ImitationDataset(
+            {k: v[mask] for k, v in self.obs.items()},
+            self.actions[mask],
+            self.episode_ids[mask],
+            dict(self.meta),
+        )
+
+    def split_by_episode(
+        self, holdout_fraction: float, rng: np.random.Generator
+    ) -> tuple[ImitationDataset, ImitationDataset]:
+        """(train, held-out) with whole episodes held out, at least one each when possible."""
+        if not 0.0 <= holdout_fraction < 1.0:
+            raise ValueError(f"holdout_fraction must be in [0, 1), got {holdout_fraction!r}")
+        eps = np.unique(self.episode_ids)
+        n_hold = round(holdout_fraction * len(eps))
+        if holdout_fraction > 0 and len(eps) >= 2:
+            n_hold = min(max(n_hold, 1), len(eps) - 1)
+        held = rng.permutation(eps)[:n_hold]
+        mask = np.isin(self.episode_ids, held)
+        return self.subset(~mask), self.subset(mask)
+
+    def save(self, path: str | os.PathLike, compress: bool = True) -> Path:
+        """Write atomically (temporary file, then rename) to ``path`` (``.npz``)."""
+        p = Path(path)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        arrays = {f"obs__{k}": v for k, v in self.obs.items()}
+        arrays.update(
+            actions=self.actions,
+            episode_ids=self.episode_ids,
+            meta=np.array(json.dumps(self.meta, sort_keys=True)),
+        )
+        tmp = p.with_name(p.name + ".tmp")
+        with open(tmp, "wb") as f:
+            (np.savez_compressed if compress else np.savez)(f, **arrays)
+        os.replace(tmp, p)
+        return p
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> ImitationDataset:
+        """Read a dataset written by :meth:`save` (no pickles are loaded)."""
+        p = Path(path)
+        if not p.is_file():
+            raise FileNotFoundError(f"dataset not found: {str(p)!r}")
+        with np.load(p, allow_pickle=False) as z:
+            missing = {"actions", "episode_ids", "meta"} - set(z.files)
+            if missing:
+                raise ValueError(
+                    f"{str(p)!r} is not an imitation dataset (missing {sorted(missing)})"
+                )
+            obs = {k[len("obs__") :]: z[k] for k in z.files if k.startswith("obs__")}
+            return cls(
+                obs,
+                z["actions"].astype(np.float32),
+                z["episode_ids"].astype(np.int64),
+                json.loads(str(z["meta"])),
+            )
+
+
+class DatasetWriter:
+    """Accumulates episodes and rewrites the ``.npz`` file after each one.
+
+    Args:
+        path: Output ``.npz`` path; an existing file is extended when ``append`` is True.
+        meta: JSON-safe facts stored with the data.
+        append: Start from the samples already in ``path``.
+    """
+
+    def __init__(
+        self, path: str | os.PathLike, meta: dict[str, Any] | None = None, append: bool = False
+    ) -> None:
+        self.path = Path(path)
+        self.data = (
+            ImitationDataset.load(self.path)
+            if append and self.path.is_file()
+            else ImitationDataset.empty(meta)
+        )
+        if meta:
+            self.data.meta.update(meta)
+
+    def add(self, episode: ImitationDataset) -> None:
+        self.data = self.data.concatenate(episode)
+        self.data.save(self.path)
+
+
+# ---------------------------------------------------------------------- roll-outs
+@dataclass
+class EpisodeRecord:
+    """One roll-out: the egocentric observations, the expert's labels and outcome facts.
+
+    ``steps`` counts the labelled states; ``expert_fraction`` the share of steps that executed
+    the expert's action.
+    """
+
+    data: ImitationDataset
+    steps: int
+    return_: float
+    coverage: float
+    expert_fraction: float
+    end_reason: str
+
+
+def _stack_obs(obs_list: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    return {k: np.stack([o[k] for o in obs_list]) for k in obs_list[0]}
+
+
+def learner_action(policy: Any, features: dict[str, np.ndarray]) -> np.ndarray:
+    """Deterministic action of an SB3 policy (or any object with ``predict``) for one observation."""
+    action, _ = policy.predict(features, deterministic=True)
+    return np.clip(np.asarray(action, dtype=np.float32).reshape(-1), -1.0, 1.0)
+
+
+def rollout_episode(
+    env: Any,
+    expert: Policy,
+    params: EgocentricParams,
+    learner: Any = None,
+    beta: float = 1.0,
+    rng: np.random.Generator | None = None,
+    seed: int | None = None,
+    max_steps: int = 1000,
+    episode_id: int = 0,
+) -> EpisodeRecord:
+    """Run one episode, labelling every visited state with the expert's action.
+
+    Each step executes the expert's action with probability ``beta`` and the learner's
+    otherwise (``learner`` may be None only when ``beta == 1``). The expert is asked every step,
+    also when the learner drives, so its internal plan follows the visited states.
+
+    Args:
+        env: The raw ``SemanticExplore-v0`` env (not wrapped).
+        expert: The labelling policy.
+        params: Egocentric feature parameters (what the learner sees).
+        learner: An SB3 policy (``predict``) or None.
+        beta: Probability of executing the expert's action.
+        rng: Generator for the beta coin flips.
+        seed: Seed for ``env.reset`` and ``expert.reset``.
+        max_steps: Step cap of the episode.
+        episode_id: Episode id stored with the samples.
+    """
+    if not 0.0 <= beta <= 1.0:
+        raise ValueError(f"beta must be in [0, 1], got {beta!r}")
+    if learner is None and beta < 1.0:
+        raise ValueError("a learner is needed when beta < 1")
+    if max_steps < 1:
+        raise ValueError(f"max_steps must be >= 1, got {max_steps!r}")
+    rng = rng if rng is not None else np.random.default_rng(seed)
+    obs, info = env.reset(seed=seed)
+    expert.reset(obs, info, seed=seed)
+    encoder = EgocentricEncoder.from_info(params, info)
+    feats: list[dict[str, np.ndarray]] = []
+    labels: list[np.ndarray] = []
+    ret, n_expert, end_reason = 0.0, 0, "max_steps"
+    for _ in range(max_steps):
+        if not encoder.matches(info):
+            encoder = EgocentricEncoder.from_info(params, info)
+        f = encoder.encode(obs)
+        a_expert = np.clip(
+            np.asarray(expert.act(obs, info), dtype=np.float32).reshape(-1), -1.0, 1.0
+        )
+        feats.append(f)
+        labels.append(a_expert)
+        if expert.done:
+            end_reason = f"expert_done:{expert.stop_reason}"
+            break
+        use_expert = beta >= 1.0 or rng.random() < beta
+        n_expert += int(use_expert)
+        action = a_expert if use_expert else learner_action(learner, f)
+        obs, reward, terminated, truncated, info = env.step(action)
+        ret += float(reward)
+        if terminated or truncated:
+            end_reason = "terminated" if terminated else "truncated"
+            break
+    n = len(labels)
+    data = ImitationDataset(
+        _stack_obs(feats), np.stack(labels).astype(np.float32), np.full(n, episode_id, np.int64)
+    )
+    return EpisodeRecord(
+        data, n, ret, float(info.get("coverage", math.nan)), n_expert / max(1, n), end_reason
+    )
+
+
+def _progress(iterable: Any, enabled: bool, desc: str, total: int | None = None) -> Any:
+    if not enabled:
+        return iterable
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, desc=desc, total=total, leave=False)
+
+
+def record_expert_dataset(
+    env: Any,
+    expert: Policy,
+    path: str | os.PathLike | None,
+    n_episodes: int,
+    params: EgocentricParams,
+    seed: int = 0,
+    max_steps: int = 1000,
+    meta: dict[str, Any] | None = None,
+    progress: bool = False,
+    log_fn: Callable[[str, float, int], None] | None = None,
+) -> ImitationDataset:
+    """Roll out the expert for ``n_episodes`` (seeds ``seed``, ``seed+1``, ...) and record them.
+
+    When ``path`` is given the ``.npz`` is rewritten after every episode. ``log_fn(tag, value,
+    step)`` receives per-episode coverage and length.
+    """
+    if n_episodes < 1:
+        raise ValueError(f"n_episodes must be >= 1, got {n_episodes!r}")
+    full_meta = {
+        "egocentric": params.to_dict(),
+        "expert": getattr(expert, "name", type(expert).__name__),
+        **(meta or {}),
+    }
+    writer = DatasetWriter(path, full_meta) if path is not None else None
+    data = ImitationDataset.empty(full_meta)
+    for ep in _progress(range(n_episodes), progress, "expert episodes"):
+        rec = rollout_episode(
+            env, expert, params, seed=seed + ep, max_steps=max_steps, episode_id=ep
+        )
+        data = data.concatenate(rec.data)
+        if writer is not None:
+            writer.add(rec.data)
+        if log_fn is not None:
+            log_fn("expert/coverage", rec.coverage, ep)
+            log_fn("expert/steps", rec.steps, ep)
+    return data
+
+
+# ----------------------------------------------------------------------------- BC
+def make_policy(
+    observation_space: Any, action_space: Any, lr: float = 3e-4, seed: int = 0, **policy_kwargs: Any
+) -> Any:
+    """A fresh SB3 actor-critic policy for the spaces (multi-input for Dict observations)."""
+    import torch as th
+    from gymnasium import spaces
+    from stable_baselines3.common.policies import ActorCriticPolicy, MultiInputActorCriticPolicy
+
+    th.manual_seed(seed)
+    cls = (
+        MultiInputActorCriticPolicy
+        if isinstance(observation_space, spaces.Dict)
+        else ActorCriticPolicy
+    )
+    return cls(observation_space, action_space, lambda _progress: lr, **policy_kwargs)
+
+
+def _to_tensors(obs: dict[str, np.ndarray], idx: np.ndarray, device: Any) -> dict[str, Any]:
+    import torch as th
+
+    return {k: th.as_tensor(v[idx], device=device) for k, v in obs.items()}
+
+
+def action_error(policy: Any, dataset: ImitationDataset, batch_size: int = 512) -> float:
+    """Mean absolute difference between the policy's deterministic actions and the labels."""
+    import torch as th
+
+    if len(dataset) == 0:
+        raise ValueError("action_error needs a non-empty dataset")
+    policy.set_training_mode(False)
+    errs = []
+    with th.no_grad():
+        for start in range(0, len(dataset), batch_size):
+            idx = np.arange(start, min(start + batch_size, len(dataset)))
+            dist = policy.get_distribution(_to_tensors(dataset.obs, idx, policy.device))
+            act = dist.get_actions(deterministic=True).cpu().numpy()
+            errs.append(np.abs(np.clip(act, -1, 1) - dataset.actions[idx]).mean(axis=1))
+    return float(np.concatenate(errs).mean())
+
+
+def train_bc(
+    dataset: ImitationDataset,
+    policy: Any,
+    epochs: int = 10,
+    batch_size: int = 64,
+    lr: float = 3e-4,
+    seed: int = 0,
+    ent_weight: float = 1e-3,
+    l2_weight: float = 0.0,
+    progress: bool = False,
+    log_fn: Callable[[str, float, int], None] | None = None,
+    step_offset: int = 0,
+) -> dict[str, list[float]]:
+    """Behaviour cloning: minimise ``-log pi(a_expert | o) - ent_weight * entropy`` with Adam.
+
+    Args:
+        dataset: Egocentric observations and expert actions.
+        policy: An SB3 ``ActorCriticPolicy`` (changed in place).
+        epochs: Passes over the dataset.
+        batch_size: Samples per gradient step.
+        lr: Adam learning rate.
+        seed: Seeds the minibatch order (numpy Generator) and torch.
+        ent_weight: Entropy bonus weight (keeps the action std from collapsing too early).
+        l2_weight: Adam weight decay.
+        progress: Show a tqdm bar over epochs.
+        log_fn: ``log_fn(tag, value, step)`` for per-epoch scalars.
+        step_offset: Added to the epoch index passed to ``log_fn`` (DAgger rounds).
+
+    Returns:
+        ``{"loss": [...], "neglogp": [...], "entropy": [...]}`` one value per epoch.
+    """
+    import torch as th
+
+    if len(dataset) == 0:
+        raise ValueError("train_bc needs a non-empty dataset")
+    if epochs < 1 or batch_size < 1 or not lr > 0:
+        raise ValueError(
+            f"epochs, batch_size and lr must be positive, got {epochs}, {batch_size}, {lr}"
+        )
+    th.manual_seed(seed)
+    rng = np.random.default_rng(seed)
+    optimizer = th.optim.Adam(policy.parameters(), lr=lr, weight_decay=l2_weight)
+    actions = th.as_tensor(dataset.actions, device=policy.device)
+    history: dict[str, list[float]] = {"loss": [], "neglogp": [], "entropy": []}
+    policy.set_training_mode(True)
+    for epoch in _progress(range(epochs), progress, "BC epochs"):
+        order = rng.permutation(len(dataset))
+        sums = np.zeros(3)
+        for start in range(0, len(order), batch_size):
+            idx = order[start : start + batch_size]
+            _values, log_prob, entropy = policy.evaluate_actions(
+                _to_tensors(dataset.obs, idx, policy.device), actions[idx]
+            )
+            neglogp = -log_prob.mean()
+            ent = entropy.mean() if entropy is not None else th.zeros(())
+            loss = neglogp - ent_weight * ent
+            optimizer.zero_grad()
+            loss.backward()
+            optimizer.step()
+            sums += np.array([loss.item(), neglogp.item(), ent.item()]) * len(idx)
+        means = sums / len(order)
+        for k, v in zip(history, means, strict=True):
+            history[k].append(float(v))
+            if log_fn is not None:
+                log_fn(f"bc/{k}", float(v), step_offset + epoch)
+    policy.set_training_mode(False)
+    return history
+
+
+# -------------------------------------------------------------------------- DAgger
+def beta_schedule(spec: float | Sequence[float] | Callable[[int], float]) -> Callable[[int], float]:
+    """Turn a schedule spec into ``round -> beta``.
+
+    A float ``p`` gives ``beta_i = p ** i`` (round 0 is pure expert, then exponential decay,
+    as in Ross et al.); a sequence gives ``beta_i = seq[min(i, len-1)]``; a callable is used as is.
+    """
+    if callable(spec):
+        return spec
+    if isinstance(spec, (int, float)):
+        p = float(spec)
+        if not 0.0 <= p <= 1.0:
+            raise ValueError(f"beta decay must be in [0, 1], got {spec!r}")
+        return lambda i: p**i
+    seq = [float(b) for b in spec]
+    if not seq or any(not 0.0 <= b <= 1.0 for b in seq):
+        raise ValueError(f"beta sequence must be non-empty with values in [0, 1], got {spec!r}")
+    return lambda i: seq[min(i, len(seq) - 1)]
+
+
+@dataclass
+class DaggerResult:
+    """Outcome of :func:`run_dagger`: the aggregated data and per-round facts."""
+
+    dataset: ImitationDataset
+    rounds: list[dict[str, float]]
+
+
+def run_dagger(
+    env: Any,
+    expert: Policy,
+    learner: Any,
+    params: EgocentricParams,
+    rounds: int = 3,
+    beta: float | Sequence[float] | Callable[[int], float] = 0.5,
+    episodes_per_round: int = 2,
+    dataset: ImitationDataset | None = None,
+    dataset_path: str | os.PathLike | None = None,
+    bc_kwargs: dict[str, Any] | None = None,
+    seed: int = 0,
+    max_steps: int = 1000,
+    progress: bool = False,
+    log_fn: Callable[[str, float, int], None] | None = None,
+) -> DaggerResult:
+    """DAgger: roll out the learner with beta-mixing, label with the expert, aggregate, refit.
+
+    Args:
+        env: The raw env.
+        expert: Labelling policy.
+        learner: SB3 actor-critic policy, refit in place after each round.
+        params: Egocentric parameters of the learner's input.
+        rounds: Number of collect-and-refit rounds.
+        beta: Schedule of the probability of executing the expert's action (see :func:`beta_schedule`).
+        episodes_per_round: Episodes collected per round.
+        dataset: Initial data (e.g. the BC dataset) to aggregate with.
+        dataset_path: When given, the aggregate is rewritten there after every episode.
+        bc_kwargs: Keyword arguments of :func:`train_bc` for each refit.
+        seed: Base seed: episode seeds, beta coin flips and refits derive from it.
+        max_steps: Step cap per episode.
+        progress: tqdm bars.
+        log_fn: ``log_fn(tag, value, step)`` for per-round scalars.
+    """
+    if rounds < 1 or episodes_per_round < 1:
+        raise ValueError(
+            f"rounds and episodes_per_round must be >= 1, got {rounds}, {episodes_per_round}"
+        )
+    sched = beta_schedule(beta)
+    rng = np.random.default_rng(seed)
+    data = (
+        dataset if dataset is not None else ImitationDataset.empty({"egocentric": params.to_dict()})
+    )
+    writer = DatasetWriter(dataset_path, data.meta) if dataset_path is not None else None
+    if writer is not None and len(data):
+        writer.data = data
+        data.save(writer.path)
+    bc_kwargs = dict(bc_kwargs or {})
+    epochs = int(bc_kwargs.get("epochs", 10))
+    history: list[dict[str, float]] = []
+    episode_seed = seed + 10_000  # away from the seeds an expert dataset usually uses
+    for r in _progress(range(rounds), progress, "DAgger rounds"):
+        b = float(sched(r))
+        t0 = time.perf_counter()
+        covs, fracs, n_new = [], [], 0
+        for _ in range(episodes_per_round):
+            ep_id = int(data.episode_ids.max()) + 1 if len(data) else 0
+            rec = rollout_episode(
+                env,
+                expert,
+                params,
+                learner,
+                b,
+                rng,
+                seed=episode_seed,
+                max_steps=max_steps,
+                episode_id=ep_id,
+            )
+            episode_seed += 1
+            data = data.concatenate(rec.data)
+            if writer is not None:
+                writer.data = data
+                data.save(writer.path)
+            covs.append(rec.coverage)
+            fracs.append(rec.expert_fraction)
+            n_new += len(rec.data)
+        fit = train_bc(
+            data, learner, seed=seed + r, log_fn=log_fn, step_offset=r * epochs, **bc_kwargs
+        )
+        facts = {
+            "round": r,
+            "beta": b,
+            "coverage": float(np.mean(covs)),
+            "expert_fraction": float(np.mean(fracs)),
+            "new_samples": n_new,
+            "dataset_size": len(data),
+            "bc_loss": fit["loss"][-1],
+            "seconds": time.perf_counter() - t0,
+        }
+        history.append(facts)
+        if log_fn is not None:
+            for k in ("beta", "coverage", "expert_fraction", "dataset_size", "bc_loss"):
+                log_fn(f"dagger/{k}", float(facts[k]), r)
+    return DaggerResult(data, history)
+
+
+# ------------------------------------------------------------------- model files
+def save_policy(policy: Any, path: str | os.PathLike, params: EgocentricParams) -> Path:
+    """Save a bare SB3 policy as a zip readable by :func:`load_model` / ``SB3Policy``."""
+    import torch as th
+
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    buf = io.BytesIO()
+    th.save({"state_dict": policy.state_dict(), "data": policy._get_constructor_parameters()}, buf)
+    meta = {
+        "format": "policy",
+        "policy_class": type(policy).__name__,
+        "egocentric": params.to_dict(),
+    }
+    with zipfile.ZipFile(p, "w") as z:
+        z.writestr("policy.pt", buf.getvalue())
+        z.writestr(MODEL_META_NAME, json.dumps(meta, sort_keys=True))
+    return p
+
+
+def tag_model_zip(path: str | os.PathLike, params: EgocentricParams, algo: str) -> None:
+    """Add the egocentric parameters to an SB3 algorithm zip (SB3 ignores the extra entry)."""
+    meta = {"format": "sb3_algorithm", "algo": algo, "egocentric": params.to_dict()}
+    with zipfile.ZipFile(path, "a") as z:
+        if MODEL_META_NAME not in z.namelist():
+            z.writestr(MODEL_META_NAME, json.dumps(meta, sort_keys=True))
+
+
+def load_model(path: str | os.PathLike, device: str = "cpu") -> tuple[Any, EgocentricParams]:
+    """Load ``(sb3_policy, egocentric_params)`` from a PPO/A2C/SAC zip or a :func:`save_policy` zip."""
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"model not found: {str(p)!r}")
+    if not zipfile.is_zipfile(p):
+        raise ValueError(f"{str(p)!r} is not a model zip")
+    with zipfile.ZipFile(p) as z:
+        names = z.namelist()
+        meta = json.loads(z.read(MODEL_META_NAME)) if MODEL_META_NAME in names else {}
+        policy_bytes = z.read("policy.pt") if "policy.pt" in names else None
+        is_algorithm_zip = "data" in names
+    params = EgocentricParams.from_dict(meta.get("egocentric"))
+    if policy_bytes is not None:
+        import torch as th
+        from stable_baselines3.common import policies as sb3_policies
+
+        cls = getattr(
+            sb3_policies, str(meta.get("policy_class", "MultiInputActorCriticPolicy")), None
+        )
+        if cls is None:
+            raise ValueError(f"{str(p)!r}: unknown policy class {meta.get('policy_class')!r}")
+        saved = th.load(io.BytesIO(policy_bytes), map_location=device, weights_only=False)
+        policy = cls(**saved["data"])
+        policy.load_state_dict(saved["state_dict"])
+        policy.to(device)
+        policy.set_training_mode(False)
+        return policy, params
+    if not is_algorithm_zip:
+        raise ValueError(f"{str(p)!r} is neither an SB3 model zip nor a saved policy")
+    import stable_baselines3
+
+    algo_name = str(meta.get("algo", "ppo")).upper()
+    algo_cls = getattr(stable_baselines3, algo_name, None) if algo_name.isalnum() else None
+    if algo_cls is None:
+        raise ValueError(f"{str(p)!r}: unknown SB3 algorithm {algo_name!r}")
+    model = algo_cls.load(p, device=device)
+    model.policy.set_training_mode(False)
+    return model.policy, params

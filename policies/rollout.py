@@ -1,0 +1,345 @@
+"""Run one exploration mission of any :class:`Policy` in a SemanticExplore env.
+
+:func:`run_mission` is the loop behind ``semexplore explore`` and the benchmark harness: reset,
+then ``act`` / ``step`` until the policy says it is done or the env terminates or truncates (or
+``max_time_s`` of simulated time pass). It records the standard exploration metrics (coverage,
+mission time, T90/T99, path length, collisions), a coverage trace, the trajectory and the wall
+time spent in each stage, and optionally writes a GIF.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from policies.base import Policy
+
+#: Stages of the per-stage wall-time split, in the order they are reported.
+STAGES: tuple[str, ...] = (
+    "env_reset",
+    "env_step",
+    "map_generation",
+    "global_planning",
+    "local_planning",
+    "policy_other",
+    "render",
+)
+
+
+@dataclass
+class MissionResult:
+    """Outcome of one mission.
+
+    Attributes:
+        world: The env's world name.
+        policy: The policy's name.
+        seed: Seed given to ``env.reset`` and ``policy.reset``.
+        coverage: Final coverage (fraction of the reachable free area mapped).
+        explored_area_m2: Final free area in the map.
+        mission_time_s: Simulated time at the end of the mission.
+        self_stopped: True when the policy ended the mission (``policy.done``).
+        stop_reason: The policy's reason, or why the env ended it.
+        path_length_m: Distance driven.
+        collisions: Wall contacts begun during the mission.
+        wall_time_s: Wall-clock time of the whole mission (reset, steps, planning, rendering).
+        steps: Env steps taken.
+        terminated: The env terminated (coverage goal reached).
+        truncated: The env truncated, or ``max_time_s`` was reached.
+        t90_s: Simulated time when coverage first reached 0.90 (None if never).
+        t99_s: Simulated time when coverage first reached 0.99 (None if never).
+        mean_map_generation_ms: Mean wall time of the steps that built a map representation.
+        mean_global_planning_ms: Mean wall time of the steps that planned globally.
+        n_replans: Steps with a global replan (``StepStats.replanned``).
+        stage_time_s: Wall time per stage (:data:`STAGES`).
+        coverage_trace: ``(sim_time_s, coverage, explored_area_m2)`` after reset and every step.
+        trajectory: ``(steps + 1, 3)`` poses ``x, y, yaw`` of the observations.
+        policy_counters: The policy's ``counters`` dict, if it has one.
+    """
+
+    world: str
+    policy: str
+    seed: int | None
+    coverage: float
+    explored_area_m2: float
+    mission_time_s: float
+    self_stopped: bool
+    stop_reason: str
+    path_length_m: float
+    collisions: int
+    wall_time_s: float
+    steps: int
+    terminated: bool
+    truncated: bool
+    t90_s: float | None
+    t99_s: float | None
+    mean_map_generation_ms: float
+    mean_global_planning_ms: float
+    n_replans: int
+    stage_time_s: dict[str, float]
+    coverage_trace: list[tuple[float, float, float]] = field(repr=False)
+    trajectory: np.ndarray = field(repr=False)
+    policy_counters: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def speedup(self) -> float:
+        """Simulated time per wall-clock time (inf for an instant mission)."""
+        return self.mission_time_s / self.wall_time_s if self.wall_time_s > 0 else math.inf
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-safe scalars (no trace, no trajectory)."""
+        return {
+            "world": self.world,
+            "policy": self.policy,
+            "seed": self.seed,
+            "coverage": round(float(self.coverage), 6),
+            "explored_area_m2": round(float(self.explored_area_m2), 4),
+            "mission_time_s": round(float(self.mission_time_s), 3),
+            "self_stopped": bool(self.self_stopped),
+            "stop_reason": self.stop_reason,
+            "path_length_m": round(float(self.path_length_m), 3),
+            "collisions": int(self.collisions),
+            "wall_time_s": round(float(self.wall_time_s), 3),
+            "steps": int(self.steps),
+            "T90_s": self.t90_s,
+            "T99_s": self.t99_s,
+            "mean_map_generation_ms": round(float(self.mean_map_generation_ms), 3),
+            "mean_global_planning_ms": round(float(self.mean_global_planning_ms), 3),
+            "n_replans": int(self.n_replans),
+            "stage_time_s": {k: round(float(v), 4) for k, v in self.stage_time_s.items()},
+            "policy_counters": dict(self.policy_counters),
+        }
+
+
+def time_to_coverage(trace: list[tuple[float, float, float]], level: float) -> float | None:
+    """First simulated time at which the coverage in ``trace`` reached ``level`` (None if never)."""
+    for t, c, _ in trace:
+        if c >= level - 1e-12:
+            return float(t)
+    return None
+
+
+def run_mission(
+    env: Any,
+    policy: Policy,
+    seed: int | None,
+    max_time_s: float | None = None,
+    progress: bool = True,
+    gif_path: str | os.PathLike | None = None,
+    on_step: Callable[[int, dict[str, Any], dict[str, Any], np.ndarray, Policy], None]
+    | None = None,
+    *,
+    gif_every_s: float = 2.0,
+    gif_fps: float = 10.0,
+    reset_options: dict[str, Any] | None = None,
+) -> MissionResult:
+    """Run one mission of ``policy`` in ``env``.
+
+    Args:
+        env: A SemanticExplore env (``gym.make`` result, possibly wrapped, raw observations).
+        policy: The policy.
+        seed: Seed for ``env.reset`` and ``policy.reset``.
+        max_time_s: Stop after this much simulated time (None: only the env's own truncation).
+        progress: Show a tqdm bar on stderr (simulated seconds, coverage).
+        gif_path: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
+        on_step: Called after every step as ``on_step(step, obs, info, action, policy)``.
+        gif_every_s: Simulated seconds between GIF frames.
+        gif_fps: GIF playback frame rate.
+        reset_options: ``options`` for ``env.reset``.
+
+    Returns:
+        The :class:`MissionResult`.
+
+    Raises:
+        ValueError: a non-positive ``max_time_s``, or ``gif_path`` with an env that cannot render
+            RGB frames.
+    """
+    if max_time_s is not None and not (max_time_s > 0 and math.isfinite(max_time_s)):
+        raise ValueError(f"max_time_s must be a positive number or None, got {max_time_s!r}")
+    if gif_path is not None:
+        if getattr(env, "render_mode", None) != "rgb_array":
+            raise ValueError(
+                f"gif_path needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
+            )
+        if not gif_every_s > 0:
+            raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
+    stage = dict.fromkeys(STAGES, 0.0)
+    wall0 = time.perf_counter()
+    obs, info = env.reset(seed=seed, options=reset_options)
+    t1 = time.perf_counter()
+    stage["env_reset"] = t1 - wall0
+    policy.reset(obs, info, seed=seed)
+    stage["policy_other"] += time.perf_counter() - t1
+
+    unwrapped = getattr(env, "unwrapped", env)
+    world_name = str(
+        getattr(getattr(unwrapped, "world", None), "name", getattr(unwrapped, "world_spec", "?"))
+    )
+    dt_s = float(info.get("dt_s", 0.2))
+    limit_s = max_time_s if max_time_s is not None else math.inf
+    trace: list[tuple[float, float, float]] = [
+        (
+            float(info.get("sim_time_s", 0.0)),
+            float(info["coverage"]),
+            float(info["explored_area_m2"]),
+        )
+    ]
+    poses = [np.asarray(obs["pose"], dtype=np.float64).copy()]
+    frames: list[np.ndarray] = []
+    next_frame_s = 0.0
+    map_ms: list[float] = []
+    glob_ms: list[float] = []
+    n_replans = 0
+    steps = 0
+    terminated = truncated = False
+
+    def grab_frame() -> None:
+        tr = time.perf_counter()
+        unwrapped.set_overlay(policy.overlay())
+        frame = env.render()
+        if frame is not None:
+            frames.append(np.asarray(frame))
+        stage["render"] += time.perf_counter() - tr
+
+    bar = _progress_bar(
+        progress, limit_s if math.isfinite(limit_s) else None, world_name, policy.name
+    )
+    try:
+        if gif_path is not None:
+            grab_frame()
+            next_frame_s = gif_every_s
+        while True:
+            ta = time.perf_counter()
+            action = policy.act(obs, info)
+            tb = time.perf_counter()
+            st = policy.last_stats
+            stage["map_generation"] += st.map_generation_ms / 1e3
+            stage["global_planning"] += st.global_planning_ms / 1e3
+            stage["local_planning"] += st.local_planning_ms / 1e3
+            stage["policy_other"] += max(
+                0.0,
+                (tb - ta)
+                - (st.map_generation_ms + st.global_planning_ms + st.local_planning_ms) / 1e3,
+            )
+            if st.map_generation_ms > 0:
+                map_ms.append(st.map_generation_ms)
+            if st.replanned or st.global_planning_ms > 0:
+                glob_ms.append(st.global_planning_ms)
+            n_replans += int(st.replanned)
+            if policy.done:
+                break
+            obs, _, terminated, truncated, info = env.step(action)
+            stage["env_step"] += time.perf_counter() - tb
+            steps += 1
+            sim_t = float(info["sim_time_s"])
+            trace.append((sim_t, float(info["coverage"]), float(info["explored_area_m2"])))
+            poses.append(np.asarray(obs["pose"], dtype=np.float64).copy())
+            if on_step is not None:
+                on_step(steps, obs, info, action, policy)
+            if gif_path is not None and sim_t >= next_frame_s - 1e-9:
+                grab_frame()
+                next_frame_s += gif_every_s
+            if bar is not None:
+                bar.update(dt_s)
+                if steps % 25 == 0:
+                    bar.set_postfix(
+                        coverage=f"{info['coverage']:.3f}",
+                        mode=str(st.extra.get("mode", "")),
+                        refresh=False,
+                    )
+            if terminated or truncated or sim_t >= limit_s - 1e-9:
+                break
+        if gif_path is not None:
+            grab_frame()
+    finally:
+        if bar is not None:
+            bar.close()
+    sim_t = float(info["sim_time_s"])
+    if policy.done:
+        reason = policy.stop_reason or "policy done"
+    elif terminated:
+        reason = "env terminated (coverage goal reached)"
+    elif truncated:
+        reason = "env truncated (episode time limit)"
+    else:
+        reason = f"max_time_s reached ({max_time_s:g} s)"
+    wall = time.perf_counter() - wall0
+    if gif_path is not None:
+        t_save = time.perf_counter()
+        save_gif(frames, gif_path, fps=gif_fps)
+        stage["render"] += time.perf_counter() - t_save
+        wall = time.perf_counter() - wall0
+    return MissionResult(
+        world=world_name,
+        policy=policy.name,
+        seed=seed,
+        coverage=float(info["coverage"]),
+        explored_area_m2=float(info["explored_area_m2"]),
+        mission_time_s=sim_t,
+        self_stopped=bool(policy.done),
+        stop_reason=reason,
+        path_length_m=float(info["path_length_m"]),
+        collisions=int(info["collisions"]),
+        wall_time_s=wall,
+        steps=steps,
+        terminated=bool(terminated),
+        truncated=bool(truncated or (not terminated and not policy.done)),
+        t90_s=time_to_coverage(trace, 0.90),
+        t99_s=time_to_coverage(trace, 0.99),
+        mean_map_generation_ms=float(np.mean(map_ms)) if map_ms else 0.0,
+        mean_global_planning_ms=float(np.mean(glob_ms)) if glob_ms else 0.0,
+        n_replans=n_replans,
+        stage_time_s=stage,
+        coverage_trace=trace,
+        trajectory=np.asarray(poses),
+        policy_counters=dict(getattr(policy, "counters", {}) or {}),
+    )
+
+
+def save_gif(frames: list[np.ndarray], path: str | os.PathLike, fps: float = 10.0) -> Path:
+    """Write RGB frames as an animated GIF with Pillow (adaptive palette, looping)."""
+    if not frames:
+        raise ValueError("no frames to write")
+    from PIL import Image
+
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    images = [
+        Image.fromarray(np.ascontiguousarray(f[..., :3]).astype(np.uint8)).convert(
+            "P", palette=Image.Palette.ADAPTIVE, colors=128
+        )
+        for f in frames
+    ]
+    images[0].save(
+        out,
+        save_all=True,
+        append_images=images[1:],
+        duration=max(20, int(round(1000.0 / fps))),
+        loop=0,
+    )
+    return out
+
+
+def _progress_bar(enabled: bool, total_s: float | None, world: str, policy: str) -> Any:
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a dependency
+        return None
+    return tqdm(
+        total=total_s,
+        unit="sim s",
+        desc=f"{policy} on {world}",
+        file=sys.stderr,
+        leave=False,
+        bar_format=None,
+        dynamic_ncols=True,
+    )

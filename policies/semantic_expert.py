@@ -1,0 +1,657 @@
+"""The paper's semantic exploration strategy as a scripted expert :class:`Policy`.
+
+Each replanning step (section II of Fredriksson et al.):
+
+1. **Pose identification.** Segment the observed occupancy grid into the semantic topometric
+   map (``segment_map``); the frontiers ``F_i`` are those of its frontier pathways.
+2. **Goal selection.** Algorithm 1 (:mod:`semexplore_gym.core.graph_search`) finds the path
+   along the map to every frontier and scores it with
+   ``C = d / L_path + w_v v - (w_p p_l + w_I (O(I) + P_u(I)))``; ``F* = argmin C``.
+3. **Navigation.** Every step, the modified potential field
+   (:mod:`semexplore_gym.core.potential_field`) follows the path to ``F*``.
+4. **Stop.** The mission ends when no frontier remains.
+
+The policy is honest: it reads only the observation (``map``, ``pose``, ``scan``) and the
+static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), never ground truth.
+
+What the paper leaves open, and how this policy handles it (parameters in
+:class:`SemanticExpertParams`, all times in simulated seconds):
+
+* **Periodic replanning** (``replan_period_s``): the map changes every step, but segmentation
+  and search run only every ``replan_period_s``, and at once when the goal is reached (within
+  ``goal_reached_radius_m``), when the path is used up, or when recovery ends.
+* **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
+  pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
+  old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
+  cheaper by more than ``switch_margin`` (cost units of ``C``). This stops the robot from
+  oscillating between near-equal frontiers.
+* **Narrow frontiers** (``min_frontier_width_m``): frontier openings narrower than this are
+  ignored; the segmentation's ``clearance_m = radius + clearance_margin_m`` already drops
+  passages the robot cannot follow.
+* **Path entry check**: when the straight first leg from the robot to the map's path crosses
+  an occupied cell (the robot stands outside every area, e.g. in a corridor the map does not
+  cover yet), a grid BFS path with the robot's clearance leads to the path's start instead.
+* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_cells``,
+  ``fallback_reach_m``): while the topometric map has no usable frontier (no frontier pathway
+  yet, frontiers sealed by the segmentation), the robot drives to the nearest frontier that a
+  BFS with its clearance can reach (:mod:`semexplore_gym.core.reachable_frontiers`).
+* **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
+  replans found no frontier from either source.
+* **Local-minimum escape** (``local_min_timeout_s``, ``escape_duration_s``,
+  ``escape_repulsion_scale``): when the field has held the robot almost still (forward command
+  below 10 % of the maximum) for ``local_min_timeout_s`` (a doorway or dead end where
+  repulsion cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the
+  collision guard of the field still keeps the robot off the walls.
+* **Stuck recovery** (``stuck_timeout_s``, ``stuck_radius_m``, ``progress_timeout_s``,
+  ``progress_min_new_cells``, ``backoff_duration_s``, ``backoff_speed_fraction``): the robot is
+  stuck when it stayed within ``stuck_radius_m`` for ``stuck_timeout_s`` while the map grew by
+  fewer than ``progress_min_new_cells`` known cells, or when for ``progress_timeout_s`` neither
+  the remaining path to its goal shrank (by 0.1 m) nor the map grew. It then backs off for
+  ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
+  space when the way back is blocked), blacklists the goal and replans.
+* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
+  blacklisted by recovery, or reached ``max_goal_reaches`` times without their frontier
+  disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
+  the mission.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from policies.base import Policy, StepStats
+from semexplore_gym.core.graph_search import (
+    FrontierCandidate,
+    FrontierCostWeights,
+    search_frontier_paths,
+)
+from semexplore_gym.core.grid import UNKNOWN, GridGeometry
+from semexplore_gym.core.line_of_sight import segment_is_clear
+from semexplore_gym.core.potential_field import (
+    PotentialFieldCommand,
+    PotentialFieldParams,
+    RobotLimits,
+    beam_angles_rad,
+    front_free_distance,
+    potential_field_command,
+    resample_polyline,
+)
+from semexplore_gym.core.reachable_frontiers import (
+    clearance_field_m,
+    grid_path_to,
+    nearest_reachable_frontier,
+)
+from semexplore_gym.core.topometric.types import TopometricMap
+
+Segmenter = Callable[..., TopometricMap]
+
+
+@dataclass(frozen=True)
+class SemanticExpertParams:
+    """All parameters of the semantic expert (defaults: the paper's weights, then ours).
+
+    Attributes:
+        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (paper: 4, 0.2, 0.1).
+        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (paper: 30, 0.065, 1.5) and
+            the command mapping.
+        prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
+        clearance_margin_m: Segmentation clearance is the robot radius plus this.
+        replan_period_s: Replanning period (segmentation + Algorithm 1).
+        goal_reached_radius_m: The goal counts as reached within this distance.
+        commitment_radius_m: A frontier this close to the current goal is the same goal.
+        switch_margin: Another frontier replaces the current one only if cheaper by this much.
+        min_frontier_width_m: Narrower frontier openings are ignored.
+        grid_fallback: Use the grid BFS frontier while the topometric map offers none.
+        fallback_min_frontier_cells: Smallest frontier group the fallback considers (cells).
+        fallback_reach_m: The fallback's goal lies within this distance of the frontier.
+        stop_confirmations: Consecutive replans without any frontier before stopping.
+        local_min_timeout_s: Time almost still (forward command < 10 % of max) before escaping.
+        escape_duration_s: Duration of a local-minimum escape.
+        escape_repulsion_scale: Factor on ``f_o`` during an escape.
+        stuck_timeout_s: Time within ``stuck_radius_m`` (and no map growth) that means stuck.
+        stuck_radius_m: See ``stuck_timeout_s``.
+        progress_timeout_s: Time without path progress nor map growth that means stuck.
+        progress_min_new_cells: Known cells the map must gain to count as growth.
+        backoff_duration_s: Length of the back-off manoeuvre of a stuck recovery.
+        backoff_speed_fraction: Back-off speed as a fraction of the top speed.
+        blacklist_radius_m: Frontiers this close to a blacklisted goal are ignored.
+        max_goal_reaches: A goal reached this many times without clearing is blacklisted.
+    """
+
+    cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
+    potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
+    prune_by: Literal["opening", "area"] = "opening"
+    clearance_margin_m: float = 0.05
+    replan_period_s: float = 1.0
+    goal_reached_radius_m: float = 0.35
+    commitment_radius_m: float = 1.0
+    switch_margin: float = 0.5
+    min_frontier_width_m: float = 0.25
+    grid_fallback: bool = True
+    fallback_min_frontier_cells: int = 4
+    fallback_reach_m: float = 0.3
+    stop_confirmations: int = 2
+    local_min_timeout_s: float = 3.0
+    escape_duration_s: float = 4.0
+    escape_repulsion_scale: float = 0.3
+    stuck_timeout_s: float = 8.0
+    stuck_radius_m: float = 0.25
+    progress_timeout_s: float = 30.0
+    progress_min_new_cells: int = 20
+    backoff_duration_s: float = 1.5
+    backoff_speed_fraction: float = 0.5
+    blacklist_radius_m: float = 0.5
+    max_goal_reaches: int = 2
+
+    def __post_init__(self) -> None:
+        if self.prune_by not in ("opening", "area"):
+            raise ValueError(f"prune_by must be 'opening' or 'area', got {self.prune_by!r}")
+        positive = (
+            "replan_period_s",
+            "goal_reached_radius_m",
+            "stuck_timeout_s",
+            "stuck_radius_m",
+            "progress_timeout_s",
+            "local_min_timeout_s",
+        )
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        nonneg = (
+            "clearance_margin_m",
+            "commitment_radius_m",
+            "switch_margin",
+            "min_frontier_width_m",
+            "fallback_reach_m",
+            "escape_duration_s",
+            "escape_repulsion_scale",
+            "backoff_duration_s",
+            "blacklist_radius_m",
+        )
+        for name in nonneg:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        if not 0.0 <= self.backoff_speed_fraction <= 1.0:
+            raise ValueError(
+                f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
+            )
+        for name in (
+            "fallback_min_frontier_cells",
+            "stop_confirmations",
+            "max_goal_reaches",
+            "progress_min_new_cells",
+        ):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
+
+
+@dataclass
+class _Plan:
+    source: Literal["semantic", "fallback"]
+    goal_xy_m: tuple[float, float]
+    path_m: np.ndarray
+    candidate: FrontierCandidate | None
+    progress: int = 0
+
+
+class SemanticExpertPolicy(Policy):
+    """The paper's exploration strategy (semantic goal selection + modified potential field).
+
+    Args:
+        params: Parameters (default: the paper's weights and our robustness settings).
+        segmenter: ``segment_map``-compatible callable ``(grid, geometry, clearance_m,
+            previous=...) -> TopometricMap``; default
+            :func:`semexplore_gym.core.topometric.segment_map`.
+
+    Attributes (after ``reset``): ``tmap`` the last topometric map, ``candidates`` the scored
+    frontiers of the last replan, ``mode`` (``"semantic"``, ``"fallback"``, ``"escape"``,
+    ``"recovery"``, ``"waiting"``, ``"done"``) and ``counters`` (replans, recoveries, ...).
+    """
+
+    name = "semantic"
+
+    def __init__(
+        self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
+    ) -> None:
+        super().__init__()
+        self.params = params if params is not None else SemanticExpertParams()
+        self._segmenter = segmenter
+        self.tmap: TopometricMap | None = None
+        self.candidates: list[FrontierCandidate] = []
+        self.mode = "idle"
+        self.counters: dict[str, int] = {}
+        self.events: list[tuple[float, str, str]] = []
+
+    # ------------------------------------------------------------------ lifecycle
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
+        super().reset(obs, info, seed=seed)
+        try:
+            self.geometry = GridGeometry.from_dict(info["map_geometry"])
+            robot = info["robot"]
+            lidar = info["lidar"]
+            self.dt_s = float(info["dt_s"])
+            self.limits = RobotLimits(
+                radius_m=float(robot["radius_m"]),
+                max_linear_speed_mps=float(robot["max_linear_speed_mps"]),
+                max_angular_speed_radps=float(robot["max_angular_speed_radps"]),
+                max_range_m=float(lidar["max_range_m"]),
+            )
+        except KeyError as e:
+            raise ValueError(
+                f"info lacks {e.args[0]!r}: reset needs the env's map_geometry, robot, lidar and dt_s"
+            ) from e
+        if self._segmenter is None:
+            from semexplore_gym.core.topometric import segment_map
+
+            self._segmenter = segment_map
+        self.clearance_m = self.limits.radius_m + self.params.clearance_margin_m
+        self.tmap = None
+        self.candidates = []
+        self.mode = "idle"
+        self.events: list[tuple[float, str, str]] = []
+        self.counters = {
+            "replans": 0,
+            "semantic_plans": 0,
+            "fallback_plans": 0,
+            "entry_detours": 0,
+            "escapes": 0,
+            "recoveries": 0,
+            "blacklisted": 0,
+            "switches": 0,
+        }
+        self._angles: np.ndarray | None = None
+        self._time_s = 0.0
+        self._plan: _Plan | None = None
+        self._next_replan_s = 0.0
+        self._empty_replans = 0
+        self._blacklist: list[tuple[float, float]] = []
+        self._reaches: list[tuple[float, float, int]] = []
+        self._area_types: np.ndarray | None = None
+        self._last_cmd: PotentialFieldCommand | None = None
+        self._still_s = 0.0
+        self._escape_until_s = -1.0
+        self._recovery_until_s = -1.0
+        self._recovery_turn = 0.0
+        self._known_cells = int(np.count_nonzero(np.asarray(obs["map"]) != UNKNOWN))
+        self._anchor_xy = (float(obs["pose"][0]), float(obs["pose"][1]))
+        self._anchor_t_s = 0.0
+        self._anchor_known = self._known_cells
+        self._progress_t_s = 0.0
+        self._progress_known = self._known_cells
+        self._best_remaining_m = math.inf
+
+    # ------------------------------------------------------------------ stepping
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        t_start = time.perf_counter()
+        stats = StepStats()
+        if self.done:
+            self.last_stats = stats
+            return np.zeros(2, dtype=np.float32)
+        grid = obs["map"]
+        pose = tuple(float(v) for v in obs["pose"])
+        scan = np.asarray(obs["scan"], dtype=np.float64)
+        if self._angles is None or len(self._angles) != len(scan):
+            self._angles = beam_angles_rad(len(scan))
+        self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
+
+        if self._time_s < self._recovery_until_s:
+            v, w = self._recovery_command(scan)
+            self.mode = "recovery"
+        else:
+            if self._recovery_until_s > 0.0:
+                # Recovery just ended: give up the goal that got us stuck, replan at once.
+                self._recovery_until_s = -1.0
+                self._blacklist_goal()
+            if self._needs_replan(pose):
+                self._replan(grid, pose, stats)
+            if self.done:
+                v, w = 0.0, 0.0
+            elif self._plan is None:
+                v, w = 0.0, 0.0
+                self.mode = "waiting"
+            else:
+                v, w = self._follow(grid, pose, scan)
+                self._watch_progress(pose)
+                if self._time_s < self._recovery_until_s:
+                    v, w = self._recovery_command(scan)
+        self._time_s += self.dt_s
+        action = np.array(
+            [
+                np.clip(v / self.limits.max_linear_speed_mps, -1.0, 1.0),
+                np.clip(w / self.limits.max_angular_speed_radps, -1.0, 1.0),
+            ],
+            dtype=np.float32,
+        )
+        total_ms = (time.perf_counter() - t_start) * 1e3
+        stats.local_planning_ms = max(
+            0.0, total_ms - stats.map_generation_ms - stats.global_planning_ms
+        )
+        stats.extra["mode"] = self.mode
+        self.last_stats = stats
+        return action
+
+    def _needs_replan(self, pose: tuple[float, float, float]) -> bool:
+        plan = self._plan
+        if plan is None or self._time_s >= self._next_replan_s - 1e-9:
+            return True
+        if (
+            math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
+            <= self.params.goal_reached_radius_m
+        ):
+            self._register_reach(plan.goal_xy_m)
+            return True
+        return plan.progress >= len(plan.path_m) - 1
+
+    # ------------------------------------------------------------------ planning
+    def _replan(self, grid: np.ndarray, pose: tuple[float, float, float], stats: StepStats) -> None:
+        prm = self.params
+        stats.replanned = True
+        self.counters["replans"] += 1
+        self._next_replan_s = self._time_s + prm.replan_period_s
+        t0 = time.perf_counter()
+        assert self._segmenter is not None
+        tmap = self._segmenter(grid, self.geometry, self.clearance_m, previous=self.tmap)
+        t1 = time.perf_counter()
+        stats.map_generation_ms = (t1 - t0) * 1e3
+        self.tmap = tmap
+        self._area_types = None
+
+        cands, _ = search_frontier_paths(
+            tmap,
+            pose[:2],
+            pose[2],
+            prm.cost,
+            prune_by=prm.prune_by,
+            min_frontier_width_m=prm.min_frontier_width_m,
+        )
+        cands = [c for c in cands if not self._is_blacklisted(c.goal_xy_m)]
+        self.candidates = cands
+        new_plan: _Plan | None = None
+        clearance: np.ndarray | None = None
+        if cands:
+            chosen = self._commit(cands)
+            path = chosen.path_m
+            if len(path) >= 2 and not segment_is_clear(
+                grid, self.geometry, pose[:2], tuple(path[1])
+            ):
+                # The straight first leg crosses a wall: reach the map's path over the grid.
+                clearance = clearance_field_m(grid, self.geometry.resolution_m)
+                detour = grid_path_to(
+                    grid,
+                    self.geometry,
+                    pose[:2],
+                    tuple(path[1]),
+                    self.clearance_m,
+                    clearance_field=clearance,
+                )
+                if detour is not None:
+                    path = np.vstack([detour, path[2:]])
+                    self.counters["entry_detours"] += 1
+                else:
+                    chosen = None  # type: ignore[assignment]
+            if chosen is not None:
+                new_plan = _Plan(
+                    "semantic",
+                    chosen.goal_xy_m,
+                    resample_polyline(path, self.geometry.resolution_m),
+                    chosen,
+                )
+        if new_plan is None and prm.grid_fallback:
+            if clearance is None:
+                clearance = clearance_field_m(grid, self.geometry.resolution_m)
+            found = nearest_reachable_frontier(
+                grid,
+                self.geometry,
+                pose[:2],
+                self.clearance_m,
+                min_frontier_cells=prm.fallback_min_frontier_cells,
+                reach_m=prm.fallback_reach_m,
+                excluded_xy_m=self._blacklist,
+                excluded_radius_m=prm.blacklist_radius_m,
+                clearance_field=clearance,
+            )
+            if found is not None:
+                new_plan = _Plan(
+                    "fallback",
+                    found.goal_xy_m,
+                    resample_polyline(found.path_m, self.geometry.resolution_m),
+                    None,
+                )
+        stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
+
+        if new_plan is None:
+            self._plan = None
+            self._empty_replans += 1
+            # Look again at the next step before giving up.
+            self._next_replan_s = self._time_s
+            if self._empty_replans >= prm.stop_confirmations:
+                self.done = True
+                self.mode = "done"
+                n_black = len(self._blacklist)
+                self.stop_reason = "no frontier left" + (
+                    f" ({n_black} unreachable frontier(s) blacklisted)" if n_black else ""
+                )
+            return
+        self._empty_replans = 0
+        old = self._plan
+        if (
+            old is None
+            or math.hypot(
+                old.goal_xy_m[0] - new_plan.goal_xy_m[0], old.goal_xy_m[1] - new_plan.goal_xy_m[1]
+            )
+            > prm.commitment_radius_m
+        ):
+            # A new goal: measure progress towards it from scratch.
+            self._best_remaining_m = math.inf
+            if old is not None:
+                self.counters["switches"] += 1
+        self._plan = new_plan
+        self.mode = new_plan.source
+        self.counters["semantic_plans" if new_plan.source == "semantic" else "fallback_plans"] += 1
+
+    def _commit(self, cands: list[FrontierCandidate]) -> FrontierCandidate:
+        """Goal commitment: keep the current frontier unless another is clearly cheaper."""
+        best = cands[0]
+        old = self._plan
+        if old is None or old.source != "semantic" or old.candidate is None:
+            return best
+        same = [
+            c
+            for c in cands
+            if c.frontier.area_id == old.candidate.frontier.area_id
+            or math.hypot(c.goal_xy_m[0] - old.goal_xy_m[0], c.goal_xy_m[1] - old.goal_xy_m[1])
+            <= self.params.commitment_radius_m
+        ]
+        if not same:
+            return best
+        keep = min(same, key=lambda c: c.cost)
+        return keep if keep.cost <= best.cost + self.params.switch_margin else best
+
+    # ------------------------------------------------------------------ following
+    def _follow(
+        self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
+    ) -> tuple[float, float]:
+        plan = self._plan
+        assert plan is not None
+        prm = self.params
+        escaping = self._time_s < self._escape_until_s
+        cmd = potential_field_command(
+            scan,
+            pose,
+            plan.path_m,
+            grid,
+            self.geometry,
+            self.limits,
+            prm.potential_field,
+            start_index=plan.progress,
+            repulsion_scale=prm.escape_repulsion_scale if escaping else 1.0,
+        )
+        self._last_cmd = cmd
+        self._advance_progress(plan, pose)
+        if not escaping:
+            self.mode = plan.source
+            if cmd.v_mps < 0.1 * self.limits.max_linear_speed_mps:
+                self._still_s += self.dt_s
+            else:
+                self._still_s = 0.0
+            if self._still_s >= prm.local_min_timeout_s:
+                self._still_s = 0.0
+                self._escape_until_s = self._time_s + prm.escape_duration_s
+                self.counters["escapes"] += 1
+                self._log("escape", f"goal={plan.goal_xy_m}")
+        else:
+            self.mode = "escape"
+        return cmd.v_mps, cmd.omega_radps
+
+    def _advance_progress(self, plan: _Plan, pose: tuple[float, float, float]) -> None:
+        # The nearest path point in a short window ahead: the part behind is done.
+        lo = plan.progress
+        hi = min(len(plan.path_m), lo + int(math.ceil(1.5 / self.geometry.resolution_m)) + 1)
+        seg = plan.path_m[lo:hi]
+        d = np.hypot(seg[:, 0] - pose[0], seg[:, 1] - pose[1])
+        i = int(np.argmin(d))
+        if d[i] <= 0.5:
+            plan.progress = lo + i
+
+    def _remaining_m(self, plan: _Plan) -> float:
+        rest = plan.path_m[plan.progress :]
+        return float(np.hypot(*np.diff(rest, axis=0).T).sum()) if len(rest) > 1 else 0.0
+
+    # ------------------------------------------------------------------ stuck handling
+    def _watch_progress(self, pose: tuple[float, float, float]) -> None:
+        prm = self.params
+        plan = self._plan
+        t = self._time_s
+        if math.hypot(
+            pose[0] - self._anchor_xy[0], pose[1] - self._anchor_xy[1]
+        ) > prm.stuck_radius_m or (
+            self._known_cells - self._anchor_known >= prm.progress_min_new_cells
+        ):
+            self._anchor_xy = (pose[0], pose[1])
+            self._anchor_t_s = t
+            self._anchor_known = self._known_cells
+        if plan is not None:
+            remaining = self._remaining_m(plan)
+            if (
+                remaining < self._best_remaining_m - 0.1
+                or self._known_cells - self._progress_known >= prm.progress_min_new_cells
+            ):
+                self._best_remaining_m = min(remaining, self._best_remaining_m)
+                self._progress_t_s = t
+                self._progress_known = self._known_cells
+        if (
+            t - self._anchor_t_s >= prm.stuck_timeout_s
+            or t - self._progress_t_s >= prm.progress_timeout_s
+        ):
+            self._start_recovery()
+
+    def _log(self, event: str, detail: str = "") -> None:
+        self.events.append((round(self._time_s, 2), event, detail))
+
+    def _start_recovery(self) -> None:
+        self.counters["recoveries"] += 1
+        goal = self._plan.goal_xy_m if self._plan is not None else None
+        self._log("recovery", f"goal={goal}")
+        self._recovery_until_s = self._time_s + self.params.backoff_duration_s
+        self._recovery_turn = 1.0 if self.rng.random() < 0.5 else -1.0
+        self.mode = "recovery"
+        self._reset_watchdogs()
+
+    def _reset_watchdogs(self) -> None:
+        self._anchor_t_s = self._progress_t_s = self._time_s + self.params.backoff_duration_s
+        self._anchor_known = self._progress_known = self._known_cells
+        self._best_remaining_m = math.inf
+        self._still_s = 0.0
+
+    def _recovery_command(self, scan: np.ndarray) -> tuple[float, float]:
+        assert self._angles is not None
+        lim = self.limits
+        margin = self.params.potential_field.safety_margin_m
+        back = front_free_distance(
+            scan, self._angles, lim.max_range_m, lim.radius_m + margin, backwards=True
+        )
+        if back > 0.05:
+            v = -self.params.backoff_speed_fraction * lim.max_linear_speed_mps
+            v = max(v, -back / self.params.potential_field.braking_time_s)
+            return v, 0.0
+        # The way back is blocked too: turn towards the most open direction.
+        ok = (scan > 0) & np.isfinite(scan)
+        if not ok.any():
+            return 0.0, self._recovery_turn * 0.5 * lim.max_angular_speed_radps
+        k = int(np.argmax(np.where(ok, scan, -1.0)))
+        ang = math.atan2(math.sin(self._angles[k]), math.cos(self._angles[k]))
+        return 0.0, float(
+            np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps)
+        )
+
+    def _blacklist_goal(self) -> None:
+        plan = self._plan
+        if plan is not None:
+            self._blacklist.append(plan.goal_xy_m)
+            self.counters["blacklisted"] += 1
+            self._log("blacklist", f"stuck: {plan.goal_xy_m}")
+        self._plan = None
+        self._next_replan_s = self._time_s
+
+    def _register_reach(self, goal: tuple[float, float]) -> None:
+        r = self.params.blacklist_radius_m
+        for i, (x, y, n) in enumerate(self._reaches):
+            if math.hypot(goal[0] - x, goal[1] - y) <= r:
+                self._reaches[i] = (x, y, n + 1)
+                if n + 1 >= self.params.max_goal_reaches:
+                    self._blacklist.append((x, y))
+                    self.counters["blacklisted"] += 1
+                    self._log("blacklist", f"reached {n + 1} times: {(x, y)}")
+                return
+        self._reaches.append((goal[0], goal[1], 1))
+        if self.params.max_goal_reaches <= 1:
+            self._blacklist.append(goal)
+            self.counters["blacklisted"] += 1
+
+    def _is_blacklisted(self, xy: tuple[float, float]) -> bool:
+        r = self.params.blacklist_radius_m
+        return any(math.hypot(xy[0] - x, xy[1] - y) <= r for x, y in self._blacklist)
+
+    # ------------------------------------------------------------------ drawing
+    def overlay(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if self.tmap is not None:
+            if self._area_types is None:
+                self._area_types = area_type_raster(self.tmap)
+            out["area_types"] = self._area_types
+        if self._plan is not None:
+            out["paths_m"] = [self._plan.path_m]
+            out["goal_m"] = self._plan.goal_xy_m
+        out["frontiers_m"] = [c.goal_xy_m for c in self.candidates]
+        if self._last_cmd is not None and self._plan is not None:
+            out["points_m"] = [self._last_cmd.goal_xy_m]
+        text = f"{self.name}: {self.mode}"
+        if self.done:
+            text += f" ({self.stop_reason})"
+        out["text"] = text
+        return out
+
+
+def area_type_raster(tmap: TopometricMap) -> np.ndarray:
+    """``(H, W)`` int16 raster of :class:`AreaType` values of the map's areas; -1 elsewhere."""
+    ids = tmap.area_ids
+    out = np.full(ids.shape, -1, dtype=np.int16)
+    inside = ids >= 0
+    if not inside.any() or not tmap.areas:
+        return out
+    uniq, inv = np.unique(ids[inside], return_inverse=True)
+    lut = np.array(
+        [int(tmap.areas[int(a)].type) if int(a) in tmap.areas else -1 for a in uniq], dtype=np.int16
+    )
+    out[inside] = lut[inv]
+    return out

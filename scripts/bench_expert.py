@@ -1,0 +1,112 @@
+"""Benchmark a whole semantic-expert mission: simulated time / wall time and the stage split.
+
+A warm-up mission (numba compilation, caches) runs first and is not timed. Then each timed
+mission runs the full loop (env stepping, segmentation, Algorithm 1, potential field) and the
+script prints the speed-up over simulated time and where the wall time went. The acceptance
+target is a maze1 mission at >= 100x simulated time.
+
+Usage::
+
+    python scripts/bench_expert.py [--world maze1] [--seeds 0 1 2] [--set KEY=VALUE] [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--world", default="maze1", help="world spec (default: maze1)")
+    ap.add_argument(
+        "--seeds", type=int, nargs="+", default=[0], help="seeds of the timed missions (default: 0)"
+    )
+    ap.add_argument(
+        "--config", default=None, help="policy config YAML (sections env / policy / params)"
+    )
+    ap.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="policy parameter override",
+    )
+    ap.add_argument(
+        "--max-time-s", type=float, default=1200.0, help="simulated time limit (default: 1200)"
+    )
+    ap.add_argument("--no-warmup", action="store_true", help="skip the untimed warm-up mission")
+    ap.add_argument(
+        "--json", action="store_true", help="print one JSON object per mission instead of the table"
+    )
+    args = ap.parse_args(argv)
+
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401
+    from policies.config import load_policy_config
+    from policies.registry import make_policy
+    from policies.rollout import STAGES, run_mission
+    from semexplore_gym.core.params import parse_override
+
+    cfg = load_policy_config(args.config)
+    kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}
+    if cfg.params:
+        kwargs["params"] = cfg.params
+    env = gym.make(
+        "SemanticExplore-v0",
+        world=args.world,
+        config=cfg.env,
+        overrides=[f"episode.max_time_s={args.max_time_s!r}"],
+    )
+    if not args.no_warmup:
+        run_mission(
+            env,
+            make_policy("semantic", **dict(kwargs)),
+            seed=args.seeds[0],
+            max_time_s=args.max_time_s,
+            progress=False,
+        )
+    rows = []
+    for seed in args.seeds:
+        res = run_mission(
+            env,
+            make_policy("semantic", **dict(kwargs)),
+            seed=seed,
+            max_time_s=args.max_time_s,
+            progress=False,
+        )
+        rows.append(res)
+        s = res.summary()
+        if args.json:
+            print(json.dumps({**s, "speedup": round(res.speedup, 1)}), flush=True)
+            continue
+        print(
+            f"{res.world} seed {seed}: {s['mission_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s wall -> {res.speedup:.0f}x "
+            f"(coverage {s['coverage']:.3f}, {s['steps']} steps, {s['n_replans']} replans, stop: {s['stop_reason']})"
+        )
+        print(
+            f"  map generation {s['mean_map_generation_ms']:.2f} ms / replan, global planning {s['mean_global_planning_ms']:.2f} ms / replan"
+        )
+        total = sum(res.stage_time_s.values())
+        print(f"  {'stage':16s} {'total s':>8s} {'ms/step':>8s} {'share':>6s}")
+        for k in STAGES:
+            v = res.stage_time_s[k]
+            print(
+                f"  {k:16s} {v:8.3f} {1e3 * v / max(1, res.steps):8.3f} {100 * v / total if total else 0:5.1f}%"
+            )
+    env.close()
+    if not args.json and len(rows) > 1:
+        sp = np.array([r.speedup for r in rows])
+        print(
+            f"speed-up over {len(rows)} missions: median {np.median(sp):.0f}x, min {sp.min():.0f}x"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,180 @@
+"""``semexplore explore``: run one exploration mission and print its metrics.
+
+Example::
+
+    semexplore explore --world maze1 --policy semantic --seed 0 --gif maze1.gif
+    semexplore explore --world ../shared/maps/turtlebot3/world/map.yaml --json
+    semexplore explore --world maze2 --config configs/expert/paper.yaml --set cost.w_v=2
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+#: Keys of the ``--json`` object, in order.
+JSON_KEYS: tuple[str, ...] = (
+    "coverage",
+    "mission_time_s",
+    "self_stopped",
+    "stop_reason",
+    "path_length_m",
+    "collisions",
+    "wall_time_s",
+)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        "explore",
+        help="run one exploration mission and print coverage, mission time, path length, collisions",
+        description="Run one exploration mission of a policy (default: the semantic expert) and print its metrics.",
+    )
+    p.add_argument(
+        "--world",
+        default="maze1",
+        help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json (default: maze1)",
+    )
+    p.add_argument(
+        "--policy", default=None, help="policy spec: semantic (default), random, sb3:MODEL.zip, ..."
+    )
+    p.add_argument(
+        "--seed", type=int, default=0, help="seed for env.reset and the policy (default: 0)"
+    )
+    p.add_argument(
+        "--config",
+        default=None,
+        help="policy config YAML with sections env / policy / params (e.g. configs/expert/paper.yaml)",
+    )
+    p.add_argument(
+        "--env-config",
+        default=None,
+        help="env config: preset name (default, paper) or YAML path; replaces the config file's env section",
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="policy parameter override, e.g. cost.w_v=2 or potential_field.f_l=1.2 (repeatable)",
+    )
+    p.add_argument(
+        "--env-set",
+        dest="env_overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="env config override, e.g. robot.max_linear_speed_mps=0.15 (repeatable)",
+    )
+    p.add_argument(
+        "--max-time-s",
+        type=float,
+        default=1200.0,
+        help="simulated time limit of the mission (default: 1200)",
+    )
+    p.add_argument(
+        "--gif",
+        default=None,
+        metavar="OUT.gif",
+        help="write an animation with the semantic areas, chosen frontier and path",
+    )
+    p.add_argument(
+        "--gif-every-s",
+        type=float,
+        default=2.0,
+        help="simulated seconds between GIF frames (default: 2)",
+    )
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print the result as one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401  (registers the env)
+    from policies.config import load_policy_config
+    from policies.registry import make_policy
+    from policies.rollout import run_mission
+    from semexplore_gym.core.params import parse_override
+
+    if not (args.max_time_s > 0):
+        raise ValueError(f"--max-time-s must be positive, got {args.max_time_s!r}")
+    cfg = load_policy_config(args.config)
+    spec = args.policy or cfg.policy or "semantic"
+    overrides: dict[str, Any] = {}
+    for text in args.overrides:
+        keys, value = parse_override(text)
+        overrides[".".join(keys)] = value
+    policy_kwargs: dict[str, Any] = dict(overrides)
+    if cfg.params:
+        policy_kwargs["params"] = cfg.params
+    policy = make_policy(spec, **policy_kwargs)
+
+    env_config = args.env_config if args.env_config is not None else cfg.env
+    # The env's own time limit must not cut the mission short.
+    env_overrides = [f"episode.max_time_s={args.max_time_s!r}", *args.env_overrides]
+    env = gym.make(
+        "SemanticExplore-v0",
+        world=args.world,
+        config=env_config,
+        overrides=env_overrides,
+        render_mode="rgb_array" if args.gif else None,
+    )
+    try:
+        result = run_mission(
+            env,
+            policy,
+            seed=args.seed,
+            max_time_s=args.max_time_s,
+            progress=not args.no_progress,
+            gif_path=args.gif,
+            gif_every_s=args.gif_every_s,
+        )
+    finally:
+        env.close()
+
+    summary = result.summary()
+    if args.json:
+        print(json.dumps({k: summary[k] for k in JSON_KEYS}))
+    else:
+        print(format_result(summary))
+    if args.gif:
+        print(f"wrote {args.gif}", file=sys.stderr)
+    return 0
+
+
+def format_result(summary: dict[str, Any]) -> str:
+    """Human-readable lines of a :meth:`MissionResult.summary`."""
+    lines = [
+        f"world            {summary['world']}",
+        f"policy           {summary['policy']} (seed {summary['seed']})",
+        f"coverage         {summary['coverage']:.4f}  ({summary['explored_area_m2']:.2f} m^2 mapped)",
+        f"mission_time_s   {summary['mission_time_s']:.1f}",
+        f"self_stopped     {summary['self_stopped']}",
+        f"stop_reason      {summary['stop_reason']}",
+        f"path_length_m    {summary['path_length_m']:.2f}",
+        f"collisions       {summary['collisions']}",
+        f"T90_s / T99_s    {_fmt_t(summary['T90_s'])} / {_fmt_t(summary['T99_s'])}",
+        f"wall_time_s      {summary['wall_time_s']:.2f}  ({_speedup(summary)} x simulated time)",
+        f"map generation   {summary['mean_map_generation_ms']:.2f} ms mean per replan ({summary['n_replans']} replans)",
+        f"global planning  {summary['mean_global_planning_ms']:.2f} ms mean per replan",
+        "stage split (s)  " + ", ".join(f"{k} {v:.3f}" for k, v in summary["stage_time_s"].items()),
+    ]
+    return "\n".join(lines)
+
+
+def _fmt_t(t: float | None) -> str:
+    return "-" if t is None else f"{t:.1f}"
+
+
+def _speedup(summary: dict[str, Any]) -> str:
+    wall = summary["wall_time_s"]
+    return f"{summary['mission_time_s'] / wall:.0f}" if wall > 0 else "inf"

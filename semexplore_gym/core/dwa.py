@@ -1,0 +1,546 @@
+"""Dynamic Window Approach local planner, after ROS ``dwa_local_planner``.
+
+Each control period the planner samples velocity pairs ``(v, omega)`` reachable within one
+period from the current velocity (the dynamic window, clipped to the robot's limits), rolls
+each pair forward at constant velocity for ``sim_time_s`` and scores the trajectory like ROS:
+
+``cost = path_distance_bias * 0.5 * (d_path(end) + d_path(front))``
+``     + goal_distance_bias * 0.5 * (d_goal(end) + d_goal(front))``
+``     + occdist_scale * max inflation cost along the trajectory``
+
+``d_path`` is the distance to the local part of the global path, ``d_goal`` the distance to the
+local goal (the last path point inside the local window), both flood-filled over the local
+window round obstacles as ROS's ``MapGrid`` does; ``end`` is the trajectory end point and
+``front`` the point ``forward_point_distance_m`` ahead of it (the ROS "alignment" and "goal
+front" terms, which turn the robot towards the path; the nose aims at a point beyond the local
+goal and alignment is dropped near the final goal, as in ROS). Distances are in metres where
+ROS counts cells (``scale = bias * resolution * 0.5``, so the weights carry over). A trajectory
+is invalid if the robot would come within ``robot_radius_m + clearance_margin_m`` of an
+obstacle, which come from the occupied cells of the map window around the robot plus the
+current LiDAR returns; a robot that is already closer than that may still rotate or move away
+(it may not get closer), in place of ROS's recovery behaviours. Unknown cells count as free, as
+in the TurtleBot3 local costmap (``track_unknown_space: false``). The oscillation and twirling
+terms and ROS's minimum-velocity filter are not modelled.
+
+The chosen command is always within ``[min_linear_speed_mps, max_linear_speed_mps]`` and
+``[-max_angular_speed_radps, max_angular_speed_radps]``; with no valid trajectory it is (0, 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+from scipy import ndimage
+
+from semexplore_gym.core.grid import OCCUPIED, GridGeometry
+from semexplore_gym.core.grid_search import distance_field
+
+__all__ = ["DWACommand", "DWAParams", "DWAPlanner", "scan_points_m"]
+
+
+@dataclass(frozen=True)
+class DWAParams:
+    """DWA parameters; defaults are the TurtleBot3 Burger ``dwa_local_planner`` settings.
+
+    Attributes:
+        max_linear_speed_mps: Highest forward speed (TB3 ``max_vel_x`` 0.22).
+        min_linear_speed_mps: Lowest linear speed; 0 = no reversing (TB3 allows -0.22; a
+            circular robot can always turn in place, so we keep it forward-only by default).
+        max_angular_speed_radps: Highest |omega| (TB3 ``max_rot_vel`` 2.75).
+        linear_accel_mps2: Linear acceleration limit (``acc_lim_x`` 2.5).
+        angular_accel_radps2: Angular acceleration limit (``acc_lim_theta`` 3.2).
+        control_period_s: Time one command is held; sets the size of the dynamic window.
+        sim_time_s: Forward simulation horizon (``sim_time`` 1.5).
+        sim_step_s: Integration step of the rollouts.
+        linear_samples: Number of v samples (``vx_samples`` 20).
+        angular_samples: Number of omega samples (``vth_samples`` 40).
+        path_distance_bias: Weight of staying on the global path (32).
+        goal_distance_bias: Weight of approaching the local goal (20).
+        occdist_scale: Weight of the obstacle cost (0.02).
+        forward_point_distance_m: Look-ahead of the alignment point (0.325).
+        robot_radius_m: Robot radius.
+        clearance_margin_m: Added to the radius in the collision test; obstacle distances are
+            measured between cell centres, so half a cell keeps the robot off the wall surface.
+        inflation_radius_m: Reach of the obstacle cost.
+        cost_scaling_factor: Decay rate of the obstacle cost, 1/m.
+        local_window_m: Side of the square local costmap around the robot (TB3: 3 m).
+        xy_goal_tolerance_m: Distance to the final goal that counts as arrived (0.05).
+    """
+
+    max_linear_speed_mps: float = 0.22
+    min_linear_speed_mps: float = 0.0
+    max_angular_speed_radps: float = 2.75
+    linear_accel_mps2: float = 2.5
+    angular_accel_radps2: float = 3.2
+    control_period_s: float = 0.2
+    sim_time_s: float = 1.5
+    sim_step_s: float = 0.1
+    linear_samples: int = 20
+    angular_samples: int = 40
+    path_distance_bias: float = 32.0
+    goal_distance_bias: float = 20.0
+    occdist_scale: float = 0.02
+    forward_point_distance_m: float = 0.325
+    robot_radius_m: float = 0.105
+    clearance_margin_m: float = 0.025
+    inflation_radius_m: float = 0.2
+    cost_scaling_factor: float = 10.0
+    local_window_m: float = 3.0
+    xy_goal_tolerance_m: float = 0.05
+
+    def __post_init__(self) -> None:
+        positive = (
+            "max_linear_speed_mps",
+            "max_angular_speed_radps",
+            "linear_accel_mps2",
+            "angular_accel_radps2",
+            "control_period_s",
+            "sim_time_s",
+            "sim_step_s",
+            "local_window_m",
+        )
+        for name in positive:
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"DWAParams.{name} must be a positive number, got {v!r}")
+        non_negative = (
+            "path_distance_bias",
+            "goal_distance_bias",
+            "occdist_scale",
+            "forward_point_distance_m",
+            "robot_radius_m",
+            "clearance_margin_m",
+            "inflation_radius_m",
+            "cost_scaling_factor",
+            "xy_goal_tolerance_m",
+        )
+        for name in non_negative:
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"DWAParams.{name} must be a number >= 0, got {v!r}")
+        if not self.min_linear_speed_mps <= self.max_linear_speed_mps:
+            raise ValueError(
+                f"min_linear_speed_mps ({self.min_linear_speed_mps}) must be <= max_linear_speed_mps ({self.max_linear_speed_mps})"
+            )
+        for name in ("linear_samples", "angular_samples"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and v >= 2):
+                raise ValueError(f"DWAParams.{name} must be an integer >= 2, got {v!r}")
+
+
+@dataclass(frozen=True)
+class DWACommand:
+    """Result of one DWA step.
+
+    Attributes:
+        v_mps: Linear velocity command.
+        omega_radps: Angular velocity command.
+        valid: False when no sampled trajectory was collision-free (the command is then 0, 0).
+        goal_reached: True when the robot is within ``xy_goal_tolerance_m`` of the path's end.
+        cost: Score of the chosen trajectory (``inf`` if none was valid).
+        trajectory_m: ``(T, 2)`` the chosen rollout (for drawing).
+    """
+
+    v_mps: float
+    omega_radps: float
+    valid: bool
+    goal_reached: bool
+    cost: float
+    trajectory_m: np.ndarray
+
+
+def scan_points_m(
+    pose: npt.ArrayLike, ranges_m: npt.ArrayLike, max_range_m: float, min_range_m: float = 0.0
+) -> np.ndarray:
+    """World ``(N, 2)`` points of the valid returns of a 360-degree scan.
+
+    Beam ``i`` points at ``yaw + i * 2*pi / n``. Ranges of 0 (invalid), below ``min_range_m``,
+    at or beyond ``max_range_m`` (no return) or not finite are dropped.
+    """
+    p = np.asarray(pose, dtype=np.float64).ravel()
+    r = np.asarray(ranges_m, dtype=np.float64).ravel()
+    if p.shape[0] < 3 or not np.isfinite(p[:3]).all():
+        raise ValueError(f"pose must be a finite (x, y, yaw), got {pose!r}")
+    n = r.shape[0]
+    ok = np.isfinite(r) & (r > 0.0) & (r >= min_range_m) & (r < max_range_m)
+    ang = p[2] + np.arange(n) * (2.0 * np.pi / max(n, 1))
+    return np.column_stack([p[0] + r[ok] * np.cos(ang[ok]), p[1] + r[ok] * np.sin(ang[ok])])
+
+
+class DWAPlanner:
+    """Follows a global path with DWA. Holds the path and the progress along it."""
+
+    def __init__(self, params: DWAParams = DWAParams()) -> None:
+        if not isinstance(params, DWAParams):
+            raise TypeError(f"params must be DWAParams, got {type(params).__name__}")
+        self.params = params
+        self._path = np.zeros((0, 2))
+        self._progress = 0
+
+    @property
+    def path_m(self) -> np.ndarray:
+        return self._path
+
+    def set_path(self, path_m: npt.ArrayLike) -> None:
+        """Track a new global path ``(K, 2)`` (K >= 1) in world metres."""
+        p = np.asarray(path_m, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 2 or p.shape[0] < 1 or not np.isfinite(p).all():
+            raise ValueError(
+                f"path_m must be a finite (K, 2) array with K >= 1, got shape {p.shape}"
+            )
+        self._path = np.ascontiguousarray(p)
+        self._progress = 0
+
+    def clear(self) -> None:
+        self._path = np.zeros((0, 2))
+        self._progress = 0
+
+    def compute(
+        self,
+        pose: npt.ArrayLike,
+        velocity: tuple[float, float],
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        obstacle_points_m: npt.ArrayLike | None = None,
+        limits: tuple[float, float] | None = None,
+    ) -> DWACommand:
+        """Choose the velocity command for this control period.
+
+        Args:
+            pose: Robot ``(x_m, y_m, yaw_rad)``.
+            velocity: Current ``(v_mps, omega_radps)`` (the last command).
+            grid: Encoded occupancy grid; its OCCUPIED cells are obstacles.
+            geometry: Frame of ``grid``.
+            obstacle_points_m: ``(N, 2)`` extra obstacle points (the current LiDAR returns).
+            limits: Optional tighter ``(max_linear_speed_mps, max_angular_speed_radps)``, e.g.
+                the env's limits.
+
+        Returns:
+            The command; ``goal_reached`` when within tolerance of the path end.
+        """
+        prm = self.params
+        p = np.asarray(pose, dtype=np.float64).ravel()
+        if p.shape[0] < 3 or not np.isfinite(p[:3]).all():
+            raise ValueError(f"pose must be a finite (x, y, yaw), got {pose!r}")
+        x0, y0, yaw0 = float(p[0]), float(p[1]), float(p[2])
+        if self._path.shape[0] == 0:
+            return DWACommand(0.0, 0.0, True, True, 0.0, np.array([[x0, y0]]))
+        goal = self._path[-1]
+        if math.hypot(goal[0] - x0, goal[1] - y0) <= prm.xy_goal_tolerance_m:
+            return DWACommand(0.0, 0.0, True, True, 0.0, np.array([[x0, y0]]))
+
+        max_v, max_w = prm.max_linear_speed_mps, prm.max_angular_speed_radps
+        if limits is not None:
+            max_v = min(max_v, float(limits[0]))
+            max_w = min(max_w, float(limits[1]))
+        min_v = min(prm.min_linear_speed_mps, max_v)
+        v_now, w_now = float(velocity[0]), float(velocity[1])
+        vs = _samples(
+            v_now, prm.linear_accel_mps2 * prm.control_period_s, min_v, max_v, prm.linear_samples
+        )
+        ws = _samples(
+            w_now,
+            prm.angular_accel_radps2 * prm.control_period_s,
+            -max_w,
+            max_w,
+            prm.angular_samples,
+        )
+
+        res = geometry.resolution_m
+        near, clear, wx0, wy0 = _local_clearance(
+            grid, geometry, x0, y0, prm.local_window_m, obstacle_points_m
+        )
+        local_path, local_goal = self._local_path(x0, y0, wx0, wy0, prm.local_window_m)
+        near_goal = math.hypot(goal[0] - x0, goal[1] - y0) <= prm.forward_point_distance_m
+        path_field, goal_field, front_field = _distance_maps(
+            clear, wx0, wy0, res, local_path, (x0, y0), prm
+        )
+        n_steps = max(1, int(round(prm.sim_time_s / prm.sim_step_s)))
+        best_i, best_j, best_cost = _evaluate(
+            x0,
+            y0,
+            yaw0,
+            vs,
+            ws,
+            n_steps,
+            prm.sim_time_s / n_steps,
+            near,
+            path_field,
+            goal_field,
+            front_field,
+            wx0,
+            wy0,
+            res,
+            prm.forward_point_distance_m,
+            not near_goal,
+            prm.robot_radius_m + prm.clearance_margin_m,
+            prm.path_distance_bias,
+            prm.goal_distance_bias,
+            prm.occdist_scale,
+            prm.robot_radius_m,
+            prm.inflation_radius_m,
+            prm.cost_scaling_factor,
+        )
+        if best_i < 0:
+            return DWACommand(0.0, 0.0, False, False, math.inf, np.array([[x0, y0]]))
+        v = float(np.clip(vs[best_i], min_v, max_v))
+        w = float(np.clip(ws[best_j], -max_w, max_w))
+        traj = _rollout(x0, y0, yaw0, v, w, n_steps, prm.sim_time_s / n_steps)
+        return DWACommand(v, w, True, False, float(best_cost), traj)
+
+    def _local_path(
+        self, x0: float, y0: float, wx0: float, wy0: float, window_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        path = self._path
+        # Progress only moves forward (ROS prunes the plan behind the robot); search a stretch
+        # ahead of it so a path that loops near itself does not make the robot jump along it.
+        ahead = path[self._progress :]
+        d = np.hypot(ahead[:, 0] - x0, ahead[:, 1] - y0)
+        horizon = min(len(d), 200)
+        self._progress += int(np.argmin(d[:horizon]))
+        rest = path[self._progress :]
+        margin = 1e-9
+        inside = (
+            (rest[:, 0] >= wx0 + margin)
+            & (rest[:, 0] <= wx0 + window_m - margin)
+            & (rest[:, 1] >= wy0 + margin)
+            & (rest[:, 1] <= wy0 + window_m - margin)
+        )
+        n_in = int(np.argmin(inside)) if not inside.all() else len(inside)
+        n_in = max(n_in, 1)
+        local = np.ascontiguousarray(rest[:n_in])
+        return local, local[-1]
+
+
+def _samples(now: float, reach: float, lo: float, hi: float, n: int) -> np.ndarray:
+    a = max(lo, now - reach)
+    b = min(hi, now + reach)
+    if a > b:
+        # The current velocity is outside the limits (e.g. limits just tightened): go to the nearest.
+        a = b = min(max(now, lo), hi)
+    s = np.linspace(a, b, n)
+    extra = [v for v in (0.0,) if a <= v <= b]
+    return np.unique(np.concatenate([s, np.asarray(extra, dtype=np.float64)]))
+
+
+def _local_clearance(
+    grid: np.ndarray,
+    geometry: GridGeometry,
+    x0: float,
+    y0: float,
+    window_m: float,
+    points: npt.ArrayLike | None,
+) -> tuple[np.ndarray, float, float]:
+    res = geometry.resolution_m
+    n = int(math.ceil(window_m / res))
+    r_c, c_c = geometry.world_to_grid(x0, y0)
+    r0 = int(r_c) - n // 2
+    c0 = int(c_c) - n // 2
+    win = np.zeros((n, n), dtype=bool)
+    h, w = geometry.shape
+    rs, re = max(r0, 0), min(r0 + n, h)
+    cs, ce = max(c0, 0), min(c0 + n, w)
+    if rs < re and cs < ce:
+        win[rs - r0 : re - r0, cs - c0 : ce - c0] = np.asarray(grid)[rs:re, cs:ce] == OCCUPIED
+    wx0 = geometry.origin_x_m + c0 * res
+    wy0 = geometry.origin_y_m + r0 * res
+    if points is not None:
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        pr = np.floor((pts[:, 1] - wy0) / res).astype(np.int64)
+        pc = np.floor((pts[:, 0] - wx0) / res).astype(np.int64)
+        ok = (pr >= 0) & (pr < n) & (pc >= 0) & (pc < n)
+        win[pr[ok], pc[ok]] = True
+    # Per window cell, the world position of its nearest obstacle cell centre; the rollouts
+    # measure the exact distance from each trajectory point to it, which removes most of the
+    # error of reading a per-cell distance at a point that may lie anywhere in the cell.
+    near = np.full((2, n, n), np.nan)
+    clear = np.full((n, n), np.inf)
+    if win.any():
+        d, idx = ndimage.distance_transform_edt(~win, return_indices=True)
+        near[0] = wx0 + (idx[1] + 0.5) * res
+        near[1] = wy0 + (idx[0] + 0.5) * res
+        clear = d * res
+    return np.ascontiguousarray(near), clear, wx0, wy0
+
+
+def _distance_maps(
+    clear: np.ndarray,
+    wx0: float,
+    wy0: float,
+    res: float,
+    local_path: np.ndarray,
+    robot_xy: tuple[float, float],
+    prm: DWAParams,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flood fills over the local window (ROS MapGrid): to the path, the goal, the nose target.
+
+    Obstacle cells block the flood and cells whose centre is within the robot radius of one
+    cost 20 times more to cross, so distances are path lengths round obstacles rather than
+    straight lines through them, yet stay finite where a robot that is already too close
+    stands (ROS would mark them as obstacles and leave the robot to its recovery behaviours).
+    """
+    n = clear.shape[0]
+    cost = np.where(clear > prm.robot_radius_m, res, 20.0 * res)
+    cost[clear <= 0.0] = np.inf
+
+    def cells(points: np.ndarray) -> np.ndarray:
+        rc = np.column_stack(
+            [np.floor((points[:, 1] - wy0) / res), np.floor((points[:, 0] - wx0) / res)]
+        ).astype(np.int64)
+        rc = rc[((rc >= 0) & (rc < n)).all(axis=1)]
+        return np.unique(rc, axis=0) if len(rc) else rc
+
+    path_rc = cells(local_path)
+    if len(path_rc) == 0:
+        inf = np.full((n, n), np.inf)
+        return inf, inf, inf
+    path_field, _ = distance_field(cost, path_rc)
+    goal = local_path[-1]
+    goal_rc = cells(goal[None, :])
+    goal_field, _ = distance_field(cost, goal_rc if len(goal_rc) else path_rc[-1:])
+    # ROS aims the nose at a point beyond the local goal, along the robot-to-goal direction, so
+    # the robot centre can settle on the goal itself (goal_front_costs).
+    d = np.array([goal[0] - robot_xy[0], goal[1] - robot_xy[1]])
+    norm = float(np.hypot(*d))
+    front_field = goal_field
+    if norm > 1e-9:
+        front = goal + prm.forward_point_distance_m * d / norm
+        front_rc = cells(front[None, :])
+        if len(front_rc) and cost[front_rc[0, 0], front_rc[0, 1]] == res:
+            front_field, _ = distance_field(cost, front_rc)
+    return path_field, goal_field, front_field
+
+
+def _rollout(x, y, yaw, v, w, n_steps, dt) -> np.ndarray:
+    out = np.empty((n_steps + 1, 2))
+    out[0] = (x, y)
+    for k in range(1, n_steps + 1):
+        x += v * math.cos(yaw) * dt
+        y += v * math.sin(yaw) * dt
+        yaw += w * dt
+        out[k] = (x, y)
+    return out
+
+
+@njit(cache=True)
+def _evaluate(
+    x0,
+    y0,
+    yaw0,
+    vs,
+    ws,
+    n_steps,
+    dt,
+    near,
+    path_field,
+    goal_field,
+    front_field,
+    wx0,
+    wy0,
+    res,
+    fwd,
+    use_alignment,
+    min_clear,
+    path_bias,
+    goal_bias,
+    occ_scale,
+    inscribed,
+    infl_radius,
+    scaling,
+):  # pragma: no cover - numba
+    n = near.shape[1]
+    now_clear = _clearance(near, x0, y0, wx0, wy0, res)
+    # A robot already too close may not get closer (give or take 5 mm, so that it can still
+    # leave along a wall at a heading a hair off parallel); otherwise keep the full clearance.
+    limit = min(min_clear, now_clear - 0.005)
+    best_cost = np.inf
+    best_i = -1
+    best_j = -1
+    # Faster samples first so that ties go to the faster trajectory.
+    for ii in range(vs.shape[0]):
+        i = vs.shape[0] - 1 - ii
+        v = vs[i]
+        for j in range(ws.shape[0]):
+            w = ws[j]
+            x = x0
+            y = y0
+            yaw = yaw0
+            lowest = np.inf
+            ok = True
+            for _ in range(n_steps):
+                x += v * math.cos(yaw) * dt
+                y += v * math.sin(yaw) * dt
+                yaw += w * dt
+                r = int(math.floor((y - wy0) / res))
+                c = int(math.floor((x - wx0) / res))
+                if r < 0 or r >= n or c < 0 or c >= n:
+                    ok = False
+                    break
+                d = _clearance(near, x, y, wx0, wy0, res)
+                if d < lowest:
+                    lowest = d
+                if d < limit:
+                    ok = False
+                    break
+            if not ok:
+                continue
+            # Inside the margin a trajectory must end at least as far out as it started, so
+            # that repeated small dips cannot ratchet the robot into the wall.
+            if now_clear < min_clear and _clearance(near, x, y, wx0, wy0, res) < now_clear:
+                continue
+            pd_end = _lookup(path_field, x, y, wx0, wy0, res)
+            gd_end = _lookup(goal_field, x, y, wx0, wy0, res)
+            if not (pd_end < np.inf and gd_end < np.inf):
+                continue  # end point cut off from the path or the goal (ROS: invalid)
+            fx = x + fwd * math.cos(yaw)
+            fy = y + fwd * math.sin(yaw)
+            pd_front = _lookup(path_field, fx, fy, wx0, wy0, res)
+            gd_front = _lookup(front_field, fx, fy, wx0, wy0, res)
+            # A nose inside a wall or off the window scores as if it were one step further.
+            if not pd_front < np.inf:
+                pd_front = pd_end + fwd
+            if not gd_front < np.inf:
+                gd_front = _lookup(front_field, x, y, wx0, wy0, res) + fwd
+                if not gd_front < np.inf:
+                    gd_front = gd_end + fwd
+            if lowest <= inscribed:
+                occ = 253.0
+            elif lowest > infl_radius:
+                occ = 0.0
+            else:
+                occ = math.floor(252.0 * math.exp(-scaling * (lowest - inscribed)))
+            cost = 0.5 * path_bias * (pd_end + (pd_front if use_alignment else 0.0))
+            cost += 0.5 * goal_bias * (gd_end + gd_front)
+            cost += occ_scale * occ
+            if cost < best_cost - 1e-12:
+                best_cost = cost
+                best_i = i
+                best_j = j
+    return best_i, best_j, best_cost
+
+
+@njit(cache=True, inline="always")
+def _lookup(field, x, y, wx0, wy0, res):  # pragma: no cover - numba
+    n = field.shape[0]
+    r = int(math.floor((y - wy0) / res))
+    c = int(math.floor((x - wx0) / res))
+    if r < 0 or r >= n or c < 0 or c >= n:
+        return np.inf
+    return field[r, c]
+
+
+@njit(cache=True, inline="always")
+def _clearance(near, x, y, wx0, wy0, res):  # pragma: no cover - numba
+    n = near.shape[1]
+    r = int(math.floor((y - wy0) / res))
+    c = int(math.floor((x - wx0) / res))
+    if r < 0 or r >= n or c < 0 or c >= n:
+        return np.inf
+    ox = near[0, r, c]
+    if not ox == ox:  # NaN: no obstacle in the window
+        return np.inf
+    return math.hypot(x - ox, y - near[1, r, c])

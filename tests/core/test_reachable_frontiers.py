@@ -1,0 +1,105 @@
+"""The grid fallback of the semantic expert: nearest frontier reachable with clearance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
+from semexplore_gym.core.reachable_frontiers import (
+    clearance_field_m,
+    frontier_groups,
+    nearest_reachable_frontier,
+)
+
+# 0.1 m cells. A room on the left; a wide corridor (5 free cells) to unknown on the right; a
+# narrow slot (1 free cell) at the top leading to unknown as well.
+MAP = """
+##########?????
+#........#?????
+#........######
+#.............?
+#.............?
+#.............?
+#.............?
+#.............?
+###############
+"""
+
+
+def test_bfs_reaches_the_frontier_through_the_wide_corridor_only():
+    grid = parse_ascii_grid(MAP)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    f = nearest_reachable_frontier(grid, geom, (0.25, 0.35), clearance_m=0.2, reach_m=0.0)
+    assert f is not None
+    # The goal is a frontier cell of the corridor's open end (column 13), usable (>= 0.2 m from walls).
+    row, col = geom.world_to_grid(*f.goal_xy_m)
+    assert int(col) == 13 and 2 <= int(row) <= 4
+    assert f.n_frontier_cells == 5
+    np.testing.assert_allclose(f.path_m[0], (0.25, 0.35))
+    assert f.path_length_m >= 13 * 0.1 - 0.35
+    # Every cell of the path keeps the clearance.
+    dist = clearance_field_m(grid, 0.1)
+    r, c = geom.world_to_grid(f.path_m[1:, 0], f.path_m[1:, 1])
+    assert (dist[r, c] >= 0.2 - 1e-9).all()
+
+
+SLOT = """
+???????????
+#####.#####
+#.........#
+#.........#
+#.........#
+#.........#
+#.........#
+###########
+"""
+
+
+def test_frontier_behind_a_narrow_slot_is_reachable_only_within_reach():
+    grid = parse_ascii_grid(SLOT)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    labels, n = frontier_groups(grid, 1)
+    assert n == 1 and labels[6, 5] > 0 and labels.astype(bool).sum() == 1
+    # The slot cell itself is 0.1 m from the walls: the robot cannot stand in it.
+    assert (
+        nearest_reachable_frontier(
+            grid, geom, (0.55, 0.35), clearance_m=0.2, min_frontier_cells=1, reach_m=0.0
+        )
+        is None
+    )
+    # It can get within 0.3 m of it (row 3, the first such cell on its way), close enough to
+    # look through.
+    f = nearest_reachable_frontier(
+        grid, geom, (0.55, 0.35), clearance_m=0.2, min_frontier_cells=1, reach_m=0.3
+    )
+    assert f is not None
+    assert tuple(int(v) for v in geom.world_to_grid(*f.goal_xy_m)) == (3, 5)
+    # Excluding it (the blacklist) leaves nothing.
+    assert (
+        nearest_reachable_frontier(
+            grid, geom, (0.55, 0.35), 0.2, 1, 0.3, excluded_xy_m=[(0.55, 0.7)]
+        )
+        is None
+    )
+
+
+def test_small_groups_are_ignored_and_reach_extends_the_goal():
+    grid = parse_ascii_grid(MAP)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    assert nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, min_frontier_cells=6) is None
+    near = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, reach_m=0.5)
+    far = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, reach_m=0.0)
+    assert near is not None and far is not None
+    assert near.path_length_m < far.path_length_m - 0.3
+
+
+def test_start_next_to_a_wall_and_validation():
+    grid = parse_ascii_grid(MAP)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    f = nearest_reachable_frontier(grid, geom, (0.15, 0.15), clearance_m=0.2)
+    assert f is not None
+    with pytest.raises(ValueError, match="clearance_m"):
+        nearest_reachable_frontier(grid, geom, (0.25, 0.35), clearance_m=-0.1)
+    with pytest.raises(ValueError, match="shape"):
+        nearest_reachable_frontier(grid, GridGeometry(0.1, 0.0, 0.0, 3, 3), (0.25, 0.35), 0.2)

@@ -1,0 +1,243 @@
+"""The semantic expert: unit behaviour on hand-built maps, then whole missions in the env."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from policies.registry import make_policy
+from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy, area_type_raster
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.topometric.types import (
+    Area,
+    AreaType,
+    Frontier,
+    GraphEdge,
+    Opening,
+    TopometricMap,
+)
+
+RES = 0.05
+GEOM = GridGeometry(RES, 0.0, 0.0, 40, 100)  # 5 m x 2 m
+
+
+def corridor_grid(known_until_m: float = 3.0, closed: bool = False) -> np.ndarray:
+    """A corridor along x (y 0.5..1.5 m free, walls beside), known up to ``known_until_m``."""
+    g = np.full(GEOM.shape, UNKNOWN, dtype=np.uint8)
+    cols = int(known_until_m / RES)
+    g[:, :cols] = OCCUPIED
+    g[10:30, 1:cols] = FREE
+    if closed:
+        g[:, cols - 1] = OCCUPIED
+    return g
+
+
+def corridor_tmap(grid: np.ndarray, *_: object, **__: object) -> TopometricMap:
+    """One frontier pathway: opening 0 at the left end, frontier opening 1 at x = 2.95 m."""
+    ids = np.where(grid == FREE, 0, -1).astype(np.int32)
+    path = np.array([[0.1, 1.0], [2.95, 1.0]])
+    openings = [
+        Opening(0, np.array([[0.1, 0.5], [0.1, 1.5]]), (0.1, 1.0), 1.0, (0, -1), False),
+        Opening(1, np.array([[2.95, 0.5], [2.95, 1.5]]), (2.95, 1.0), 1.0, (0, -1), True),
+    ]
+    area = Area(
+        0,
+        AreaType.FRONTIER_PATHWAY,
+        (1.5, 1.0),
+        (0, 1),
+        {0: path, 1: path[::-1].copy()},
+        int((ids == 0).sum()),
+    )
+    frontier = Frontier(0, 1, (2.95, 1.0), 1.0, None, 2.85)
+    return TopometricMap(
+        GEOM,
+        ids,
+        {0: area},
+        openings,
+        [frontier],
+        [GraphEdge(0, 1, 0, 2.85, path)],
+        float("nan"),
+        0.155,
+    )
+
+
+def empty_tmap(grid: np.ndarray, *_: object, **__: object) -> TopometricMap:
+    return TopometricMap(
+        GEOM, np.full(grid.shape, -1, np.int32), {}, [], [], [], float("nan"), 0.155
+    )
+
+
+INFO = {
+    "map_geometry": GEOM.to_dict(),
+    "robot": {"radius_m": 0.105, "max_linear_speed_mps": 0.22, "max_angular_speed_radps": 2.84},
+    "lidar": {
+        "n_beams": 360,
+        "min_range_m": 0.12,
+        "max_range_m": 3.5,
+        "angle_increment_rad": 2 * math.pi / 360,
+    },
+    "dt_s": 0.2,
+}
+
+
+def obs_at(
+    grid: np.ndarray, x: float, y: float, yaw: float, scan: np.ndarray | None = None
+) -> dict[str, np.ndarray]:
+    return {
+        "map": grid,
+        "pose": np.array([x, y, yaw], dtype=np.float32),
+        "scan": scan if scan is not None else np.full(360, 3.5, dtype=np.float32),
+    }
+
+
+def test_semantic_plan_drives_towards_the_frontier_and_reports_stats():
+    grid = corridor_grid()
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    obs = obs_at(grid, 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    a = pol.act(obs, INFO)
+    assert a.dtype == np.float32 and a.shape == (2,)
+    assert a[0] == pytest.approx(1.0) and abs(a[1]) < 1e-6
+    assert pol.mode == "semantic" and not pol.done
+    assert pol.last_stats.replanned
+    assert pol.last_stats.map_generation_ms > 0 and pol.last_stats.global_planning_ms > 0
+    assert [c.goal_xy_m for c in pol.candidates] == [(2.95, 1.0)]
+    # Within the replanning period the plan is only followed.
+    pol.act(obs, INFO)
+    assert not pol.last_stats.replanned and pol.last_stats.map_generation_ms == 0.0
+    ov = pol.overlay()
+    assert ov["area_types"].shape == GEOM.shape and ov["area_types"].dtype == np.int16
+    assert set(np.unique(ov["area_types"])) == {-1, int(AreaType.FRONTIER_PATHWAY)}
+    assert ov["goal_m"] == (2.95, 1.0) and ov["frontiers_m"] == [(2.95, 1.0)]
+    np.testing.assert_allclose(ov["paths_m"][0][-1], (2.95, 1.0))
+
+
+def test_goal_behind_the_robot_turns_it_round_first():
+    grid = corridor_grid()
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    obs = obs_at(grid, 0.5, 1.0, math.pi)
+    pol.reset(obs, INFO, seed=0)
+    a = pol.act(obs, INFO)
+    assert a[0] == 0.0 and abs(a[1]) == pytest.approx(1.0)
+
+
+def test_fallback_without_frontier_pathways_then_stop_when_nothing_is_left():
+    pol = SemanticExpertPolicy(segmenter=empty_tmap)
+    grid = corridor_grid()
+    obs = obs_at(grid, 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    a = pol.act(obs, INFO)
+    assert pol.mode == "fallback" and a[0] > 0.5
+    assert pol.overlay()["goal_m"][0] > 2.5  # the corridor's open end
+    # A closed corridor has no frontier: the policy stops after the confirmations.
+    closed = corridor_grid(closed=True)
+    pol = SemanticExpertPolicy(SemanticExpertParams(stop_confirmations=2), segmenter=empty_tmap)
+    obs = obs_at(closed, 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    a1 = pol.act(obs, INFO)
+    assert not pol.done and np.all(a1 == 0)
+    pol.act(obs, INFO)
+    assert pol.done and pol.stop_reason == "no frontier left" and pol.mode == "done"
+    assert np.all(pol.act(obs, INFO) == 0)
+
+
+def test_fallback_can_be_disabled():
+    pol = SemanticExpertPolicy(
+        SemanticExpertParams(grid_fallback=False, stop_confirmations=1), segmenter=empty_tmap
+    )
+    obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    pol.act(obs, INFO)
+    assert pol.done
+
+
+def test_stuck_robot_backs_off_and_blacklists_its_goal():
+    prm = SemanticExpertParams(
+        stuck_timeout_s=2.0, backoff_duration_s=1.0, local_min_timeout_s=100.0
+    )
+    pol = SemanticExpertPolicy(prm, segmenter=corridor_tmap)
+    grid = corridor_grid()
+    obs = obs_at(grid, 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    modes = []
+    actions = []
+    for _ in range(20):  # the pose never changes: the robot is stuck
+        actions.append(pol.act(obs, INFO))
+        modes.append(pol.mode)
+    assert "recovery" in modes
+    k = modes.index("recovery")
+    assert k == pytest.approx(2.0 / 0.2, abs=1)
+    assert actions[k][0] < 0  # backs off (nothing behind it in this scan)
+    assert pol.counters["recoveries"] >= 1 and pol.counters["blacklisted"] >= 1
+    # The only frontier is blacklisted; the fallback's frontier is the same place, also excluded.
+    assert pol.done and "blacklisted" in pol.stop_reason
+
+
+def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
+    from semexplore_gym.core.graph_search import FrontierCandidate
+
+    def cand(x: float, cost: float, area: int) -> FrontierCandidate:
+        f = Frontier(area, area, (x, 1.0), 1.0, None, 1.0)
+        return FrontierCandidate(
+            f,
+            (x, 1.0),
+            np.array([[0.0, 1.0], [x, 1.0]]),
+            (area,),
+            x,
+            0.0,
+            1.0,
+            0,
+            0,
+            2.0,
+            cost,
+            0.0,
+            cost,
+        )
+
+    pol = SemanticExpertPolicy(SemanticExpertParams(switch_margin=0.5))
+    from policies.semantic_expert import _Plan
+
+    current = cand(3.0, 1.0, 7)
+    pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)
+    other = cand(-2.0, 0.8, 8)
+    moved = cand(3.4, 1.1, 7)  # the same frontier pathway, its frontier receded
+    assert pol._commit([other, moved]) is moved
+    much_cheaper = cand(-2.0, 0.2, 8)
+    assert pol._commit([much_cheaper, moved]) is much_cheaper
+
+
+def test_reset_needs_the_env_facts_and_params_validate():
+    pol = SemanticExpertPolicy(segmenter=empty_tmap)
+    with pytest.raises(ValueError, match="map_geometry"):
+        pol.reset(obs_at(corridor_grid(), 0.5, 1.0, 0.0), {"dt_s": 0.2}, seed=0)
+    with pytest.raises(ValueError, match="replan_period_s"):
+        SemanticExpertParams(replan_period_s=0.0)
+    with pytest.raises(ValueError, match="prune_by"):
+        SemanticExpertParams(prune_by="node")  # type: ignore[arg-type]
+
+
+def test_registry_builds_the_expert_with_overrides():
+    pol = make_policy(
+        "semantic", **{"cost.w_v": 2.0, "potential_field": {"f_l": 1.2}, "replan_period_s": 2}
+    )
+    assert isinstance(pol, SemanticExpertPolicy)
+    assert pol.params.cost.w_v == 2.0 and pol.params.cost.w_p == 0.2
+    assert pol.params.potential_field.f_l == 1.2 and pol.params.replan_period_s == 2.0
+    with pytest.raises(ValueError, match="cost.w_x"):
+        make_policy("semantic", **{"cost.w_x": 1.0})
+    with pytest.raises(ValueError, match="unknown policy"):
+        make_policy("telepathy")
+    rnd = make_policy("random")
+    rnd.reset(obs_at(corridor_grid(), 0.5, 1.0, 0.0), INFO, seed=3)
+    a = rnd.act({}, {})
+    rnd.reset(obs_at(corridor_grid(), 0.5, 1.0, 0.0), INFO, seed=3)
+    assert np.array_equal(a, rnd.act({}, {})) and np.all(np.abs(a) <= 1)
+
+
+def test_area_type_raster_maps_ids_to_types():
+    tm = corridor_tmap(corridor_grid())
+    r = area_type_raster(tm)
+    assert (r[tm.area_ids == 0] == int(AreaType.FRONTIER_PATHWAY)).all()
+    assert (r[tm.area_ids < 0] == -1).all()
