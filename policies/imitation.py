@@ -118,7 +118,7 @@ class ImitationDataset:
         """Write atomically (temporary file, then rename) to ``path`` (``.npz``)."""
         p = Path(path)
         p.parent.mkdir(parents=True, exist_ok=True)
-        arrays = {f"obs__{k}": v for k, v in self.obs.items()}
+        arrays: dict[str, Any] = {f"obs__{k}": v for k, v in self.obs.items()}
         arrays.update(
             actions=self.actions,
             episode_ids=self.episode_ids,
@@ -374,6 +374,7 @@ def train_bc(
     progress: bool = False,
     log_fn: Callable[[str, float, int], None] | None = None,
     step_offset: int = 0,
+    eval_data: ImitationDataset | None = None,
 ) -> dict[str, list[float]]:
     """Behaviour cloning: minimise ``-log pi(a_expert | o) - ent_weight * entropy`` with Adam.
 
@@ -389,9 +390,11 @@ def train_bc(
         progress: Show a tqdm bar over epochs.
         log_fn: ``log_fn(tag, value, step)`` for per-epoch scalars.
         step_offset: Added to the epoch index passed to ``log_fn`` (DAgger rounds).
+        eval_data: Held-out samples; their :func:`action_error` is recorded after each epoch.
 
     Returns:
-        ``{"loss": [...], "neglogp": [...], "entropy": [...]}`` one value per epoch.
+        ``{"loss": [...], "neglogp": [...], "entropy": [...]}`` one value per epoch, plus
+        ``"eval_action_error"`` when ``eval_data`` is given.
     """
     import torch as th
 
@@ -406,8 +409,8 @@ def train_bc(
     optimizer = th.optim.Adam(policy.parameters(), lr=lr, weight_decay=l2_weight)
     actions = th.as_tensor(dataset.actions, device=policy.device)
     history: dict[str, list[float]] = {"loss": [], "neglogp": [], "entropy": []}
-    policy.set_training_mode(True)
     for epoch in _progress(range(epochs), progress, "BC epochs"):
+        policy.set_training_mode(True)
         order = rng.permutation(len(dataset))
         sums = np.zeros(3)
         for start in range(0, len(order), batch_size):
@@ -423,10 +426,15 @@ def train_bc(
             optimizer.step()
             sums += np.array([loss.item(), neglogp.item(), ent.item()]) * len(idx)
         means = sums / len(order)
-        for k, v in zip(history, means, strict=True):
+        for k, v in zip(("loss", "neglogp", "entropy"), means, strict=True):
             history[k].append(float(v))
             if log_fn is not None:
                 log_fn(f"bc/{k}", float(v), step_offset + epoch)
+        if eval_data is not None and len(eval_data):
+            err = action_error(policy, eval_data)
+            history.setdefault("eval_action_error", []).append(err)
+            if log_fn is not None:
+                log_fn("bc/eval_action_error", err, step_offset + epoch)
     policy.set_training_mode(False)
     return history
 

@@ -17,9 +17,11 @@ static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), nev
 What the paper leaves open, and how this policy handles it (parameters in
 :class:`SemanticExpertParams`, all times in simulated seconds):
 
-* **Periodic replanning** (``replan_period_s``): the map changes every step, but segmentation
-  and search run only every ``replan_period_s``, and at once when the goal is reached (within
-  ``goal_reached_radius_m``), when the path is used up, or when recovery ends.
+* **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
+  ``goal_check_radius_m``): the map changes every step, but segmentation and search run only
+  every ``replan_period_s``, and at once when the goal is reached, when it vanishes (no
+  UNKNOWN cell is left within ``goal_check_radius_m`` of it: its frontier has been mapped),
+  when the path is used up, or when a recovery ends.
 * **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
   pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
   old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
@@ -79,6 +81,7 @@ from semexplore_gym.core.potential_field import (
     RobotLimits,
     beam_angles_rad,
     front_free_distance,
+    nearby_obstacle_points,
     potential_field_command,
     resample_polyline,
 )
@@ -104,6 +107,8 @@ class SemanticExpertParams:
         clearance_margin_m: Segmentation clearance is the robot radius plus this.
         replan_period_s: Replanning period (segmentation + Algorithm 1).
         goal_reached_radius_m: The goal counts as reached within this distance.
+        goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
+            left within this distance of it.
         commitment_radius_m: A frontier this close to the current goal is the same goal.
         switch_margin: Another frontier replaces the current one only if cheaper by this much.
         min_frontier_width_m: Narrower frontier openings are ignored.
@@ -130,6 +135,7 @@ class SemanticExpertParams:
     clearance_margin_m: float = 0.05
     replan_period_s: float = 1.0
     goal_reached_radius_m: float = 0.35
+    goal_check_radius_m: float = 0.5
     commitment_radius_m: float = 1.0
     switch_margin: float = 0.5
     min_frontier_width_m: float = 0.25
@@ -155,6 +161,7 @@ class SemanticExpertParams:
         positive = (
             "replan_period_s",
             "goal_reached_radius_m",
+            "goal_check_radius_m",
             "stuck_timeout_s",
             "stuck_radius_m",
             "progress_timeout_s",
@@ -305,14 +312,14 @@ class SemanticExpertPolicy(Policy):
         self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
 
         if self._time_s < self._recovery_until_s:
-            v, w = self._recovery_command(scan)
+            v, w = self._recovery_command(grid, pose, scan)
             self.mode = "recovery"
         else:
             if self._recovery_until_s > 0.0:
                 # Recovery just ended: give up the goal that got us stuck, replan at once.
                 self._recovery_until_s = -1.0
                 self._blacklist_goal()
-            if self._needs_replan(pose):
+            if self._needs_replan(grid, pose):
                 self._replan(grid, pose, stats)
             if self.done:
                 v, w = 0.0, 0.0
@@ -323,7 +330,7 @@ class SemanticExpertPolicy(Policy):
                 v, w = self._follow(grid, pose, scan)
                 self._watch_progress(pose)
                 if self._time_s < self._recovery_until_s:
-                    v, w = self._recovery_command(scan)
+                    v, w = self._recovery_command(grid, pose, scan)
         self._time_s += self.dt_s
         action = np.array(
             [
@@ -340,7 +347,7 @@ class SemanticExpertPolicy(Policy):
         self.last_stats = stats
         return action
 
-    def _needs_replan(self, pose: tuple[float, float, float]) -> bool:
+    def _needs_replan(self, grid: np.ndarray, pose: tuple[float, float, float]) -> bool:
         plan = self._plan
         if plan is None or self._time_s >= self._next_replan_s - 1e-9:
             return True
@@ -350,7 +357,18 @@ class SemanticExpertPolicy(Policy):
         ):
             self._register_reach(plan.goal_xy_m)
             return True
-        return plan.progress >= len(plan.path_m) - 1
+        if plan.progress >= len(plan.path_m) - 1:
+            return True
+        # Goal vanished: no unknown cell is left near it (its frontier has been mapped).
+        return not self._unknown_near(grid, plan.goal_xy_m, self.params.goal_check_radius_m)
+
+    def _unknown_near(self, grid: np.ndarray, xy: tuple[float, float], radius_m: float) -> bool:
+        g = self.geometry
+        r0, c0 = (int(v) for v in g.world_to_grid(xy[0] - radius_m, xy[1] - radius_m))
+        r1, c1 = (int(v) for v in g.world_to_grid(xy[0] + radius_m, xy[1] + radius_m))
+        if r0 < 0 or c0 < 0 or r1 >= g.height or c1 >= g.width:
+            return True  # the map's edge: beyond it is unknown
+        return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())
 
     # ------------------------------------------------------------------ planning
     def _replan(self, grid: np.ndarray, pose: tuple[float, float, float], stats: StepStats) -> None:
@@ -573,16 +591,23 @@ class SemanticExpertPolicy(Policy):
         self._best_remaining_m = math.inf
         self._still_s = 0.0
 
-    def _recovery_command(self, scan: np.ndarray) -> tuple[float, float]:
+    def _recovery_command(self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray) -> tuple[float, float]:
         assert self._angles is not None
         lim = self.limits
-        margin = self.params.potential_field.safety_margin_m
+        pf = self.params.potential_field
+        near = nearby_obstacle_points(grid, self.geometry, pose, max(pf.map_guard_radius_m, 0.3))
         back = front_free_distance(
-            scan, self._angles, lim.max_range_m, lim.radius_m + margin, backwards=True
+            scan,
+            self._angles,
+            lim.max_range_m,
+            lim.radius_m + pf.safety_margin_m,
+            backwards=True,
+            contact_half_width_m=lim.radius_m + pf.contact_margin_m,
+            extra_points_xy=near,
         )
         if back > 0.05:
             v = -self.params.backoff_speed_fraction * lim.max_linear_speed_mps
-            v = max(v, -back / self.params.potential_field.braking_time_s)
+            v = max(v, -back / pf.braking_time_s)
             return v, 0.0
         # The way back is blocked too: turn towards the most open direction.
         ok = (scan > 0) & np.isfinite(scan)
@@ -590,9 +615,7 @@ class SemanticExpertPolicy(Policy):
             return 0.0, self._recovery_turn * 0.5 * lim.max_angular_speed_radps
         k = int(np.argmax(np.where(ok, scan, -1.0)))
         ang = math.atan2(math.sin(self._angles[k]), math.cos(self._angles[k]))
-        return 0.0, float(
-            np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps)
-        )
+        return 0.0, float(np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps))
 
     def _blacklist_goal(self) -> None:
         plan = self._plan

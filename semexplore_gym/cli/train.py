@@ -275,6 +275,11 @@ def _train_imitation(
     }
     if len(held):
         metrics["heldout_action_error_before"] = action_error(policy, held)
+        # Reference: always answering the training set's mean action.
+        mean_action = train.actions.mean(axis=0)
+        metrics["heldout_action_error_mean_action"] = float(
+            np.abs(held.actions - mean_action).mean()
+        )
     bc = cfg.bc
     bc_kwargs = {
         "batch_size": bc.batch_size,
@@ -284,7 +289,10 @@ def _train_imitation(
         "progress": progress,
     }
     t0 = time.perf_counter()
-    hist = train_bc(train, policy, epochs=bc.epochs, seed=cfg.seed, log_fn=log, **bc_kwargs)
+    eval_data = held if len(held) else None
+    hist = train_bc(
+        train, policy, epochs=bc.epochs, seed=cfg.seed, log_fn=log, eval_data=eval_data, **bc_kwargs
+    )
     metrics["bc_s"] = time.perf_counter() - t0
     metrics["bc_final_loss"] = hist["loss"][-1]
     if len(held):
@@ -303,7 +311,12 @@ def _train_imitation(
             episodes_per_round=d.episodes_per_round,
             dataset=train,
             dataset_path=out / "dagger_dataset.npz",
-            bc_kwargs={**bc_kwargs, "epochs": d.epochs_per_round, "progress": False},
+            bc_kwargs={
+                **bc_kwargs,
+                "epochs": d.epochs_per_round,
+                "progress": False,
+                "eval_data": eval_data,
+            },
             seed=cfg.seed,
             max_steps=cfg.expert.max_steps,
             progress=progress,

@@ -20,7 +20,7 @@ obstacle, which come from the occupied cells of the map window around the robot 
 current LiDAR returns; a robot that is already closer than that may still rotate or move away
 (it may not get closer), in place of ROS's recovery behaviours. Unknown cells count as free, as
 in the TurtleBot3 local costmap (``track_unknown_space: false``). The oscillation and twirling
-terms and ROS's minimum-velocity filter are not modelled.
+terms are not modelled; ROS's minimum-velocity filter is (``min_trans_speed_mps``).
 
 The chosen command is always within ``[min_linear_speed_mps, max_linear_speed_mps]`` and
 ``[-max_angular_speed_radps, max_angular_speed_radps]``; with no valid trajectory it is (0, 0).
@@ -56,6 +56,13 @@ class DWAParams:
         control_period_s: Time one command is held; sets the size of the dynamic window.
         sim_time_s: Forward simulation horizon (``sim_time`` 1.5).
         sim_step_s: Integration step of the rollouts.
+        min_trans_speed_mps: With ``min_rot_speed_radps``, ROS's minimum-velocity filter: a
+            sample slower than this in v *and* slower than ``min_rot_speed_radps`` in omega is
+            not considered, so the robot never creeps or stands still (TB3 ``min_trans_vel``
+            0.11; 0 disables the filter). Unlike ROS, where a robot at rest cannot reach
+            ``min_rot_vel`` within one period and so cannot turn in place, turning at the
+            fastest reachable rate is allowed.
+        min_rot_speed_radps: See ``min_trans_speed_mps`` (TB3 ``min_rot_vel`` 1.37).
         linear_samples: Number of v samples (``vx_samples`` 20).
         angular_samples: Number of omega samples (``vth_samples`` 40).
         path_distance_bias: Weight of staying on the global path (32).
@@ -79,6 +86,8 @@ class DWAParams:
     control_period_s: float = 0.2
     sim_time_s: float = 1.5
     sim_step_s: float = 0.1
+    min_trans_speed_mps: float = 0.11
+    min_rot_speed_radps: float = 1.37
     linear_samples: int = 20
     angular_samples: int = 40
     path_distance_bias: float = 32.0
@@ -117,6 +126,8 @@ class DWAParams:
             "inflation_radius_m",
             "cost_scaling_factor",
             "xy_goal_tolerance_m",
+            "min_trans_speed_mps",
+            "min_rot_speed_radps",
         )
         for name in non_negative:
             v = getattr(self, name)
@@ -284,6 +295,11 @@ class DWAPlanner:
             prm.robot_radius_m,
             prm.inflation_radius_m,
             prm.cost_scaling_factor,
+            prm.min_trans_speed_mps,
+            prm.min_rot_speed_radps,
+            # A robot too slow to reach min_rot_speed within one period may still turn in place
+            # at the fastest rate it can reach (ROS would declare failure and run a recovery).
+            min(prm.min_rot_speed_radps, float(np.abs(ws).max())),
         )
         if best_i < 0:
             return DWACommand(0.0, 0.0, False, False, math.inf, np.array([[x0, y0]]))
@@ -451,6 +467,9 @@ def _evaluate(
     inscribed,
     infl_radius,
     scaling,
+    min_trans,
+    min_rot,
+    min_spin,
 ):  # pragma: no cover - numba
     n = near.shape[1]
     now_clear = _clearance(near, x0, y0, wx0, wy0, res)
@@ -466,6 +485,8 @@ def _evaluate(
         v = vs[i]
         for j in range(ws.shape[0]):
             w = ws[j]
+            if abs(v) < min_trans and abs(w) < min_rot and not (v == 0.0 and abs(w) >= min_spin):
+                continue
             x = x0
             y = y0
             yaw = yaw0

@@ -422,78 +422,79 @@ def _xy(p: npt.ArrayLike, name: str) -> tuple[float, float]:
 
 
 @njit(cache=True)
-def _heap_push(keys, vals, size, key, val):  # pragma: no cover - numba
-    if size == keys.shape[0]:
-        nk = np.empty(2 * size, dtype=keys.dtype)
-        nv = np.empty(2 * size, dtype=vals.dtype)
-        nk[:size] = keys
-        nv[:size] = vals
-        keys = nk
-        vals = nv
-    i = size
-    keys[i] = key
-    vals[i] = val
+def _sift_up(heap, pos, prio, i):  # pragma: no cover - numba
+    item = heap[i]
+    key = prio[item]
     while i > 0:
         p = (i - 1) >> 1
-        if keys[p] <= keys[i]:
+        up = heap[p]
+        if prio[up] <= key:
             break
-        keys[p], keys[i] = keys[i], keys[p]
-        vals[p], vals[i] = vals[i], vals[p]
+        heap[i] = up
+        pos[up] = i
         i = p
-    return keys, vals, size + 1
+    heap[i] = item
+    pos[item] = i
 
 
 @njit(cache=True)
-def _heap_pop(keys, vals, size):  # pragma: no cover - numba
-    key = keys[0]
-    val = vals[0]
-    size -= 1
-    keys[0] = keys[size]
-    vals[0] = vals[size]
-    i = 0
+def _sift_down(heap, pos, prio, size, i):  # pragma: no cover - numba
+    item = heap[i]
+    key = prio[item]
     while True:
-        left = 2 * i + 1
-        if left >= size:
+        child = 2 * i + 1
+        if child >= size:
             break
-        m = left
-        if left + 1 < size and keys[left + 1] < keys[left]:
-            m = left + 1
-        if keys[i] <= keys[m]:
+        if child + 1 < size and prio[heap[child + 1]] < prio[heap[child]]:
+            child += 1
+        down = heap[child]
+        if key <= prio[down]:
             break
-        keys[m], keys[i] = keys[i], keys[m]
-        vals[m], vals[i] = vals[i], vals[m]
-        i = m
-    return key, val, size
+        heap[i] = down
+        pos[down] = i
+        i = child
+    heap[i] = item
+    pos[item] = i
 
 
 @njit(cache=True)
 def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - numba
-    """Dijkstra (h_weight = 0) or A* (octile heuristic * h_weight) with lazy deletion.
+    """Dijkstra (h_weight = 0) or A* (octile heuristic * h_weight) on an indexed binary heap.
 
     ``starts`` are flat source indices (all at distance 0). Fills dist/parent (flat) in place;
-    stops when ``goal`` (flat index, -1 = none) is settled.
+    stops when ``goal`` (flat index, -1 = none) is settled. Each cell is in the heap at most
+    once (decrease-key through ``pos``), so memory stays O(cells).
     """
     h, w = cost.shape
+    n = h * w
     sqrt2 = math.sqrt(2.0)
     dr = np.array([1, -1, 0, 0, 1, 1, -1, -1])
     dc = np.array([0, 0, 1, -1, 1, -1, 1, -1])
     step = np.array([1.0, 1.0, 1.0, 1.0, sqrt2, sqrt2, sqrt2, sqrt2])
     gr = goal // w if goal >= 0 else 0
     gc = goal - gr * w if goal >= 0 else 0
-    closed = np.zeros(h * w, dtype=np.uint8)
-    keys = np.empty(1024, dtype=np.float64)
-    vals = np.empty(1024, dtype=np.int64)
+    # pos: -1 never queued, -2 settled, else index in the heap.
+    pos = np.full(n, -1, dtype=np.int64)
+    heap = np.empty(n, dtype=np.int64)
+    prio = np.empty(n, dtype=np.float64)
     size = 0
     for i in range(starts.shape[0]):
         st = starts[i]
-        if dist[st] > 0.0:
+        if pos[st] == -1:
             dist[st] = 0.0
-            keys, vals, size = _heap_push(keys, vals, size, 0.0, st)
+            prio[st] = 0.0
+            heap[size] = st
+            pos[st] = size
+            size += 1
+            _sift_up(heap, pos, prio, size - 1)
     while size > 0:
-        _, u, size = _heap_pop(keys, vals, size)
-        if closed[u]:
-            continue
-        closed[u] = 1
+        u = heap[0]
+        size -= 1
+        pos[u] = -2
+        if size > 0:
+            heap[0] = heap[size]
+            pos[heap[0]] = 0
+            _sift_down(heap, pos, prio, size, 0)
         if u == goal:
             break
         ur = u // w
@@ -512,7 +513,8 @@ def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - n
                 if not (cost[ur, nc] < np.inf and cost[nr, uc] < np.inf):
                     continue
             v = nr * w + nc
-            if closed[v]:
+            pv = pos[v]
+            if pv == -2:
                 continue
             nd = du + step[k] * cv
             if nd < dist[v]:
@@ -525,7 +527,14 @@ def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - n
                     lo = min(ddr, ddc)
                     hi = max(ddr, ddc)
                     pri = nd + h_weight * ((hi - lo) + sqrt2 * lo)
-                keys, vals, size = _heap_push(keys, vals, size, pri, v)
+                prio[v] = pri
+                if pv == -1:
+                    heap[size] = v
+                    pos[v] = size
+                    size += 1
+                    _sift_up(heap, pos, prio, size - 1)
+                else:
+                    _sift_up(heap, pos, prio, pv)
 
 
 @njit(cache=True)

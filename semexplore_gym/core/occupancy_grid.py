@@ -143,7 +143,7 @@ class OccupancyGrid:
                 raise TypeError(f"count_mask must have dtype bool, got {mask.dtype}")
             if mask.shape != shape:
                 raise ValueError(f"count_mask shape {mask.shape} != grid shape {shape}")
-            mask = np.ascontiguousarray(mask)
+            mask = mask.copy()  # private: its flags are changed below
         self.geometry = geometry
         self.params = params
         self._count_mask = mask
@@ -167,6 +167,10 @@ class OccupancyGrid:
             ],
             dtype=f32,
         )
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._count_mask.flags.writeable = False
 
     def reset(self) -> None:
         """Forget everything: all cells UNKNOWN, counters zero."""
@@ -276,7 +280,7 @@ class OccupancyGrid:
             k = int(np.argwhere(~np.isfinite(bad) if status == 1 else bad < 0)[0, 0])
             what = "beam_angles_rad" if status == 1 else "ranges_m"
             raise ValueError(
-                f"{what}[{k}] = {bad[k]!r} is invalid ({'not finite' if status == 1 else 'negative'})"
+                f"{what}[{k}] = {float(bad[k])!r} is invalid ({'not finite' if status == 1 else 'negative'})"
             )
         self.n_free_cells += d_free
         self.n_free_in_mask += d_free_mask

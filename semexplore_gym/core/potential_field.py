@@ -21,7 +21,8 @@ Beyond the paper (all named in :class:`PotentialFieldParams`):
   turns in place when ``F`` points more than ``turn_in_place_rad`` away from the heading, and
   otherwise drives at ``v_max * cos(angle)``.
 * A collision guard caps ``v`` so that the robot (radius plus ``safety_margin_m``) can stop
-  within ``braking_time_s`` before any scan point in its swept corridor.
+  within ``braking_time_s`` before any scan point or nearby mapped wall cell in its swept
+  corridor (see :func:`front_free_distance`).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.grid import OCCUPIED, GridGeometry
 from semexplore_gym.core.line_of_sight import farthest_visible_index
 
 
@@ -52,6 +53,11 @@ class PotentialFieldParams:
         heading_gain_per_s: ``omega = gain * angle(F)`` (rad/s per rad).
         turn_in_place_rad: Above this angle between heading and ``F`` the robot only turns.
         safety_margin_m: Clearance kept beyond the robot radius by the collision guard.
+        contact_margin_m: Points already within the safety margin stop the robot only when it
+            would pass closer than the radius plus this (it may pass close to corners). Keep
+            the radius plus this above the LiDAR's minimum range so passing points stay seen.
+        map_guard_radius_m: The guard also treats OCCUPIED map cells within this distance as
+            obstacles (walls inside the LiDAR's minimum range); 0 disables.
         braking_time_s: The guard allows ``v <= free_distance / braking_time_s``.
     """
 
@@ -61,14 +67,16 @@ class PotentialFieldParams:
     reference_n_beams: int = 360
     min_lookahead_m: float = 0.3
     max_lookahead_m: float = 3.0
-    lookahead_clearance_m: float = 0.05
+    lookahead_clearance_m: float = 0.1
     heading_gain_per_s: float = 2.5
     turn_in_place_rad: float = 1.0
     safety_margin_m: float = 0.04
+    contact_margin_m: float = 0.025
+    map_guard_radius_m: float = 0.3
     braking_time_s: float = 0.6
 
     def __post_init__(self) -> None:
-        for name in ("f_g", "f_o", "f_l", "lookahead_clearance_m", "safety_margin_m"):
+        for name in ("f_g", "f_o", "f_l", "lookahead_clearance_m", "safety_margin_m", "contact_margin_m", "map_guard_radius_m"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -171,19 +179,68 @@ def front_free_distance(
     max_range_m: float,
     half_width_m: float,
     backwards: bool = False,
+    contact_half_width_m: float | None = None,
+    extra_points_xy: np.ndarray | None = None,
 ) -> float:
-    """Distance the robot can drive straight (forward, or backward) before a scan point enters
-    its swept corridor of half-width ``half_width_m``; inf when nothing is in the way."""
+    """Distance the robot can drive straight (forward, or backward) before an obstacle point
+    enters its swept corridor of half-width ``half_width_m``; inf when nothing is in the way.
+
+    The obstacle points are the scan's returns plus ``extra_points_xy`` (``(K, 2)`` in the robot
+    frame, e.g. mapped walls too close for the LiDAR's minimum range). With
+    ``contact_half_width_m`` (the robot radius plus a little), a point that is already inside
+    the ``half_width_m`` corridor but passes beside the robot farther than
+    ``contact_half_width_m`` does not stop it (it only passes close, e.g. a wall end at a corner);
+    a point nearer the centre line limits the travel to where it would touch.
+    """
     ok = valid_beams(scan_m, max_range_m)
-    x = scan_m * np.cos(angles_rad)
-    y = scan_m * np.sin(angles_rad)
+    x = scan_m[ok] * np.cos(angles_rad[ok])
+    y = scan_m[ok] * np.sin(angles_rad[ok])
+    if extra_points_xy is not None and len(extra_points_xy):
+        x = np.concatenate([x, extra_points_xy[:, 0]])
+        y = np.concatenate([y, extra_points_xy[:, 1]])
     if backwards:
         x = -x
-    hit = ok & (x > 0.0) & (np.abs(y) < half_width_m)
+    hit = (x > 0.0) & (np.abs(y) < half_width_m)
     if not hit.any():
         return math.inf
-    free = x[hit] - np.sqrt(half_width_m**2 - y[hit] ** 2)
+    xh = x[hit]
+    yh = y[hit]
+    free = xh - np.sqrt(half_width_m**2 - yh**2)
+    if contact_half_width_m is not None:
+        inside = free < 0.0
+        if inside.any():
+            hard = np.abs(yh) < contact_half_width_m
+            contact = xh - np.sqrt(np.maximum(contact_half_width_m**2 - yh**2, 0.0))
+            free = np.where(inside, np.where(hard, contact, np.inf), free)
     return float(max(0.0, free.min()))
+
+
+def nearby_obstacle_points(
+    grid: np.ndarray, geometry: GridGeometry, pose: tuple[float, float, float], radius_m: float
+) -> np.ndarray:
+    """OCCUPIED cells within ``radius_m`` of the robot as ``(K, 2)`` points in the robot frame.
+
+    Each cell is represented by the point of its square nearest the robot, so the points are
+    never farther than the mapped wall.
+    """
+    x, y, yaw = pose
+    res = geometry.resolution_m
+    r0, c0 = (int(v) for v in geometry.world_to_grid(x - radius_m, y - radius_m))
+    r1, c1 = (int(v) for v in geometry.world_to_grid(x + radius_m, y + radius_m))
+    r0, c0 = max(r0, 0), max(c0, 0)
+    r1, c1 = min(r1, geometry.height - 1), min(c1, geometry.width - 1)
+    if r0 > r1 or c0 > c1:
+        return np.empty((0, 2))
+    rows, cols = np.nonzero(grid[r0 : r1 + 1, c0 : c1 + 1] == OCCUPIED)
+    if len(rows) == 0:
+        return np.empty((0, 2))
+    lo_x = geometry.origin_x_m + (cols + c0) * res
+    lo_y = geometry.origin_y_m + (rows + r0) * res
+    px = np.clip(x, lo_x, lo_x + res) - x
+    py = np.clip(y, lo_y, lo_y + res) - y
+    keep = px * px + py * py <= radius_m * radius_m
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.column_stack([c * px[keep] + s * py[keep], -s * px[keep] + c * py[keep]])
 
 
 def resample_polyline(poly: npt.ArrayLike, step_m: float) -> np.ndarray:
@@ -217,8 +274,9 @@ def select_lookahead(
 
     ``G`` is the farthest point at or after ``start_index`` within ``radius_m`` of the robot and
     in line of sight on ``grid`` (unknown cells do not block; obstacles within ``clearance_m`` of
-    the sight line do). If there is none, the nearest visible point after ``start_index``, else
-    the nearest point (not visible).
+    the sight line do; if no point passes with the clearance, a thin sight line is enough). If
+    there is none, the nearest visible point after ``start_index``, else the nearest point (not
+    visible).
     """
     n = len(path_m)
     if n == 0:
@@ -227,19 +285,22 @@ def select_lookahead(
     pts = path_m[start:]
     dist = np.hypot(pts[:, 0] - robot_xy_m[0], pts[:, 1] - robot_xy_m[1])
     inside = dist <= radius_m + 1e-9
+    # First with the clearance; beside a wall (closer than the clearance) every sight line
+    # fails it, so then with a thin line.
+    tiers = (clearance_m, 0.0) if clearance_m > 0.0 else (0.0,)
     if inside.any():
-        i = farthest_visible_index(grid, geometry, robot_xy_m, pts, inside, clearance_m)
-        if i >= 0:
-            return start + i, True
+        for clr in tiers:
+            i = farthest_visible_index(grid, geometry, robot_xy_m, pts, inside, clr)
+            if i >= 0:
+                return start + i, True
     # Nothing visible within the radius: try the nearest points first.
     order = np.argsort(dist, kind="stable")[:64]
     # farthest_visible_index scans from the back, so reversing tries the nearest point first.
     near = np.ascontiguousarray(pts[order[::-1]])
-    j = farthest_visible_index(
-        grid, geometry, robot_xy_m, near, np.ones(len(near), dtype=bool), clearance_m
-    )
-    if j >= 0:
-        return start + int(order[::-1][j]), True
+    for clr in tiers:
+        j = farthest_visible_index(grid, geometry, robot_xy_m, near, np.ones(len(near), dtype=bool), clr)
+        if j >= 0:
+            return start + int(order[::-1][j]), True
     return start + int(order[0]), False
 
 
@@ -299,7 +360,8 @@ def potential_field_command(
         goal_angle = 0.0
     fx, fy = field_force(scan, angles, goal_angle, p, limits.max_range_m, repulsion_scale)
 
-    v, omega, front = force_to_velocity(fx, fy, scan, angles, limits, p)
+    near = nearby_obstacle_points(grid, geometry, (x, y, yaw), p.map_guard_radius_m) if p.map_guard_radius_m > 0 else None
+    v, omega, front = force_to_velocity(fx, fy, scan, angles, limits, p, near)
     return PotentialFieldCommand(
         v, omega, (gx, gy), int(gi), bool(visible), (fx, fy), l_min, lookahead, front
     )
@@ -312,8 +374,12 @@ def force_to_velocity(
     angles: np.ndarray,
     limits: RobotLimits,
     params: PotentialFieldParams,
+    extra_points_xy: np.ndarray | None = None,
 ) -> tuple[float, float, float]:
     """Map ``F`` (robot frame) to ``(v, omega)`` within the limits, with the collision guard.
+
+    ``extra_points_xy`` are further obstacle points for the guard (robot frame), e.g. from
+    :func:`nearby_obstacle_points`.
 
     Returns:
         ``(v_mps, omega_radps, front_free_m)``.
@@ -328,7 +394,12 @@ def force_to_velocity(
     else:
         v = limits.max_linear_speed_mps * max(0.0, math.cos(phi))
     front = front_free_distance(
-        scan, angles, limits.max_range_m, limits.radius_m + params.safety_margin_m
+        scan,
+        angles,
+        limits.max_range_m,
+        limits.radius_m + params.safety_margin_m,
+        contact_half_width_m=limits.radius_m + params.contact_margin_m,
+        extra_points_xy=extra_points_xy,
     )
     v = min(v, front / params.braking_time_s)
     return float(v), float(omega), front

@@ -174,12 +174,3 @@ class Renderer:
             pygame.quit()
             self._window = None
 
-
-def save_gif(frames: list[np.ndarray], path: str, fps: float = 10.0) -> None:
-    """Write frames as an animated GIF with Pillow."""
-    from PIL import Image
-
-    if not frames:
-        raise ValueError(f"no frames to write to {path!r}")
-    images = [Image.fromarray(f) for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0, optimize=False)

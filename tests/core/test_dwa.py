@@ -112,20 +112,40 @@ def test_follows_a_detour_round_an_obstacle_without_touching_it() -> None:
     assert poses[:, 1].max() > 0.2  # it really went round
 
 
-def test_stops_before_a_blocking_obstacle_seen_only_by_the_lidar() -> None:
+def test_never_drives_into_an_obstacle_seen_only_by_the_lidar() -> None:
     prm = DWAParams()
     grid, geo = _world()  # the map knows nothing
-    wall = np.column_stack([np.full(41, 1.5), np.linspace(-1.0, 1.0, 41)])
+    wall = np.column_stack([np.full(81, 1.5), np.linspace(-1.0, 1.0, 81)])
     planner = DWAPlanner(prm)
     planner.set_path(_straight_path())
-    poses, cmds, arrived = _simulate(planner, grid, geo, (0.0, 0.0, 0.0), n_steps=80, points=wall)
-    assert not arrived
-    assert poses[:, 0].max() < 1.5 - prm.robot_radius_m
-    assert cmds[-1][0] == pytest.approx(0.0, abs=1e-9)
+    poses, _, _ = _simulate(planner, grid, geo, (0.0, 0.0, 0.0), n_steps=80, points=wall)
+    d = np.hypot(poses[:, None, 0] - wall[None, :, 0], poses[:, None, 1] - wall[None, :, 1])
+    assert d.min() > prm.robot_radius_m + prm.clearance_margin_m - 0.01
+    assert poses[:, 0].max() > 1.0  # it did drive up to the wall
     # Without the scan points it drives through the (unmapped) wall.
     planner.set_path(_straight_path())
     poses2, _, arrived2 = _simulate(planner, grid, geo, (0.0, 0.0, 0.0), n_steps=80)
     assert arrived2 and poses2[:, 0].max() > 2.9
+
+
+def test_min_velocity_filter_never_creeps_or_stands_still() -> None:
+    prm = DWAParams()
+    grid, geo = _world()
+    planner = DWAPlanner(prm)
+    planner.set_path(_straight_path())
+    _, cmds, arrived = _simulate(planner, grid, geo, (0.0, 0.0, math.pi), n_steps=120)
+    assert arrived
+    slow = (np.abs(cmds[:, 0]) < prm.min_trans_speed_mps - 1e-9) & (
+        np.abs(cmds[:, 1]) < prm.min_rot_speed_radps - 1e-9
+    )
+    # Only while spinning up from rest may it turn slower than min_rot_speed (and then v = 0).
+    assert (cmds[slow, 0] == 0.0).all()
+    assert slow.sum() <= 3
+    # With the filter off it may.
+    planner = DWAPlanner(DWAParams(min_trans_speed_mps=0.0, min_rot_speed_radps=0.0))
+    planner.set_path(_straight_path())
+    _, cmds0, arrived0 = _simulate(planner, grid, geo, (0.0, 0.0, math.pi), n_steps=120)
+    assert arrived0
 
 
 def test_robot_too_close_to_a_wall_moves_on_without_getting_closer() -> None:

@@ -21,10 +21,6 @@ def unit_grid(height: int = 5, width: int = 8, **kw) -> OccupancyGrid:
     return OccupancyGrid(GridGeometry(1.0, 0.0, 0.0, height, width), P, **kw)
 
 
-def ascii_map(og: OccupancyGrid) -> np.ndarray:
-    return og.encoded_copy()
-
-
 def test_single_beam_axis_aligned() -> None:
     og = unit_grid()
     d = og.integrate_scan(0.5, 2.5, 0.0, [0.0], [4.2], 10.0)
@@ -256,6 +252,9 @@ def test_count_mask_counts_only_masked_cells() -> None:
     og = unit_grid(count_mask=mask)
     og.integrate_scan(0.5, 2.5, 0.0, [0.0], [4.2], 10.0)
     assert og.n_free_cells == 4 and og.n_free_in_mask == 2
+    assert mask.flags.writeable  # the caller's array is copied, not frozen
+    mask[2, 3] = True
+    assert og.n_mask_cells == 2
 
 
 def test_grid_geometry_from_params() -> None:

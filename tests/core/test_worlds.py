@@ -12,6 +12,7 @@ from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds import (
     World,
     distance_to_segments_m,
+    fixed_mazes,
     list_world_names,
     make_world,
     parse_world_spec,
@@ -23,7 +24,6 @@ from semexplore_gym.core.worlds import (
     world_family_parameters,
     world_from_segments,
 )
-from semexplore_gym.core.worlds import fixed_mazes
 
 ROBOT_RADIUS_M = 0.105
 CLEARANCE_M = ROBOT_RADIUS_M + 0.05
@@ -64,7 +64,9 @@ def test_unknown_world_lists_available() -> None:
 
 
 def test_unknown_parameter_lists_valid_ones() -> None:
-    with pytest.raises(ValueError, match=r"unknown maze parameter 'width'.*corridor_width_m.*braid"):
+    with pytest.raises(
+        ValueError, match=r"unknown maze parameter 'width'.*corridor_width_m.*braid"
+    ):
         make_world("maze:width=3")
 
 
@@ -105,7 +107,9 @@ def test_seed_drawn_from_rng_is_reproducible() -> None:
     b = make_world("maze:size_m=5", np.random.default_rng(7))
     c = make_world("maze:size_m=5", np.random.default_rng(8))
     assert np.array_equal(a.segments_m, b.segments_m)
-    assert a.metadata["params"]["seed"] == b.metadata["params"]["seed"] != c.metadata["params"]["seed"]
+    assert (
+        a.metadata["params"]["seed"] == b.metadata["params"]["seed"] != c.metadata["params"]["seed"]
+    )
     # The resolved spec rebuilds the same world.
     again = make_world(a.metadata["spec"])
     assert np.array_equal(again.segments_m, a.segments_m)
@@ -124,7 +128,9 @@ def test_world_pickles_with_derived_cache() -> None:
 # --------------------------------------------------------------------------- fixed mazes
 
 
-def _walls_from_sketch(sketch: str, widths_m: tuple[float, ...], heights_m: tuple[float, ...]) -> set:
+def _walls_from_sketch(
+    sketch: str, widths_m: tuple[float, ...], heights_m: tuple[float, ...]
+) -> set:
     """Unit wall edges drawn in a maze sketch ('+---+' / '|'), top line = largest y."""
     lines = [ln.strip() for ln in sketch.strip("\n").splitlines() if ln.strip()]
     n_rows, n_cols = (len(lines) - 1) // 2, (len(lines[0]) - 1) // 4
@@ -147,7 +153,9 @@ def _walls_from_sketch(sketch: str, widths_m: tuple[float, ...], heights_m: tupl
     return edges
 
 
-def _unit_edges(segments: np.ndarray, widths_m: tuple[float, ...], heights_m: tuple[float, ...]) -> set:
+def _unit_edges(
+    segments: np.ndarray, widths_m: tuple[float, ...], heights_m: tuple[float, ...]
+) -> set:
     """Split merged axis-aligned segments back into cell edges of the maze grid."""
     xs = np.round(np.concatenate([[0.0], np.cumsum(widths_m)]), 6)
     ys = np.round(np.concatenate([[0.0], np.cumsum(heights_m)]), 6)
@@ -157,17 +165,19 @@ def _unit_edges(segments: np.ndarray, widths_m: tuple[float, ...], heights_m: tu
             lo, hi = sorted((x0, x1))
             inner = xs[(xs >= lo) & (xs <= hi)]
             assert inner[0] == lo and inner[-1] == hi, "segment does not end on grid lines"
-            edges |= {(a, y0, b, y0) for a, b in zip(inner[:-1], inner[1:])}
+            edges |= {(a, y0, b, y0) for a, b in zip(inner[:-1], inner[1:], strict=True)}
         else:
             assert x0 == x1, "maze walls are axis-aligned"
             lo, hi = sorted((y0, y1))
             inner = ys[(ys >= lo) & (ys <= hi)]
             assert inner[0] == lo and inner[-1] == hi
-            edges |= {(x0, a, x0, b) for a, b in zip(inner[:-1], inner[1:])}
+            edges |= {(x0, a, x0, b) for a, b in zip(inner[:-1], inner[1:], strict=True)}
     return edges
 
 
-def _cell_degrees(edges: set, widths_m: tuple[float, ...], heights_m: tuple[float, ...]) -> np.ndarray:
+def _cell_degrees(
+    edges: set, widths_m: tuple[float, ...], heights_m: tuple[float, ...]
+) -> np.ndarray:
     xs = np.round(np.concatenate([[0.0], np.cumsum(widths_m)]), 6)
     ys = np.round(np.concatenate([[0.0], np.cumsum(heights_m)]), 6)
     deg = np.zeros((len(heights_m), len(widths_m)), dtype=int)
@@ -184,8 +194,18 @@ def _cell_degrees(edges: set, widths_m: tuple[float, ...], heights_m: tuple[floa
 
 
 MAZES = [
-    ("maze1", fixed_mazes.make_maze1, fixed_mazes.MAZE1_COLUMN_WIDTHS_M, fixed_mazes.MAZE1_ROW_HEIGHTS_M),
-    ("maze2", fixed_mazes.make_maze2, fixed_mazes.MAZE2_COLUMN_WIDTHS_M, fixed_mazes.MAZE2_ROW_HEIGHTS_M),
+    (
+        "maze1",
+        fixed_mazes.make_maze1,
+        fixed_mazes.MAZE1_COLUMN_WIDTHS_M,
+        fixed_mazes.MAZE1_ROW_HEIGHTS_M,
+    ),
+    (
+        "maze2",
+        fixed_mazes.make_maze2,
+        fixed_mazes.MAZE2_COLUMN_WIDTHS_M,
+        fixed_mazes.MAZE2_ROW_HEIGHTS_M,
+    ),
 ]
 
 
@@ -253,7 +273,9 @@ def test_procedural_determinism(family: str) -> None:
     c = make_world(f"{family},seed=4")
     assert np.array_equal(a.segments_m, b.segments_m)
     assert a.start_pose == b.start_pose
-    assert a.segments_m.shape != c.segments_m.shape or not np.array_equal(a.segments_m, c.segments_m)
+    assert a.segments_m.shape != c.segments_m.shape or not np.array_equal(
+        a.segments_m, c.segments_m
+    )
 
 
 def _check_connected_and_enclosed(world: World) -> None:
@@ -265,9 +287,13 @@ def _check_connected_and_enclosed(world: World) -> None:
     centres = free & (dist >= CLEARANCE_M)
     labels, n = ndimage.label(centres, structure=FOUR)
     sizes = np.bincount(labels.ravel())[1:]
-    assert sizes.max() >= 0.995 * sizes.sum(), f"{world.name}: robot space split into {n} parts {sorted(sizes)[-3:]}"
+    assert sizes.max() >= 0.995 * sizes.sum(), (
+        f"{world.name}: robot space split into {n} parts {sorted(sizes)[-3:]}"
+    )
     validate_start_pose(world, world.start_pose, CLEARANCE_M)
-    reach = reachable_free_mask(world, geometry, world.start_pose[:2], ROBOT_RADIUS_M, CLEARANCE_M, free_mask=free)
+    reach = reachable_free_mask(
+        world, geometry, world.start_pose[:2], ROBOT_RADIUS_M, CLEARANCE_M, free_mask=free
+    )
     assert reach.sum() >= 0.7 * free.sum()
 
 
@@ -324,7 +350,9 @@ def _two_rooms(door_width_m: float) -> World:
         (0.0, 2.0, 0.0, 0.0),
         (3.0, door_width_m, 3.0, 1.0),
     ]
-    return world_from_segments("two_rooms", np.array(segs), [(1.0, 1.0), (3.5, 0.5)], resolution_m=0.025)
+    return world_from_segments(
+        "two_rooms", np.array(segs), [(1.0, 1.0), (3.5, 0.5)], resolution_m=0.025
+    )
 
 
 def test_sample_start_pose_deterministic_with_clearance() -> None:

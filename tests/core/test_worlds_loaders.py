@@ -32,12 +32,21 @@ def _segments_intersect(p0, p1, q0, q1) -> bool:
     d2 = _cross(p1 - p0, q1 - p0)
     d3 = _cross(q1 - q0, p0 - q0)
     d4 = _cross(q1 - q0, p1 - q0)
-    if ((d1 > 0) != (d2 > 0)) and ((d3 > 0) != (d4 > 0)) and d1 != 0 and d2 != 0 and d3 != 0 and d4 != 0:
+    if (
+        ((d1 > 0) != (d2 > 0))
+        and ((d3 > 0) != (d4 > 0))
+        and d1 != 0
+        and d2 != 0
+        and d3 != 0
+        and d4 != 0
+    ):
         return True
 
     def on(a, b, c) -> bool:
-        return abs(_cross(b - a, c - a)) < 1e-12 and min(a[0], b[0]) - 1e-12 <= c[0] <= max(a[0], b[0]) + 1e-12 and (
-            min(a[1], b[1]) - 1e-12 <= c[1] <= max(a[1], b[1]) + 1e-12
+        return (
+            abs(_cross(b - a, c - a)) < 1e-12
+            and min(a[0], b[0]) - 1e-12 <= c[0] <= max(a[0], b[0]) + 1e-12
+            and (min(a[1], b[1]) - 1e-12 <= c[1] <= max(a[1], b[1]) + 1e-12)
         )
 
     return on(p0, p1, q0) or on(p0, p1, q1) or on(q0, q1, p0) or on(q0, q1, p1)
@@ -130,7 +139,9 @@ def test_every_boundary_unit_edge_has_exactly_one_free_side() -> None:
             for r in range(round((min(y0, y1) - 2.0) / 0.05), round((max(y0, y1) - 2.0) / 0.05)):
                 assert padded[r + 1, k] != padded[r + 1, k + 1]
                 n_unit += 1
-    expected = np.count_nonzero(padded[1:] != padded[:-1]) + np.count_nonzero(padded[:, 1:] != padded[:, :-1])
+    expected = np.count_nonzero(padded[1:] != padded[:-1]) + np.count_nonzero(
+        padded[:, 1:] != padded[:, :-1]
+    )
     assert n_unit == expected
 
 
@@ -155,7 +166,9 @@ def test_rasterize_free_thin_vector_wall_separates() -> None:
 # --------------------------------------------------------------------------- ROS map_server
 
 
-def _write_map(tmp_path: Path, pixels: np.ndarray, yaml_text: str, image_name: str = "m.pgm") -> Path:
+def _write_map(
+    tmp_path: Path, pixels: np.ndarray, yaml_text: str, image_name: str = "m.pgm"
+) -> Path:
     Image.fromarray(pixels).save(tmp_path / image_name)
     path = tmp_path / "m.yaml"
     path.write_text(yaml_text)
@@ -202,24 +215,58 @@ def test_ros_absolute_image_path_falls_back_to_basename(tmp_path: Path) -> None:
     [
         ("image: [m.pgm\nresolution: 0.5", ValueError, "m.yaml: malformed YAML"),
         ("- just\n- a list\n", ValueError, "m.yaml: expected a mapping"),
-        ("resolution: 0.5\norigin: [0, 0, 0]\n", ValueError, "m.yaml: missing required key 'image'"),
-        ("image: m.pgm\norigin: [0, 0, 0]\n", ValueError, "m.yaml: missing required key 'resolution'"),
+        (
+            "resolution: 0.5\norigin: [0, 0, 0]\n",
+            ValueError,
+            "m.yaml: missing required key 'image'",
+        ),
+        (
+            "image: m.pgm\norigin: [0, 0, 0]\n",
+            ValueError,
+            "m.yaml: missing required key 'resolution'",
+        ),
         ("image: m.pgm\nresolution: 0.5\n", ValueError, "m.yaml: missing required key 'origin'"),
-        ("image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n", ValueError, "key 'resolution' must be positive"),
-        ("image: m.pgm\nresolution: -1\norigin: [0, 0, 0]\n", ValueError, "key 'resolution' must be positive"),
-        ("image: m.pgm\nresolution: fine\norigin: [0, 0, 0]\n", ValueError, "key 'resolution' must be a number"),
+        (
+            "image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n",
+            ValueError,
+            "key 'resolution' must be positive",
+        ),
+        (
+            "image: m.pgm\nresolution: -1\norigin: [0, 0, 0]\n",
+            ValueError,
+            "key 'resolution' must be positive",
+        ),
+        (
+            "image: m.pgm\nresolution: fine\norigin: [0, 0, 0]\n",
+            ValueError,
+            "key 'resolution' must be a number",
+        ),
         ("image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0.3]\n", ValueError, "only yaw 0"),
-        ("image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0]\nnegate: 2\n", ValueError, "key 'negate' must be 0 or 1"),
-        ("image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0]\nmode: fuzzy\n", ValueError, "key 'mode' must be one of"),
+        (
+            "image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0]\nnegate: 2\n",
+            ValueError,
+            "key 'negate' must be 0 or 1",
+        ),
+        (
+            "image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0]\nmode: fuzzy\n",
+            ValueError,
+            "key 'mode' must be one of",
+        ),
         (
             "image: m.pgm\nresolution: 0.5\norigin: [0, 0, 0]\nfree_thresh: 0.9\noccupied_thresh: 0.5\n",
             ValueError,
             "must satisfy 0 <= free_thresh <= occupied_thresh <= 1",
         ),
-        ("image: other.pgm\nresolution: 0.5\norigin: [0, 0, 0]\n", FileNotFoundError, "image 'other.pgm' not found"),
+        (
+            "image: other.pgm\nresolution: 0.5\norigin: [0, 0, 0]\n",
+            FileNotFoundError,
+            "image 'other.pgm' not found",
+        ),
     ],
 )
-def test_ros_yaml_errors_name_file_and_key(tmp_path: Path, text: str, error: type, message: str) -> None:
+def test_ros_yaml_errors_name_file_and_key(
+    tmp_path: Path, text: str, error: type, message: str
+) -> None:
     path = _write_map(tmp_path, PIXELS, text)
     with pytest.raises(error, match=message):
         load_ros_map(path)
@@ -258,7 +305,17 @@ def _plan(tmp_path: Path, verts: list) -> Path:
 
 # A 4 x 3 m house, clockwise, with a 0.1 m thick interior wall slit from the bottom up to
 # y = 2.0 at x = 1.95..2.05, and an extra collinear vertex in the top edge.
-SLIT_HOUSE = [[0, 0], [0, 3], [2, 3], [4, 3], [4, 0], [2.05, 0], [2.05, 2.0], [1.95, 2.0], [1.95, 0]]
+SLIT_HOUSE = [
+    [0, 0],
+    [0, 3],
+    [2, 3],
+    [4, 3],
+    [4, 0],
+    [2.05, 0],
+    [2.05, 2.0],
+    [1.95, 2.0],
+    [1.95, 0],
+]
 
 
 def test_houseexpo_polygon_with_slit(tmp_path: Path) -> None:
@@ -280,7 +337,11 @@ def test_houseexpo_polygon_with_slit(tmp_path: Path) -> None:
     coarse = GridGeometry(0.1, -0.3, -0.3, 36, 46)
     free = rasterize_free(world, coarse)
     r, c = coarse.world_to_grid(2.0, 1.0)
-    assert not free[r, c] and free[coarse.world_to_grid(1.5, 1.0)] and free[coarse.world_to_grid(2.5, 1.0)]
+    assert (
+        not free[r, c]
+        and free[coarse.world_to_grid(1.5, 1.0)]
+        and free[coarse.world_to_grid(2.5, 1.0)]
+    )
     assert not free[[0, -1]].any() and not free[:, [0, -1]].any()
 
 

@@ -69,7 +69,11 @@ README_STATS = {
 @pytest.mark.parametrize("rel", sorted(README_STATS))
 def test_ros_fractions_match_readme(rel: str, worlds: dict) -> None:
     meta = worlds[rel].metadata
-    got = (100 * meta["free_fraction"], 100 * meta["occupied_fraction"], 100 * meta["unknown_fraction"])
+    got = (
+        100 * meta["free_fraction"],
+        100 * meta["occupied_fraction"],
+        100 * meta["unknown_fraction"],
+    )
     assert got == pytest.approx(README_STATS[rel], abs=0.06)
 
 

@@ -176,3 +176,13 @@ def test_wrapper_on_the_env_matches_the_pure_function() -> None:
         obs, _r, _te, _tr, info = env.step(np.array([0.5, 0.2], np.float32))
         assert env.observation_space.contains(obs)
     env.close()
+
+
+def test_wrapped_env_passes_the_sb3_env_checker() -> None:
+    pytest.importorskip("torch")
+    env_checker = pytest.importorskip("stable_baselines3.common.env_checker")
+    from semexplore_gym.wrappers.egocentric import EgocentricObservation
+
+    env = EgocentricObservation(_make_env(), crop_cells=36, crop_resolution_m=0.15)
+    env_checker.check_env(env, warn=False)
+    env.close()

@@ -21,88 +21,132 @@ OCCUPIED_V = 0
 
 
 @njit(cache=True)
-def filter_small_blobs(work: np.ndarray, value: int, max_cells: int, holes: bool) -> int:
-    """Rewrite small 8-connected blobs of ``value`` that do not touch the array edge, in place.
+def scan_grid(enc: np.ndarray) -> tuple[int, int, int, int, int]:
+    """One pass: index of the first value outside the encoding (-1 if none) and the free bbox.
 
-    Only blobs that touch a FREE cell are examined. ``holes=False`` (occupied specks): a blob of
-    at most ``max_cells`` whose neighbours are all FREE becomes FREE. ``holes=True`` (unknown
-    holes): such a blob becomes FREE when all its neighbours are FREE, OCCUPIED otherwise.
+    Returns ``(bad_flat_index, rmin, rmax, cmin, cmax)``; ``rmin == -1`` when there is no free cell.
+    """
+    H, W = enc.shape
+    rmin = -1
+    rmax = -1
+    cmin = W
+    cmax = -1
+    for r in range(H):
+        row_free = False
+        for c in range(W):
+            v = enc[r, c]
+            if v == FREE_V:
+                row_free = True
+                if c < cmin:
+                    cmin = c
+                if c > cmax:
+                    cmax = c
+            elif v != UNKNOWN_V and v != OCCUPIED_V:
+                return r * W + c, -1, -1, -1, -1
+        if row_free:
+            if rmin < 0:
+                rmin = r
+            rmax = r
+    return -1, rmin, rmax, cmin, cmax
+
+
+@njit(cache=True)
+def _flood_blob(work, state, stack, blob, start, value, max_cells):
+    """Collect the 8-connected blob of ``value`` at ``start``; returns its size or -1 if too big."""
+    H, W = work.shape
+    n_blob = 0
+    top = 0
+    stack[top] = start
+    top += 1
+    state[start] = 2
+    big = False
+    while top > 0:
+        top -= 1
+        j = stack[top]
+        if n_blob >= max_cells:
+            big = True
+            state[j] = 1
+            break
+        blob[n_blob] = j
+        n_blob += 1
+        jr = j // W
+        jc = j - jr * W
+        if jr == 0 or jc == 0 or jr == H - 1 or jc == W - 1:
+            big = True
+            break
+        for dr in range(-1, 2):
+            for dc in range(-1, 2):
+                k = j + dr * W + dc
+                if state[k] == 0 and work[jr + dr, jc + dc] == value:
+                    state[k] = 2
+                    stack[top] = k
+                    top += 1
+    if big:
+        # every cell reached belongs to the same big blob: never start from them again
+        for t in range(n_blob):
+            state[blob[t]] = 1
+        for t in range(top):
+            state[stack[t]] = 1
+        return -1
+    return n_blob
+
+
+@njit(cache=True)
+def filter_small_blobs(work: np.ndarray, max_speck_cells: int, max_hole_cells: int) -> int:
+    """Erase occupied specks and close unknown holes next to free cells, in place.
+
+    An 8-connected OCCUPIED blob of at most ``max_speck_cells`` not touching the array edge whose
+    neighbours are all FREE becomes FREE. An UNKNOWN blob of at most ``max_hole_cells`` not
+    touching the edge becomes FREE when its neighbours are all FREE, OCCUPIED otherwise.
     Returns the number of cells changed.
     """
     H, W = work.shape
-    if max_cells <= 0:
+    if max_speck_cells <= 0 and max_hole_cells <= 0:
         return 0
-    state = np.zeros(H * W, np.uint8)  # 1 = known big/edge blob or already handled, 2 = current
-    stack = np.empty(8 * (max_cells + 2), np.int64)
-    blob = np.empty(max_cells + 1, np.int64)
+    state = np.zeros(H * W, np.uint8)  # 1 = big/edge blob or handled, 2 = current blob
+    mx = max(max_speck_cells, max_hole_cells)
+    stack = np.empty(8 * (mx + 2), np.int64)
+    blob = np.empty(mx + 1, np.int64)
     changed = 0
+    wf = work.ravel()
     for r in range(1, H - 1):
         for c in range(1, W - 1):
-            i = r * W + c
-            if work[r, c] != value or state[i] != 0:
+            if work[r, c] != FREE_V:
                 continue
-            touches_free = False
+            i = r * W + c
             for dr in range(-1, 2):
                 for dc in range(-1, 2):
-                    if work[r + dr, c + dc] == FREE_V:
-                        touches_free = True
-            if not touches_free:
-                continue
-            n_blob = 0
-            top = 0
-            stack[top] = i
-            top += 1
-            state[i] = 2
-            big = False
-            while top > 0:
-                top -= 1
-                j = stack[top]
-                if n_blob >= max_cells:
-                    big = True
-                    state[j] = 1
-                    break
-                blob[n_blob] = j
-                n_blob += 1
-                jr = j // W
-                jc = j - jr * W
-                if jr == 0 or jc == 0 or jr == H - 1 or jc == W - 1:
-                    big = True
-                    break
-                for dr in range(-1, 2):
-                    for dc in range(-1, 2):
-                        k = j + dr * W + dc
-                        if state[k] == 0 and work[jr + dr, jc + dc] == value:
-                            state[k] = 2
-                            stack[top] = k
-                            top += 1
-            if big:
-                # every cell reached belongs to the same big blob: never start from them again
-                for t in range(n_blob):
-                    state[blob[t]] = 1
-                for t in range(top):
-                    state[stack[t]] = 1
-                continue
-            all_free = True
-            for t in range(n_blob):
-                j = blob[t]
-                jr = j // W
-                jc = j - jr * W
-                for dr in range(-1, 2):
-                    for dc in range(-1, 2):
-                        v = work[jr + dr, jc + dc]
-                        if state[j + dr * W + dc] != 2 and v != FREE_V:
-                            all_free = False
-            new_v = -1
-            if all_free:
-                new_v = FREE_V
-            elif holes:
-                new_v = OCCUPIED_V
-            for t in range(n_blob):
-                j = blob[t]
-                state[j] = 1
-                if new_v >= 0:
-                    work[j // W, j % W] = new_v
-                    changed += 1
+                    j = i + dr * W + dc
+                    v = wf[j]
+                    if v == FREE_V or state[j] != 0:
+                        continue
+                    limit = max_speck_cells if v == OCCUPIED_V else max_hole_cells
+                    if limit <= 0:
+                        state[j] = 1
+                        continue
+                    n_blob = _flood_blob(work, state, stack, blob, j, v, limit)
+                    if n_blob < 0:
+                        continue
+                    all_free = True
+                    for t in range(n_blob):
+                        q = blob[t]
+                        qr = q // W
+                        qc = q - qr * W
+                        for er in range(-1, 2):
+                            for ec in range(-1, 2):
+                                if state[q + er * W + ec] != 2 and work[qr + er, qc + ec] != FREE_V:
+                                    all_free = False
+                    new_v = -1
+                    if all_free:
+                        new_v = FREE_V
+                    elif v == UNKNOWN_V:
+                        new_v = OCCUPIED_V
+                    for t in range(n_blob):
+                        q = blob[t]
+                        state[q] = 1
+                        if new_v >= 0:
+                            wf[q] = new_v
+                            changed += 1
     return changed
 
 
@@ -112,63 +156,83 @@ def filter_small_blobs(work: np.ndarray, value: int, max_cells: int, holes: bool
 
 
 @njit(cache=True)
-def edt_to_blocked(free: np.ndarray) -> np.ndarray:
-    """Distance in cells from each cell centre to the nearest non-free cell centre (0 on those)."""
+def _fh_run(grow, a, b, f, v, z, drow, crow, min_clear_cells):
+    """Lower envelope of parabolas over the free run [a, b) of one row (blocked at a-1 and b)."""
+    n = b - a + 2  # positions 0..n-1 are columns a-1..b
+    f[0] = 0.0
+    f[n - 1] = 0.0
+    for j in range(a, b):
+        gj = float(grow[j])
+        f[j - a + 1] = gj * gj
+    k = 0
+    v[0] = 0
+    z[0] = -1e300
+    z[1] = 1e300
+    for q in range(1, n):
+        fq = f[q] + q * q
+        p = v[k]
+        s = (fq - (f[p] + p * p)) / (2.0 * (q - p))
+        while s <= z[k]:
+            k -= 1
+            p = v[k]
+            s = (fq - (f[p] + p * p)) / (2.0 * (q - p))
+        k += 1
+        v[k] = q
+        z[k] = s
+        z[k + 1] = 1e300
+    k = 0
+    for q in range(1, n - 1):
+        while z[k + 1] < q:
+            k += 1
+        p = v[k]
+        d = np.sqrt((q - p) * (q - p) + f[p]) - 0.5
+        drow[a + q - 1] = d
+        if d >= min_clear_cells:
+            crow[a + q - 1] = 1
+
+
+@njit(cache=True)
+def clearance_field(free: np.ndarray, min_clear_cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """Exact Euclidean clearance of free cells and the configuration space.
+
+    ``dcell`` is the distance from a cell centre to the nearest non-free cell centre minus half
+    a cell (the distance to that cell's edge; outside the array counts as non-free; 0 on non-free
+    cells). ``cspace`` is ``free & dcell >= min_clear_cells``. The row pass of Felzenszwalb and
+    Huttenlocher's transform runs over free runs only: the blocked cell ending a run is closer
+    than any column beyond it.
+    """
     H, W = free.shape
-    g = np.empty((H, W), np.float64)
+    g = np.empty((H, W), np.int32)
     for c in range(W):
-        g[0, c] = 1.0 if free[0, c] else 0.0
+        g[0, c] = 1 if free[0, c] else 0
     for r in range(1, H):
         for c in range(W):
-            g[r, c] = g[r - 1, c] + 1.0 if free[r, c] else 0.0
+            g[r, c] = g[r - 1, c] + 1 if free[r, c] else 0
     for c in range(W):
-        if g[H - 1, c] > 1.0:
-            g[H - 1, c] = 1.0
+        if g[H - 1, c] > 1:
+            g[H - 1, c] = 1
     for r in range(H - 2, -1, -1):
         for c in range(W):
-            if g[r + 1, c] + 1.0 < g[r, c]:
-                g[r, c] = g[r + 1, c] + 1.0
-    out = np.empty((H, W), np.float32)
-    n = W + 2
-    f = np.empty(n, np.float64)
-    v = np.empty(n, np.int64)
-    z = np.empty(n + 1, np.float64)
+            up = g[r + 1, c] + 1
+            if up < g[r, c]:
+                g[r, c] = up
+    dcell = np.zeros((H, W), np.float32)
+    cspace = np.zeros((H, W), np.uint8)
+    f = np.empty(W + 2, np.float64)
+    v = np.empty(W + 2, np.int64)
+    z = np.empty(W + 3, np.float64)
     for r in range(H):
-        f[0] = 0.0
-        f[n - 1] = 0.0
-        for c in range(W):
-            f[c + 1] = g[r, c] * g[r, c]
-        k = 0
-        v[0] = 0
-        z[0] = -1e300
-        z[1] = 1e300
-        for q in range(1, n):
-            fq = f[q] + q * q
-            while True:
-                p = v[k]
-                s = (fq - (f[p] + p * p)) / (2.0 * (q - p))
-                if s <= z[k] and k > 0:
-                    k -= 1
-                    continue
-                break
-            if s <= z[k]:
-                # only possible for k == 0: the new parabola replaces the first one
-                v[0] = q
-                z[0] = -1e300
-                z[1] = 1e300
+        row = free[r]
+        c = 0
+        while c < W:
+            if not row[c]:
+                c += 1
                 continue
-            k += 1
-            v[k] = q
-            z[k] = s
-            z[k + 1] = 1e300
-        k = 0
-        for c in range(W):
-            q = c + 1
-            while z[k + 1] < q:
-                k += 1
-            p = v[k]
-            out[r, c] = np.sqrt((q - p) * (q - p) + f[p])
-    return out
+            a = c
+            while c < W and row[c]:
+                c += 1
+            _fh_run(g[r], a, c, f, v, z, dcell[r], cspace[r], min_clear_cells)
+    return dcell, cspace
 
 
 # ----------------------------------------------------------------------------------------------
@@ -248,74 +312,100 @@ def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
             if img[r, c] and _mdeg(img, r, c) >= 3 and _zs_ok(img, r, c, 2):
                 img[r, c] = 0
                 changed = True
+    f = img.ravel()
     n = 0
     for k in range(px.size):
-        if img.ravel()[px[k]]:
+        if f[px[k]]:
             n += 1
     out = np.empty(n, np.int64)
     n = 0
     for k in range(px.size):
-        if img.ravel()[px[k]]:
+        if f[px[k]]:
             out[n] = px[k]
             n += 1
     return out
 
 
 @njit(cache=True)
+def _zs_tables() -> np.ndarray:
+    """Deletability of a pixel by its 8-neighbour code (bit k = P(k+2), P2 = row-1), per mode.
+
+    Mode 0/1: the two Zhang-Suen sub-iterations; mode 2: simple point with 2..6 neighbours.
+    """
+    t = np.zeros((3, 256), np.uint8)
+    img = np.zeros((3, 3), np.uint8)
+    rr = (0, 0, 1, 2, 2, 2, 1, 0)
+    cc = (1, 2, 2, 2, 1, 0, 0, 0)
+    for code in range(256):
+        for k in range(8):
+            img[rr[k], cc[k]] = (code >> k) & 1
+        img[1, 1] = 1
+        for mode in range(3):
+            t[mode, code] = 1 if _zs_ok(img, 1, 1, mode) else 0
+    return t
+
+
+@njit(cache=True)
+def _code(f: np.ndarray, i: int, W: int) -> int:
+    return (
+        int(f[i - W])
+        | (int(f[i - W + 1]) << 1)
+        | (int(f[i + 1]) << 2)
+        | (int(f[i + W + 1]) << 3)
+        | (int(f[i + W]) << 4)
+        | (int(f[i + W - 1]) << 5)
+        | (int(f[i - 1]) << 6)
+        | (int(f[i - W - 1]) << 7)
+    )
+
+
+@njit(cache=True)
 def thin(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Zhang-Suen thinning with a work list and a sequential re-check (keeps 2x2 blocks connected).
 
-    Returns the skeleton image (uint8 0/1) and the flat indices of its pixels. Junction blobs
-    are reduced afterwards: pixels of m-degree >= 3 that are simple points are removed.
+    ``mask`` is uint8 0/1 with an empty border. Returns the skeleton image (uint8 0/1) and the
+    flat indices of its pixels. Junction blobs are reduced afterwards (see :func:`reduce_blobs`).
     """
     img = mask.copy()
     H, W = img.shape
+    f = img.ravel()
+    tab = _zs_tables()
     n_fg = 0
-    for r in range(H):
-        for c in range(W):
-            if img[r, c]:
-                n_fg += 1
+    for i in range(H * W):
+        if f[i]:
+            n_fg += 1
     cand = np.empty(n_fg + 1, np.int64)
     nxt = np.empty(n_fg + 1, np.int64)
     marked = np.empty(n_fg + 1, np.int64)
     flag = np.zeros(H * W, np.uint8)
     n = 0
-    for r in range(1, H - 1):
-        for c in range(1, W - 1):
-            if img[r, c]:
-                border = False
-                for dr in range(-1, 2):
-                    for dc in range(-1, 2):
-                        if img[r + dr, c + dc] == 0:
-                            border = True
-                if border:
-                    cand[n] = r * W + c
-                    n += 1
+    for i in range(W, H * W - W):
+        if f[i] and _code(f, i, W) != 255:
+            cand[n] = i
+            n += 1
     while n > 0:
         nn = 0
         for sub in range(2):
             m = 0
-            for src in range(2):
-                cnt = n if src == 0 else nn
-                for k in range(cnt):
-                    i = cand[k] if src == 0 else nxt[k]
-                    r = i // W
-                    c = i - r * W
-                    if img[r, c] and _zs_ok(img, r, c, sub):
+            for k in range(n):
+                i = cand[k]
+                if f[i] and tab[sub, _code(f, i, W)]:
+                    marked[m] = i
+                    m += 1
+            if sub == 1:
+                for k in range(nn):
+                    i = nxt[k]
+                    if f[i] and tab[sub, _code(f, i, W)]:
                         marked[m] = i
                         m += 1
-                if sub == 0:
-                    break
             for k in range(m):
                 i = marked[k]
-                r = i // W
-                c = i - r * W
-                if img[r, c] and _zs_ok(img, r, c, sub):
-                    img[r, c] = 0
+                if f[i] and tab[sub, _code(f, i, W)]:
+                    f[i] = 0
                     for dr in range(-1, 2):
                         for dc in range(-1, 2):
                             j = i + dr * W + dc
-                            if img[r + dr, c + dc] and flag[j] == 0:
+                            if f[j] and flag[j] == 0:
                                 flag[j] = 1
                                 nxt[nn] = j
                                 nn += 1
@@ -324,17 +414,15 @@ def thin(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             cand[k] = nxt[k]
         n = nn
     cnt = 0
-    for r in range(H):
-        for c in range(W):
-            if img[r, c]:
-                cnt += 1
+    for i in range(H * W):
+        if f[i]:
+            cnt += 1
     px = np.empty(cnt, np.int64)
     cnt = 0
-    for r in range(H):
-        for c in range(W):
-            if img[r, c]:
-                px[cnt] = r * W + c
-                cnt += 1
+    for i in range(H * W):
+        if f[i]:
+            px[cnt] = i
+            cnt += 1
     px = reduce_blobs(img, px)
     return img, px
 

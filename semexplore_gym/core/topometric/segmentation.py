@@ -77,7 +77,7 @@ def _as_encoded_grid(grid: npt.ArrayLike) -> np.ndarray:
     if a.size == 0:
         raise ValueError(f"grid is empty (shape {a.shape})")
     if a.dtype == np.uint8:
-        return validate_encoded_grid(a)
+        return a
     if a.dtype == np.bool_ or not np.issubdtype(a.dtype, np.integer):
         raise TypeError(
             f"grid must be the uint8 encoding (UNKNOWN={UNKNOWN}, FREE={FREE}, OCCUPIED={OCCUPIED}) "
@@ -204,16 +204,16 @@ class _Segmenter:
     def run(self) -> TopometricMap:
         p = self.p
         res = self.res
-        enc = self.enc
+        enc = np.ascontiguousarray(self.enc)
         H0, W0 = enc.shape
-        free0 = enc == FREE
-        rows = np.flatnonzero(free0.any(axis=1))
-        if rows.size == 0:
+        bad, rmin, rmax, cmin, cmax = K.scan_grid(enc)
+        if bad >= 0:
+            validate_encoded_grid(enc)  # raises with the offending value and position
+        if rmin < 0:
             self._lap("prepare")
             return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
-        cols = np.flatnonzero(free0[rows[0] : rows[-1] + 1].any(axis=0))
-        r0, r1 = int(rows[0]) - _MARGIN, int(rows[-1]) + _MARGIN + 1
-        c0, c1 = int(cols[0]) - _MARGIN, int(cols[-1]) + _MARGIN + 1
+        r0, r1 = rmin - _MARGIN, rmax + _MARGIN + 1
+        c0, c1 = cmin - _MARGIN, cmax + _MARGIN + 1
         work = np.full((r1 - r0, c1 - c0), UNKNOWN, dtype=np.uint8)
         sr0, sr1, sc0, sc1 = max(r0, 0), min(r1, H0), max(c0, 0), min(c1, W0)
         work[sr0 - r0 : sr1 - r0, sc0 - c0 : sc1 - c0] = enc[sr0:sr1, sc0:sc1]
@@ -223,23 +223,20 @@ class _Segmenter:
         self.H, self.W = H, W
 
         cell_area = res * res
-        K.filter_small_blobs(work, OCCUPIED, int(p.max_speckle_area_m2 / cell_area + 1e-9), False)
-        K.filter_small_blobs(work, UNKNOWN, int(p.max_hole_area_m2 / cell_area + 1e-9), True)
+        K.filter_small_blobs(work, int(p.max_speckle_area_m2 / cell_area + 1e-9), int(p.max_hole_area_m2 / cell_area + 1e-9))
         free = work == FREE
         self.free = free
         self._lap("filter")
 
-        edt = K.edt_to_blocked(free)
-        dcell = edt - np.float32(0.5)
+        dcell, cs_u8 = K.clearance_field(free, self.clear_m / res - 1e-6)
+        cspace = cs_u8.view(np.bool_)
         self.dcell = dcell
-        clear_cells = self.clear_m / res
-        cspace = free & (dcell >= np.float32(clear_cells - 1e-6))
         self.cspace = cspace
         self._lap("distance")
         if not cspace.any():
             return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
 
-        sk, px = K.thin(cspace.view(np.uint8))
+        sk, px = K.thin(cs_u8)
         self._lap("skeleton")
 
         st = np.full(H * W, -1, dtype=np.int32)

@@ -50,7 +50,11 @@ class CaveParams:
     min_passage_m: float = 0.6
 
     def __post_init__(self) -> None:
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or self.seed < 0
+        ):
             raise ValueError(f"cave parameter seed={self.seed!r} must be a non-negative integer")
         check_range("cave", "size_m", self.size_m, 4.0, 50.0)
         check_range("cave", "feature_size_m", self.feature_size_m, 0.2, self.size_m / 4.0)
@@ -129,6 +133,7 @@ def generate_cave(params: CaveParams, name: str | None = None) -> World:
     rng = np.random.default_rng(params.seed)
     free, core = carve_cave(params, rng)
     segments = contour_segments(free, _RES_M, _SIMPLIFY_TOLERANCE_M)
+    size_m = free.shape[0] * _RES_M
     rows, cols = np.nonzero(core)
     interior = np.column_stack([(cols + 0.5) * _RES_M, (rows + 0.5) * _RES_M])
     k = int(rng.integers(len(rows)))
@@ -142,5 +147,6 @@ def generate_cave(params: CaveParams, name: str | None = None) -> World:
         segments,
         interior,
         start_pose=start,
+        bounds_m=(0.0, 0.0, size_m, size_m),
         metadata={"source": "procedural", "family": "cave", "params": asdict(params), "spec": spec},
     )

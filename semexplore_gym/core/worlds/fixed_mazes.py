@@ -158,7 +158,12 @@ def make_maze1(name: str = "maze1") -> World:
         np.array(MAZE1_SEGMENTS_M),
         _cell_centres_m(MAZE1_COLUMN_WIDTHS_M, MAZE1_ROW_HEIGHTS_M),
         start_pose=MAZE1_START_POSE,
-        metadata={"source": "fixed_maze", "maze": "maze1", "column_widths_m": MAZE1_COLUMN_WIDTHS_M, "row_heights_m": MAZE1_ROW_HEIGHTS_M},
+        metadata={
+            "source": "fixed_maze",
+            "maze": "maze1",
+            "column_widths_m": MAZE1_COLUMN_WIDTHS_M,
+            "row_heights_m": MAZE1_ROW_HEIGHTS_M,
+        },
     )
 
 
@@ -193,5 +198,10 @@ def make_maze2(name: str = "maze2") -> World:
         np.array(MAZE2_SEGMENTS_M),
         _cell_centres_m(MAZE2_COLUMN_WIDTHS_M, MAZE2_ROW_HEIGHTS_M),
         start_pose=MAZE2_START_POSE,
-        metadata={"source": "fixed_maze", "maze": "maze2", "column_widths_m": MAZE2_COLUMN_WIDTHS_M, "row_heights_m": MAZE2_ROW_HEIGHTS_M},
+        metadata={
+            "source": "fixed_maze",
+            "maze": "maze2",
+            "column_widths_m": MAZE2_COLUMN_WIDTHS_M,
+            "row_heights_m": MAZE2_ROW_HEIGHTS_M,
+        },
     )

@@ -88,7 +88,9 @@ def _points_to_segments_kernel(pts: np.ndarray, seg: np.ndarray) -> np.ndarray:
     return out
 
 
-def segment_distance_field(segments_m: npt.ArrayLike, geometry: GridGeometry, max_distance_m: float) -> np.ndarray:
+def segment_distance_field(
+    segments_m: npt.ArrayLike, geometry: GridGeometry, max_distance_m: float
+) -> np.ndarray:
     """Distance from every cell centre to the nearest wall segment, clipped at ``max_distance_m``.
 
     Only cells within ``max_distance_m`` of some segment are visited, so the cost grows with the
@@ -118,7 +120,9 @@ def segment_distance_field(segments_m: npt.ArrayLike, geometry: GridGeometry, ma
 
 
 @njit(cache=True)
-def _distance_field_kernel(seg: np.ndarray, ox: float, oy: float, res: float, max_d: float, out: np.ndarray) -> None:
+def _distance_field_kernel(
+    seg: np.ndarray, ox: float, oy: float, res: float, max_d: float, out: np.ndarray
+) -> None:
     h, w = out.shape
     for i in range(seg.shape[0]):
         x0 = seg[i, 0]
@@ -148,7 +152,9 @@ def _distance_field_kernel(seg: np.ndarray, ox: float, oy: float, res: float, ma
                     out[r, c] = d
 
 
-def crossed_links(segments_m: npt.ArrayLike, geometry: GridGeometry) -> tuple[np.ndarray, np.ndarray]:
+def crossed_links(
+    segments_m: npt.ArrayLike, geometry: GridGeometry
+) -> tuple[np.ndarray, np.ndarray]:
     """Links between 4-neighbour cell centres that a wall segment touches or crosses.
 
     Touching counts as crossing (with a tolerance of 1e-7 cells), so two walls meeting at a
@@ -164,13 +170,31 @@ def crossed_links(segments_m: npt.ArrayLike, geometry: GridGeometry) -> tuple[np
     cut_x = np.zeros((h, max(w - 1, 0)), dtype=np.bool_)
     cut_y = np.zeros((max(h - 1, 0), w), dtype=np.bool_)
     res = float(geometry.resolution_m)
-    _cut_links_kernel(seg, float(geometry.origin_x_m), float(geometry.origin_y_m), res, h, w, 1e-7 * res, cut_x, cut_y)
+    _cut_links_kernel(
+        seg,
+        float(geometry.origin_x_m),
+        float(geometry.origin_y_m),
+        res,
+        h,
+        w,
+        1e-7 * res,
+        cut_x,
+        cut_y,
+    )
     return cut_x, cut_y
 
 
 @njit(cache=True)
 def _cut_links_kernel(
-    seg: np.ndarray, ox: float, oy: float, res: float, h: int, w: int, eps: float, cut_x: np.ndarray, cut_y: np.ndarray
+    seg: np.ndarray,
+    ox: float,
+    oy: float,
+    res: float,
+    h: int,
+    w: int,
+    eps: float,
+    cut_x: np.ndarray,
+    cut_y: np.ndarray,
 ) -> None:
     for i in range(seg.shape[0]):
         x0 = seg[i, 0]
@@ -230,14 +254,20 @@ def flood_fill_links(
     passable = np.ascontiguousarray(passable, dtype=np.bool_)
     seed_mask = np.ascontiguousarray(seed_mask, dtype=np.bool_)
     h, w = passable.shape
-    if seed_mask.shape != (h, w) or cut_x.shape != (h, max(w - 1, 0)) or cut_y.shape != (max(h - 1, 0), w):
+    if (
+        seed_mask.shape != (h, w)
+        or cut_x.shape != (h, max(w - 1, 0))
+        or cut_y.shape != (max(h - 1, 0), w)
+    ):
         raise ValueError(
             f"shape mismatch: passable {passable.shape}, seed_mask {seed_mask.shape}, cut_x {cut_x.shape}, cut_y {cut_y.shape}"
         )
     seeds = np.flatnonzero(seed_mask & passable).astype(np.int64)
     out = np.zeros((h, w), dtype=np.bool_)
     if seeds.size:
-        _flood_fill_kernel(passable, np.ascontiguousarray(cut_x), np.ascontiguousarray(cut_y), seeds, out)
+        _flood_fill_kernel(
+            passable, np.ascontiguousarray(cut_x), np.ascontiguousarray(cut_y), seeds, out
+        )
     return out
 
 
@@ -280,7 +310,9 @@ def _flood_fill_kernel(
             top += 1
 
 
-def merge_polyline_edges(vertices_xy_m: npt.ArrayLike, closed: bool = True, tol_m: float = 1e-9) -> np.ndarray:
+def merge_polyline_edges(
+    vertices_xy_m: npt.ArrayLike, closed: bool = True, tol_m: float = 1e-9
+) -> np.ndarray:
     """Segments along a polyline, merging consecutive collinear edges and dropping repeated vertices.
 
     Args:
@@ -351,13 +383,19 @@ def polygon_inside_mask(vertices_xy_m: npt.ArrayLike, geometry: GridGeometry) ->
     h, w = geometry.shape
     toggles = np.zeros((h, w + 1), dtype=np.int32)
     _polygon_crossings_kernel(
-        np.ascontiguousarray(v), float(geometry.origin_x_m), float(geometry.origin_y_m), float(geometry.resolution_m), toggles
+        np.ascontiguousarray(v),
+        float(geometry.origin_x_m),
+        float(geometry.origin_y_m),
+        float(geometry.resolution_m),
+        toggles,
     )
     return (np.cumsum(toggles, axis=1)[:, :w] & 1).astype(bool)
 
 
 @njit(cache=True)
-def _polygon_crossings_kernel(v: np.ndarray, ox: float, oy: float, res: float, toggles: np.ndarray) -> None:
+def _polygon_crossings_kernel(
+    v: np.ndarray, ox: float, oy: float, res: float, toggles: np.ndarray
+) -> None:
     h = toggles.shape[0]
     w = toggles.shape[1] - 1
     n = v.shape[0]

@@ -41,7 +41,11 @@ class MazeParams:
     braid: float = 0.0
 
     def __post_init__(self) -> None:
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or self.seed < 0
+        ):
             raise ValueError(f"maze parameter seed={self.seed!r} must be a non-negative integer")
         check_range("maze", "corridor_width_m", self.corridor_width_m, 0.6, 5.0)
         check_range("maze", "size_m", self.size_m, 2.0 * self.corridor_width_m, 50.0)
@@ -53,7 +57,9 @@ class MazeParams:
         return max(2, int(round(self.size_m / self.corridor_width_m)))
 
 
-def carve_maze(n_rows: int, n_cols: int, rng: np.random.Generator, braid: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def carve_maze(
+    n_rows: int, n_cols: int, rng: np.random.Generator, braid: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Carve a maze on an ``n_rows x n_cols`` cell grid.
 
     Returns:
@@ -96,7 +102,9 @@ def carve_maze(n_rows: int, n_cols: int, rng: np.random.Generator, braid: float 
             closed = [
                 (r + dr, c + dc)
                 for dr, dc in steps
-                if 0 <= r + dr < n_rows and 0 <= c + dc < n_cols and _wall_between(h_walls, v_walls, (r, c), (r + dr, c + dc))
+                if 0 <= r + dr < n_rows
+                and 0 <= c + dc < n_cols
+                and _wall_between(h_walls, v_walls, (r, c), (r + dr, c + dc))
             ]
             if not closed:
                 continue
@@ -110,14 +118,18 @@ def _open_sides(h_walls: np.ndarray, v_walls: np.ndarray) -> np.ndarray:
     return (~h_walls[1:]).astype(np.int64) + ~h_walls[:-1] + ~v_walls[:, 1:] + ~v_walls[:, :-1]
 
 
-def _wall_between(h_walls: np.ndarray, v_walls: np.ndarray, a: tuple[int, int], b: tuple[int, int]) -> bool:
+def _wall_between(
+    h_walls: np.ndarray, v_walls: np.ndarray, a: tuple[int, int], b: tuple[int, int]
+) -> bool:
     (r, c), (r2, c2) = a, b
     if r2 != r:
         return bool(h_walls[max(r, r2), c])
     return bool(v_walls[r, max(c, c2)])
 
 
-def _open_wall(h_walls: np.ndarray, v_walls: np.ndarray, a: tuple[int, int], b: tuple[int, int]) -> None:
+def _open_wall(
+    h_walls: np.ndarray, v_walls: np.ndarray, a: tuple[int, int], b: tuple[int, int]
+) -> None:
     (r, c), (r2, c2) = a, b
     if r2 != r:
         h_walls[max(r, r2), c] = False
@@ -125,7 +137,9 @@ def _open_wall(h_walls: np.ndarray, v_walls: np.ndarray, a: tuple[int, int], b: 
         v_walls[r, max(c, c2)] = False
 
 
-def maze_walls_to_segments(h_walls: np.ndarray, v_walls: np.ndarray, xs_m: np.ndarray, ys_m: np.ndarray) -> np.ndarray:
+def maze_walls_to_segments(
+    h_walls: np.ndarray, v_walls: np.ndarray, xs_m: np.ndarray, ys_m: np.ndarray
+) -> np.ndarray:
     """Merge standing cell walls into maximal straight segments.
 
     Args:
@@ -138,7 +152,10 @@ def maze_walls_to_segments(h_walls: np.ndarray, v_walls: np.ndarray, xs_m: np.nd
         ``(N, 4)`` segments, horizontal ones first.
     """
     out = []
-    for walls, along, across, horizontal in ((h_walls, xs_m, ys_m, True), (v_walls.T, ys_m, xs_m, False)):
+    for walls, along, across, horizontal in (
+        (h_walls, xs_m, ys_m, True),
+        (v_walls.T, ys_m, xs_m, False),
+    ):
         padded = np.zeros((walls.shape[0], walls.shape[1] + 2), dtype=np.int8)
         padded[:, 1:-1] = walls
         d = np.diff(padded, axis=1)
@@ -147,7 +164,9 @@ def maze_walls_to_segments(h_walls: np.ndarray, v_walls: np.ndarray, xs_m: np.nd
         a0 = along[first]
         a1 = along[last]
         k = across[line]
-        out.append(np.column_stack([a0, k, a1, k]) if horizontal else np.column_stack([k, a0, k, a1]))
+        out.append(
+            np.column_stack([a0, k, a1, k]) if horizontal else np.column_stack([k, a0, k, a1])
+        )
     return np.vstack(out)
 
 
@@ -184,5 +203,11 @@ def generate_maze(params: MazeParams, name: str | None = None) -> World:
         segments,
         interior,
         start_pose=start,
-        metadata={"source": "procedural", "family": "maze", "params": asdict(params), "spec": spec, "n_cells": n},
+        metadata={
+            "source": "procedural",
+            "family": "maze",
+            "params": asdict(params),
+            "spec": spec,
+            "n_cells": n,
+        },
     )

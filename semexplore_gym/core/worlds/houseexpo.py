@@ -50,7 +50,9 @@ def read_houseexpo_json(path: str | os.PathLike) -> dict:
     except json.JSONDecodeError as exc:
         raise ValueError(f"{p}: malformed JSON: {exc}") from exc
     if not isinstance(doc, dict):
-        raise ValueError(f"{p}: expected a JSON object with a 'verts' key, got {type(doc).__name__}")
+        raise ValueError(
+            f"{p}: expected a JSON object with a 'verts' key, got {type(doc).__name__}"
+        )
     if "verts" not in doc:
         raise ValueError(f"{p}: missing required key 'verts'")
     try:
@@ -58,7 +60,9 @@ def read_houseexpo_json(path: str | os.PathLike) -> dict:
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{p}: key 'verts' must be a list of [x, y] numbers: {exc}") from exc
     if verts.ndim != 2 or verts.shape[1] != 2 or verts.shape[0] < 3:
-        raise ValueError(f"{p}: key 'verts' must hold at least 3 [x, y] points, got shape {verts.shape}")
+        raise ValueError(
+            f"{p}: key 'verts' must hold at least 3 [x, y] points, got shape {verts.shape}"
+        )
     if not np.isfinite(verts).all():
         raise ValueError(f"{p}: key 'verts' contains NaN or inf")
     out = dict(doc)
@@ -67,7 +71,10 @@ def read_houseexpo_json(path: str | os.PathLike) -> dict:
 
 
 def load_houseexpo_world(
-    path: str | os.PathLike, name: str | None = None, *, resolution_m: float = DEFAULT_VECTOR_RESOLUTION_M
+    path: str | os.PathLike,
+    name: str | None = None,
+    *,
+    resolution_m: float = DEFAULT_VECTOR_RESOLUTION_M,
 ) -> World:
     """A vector :class:`World` from a HouseExpo JSON plan.
 
@@ -84,7 +91,9 @@ def load_houseexpo_world(
     bounds = segments_bounds_m(segments)
     geometry = GridGeometry.covering(*bounds, resolution_m=resolution_m, margin_m=resolution_m)
     inside = polygon_inside_mask(verts, geometry)
-    free = mark_walls(inside & ~cells_near_walls(segments, geometry), *crossed_links(segments, geometry))
+    free = mark_walls(
+        inside & ~cells_near_walls(segments, geometry), *crossed_links(segments, geometry)
+    )
     if not free.any():
         raise ValueError(f"{path}: the polygon has no free cell at {resolution_m} m resolution")
     x, y = verts[:, 0], verts[:, 1]

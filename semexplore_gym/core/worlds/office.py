@@ -53,7 +53,11 @@ class OfficeParams:
     room_link_prob: float = 0.3
 
     def __post_init__(self) -> None:
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or self.seed < 0
+        ):
             raise ValueError(f"office parameter seed={self.seed!r} must be a non-negative integer")
         check_range("office", "size_m", self.size_m, 8.0, 100.0)
         check_range("office", "corridor_width_m", self.corridor_width_m, 0.8, 4.0)
@@ -163,12 +167,21 @@ def generate_office(params: OfficeParams, name: str | None = None) -> World:
                 rx1 = bounds[k + 1] - (t // 2 if k < len(bounds) - 2 else 0)
                 dx = int(rng.integers(rx0 + margin, max(rx0 + margin + 1, rx1 - margin - dw + 1)))
                 free[door_rows[0] : door_rows[1], dx : dx + dw] = True
-                if k < len(cuts) and drawn[k] and rng.random() < params.room_link_prob and ry1 - ry0 >= dw + 2 * margin:
+                if (
+                    k < len(cuts)
+                    and drawn[k]
+                    and rng.random() < params.room_link_prob
+                    and ry1 - ry0 >= dw + 2 * margin
+                ):
                     dy = int(rng.integers(ry0 + margin, ry1 - margin - dw + 1))
                     free[dy : dy + dw, cuts[k] - t // 2 : cuts[k] + t - t // 2] = True
             # The end rooms of a span may also open onto the vertical corridor beside them.
             for wall_col in (left_wall, right_wall):
-                if wall_col is not None and ry1 - ry0 >= dw + 2 * margin and rng.random() < _SIDE_DOOR_PROB:
+                if (
+                    wall_col is not None
+                    and ry1 - ry0 >= dw + 2 * margin
+                    and rng.random() < _SIDE_DOOR_PROB
+                ):
                     dy = int(rng.integers(ry0 + margin, ry1 - margin - dw + 1))
                     free[dy : dy + dw, wall_col : wall_col + t] = True
 
@@ -184,6 +197,7 @@ def generate_office(params: OfficeParams, name: str | None = None) -> World:
         free,
         GridGeometry(_RES_M, 0.0, 0.0, n, n),
         start_pose=start,
+        bounds_m=(0.0, 0.0, n * _RES_M, n * _RES_M),
         metadata={
             "source": "procedural",
             "family": "office",

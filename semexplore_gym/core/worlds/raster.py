@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
+from numba import njit
 from scipy import ndimage
 
 from semexplore_gym.core.grid import GridGeometry
@@ -37,28 +38,21 @@ def remove_small_free_components(free_mask: np.ndarray, min_free_cells: int) -> 
     Such specks (isolated free pixels in SLAM maps, anti-aliasing dots) are too small for a
     robot and would only add tiny closed walls.
     """
-    free = np.asarray(free_mask, dtype=bool)
+    free = np.array(free_mask, dtype=bool)
     if min_free_cells <= 1:
-        return free.copy()
+        return free
     labels, n = ndimage.label(free, structure=_FOUR_CONNECTED)
     if n == 0:
-        return free.copy()
+        return free
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
-    keep = sizes >= min_free_cells
-    keep[0] = False
-    return keep[labels]
-
-
-def _runs_along_rows(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Maximal runs of True along axis 1: ``(row, first_col, end_col_exclusive)`` for each run."""
-    h, w = edges.shape
-    padded = np.zeros((h, w + 2), dtype=np.int8)
-    padded[:, 1:-1] = edges
-    d = np.diff(padded, axis=1)
-    start_r, start_c = np.nonzero(d == 1)
-    _, end_c = np.nonzero(d == -1)
-    # np.nonzero walks row-major, so the k-th start and k-th end belong to the same run.
-    return start_r, start_c, end_c
+    small = np.flatnonzero(sizes[1:] < min_free_cells) + 1
+    if small.size:
+        # Clear each speck inside its own bounding box: cheaper than a full-size gather.
+        boxes = ndimage.find_objects(labels)
+        for label in small:
+            box = boxes[label - 1]
+            free[box][labels[box] == label] = False
+    return free
 
 
 def raster_to_segments(free_mask: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:
@@ -71,30 +65,92 @@ def raster_to_segments(free_mask: npt.ArrayLike, geometry: GridGeometry) -> np.n
     Returns:
         ``(N, 4)`` float64 segments ``x0, y0, x1, y1`` in metres, axis-aligned and maximal:
         collinear touching unit edges are merged (a straight 10-cell wall face is one segment).
-        Horizontal segments come first, ordered by y then x; then vertical ones by x then y.
+        Horizontal segments come first, ordered by y then x; then vertical ones, ordered by
+        the row where they end, then x.
     """
     free = np.asarray(free_mask, dtype=bool)
     if free.shape != geometry.shape:
         raise ValueError(f"free_mask shape {free.shape} != geometry shape {geometry.shape}")
     h, w = free.shape
-    padded = np.zeros((h + 2, w + 2), dtype=bool)
+    padded = np.zeros((h + 2, w + 2), dtype=np.bool_)
     padded[1:-1, 1:-1] = free
+    runs = np.empty(
+        (_edge_runs_kernel(padded, np.empty((0, 4), dtype=np.int64), False), 4), dtype=np.int64
+    )
+    _edge_runs_kernel(padded, runs, True)
     res = float(geometry.resolution_m)
-    ox = float(geometry.origin_x_m)
-    oy = float(geometry.origin_y_m)
+    out = np.empty((runs.shape[0], 4), dtype=np.float64)
+    horizontal = runs[:, 0] == 0
+    line, a, b = runs[:, 1], runs[:, 2], runs[:, 3]
+    # Horizontal run on grid line y = oy + line*res from x = ox + a*res to ox + b*res.
+    out[:, 0] = np.where(horizontal, a, line)
+    out[:, 1] = np.where(horizontal, line, a)
+    out[:, 2] = np.where(horizontal, b, line)
+    out[:, 3] = np.where(horizontal, line, b)
+    out *= res
+    out[:, [0, 2]] += geometry.origin_x_m
+    out[:, [1, 3]] += geometry.origin_y_m
+    return out
 
-    # Edge on grid line y = oy + k * res between padded rows k and k+1, for columns 0..w-1.
-    horizontal = padded[:-1, 1:-1] != padded[1:, 1:-1]  # (h + 1, w)
-    k, c0, c1 = _runs_along_rows(horizontal)
-    yh = oy + k * res
-    seg_h = np.column_stack([ox + c0 * res, yh, ox + c1 * res, yh])
 
-    # Edge on grid line x = ox + k * res between padded columns k and k+1, for rows 0..h-1.
-    vertical = padded[1:-1, :-1] != padded[1:-1, 1:]  # (h, w + 1)
-    k, r0, r1 = _runs_along_rows(vertical.T)
-    xv = ox + k * res
-    seg_v = np.column_stack([xv, oy + r0 * res, xv, oy + r1 * res])
-    return np.ascontiguousarray(np.vstack([seg_h, seg_v]).astype(np.float64))
+@njit(cache=True)
+def _edge_runs_kernel(padded: np.ndarray, out: np.ndarray, fill: bool) -> int:
+    """Maximal runs of boundary edges of a zero-padded mask; returns their number and, when
+    ``fill``, writes them to ``out`` as rows ``(kind, line, first, end)`` (kind 0 = along x).
+
+    Called twice (count, then fill) because growing a buffer inside the loop is several
+    times slower.
+    """
+    h = padded.shape[0] - 2
+    w = padded.shape[1] - 2
+    n = 0
+    # Along x: grid line k lies between padded rows k and k + 1.
+    for k in range(h + 1):
+        start = -1
+        for c in range(w):
+            if padded[k, c + 1] != padded[k + 1, c + 1]:
+                if start < 0:
+                    start = c
+            elif start >= 0:
+                if fill:
+                    out[n, 0] = 0
+                    out[n, 1] = k
+                    out[n, 2] = start
+                    out[n, 3] = c
+                n += 1
+                start = -1
+        if start >= 0:
+            if fill:
+                out[n, 0] = 0
+                out[n, 1] = k
+                out[n, 2] = start
+                out[n, 3] = w
+            n += 1
+    # Along y: grid line k lies between padded columns k and k + 1; walk rows in the outer loop
+    # for memory order, keeping one open run per line.
+    open_start = np.full(w + 1, -1, dtype=np.int64)
+    for r in range(h):
+        for k in range(w + 1):
+            if padded[r + 1, k] != padded[r + 1, k + 1]:
+                if open_start[k] < 0:
+                    open_start[k] = r
+            elif open_start[k] >= 0:
+                if fill:
+                    out[n, 0] = 1
+                    out[n, 1] = k
+                    out[n, 2] = open_start[k]
+                    out[n, 3] = r
+                n += 1
+                open_start[k] = -1
+    for k in range(w + 1):
+        if open_start[k] >= 0:
+            if fill:
+                out[n, 0] = 1
+                out[n, 1] = k
+                out[n, 2] = open_start[k]
+                out[n, 3] = h
+            n += 1
+    return n
 
 
 def cells_near_walls(segments_m: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:
@@ -105,7 +161,9 @@ def cells_near_walls(segments_m: npt.ArrayLike, geometry: GridGeometry) -> np.nd
     return dist < half * (1.0 - _HALF_CELL_TOLERANCE)
 
 
-def sample_mask(mask: np.ndarray, mask_geometry: GridGeometry, geometry: GridGeometry) -> np.ndarray:
+def sample_mask(
+    mask: np.ndarray, mask_geometry: GridGeometry, geometry: GridGeometry
+) -> np.ndarray:
     """Nearest-cell resampling: the value of ``mask`` at each cell centre of ``geometry``.
 
     Centres outside ``mask_geometry`` read False.
@@ -175,7 +233,9 @@ def rasterize_free(
 
     segments = as_segments(world_or_segments)
     if interior_points_m is None:
-        raise ValueError("rasterize_free needs interior_points_m when given bare segments (where is the inside?)")
+        raise ValueError(
+            "rasterize_free needs interior_points_m when given bare segments (where is the inside?)"
+        )
     pts = np.atleast_2d(np.asarray(interior_points_m, dtype=np.float64))
     if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
         raise ValueError(f"interior_points_m must be finite (K, 2) points, got shape {pts.shape}")

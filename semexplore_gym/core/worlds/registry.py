@@ -38,7 +38,9 @@ def list_world_names() -> list[str]:
 def world_family_parameters(family: str) -> dict[str, object]:
     """Default parameters of a procedural family, e.g. ``{"seed": 0, "size_m": 20.0, ...}``."""
     if family not in _FAMILIES:
-        raise ValueError(f"unknown world family {family!r}; families: {', '.join(sorted(_FAMILIES))}")
+        raise ValueError(
+            f"unknown world family {family!r}; families: {', '.join(sorted(_FAMILIES))}"
+        )
     return {f.name: f.default for f in dataclasses.fields(_FAMILIES[family][0])}
 
 
@@ -59,14 +61,18 @@ def parse_world_spec(spec: str) -> tuple[str, dict[str, str]]:
     name, sep, rest = spec.strip().partition(":")
     name = name.strip()
     if not name:
-        raise ValueError(f"world spec {spec!r} has no name; available worlds: {', '.join(list_world_names())}")
+        raise ValueError(
+            f"world spec {spec!r} has no name; available worlds: {', '.join(list_world_names())}"
+        )
     params: dict[str, str] = {}
     if sep and rest.strip():
         for item in rest.split(","):
             key, eq, value = item.partition("=")
             key = key.strip()
             if not eq or not key:
-                raise ValueError(f"world spec {spec!r}: parameter {item.strip()!r} is not key=value")
+                raise ValueError(
+                    f"world spec {spec!r}: parameter {item.strip()!r} is not key=value"
+                )
             if key in params:
                 raise ValueError(f"world spec {spec!r}: parameter {key!r} given twice")
             params[key] = value.strip()
@@ -118,12 +124,16 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
             return load_ros_map_world(path, name=str(spec))
         if path.suffix.lower() in _JSON_SUFFIXES:
             return load_houseexpo_world(path, name=str(spec))
-        raise ValueError(f"world file {path} has an unsupported extension; use .yaml/.yml (ROS map) or .json (HouseExpo)")
+        raise ValueError(
+            f"world file {path} has an unsupported extension; use .yaml/.yml (ROS map) or .json (HouseExpo)"
+        )
 
-    name, raw_params = parse_world_spec(spec)
+    name, raw_params = parse_world_spec(str(spec))
     if name in _FIXED:
         if raw_params:
-            raise ValueError(f"world {name!r} is fixed and takes no parameters, got {', '.join(raw_params)}")
+            raise ValueError(
+                f"world {name!r} is fixed and takes no parameters, got {', '.join(raw_params)}"
+            )
         return _FIXED[name](name)
     if name not in _FAMILIES:
         raise ValueError(
@@ -135,7 +145,9 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
     kwargs: dict[str, object] = {}
     for key, raw in raw_params.items():
         if key not in fields:
-            raise ValueError(f"unknown {name} parameter {key!r}; valid parameters: {', '.join(fields)}")
+            raise ValueError(
+                f"unknown {name} parameter {key!r}; valid parameters: {', '.join(fields)}"
+            )
         kwargs[key] = _convert(name, key, raw, fields[key].type)
     if "seed" not in kwargs:
         kwargs["seed"] = int(rng.integers(0, 2**31 - 1)) if rng is not None else 0

@@ -98,7 +98,9 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
     except yaml.YAMLError as exc:
         raise ValueError(f"{yaml_path}: malformed YAML: {exc}") from exc
     if not isinstance(doc, dict):
-        raise ValueError(f"{yaml_path}: expected a mapping of map_server keys, got {type(doc).__name__}")
+        raise ValueError(
+            f"{yaml_path}: expected a mapping of map_server keys, got {type(doc).__name__}"
+        )
 
     if "image" not in doc:
         raise ValueError(f"{yaml_path}: missing required key 'image'")
@@ -117,11 +119,16 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
     if (
         not isinstance(origin, (list, tuple))
         or len(origin) not in (2, 3)
-        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in origin)
+        or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+            for v in origin
+        )
     ):
         raise ValueError(f"{yaml_path}: key 'origin' must be [x, y, yaw] numbers, got {origin!r}")
     if len(origin) == 3 and abs(float(origin[2])) > 1e-9:
-        raise ValueError(f"{yaml_path}: key 'origin' has yaw {origin[2]!r}; only yaw 0 maps are supported")
+        raise ValueError(
+            f"{yaml_path}: key 'origin' has yaw {origin[2]!r}; only yaw 0 maps are supported"
+        )
 
     negate_raw = doc.get("negate", 0)
     if negate_raw not in (0, 1):
@@ -135,7 +142,9 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
         )
     mode = doc.get("mode", "trinary")
     if not isinstance(mode, str) or mode.strip().lower() not in _MODES:
-        raise ValueError(f"{yaml_path}: key 'mode' must be one of {', '.join(_MODES)}, got {mode!r}")
+        raise ValueError(
+            f"{yaml_path}: key 'mode' must be one of {', '.join(_MODES)}, got {mode!r}"
+        )
     return RosMapMetadata(
         yaml_path=yaml_path,
         image_path=image_path,
@@ -164,9 +173,11 @@ def _resolve_image(yaml_path: Path, image: str) -> Path:
 
 
 def read_grey_image(path: str | os.PathLike) -> np.ndarray:
-    """Grey values 0..255 (float32) of an image file, as stored (row 0 = top of the image).
+    """Grey values of an image file, as stored (row 0 = top of the image).
 
-    RGB(A) images give the mean of R, G and B; alpha is ignored; 16-bit images are scaled.
+    Returns:
+        ``(H, W)`` grey values in 0..255: the uint8 pixels of an 8-bit greyscale image as they
+        are, otherwise float32 (RGB(A): the mean of R, G and B, alpha ignored; 16-bit: scaled).
     """
     try:
         with Image.open(path) as im:
@@ -181,13 +192,17 @@ def read_grey_image(path: str | os.PathLike) -> np.ndarray:
             arr = np.asarray(im)
     except OSError as exc:
         raise ValueError(f"{path}: cannot read image: {exc}") from exc
-    if mode in ("RGB", "RGBA", "RGBX"):
+    if mode == "L":
+        grey = arr
+    elif mode in ("RGB", "RGBA", "RGBX"):
         grey = arr[..., :3].astype(np.float32).mean(axis=-1)
-    elif mode == "L":
-        grey = arr.astype(np.float32)
     elif mode.startswith("I"):
         # 16-bit (or 32-bit integer) greys: scale the type's range onto 0..255.
-        top = 65535.0 if (mode.startswith("I;16") or arr.max(initial=0) <= 65535) else float(arr.max())
+        top = (
+            65535.0
+            if (mode.startswith("I;16") or arr.max(initial=0) <= 65535)
+            else float(arr.max())
+        )
         grey = arr.astype(np.float32) * np.float32(255.0 / top)
     elif mode == "F":
         grey = np.clip(arr.astype(np.float32), 0.0, 255.0)
@@ -212,18 +227,33 @@ def load_ros_map(path: str | os.PathLike) -> tuple[np.ndarray, GridGeometry]:
     return _encode(meta)
 
 
-def _encode(meta: RosMapMetadata) -> tuple[np.ndarray, GridGeometry]:
-    grey = read_grey_image(meta.image_path)[::-1]
+def _classify(grey: np.ndarray, meta: RosMapMetadata) -> np.ndarray:
     p = grey / np.float32(255.0) if meta.negate else (np.float32(255.0) - grey) / np.float32(255.0)
-    grid = np.full(grey.shape, UNKNOWN, dtype=np.uint8)
-    grid[p > meta.occupied_thresh] = OCCUPIED
-    grid[p < meta.free_thresh] = FREE
-    geometry = GridGeometry(meta.resolution_m, meta.origin_x_m, meta.origin_y_m, grey.shape[0], grey.shape[1])
+    out = np.full(grey.shape, UNKNOWN, dtype=np.uint8)
+    out[p > meta.occupied_thresh] = OCCUPIED
+    out[p < meta.free_thresh] = FREE
+    return out
+
+
+def _encode(meta: RosMapMetadata) -> tuple[np.ndarray, GridGeometry]:
+    grey = read_grey_image(meta.image_path)
+    if grey.dtype == np.uint8:
+        # 256-entry table: the same float rule as below, applied once per grey level.
+        table = _classify(np.arange(256, dtype=np.float32)[None, :], meta)[0]
+        grid = table[grey[::-1]]
+    else:
+        grid = _classify(grey[::-1], meta)
+    geometry = GridGeometry(
+        meta.resolution_m, meta.origin_x_m, meta.origin_y_m, grid.shape[0], grid.shape[1]
+    )
     return grid, geometry
 
 
 def load_ros_map_world(
-    path: str | os.PathLike, name: str | None = None, *, min_free_cells: int = DEFAULT_MIN_FREE_CELLS
+    path: str | os.PathLike,
+    name: str | None = None,
+    *,
+    min_free_cells: int = DEFAULT_MIN_FREE_CELLS,
 ) -> World:
     """A raster :class:`World` from a map_server map.
 

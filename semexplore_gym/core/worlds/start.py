@@ -26,7 +26,9 @@ _FOUR_CONNECTED = ndimage.generate_binary_structure(2, 1)
 def _check_distance(name: str, value: float, allow_zero: bool = True) -> float:
     v = float(value)
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise ValueError(f"{name} must be a {'non-negative' if allow_zero else 'positive'} finite distance, got {value!r}")
+        raise ValueError(
+            f"{name} must be a {'non-negative' if allow_zero else 'positive'} finite distance, got {value!r}"
+        )
     return v
 
 
@@ -44,7 +46,9 @@ def _start_cells(world: World, clearance_m: float) -> np.ndarray:
     return np.flatnonzero(labels == int(np.argmax(sizes)))
 
 
-def sample_start_pose(world: World, rng: np.random.Generator, clearance_m: float) -> tuple[float, float, float]:
+def sample_start_pose(
+    world: World, rng: np.random.Generator, clearance_m: float
+) -> tuple[float, float, float]:
     """A random start pose at least ``clearance_m`` from every wall.
 
     The position is the centre of a cell drawn uniformly from the largest 4-connected set of
@@ -66,7 +70,9 @@ def sample_start_pose(world: World, rng: np.random.Generator, clearance_m: float
     clearance_m = _check_distance("clearance_m", clearance_m)
     cells = world.derived(("start_cells", clearance_m), lambda: _start_cells(world, clearance_m))
     if cells.size == 0:
-        raise ValueError(f"world {world.name!r} has no free cell with {clearance_m} m clearance from the walls")
+        raise ValueError(
+            f"world {world.name!r} has no free cell with {clearance_m} m clearance from the walls"
+        )
     k = cells[int(rng.integers(cells.size))]
     row, col = divmod(int(k), world.free_geometry.width)
     x, y = world.free_geometry.grid_to_world(row, col)
@@ -91,9 +97,13 @@ def validate_start_pose(
     x, y, yaw = (float(v) for v in p)
     xmin, ymin, xmax, ymax = world.bounds_m
     if not (xmin <= x <= xmax and ymin <= y <= ymax):
-        raise ValueError(f"start pose ({x:g}, {y:g}, {yaw:g}) is outside the world bounds {world.bounds_m}")
+        raise ValueError(
+            f"start pose ({x:g}, {y:g}, {yaw:g}) is outside the world bounds {world.bounds_m}"
+        )
     row, col = world.free_geometry.world_to_grid(x, y)
-    inside = bool(world.free_geometry.contains(row, col)) and bool(world.free_mask[int(row), int(col)])
+    inside = bool(world.free_geometry.contains(row, col)) and bool(
+        world.free_mask[int(row), int(col)]
+    )
     dist = float(distance_to_segments_m([x, y], world.segments_m)[0])
     if not inside:
         raise ValueError(

@@ -48,7 +48,9 @@ class World:
     def __post_init__(self) -> None:
         seg = np.asarray(self.segments_m, dtype=np.float64)
         if seg.ndim != 2 or seg.shape[1] != 4:
-            raise ValueError(f"world {self.name!r}: segments_m must have shape (N, 4), got {seg.shape}")
+            raise ValueError(
+                f"world {self.name!r}: segments_m must have shape (N, 4), got {seg.shape}"
+            )
         if not np.isfinite(seg).all():
             raise ValueError(f"world {self.name!r}: segments_m contains NaN or inf")
         if self.free_mask.shape != self.free_geometry.shape:

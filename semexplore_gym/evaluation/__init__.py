@@ -1,0 +1,1 @@
+"""Benchmark harness, figures and summaries (above envs and policies; used by the CLI)."""

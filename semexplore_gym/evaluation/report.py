@@ -1,0 +1,214 @@
+"""Figures and ``summary.md`` from a benchmark directory (see :mod:`.harness`).
+
+Figures follow the paper's: explored free area over time (mean and a min-max band, one panel
+per world), mission-time box plots, map-generation / frontier-detection compute time,
+global-navigation compute time, and the trajectory of the median run of each world and policy.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from semexplore_gym.evaluation.harness import read_runs, task_stem
+
+#: The policy every other one is compared against in ``summary.md``.
+REFERENCE_POLICY = "semantic"
+
+SUMMARY_METRICS: tuple[tuple[str, str], ...] = (
+    ("mission_time_s", "mission time (s)"),
+    ("coverage", "coverage"),
+    ("path_length_m", "path length (m)"),
+    ("T90_s", "T90 (s)"),
+    ("T99_s", "T99 (s)"),
+    ("mean_map_generation_ms", "map generation (ms)"),
+    ("mean_global_planning_ms", "global planning (ms)"),
+    ("wall_time_s", "wall time (s)"),
+    ("collisions", "collisions"),
+)
+
+
+def _values(rows: list[dict[str, Any]], key: str) -> np.ndarray:
+    return np.array([r[key] for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))], dtype=np.float64)
+
+
+def _median_iqr(v: np.ndarray) -> str:
+    if v.size == 0:
+        return "–"
+    q1, med, q3 = np.percentile(v, [25, 50, 75])
+    fmt = (lambda x: f"{x:.3f}") if abs(med) < 10 else (lambda x: f"{x:.1f}")
+    return f"{fmt(med)} [{fmt(q1)}–{fmt(q3)}]"
+
+
+def group_runs(rows: list[dict[str, Any]]) -> dict[str, dict[str, list[dict[str, Any]]]]:
+    """``{world: {policy: [rows]}}`` in first-seen order."""
+    out: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        out[r["world"]][r["policy"]].append(r)
+    return out
+
+
+def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY) -> Path:
+    """Write ``summary.md``: medians/IQRs, and the reference policy against each other one."""
+    from scipy.stats import mannwhitneyu
+
+    out = Path(out_dir)
+    rows = read_runs(out / "runs.csv")
+    if not rows:
+        raise ValueError(f"no finished missions in {out / 'runs.csv'}")
+    groups = group_runs(rows)
+    lines = ["# Benchmark summary", "", f"{len(rows)} missions from `{out / 'runs.csv'}`. Cells: median [IQR].", ""]
+    for world, by_policy in groups.items():
+        lines += [f"## {world}", ""]
+        header = "| policy | n | self-stopped | " + " | ".join(label for _, label in SUMMARY_METRICS) + " |"
+        lines += [header, "|" + "---|" * (3 + len(SUMMARY_METRICS))]
+        for policy, rs in by_policy.items():
+            stopped = sum(1 for r in rs if r["self_stopped"])
+            cells = [_median_iqr(_values(rs, key)) for key, _ in SUMMARY_METRICS]
+            lines.append(f"| {policy} | {len(rs)} | {stopped}/{len(rs)} | " + " | ".join(cells) + " |")
+        lines.append("")
+        if reference in by_policy and len(by_policy) > 1:
+            lines += [
+                f"{reference} vs each other policy, paired by seed. Ratio = median({reference}) / median(other); "
+                "p = two-sided Mann–Whitney U; wins = seeds where "
+                f"{reference} is lower.",
+                "",
+                "| vs | metric | ratio of medians | p (Mann–Whitney U) | wins |",
+                "|---|---|---:|---:|---:|",
+            ]
+            ref_rows = {r["seed"]: r for r in by_policy[reference]}
+            for other, rs in by_policy.items():
+                if other == reference:
+                    continue
+                other_rows = {r["seed"]: r for r in rs}
+                seeds = sorted(set(ref_rows) & set(other_rows))
+                for key, label in (("mission_time_s", "mission time"), ("mean_map_generation_ms", "map generation ms"), ("mean_global_planning_ms", "global planning ms")):
+                    a = np.array([ref_rows[s][key] for s in seeds if ref_rows[s][key] is not None and other_rows[s][key] is not None], dtype=float)
+                    b = np.array([other_rows[s][key] for s in seeds if ref_rows[s][key] is not None and other_rows[s][key] is not None], dtype=float)
+                    if a.size == 0:
+                        lines.append(f"| {other} | {label} | – | – | – |")
+                        continue
+                    ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
+                    p = mannwhitneyu(a, b, alternative="two-sided").pvalue if a.size >= 2 and not (np.all(a == a[0]) and np.array_equal(a, b)) else float("nan")
+                    wins = int(np.sum(a < b))
+                    lines.append(f"| {other} | {label} | {ratio:.2f} | {p:.3g} | {wins}/{a.size} |")
+            lines.append("")
+    path = out / "summary.md"
+    path.write_text("\n".join(lines))
+    return path
+
+
+def _trace(out: Path, r: dict[str, Any]) -> np.ndarray | None:
+    p = out / "traces" / f"{task_stem(r['world'], r['policy'], int(r['seed']))}.csv"
+    if not p.exists():
+        return None
+    t = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    return t if t.size else None
+
+
+def write_plots(out_dir: str | os.PathLike) -> list[Path]:
+    """Write the benchmark figures as PNGs into ``out_dir``; returns their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    rows = read_runs(out / "runs.csv")
+    if not rows:
+        raise ValueError(f"no finished missions in {out / 'runs.csv'}")
+    groups = group_runs(rows)
+    worlds = list(groups)
+    policies = list(dict.fromkeys(r["policy"] for r in rows))
+    colours = {p: plt.get_cmap("tab10")(i % 10) for i, p in enumerate(policies)}
+    paths: list[Path] = []
+
+    # 1. Explored free area over time, mean and min-max band.
+    fig, axes = plt.subplots(1, len(worlds), figsize=(5.2 * len(worlds), 4), squeeze=False)
+    for ax, world in zip(axes[0], worlds):
+        for policy, rs in groups[world].items():
+            traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
+            if not traces:
+                continue
+            t_end = max(float(t[-1, 0]) for t in traces)
+            grid = np.linspace(0.0, max(t_end, 1e-6), 300)
+            # After a mission ends its area stays at its final value.
+            ys = np.stack([np.interp(grid, t[:, 0], t[:, 2]) for t in traces])
+            ax.plot(grid, ys.mean(axis=0), color=colours[policy], label=f"{policy} (n={len(traces)})")
+            ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
+        ax.set_title(world)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("explored free area (m²)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths.append(_save(fig, out / "explored_area.png"))
+
+    # 2-4. Box plots per world: mission time, map-generation time, global-planning time.
+    for key, ylabel, name in (
+        ("mission_time_s", "mission time (s)", "mission_time.png"),
+        ("mean_map_generation_ms", "map generation / frontier detection (ms per update)", "map_generation_time.png"),
+        ("mean_global_planning_ms", "global navigation planning (ms per plan)", "global_planning_time.png"),
+    ):
+        fig, axes = plt.subplots(1, len(worlds), figsize=(4.2 * len(worlds), 4), squeeze=False)
+        for ax, world in zip(axes[0], worlds):
+            names = list(groups[world])
+            data = [_values(groups[world][p], key) for p in names]
+            ax.boxplot([d if d.size else np.array([np.nan]) for d in data], tick_labels=names)
+            for i, d in enumerate(data):
+                ax.scatter(np.full(d.size, i + 1) + np.linspace(-0.08, 0.08, max(d.size, 1))[: d.size], d, s=10, color=colours[names[i]], zorder=3)
+            ax.set_title(world)
+            ax.set_ylabel(ylabel)
+            ax.grid(alpha=0.3, axis="y")
+        fig.tight_layout()
+        paths.append(_save(fig, out / name))
+
+    # 5. Trajectory of the median (by mission time) run of each world and policy.
+    paths.append(_trajectory_figure(out, groups, worlds, policies, colours, plt))
+    return paths
+
+
+def _trajectory_figure(out: Path, groups: Any, worlds: list[str], policies: list[str], colours: dict, plt: Any) -> Path:
+    from semexplore_gym.core.worlds import make_world
+
+    fig, axes = plt.subplots(len(worlds), len(policies), figsize=(3.6 * len(policies), 3.6 * len(worlds)), squeeze=False)
+    for i, world in enumerate(worlds):
+        for j, policy in enumerate(policies):
+            ax = axes[i][j]
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            rs = groups[world].get(policy, [])
+            if not rs:
+                ax.set_title(f"{world} / {policy}: no run", fontsize=8)
+                continue
+            rs = sorted(rs, key=lambda r: r["mission_time_s"])
+            r = rs[(len(rs) - 1) // 2]
+            try:
+                w = make_world(world.replace("seed=*", f"seed={r['seed']}"))
+                seg = w.segments_m
+                ax.plot(seg[:, [0, 2]].T, seg[:, [1, 3]].T, color="0.2", lw=0.8)
+            except (ValueError, FileNotFoundError):
+                pass
+            tp = out / "trajectories" / f"{task_stem(r['world'], r['policy'], int(r['seed']))}.npy"
+            if tp.exists():
+                traj = np.load(tp)
+                ax.plot(traj[:, 0], traj[:, 1], color=colours[policy], lw=1.2)
+                ax.plot(traj[0, 0], traj[0, 1], "o", color="green", ms=5)
+                ax.plot(traj[-1, 0], traj[-1, 1], "s", color="red", ms=5)
+            ax.set_title(f"{world} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, out / "trajectories.png")
+
+
+def _save(fig: Any, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
