@@ -119,10 +119,14 @@ def test_seed_drawn_from_rng_is_reproducible() -> None:
 def test_world_pickles_with_derived_cache() -> None:
     world = make_world("maze1")
     sample_start_pose(world, np.random.default_rng(0), CLEARANCE_M)
+    assert world._derived
     clone = pickle.loads(pickle.dumps(world))
+    assert clone._derived == {}
     assert np.array_equal(clone.segments_m, world.segments_m)
     assert np.array_equal(clone.free_mask, world.free_mask)
     assert clone.start_pose == world.start_pose
+    pose = sample_start_pose(clone, np.random.default_rng(0), CLEARANCE_M)
+    assert pose == sample_start_pose(world, np.random.default_rng(0), CLEARANCE_M)
 
 
 # --------------------------------------------------------------------------- fixed mazes
@@ -276,6 +280,13 @@ def test_procedural_determinism(family: str) -> None:
     assert a.segments_m.shape != c.segments_m.shape or not np.array_equal(
         a.segments_m, c.segments_m
     )
+
+
+@pytest.mark.parametrize("family", ["maze:size_m=6", "office:size_m=12", "cave:size_m=8"])
+def test_procedural_bounds_do_not_depend_on_seed(family: str) -> None:
+    """An env redraws procedural worlds at reset on one map grid, so the box must not move."""
+    boxes = {make_world(f"{family},seed={seed}").bounds_m for seed in range(3)}
+    assert len(boxes) == 1
 
 
 def _check_connected_and_enclosed(world: World) -> None:

@@ -121,6 +121,23 @@ def test_raster_outside_counts_as_obstacle_and_specks_are_dropped() -> None:
     assert np.array_equal(rasterize_free(world, geometry), expected)
 
 
+@pytest.mark.parametrize("min_cells", [2, 4, 9])
+def test_remove_small_free_components_matches_labelling(min_cells: int) -> None:
+    from scipy import ndimage
+
+    from semexplore_gym.core.worlds.raster import remove_small_free_components
+
+    rng = np.random.default_rng(min_cells)
+    four = ndimage.generate_binary_structure(2, 1)
+    for _ in range(10):
+        free = rng.random((30, 40)) > rng.uniform(0.3, 0.7)
+        labels, _ = ndimage.label(free, structure=four)
+        sizes = np.bincount(labels.ravel())
+        keep = sizes >= min_cells
+        keep[0] = False
+        assert np.array_equal(remove_small_free_components(free, min_cells), keep[labels])
+
+
 def test_every_boundary_unit_edge_has_exactly_one_free_side() -> None:
     rng = np.random.default_rng(0)
     free = rng.random((30, 40)) > 0.4

@@ -33,7 +33,12 @@ def _resolve_bounds(
     if len(b) != 4 or not np.isfinite(b).all():
         raise ValueError(f"world {name!r}: bounds_m must be four finite numbers, got {bounds_m!r}")
     tol = 1e-9 * max(1.0, *(abs(v) for v in tight))
-    if b[0] > tight[0] + tol or b[1] > tight[1] + tol or b[2] < tight[2] - tol or b[3] < tight[3] - tol:
+    if (
+        b[0] > tight[0] + tol
+        or b[1] > tight[1] + tol
+        or b[2] < tight[2] - tol
+        or b[3] < tight[3] - tol
+    ):
         raise ValueError(f"world {name!r}: bounds_m {b} does not contain the walls' box {tight}")
     return (min(b[0], tight[0]), min(b[1], tight[1]), max(b[2], tight[2]), max(b[3], tight[3]))
 

@@ -161,6 +161,7 @@ def make_maze1(name: str = "maze1") -> World:
         metadata={
             "source": "fixed_maze",
             "maze": "maze1",
+            "spec": "maze1",
             "column_widths_m": MAZE1_COLUMN_WIDTHS_M,
             "row_heights_m": MAZE1_ROW_HEIGHTS_M,
         },
@@ -201,6 +202,7 @@ def make_maze2(name: str = "maze2") -> World:
         metadata={
             "source": "fixed_maze",
             "maze": "maze2",
+            "spec": "maze2",
             "column_widths_m": MAZE2_COLUMN_WIDTHS_M,
             "row_heights_m": MAZE2_ROW_HEIGHTS_M,
         },

@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 from numba import njit
-from scipy import ndimage
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.geometry import (
@@ -29,8 +28,6 @@ from semexplore_gym.core.worlds.world import World
 # every raster-derived wall) must count as free despite rounding.
 _HALF_CELL_TOLERANCE = 1e-5
 
-_FOUR_CONNECTED = ndimage.generate_binary_structure(2, 1)
-
 
 def remove_small_free_components(free_mask: np.ndarray, min_free_cells: int) -> np.ndarray:
     """Drop 4-connected free components smaller than ``min_free_cells`` cells.
@@ -38,21 +35,56 @@ def remove_small_free_components(free_mask: np.ndarray, min_free_cells: int) -> 
     Such specks (isolated free pixels in SLAM maps, anti-aliasing dots) are too small for a
     robot and would only add tiny closed walls.
     """
-    free = np.array(free_mask, dtype=bool)
-    if min_free_cells <= 1:
-        return free
-    labels, n = ndimage.label(free, structure=_FOUR_CONNECTED)
-    if n == 0:
-        return free
-    sizes = np.bincount(labels.ravel(), minlength=n + 1)
-    small = np.flatnonzero(sizes[1:] < min_free_cells) + 1
-    if small.size:
-        # Clear each speck inside its own bounding box: cheaper than a full-size gather.
-        boxes = ndimage.find_objects(labels)
-        for label in small:
-            box = boxes[label - 1]
-            free[box][labels[box] == label] = False
+    free = np.array(free_mask, dtype=np.bool_)
+    if free.ndim != 2:
+        raise ValueError(f"free_mask must be 2-D, got shape {free.shape}")
+    if min_free_cells > 1 and free.any():
+        _drop_small_components_kernel(free, int(min_free_cells))
     return free
+
+
+@njit(cache=True)
+def _drop_small_components_kernel(free: np.ndarray, min_cells: int) -> None:
+    # A search from each unvisited free cell stops as soon as it has seen min_cells cells or a
+    # cell already known to be in a big component; only a search that runs out of cells first
+    # has found a whole small component. Every cell is explored once: O(H * W), and no labels.
+    h, w = free.shape
+    state = np.zeros((h, w), dtype=np.uint8)  # 0 unseen, 1 big, 2 small
+    queue = np.empty(min_cells + 4, dtype=np.int64)
+    for r0 in range(h):
+        for c0 in range(w):
+            if not free[r0, c0] or state[r0, c0] != 0:
+                continue
+            state[r0, c0] = 3  # in the current search
+            queue[0] = r0 * w + c0
+            n = 1
+            head = 0
+            big = False
+            while head < n and not big:
+                s = queue[head]
+                head += 1
+                r = s // w
+                c = s % w
+                for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+                    rr = r + dr
+                    cc = c + dc
+                    if rr < 0 or rr >= h or cc < 0 or cc >= w or not free[rr, cc]:
+                        continue
+                    if state[rr, cc] == 1:
+                        big = True
+                        break
+                    if state[rr, cc] == 0:
+                        state[rr, cc] = 3
+                        queue[n] = rr * w + cc
+                        n += 1
+                        if n >= min_cells:
+                            big = True
+                            break
+            mark = 1 if big else 2
+            for k in range(n):
+                state[queue[k] // w, queue[k] % w] = mark
+                if not big:
+                    free[queue[k] // w, queue[k] % w] = False
 
 
 def raster_to_segments(free_mask: npt.ArrayLike, geometry: GridGeometry) -> np.ndarray:

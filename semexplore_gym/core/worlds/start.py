@@ -43,7 +43,8 @@ def _start_cells(world: World, clearance_m: float) -> np.ndarray:
         return np.zeros(0, dtype=np.int64)
     sizes = np.bincount(labels.ravel())
     sizes[0] = 0
-    return np.flatnonzero(labels == int(np.argmax(sizes)))
+    cells = np.flatnonzero(labels == int(np.argmax(sizes)))
+    return cells.astype(np.int32) if ok.size < 2**31 else cells
 
 
 def sample_start_pose(

@@ -77,6 +77,17 @@ class World:
             self._derived[key] = compute()
         return self._derived[key]
 
+    def __getstate__(self) -> dict:
+        # The derived cache can be large (start-cell indices of big maps) and is cheap to
+        # rebuild, so it does not travel with a pickled world.
+        state = dict(self.__dict__)
+        state["_derived"] = {}
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
+
     @property
     def size_m(self) -> tuple[float, float]:
         xmin, ymin, xmax, ymax = self.bounds_m
