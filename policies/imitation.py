@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from policies.base import Policy
-from semexplore_gym.wrappers.egocentric import EgocentricEncoder, EgocentricParams
+from semexplore_gym.core.egocentric import EgocentricEncoder, EgocentricParams
 
 #: Name of the JSON record stored inside model zips: policy class and feature parameters.
 MODEL_META_NAME = "semexplore.json"
@@ -198,10 +198,21 @@ def _stack_obs(obs_list: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
     return {k: np.stack([o[k] for o in obs_list]) for k in obs_list[0]}
 
 
-def learner_action(policy: Any, features: dict[str, np.ndarray]) -> np.ndarray:
-    """Deterministic action of an SB3 policy (or any object with ``predict``) for one observation."""
-    action, _ = policy.predict(features, deterministic=True)
-    return np.clip(np.asarray(action, dtype=np.float32).reshape(-1), -1.0, 1.0)
+def learner_action(
+    policy: Any, features: dict[str, np.ndarray], deterministic: bool = True
+) -> np.ndarray:
+    """Action of an SB3 policy for one egocentric observation, clipped to [-1, 1].
+
+    Calls the policy's network directly: SB3's ``predict`` also toggles the training mode and
+    re-validates the observation each call, which costs more than the forward pass itself.
+    The policy must already be in evaluation mode (``set_training_mode(False)``).
+    """
+    import torch as th
+
+    with th.inference_mode():
+        obs_t = {k: th.as_tensor(v, device=policy.device).unsqueeze(0) for k, v in features.items()}
+        action = policy._predict(obs_t, deterministic=deterministic)
+    return np.clip(action.cpu().numpy().astype(np.float32).reshape(-1), -1.0, 1.0)
 
 
 def rollout_episode(
@@ -239,6 +250,8 @@ def rollout_episode(
     if max_steps < 1:
         raise ValueError(f"max_steps must be >= 1, got {max_steps!r}")
     rng = rng if rng is not None else np.random.default_rng(seed)
+    if learner is not None and hasattr(learner, "set_training_mode"):
+        learner.set_training_mode(False)
     obs, info = env.reset(seed=seed)
     expert.reset(obs, info, seed=seed)
     encoder = EgocentricEncoder.from_info(params, info)

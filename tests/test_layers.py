@@ -15,7 +15,7 @@ FORBIDDEN = {
     "semexplore_gym/sim": ["gymnasium", "semexplore_gym.envs", "semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
     "semexplore_gym/envs": ["semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
     "semexplore_gym/wrappers": ["semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
-    "policies": ["pymunk", "semexplore_gym.sim", "semexplore_gym.envs", "semexplore_gym.cli", "semexplore_gym.evaluation"],
+    "policies": ["pymunk", "semexplore_gym.sim", "semexplore_gym.envs", "semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation"],
 }
 
 

@@ -376,6 +376,18 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _command_line(args: argparse.Namespace) -> str:
+    """The ``semexplore train`` command that reproduces this run (also when called via ``main``)."""
+    parts = ["semexplore", "train", "--algo", args.algo, "--out", str(args.out)]
+    if args.config:
+        parts += ["--config", str(args.config)]
+    for text in args.overrides:
+        parts += ["--set", text]
+    if args.no_progress:
+        parts.append("--no-progress")
+    return shlex.join(parts)
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         import stable_baselines3  # noqa: F401
@@ -390,6 +402,8 @@ def run(args: argparse.Namespace) -> int:
         cfg = load_train_config(args.config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
+    if cfg.torch_threads < 1:
+        raise ValueError(f"torch_threads must be >= 1, got {cfg.torch_threads!r}")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yaml").write_text(yaml.safe_dump(to_dict(cfg), sort_keys=False))
@@ -397,29 +411,26 @@ def run(args: argparse.Namespace) -> int:
         json.dumps(
             {
                 "args": {k: v for k, v in vars(args).items() if not k.startswith("_")},
-                "argv": sys.argv,
-                "command_line": shlex.join(sys.argv),
+                "process_argv": sys.argv,
+                "command_line": _command_line(args),
             },
             indent=2,
         )
     )
     import torch
 
-    if cfg.torch_threads < 1:
-        raise ValueError(f"torch_threads must be >= 1, got {cfg.torch_threads!r}")
     # Small CNN/MLP nets train faster single-threaded than with threads fighting over 2 cores.
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
-    log = ScalarLogger(out / "tb" / args.algo)
     t0 = time.perf_counter()
-    try:
-        metrics = (
-            _train_ppo(cfg, args, out)
-            if args.algo == "ppo"
-            else _train_imitation(cfg, args, out, log)
-        )
-    finally:
-        log.close()
+    if args.algo == "ppo":
+        metrics = _train_ppo(cfg, args, out)  # SB3's own logger writes out/tb/ppo_N
+    else:
+        log = ScalarLogger(out / "tb" / args.algo)
+        try:
+            metrics = _train_imitation(cfg, args, out, log)
+        finally:
+            log.close()
     metrics["total_s"] = time.perf_counter() - t0
     metrics["model"] = str(out / "model.zip")
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))

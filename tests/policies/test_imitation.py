@@ -326,6 +326,10 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
         ]
     )
     assert rc == 0 and (ppo_out / "model.zip").is_file()
+    assert list((ppo_out / "tb").rglob("events.out.tfevents.*")), "no PPO TensorBoard log"
+    recorded = json.loads((ppo_out / "args.json").read_text())
+    assert recorded["command_line"].startswith("semexplore train --algo ppo --out ")
+    assert "ppo.total_timesteps=64" in recorded["command_line"]
     from policies.sb3_policy import SB3Policy
 
     assert SB3Policy(ppo_out / "model.zip").params.crop_cells == 36
