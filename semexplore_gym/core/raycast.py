@@ -9,14 +9,16 @@ The geometry matches pymunk's ``Space.segment_query_first`` on radius-0 segments
 
 * A ray hits a segment when it crosses it at a distance ``0 < t < max_range_m``.
   Segment end points count: a ray through an end point hits.
-* A segment collinear with the ray, or one whose line passes through the origin, is
+* A segment collinear with the ray, or one whose line passes through the sensor, is
   never hit. Zero-length segments are never hit.
 * A sensor lying exactly on a segment reads ``0.0`` on every ray, as pymunk does: it is
   inside the wall.
 
 One scan gathers the segments of the buckets near the sensor once, drops those farther
 than ``max_range_m``, sorts the rest into angular bins around the sensor, and then tests
-each ray only against the segments of its bin. Everything runs in single-threaded numba.
+each ray only against the segments of its bin (about 1-2 tests per ray in a building).
+Everything runs in single-threaded numba. Walking the buckets along each ray instead was
+measured about 2x slower on 40- to 12k-segment worlds (``scripts/bench_lidar.py`` worlds).
 """
 
 from __future__ import annotations

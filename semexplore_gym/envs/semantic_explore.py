@@ -169,8 +169,7 @@ class SemanticExploreEnv(gym.Env):
         self.lidar = Lidar(cfg.lidar, SegmentIndex(self.world.segments_m))
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping)
         self.odometry = OdometryDrift(cfg.odometry)
-        o = cfg.odometry
-        self._odometry_noisy = any(v != 0 for v in (o.rot_from_rot, o.rot_from_trans, o.trans_from_trans, o.trans_from_rot))
+        self._odometry_noisy = not cfg.odometry.is_perfect
 
     def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         cfg = self.config
