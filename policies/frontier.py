@@ -17,7 +17,10 @@ planner (:mod:`semexplore_gym.core.dwa`), with move_base's failure handling:
 :class:`FrontierExplorationPolicy` (``"frontier"``) follows ``frontier_exploration``
 (``explore_server`` + ``BoundedExploreLayer``, indigo; blacklist of the melodic plugin):
 
-* every ``1 / frequency_hz`` (2 Hz in its ``global_map.launch``) it runs the wavefront
+* when the current goal has ended (``frequency_hz = 0``, the ``explore_server`` default: it
+  commits to each goal until move_base reports success or abort), or every
+  ``1 / frequency_hz`` (2 Hz in ``global_map.launch``; at that rate the robot tends to flip
+  between frontiers at similar distances, the goal switching users report), it runs the wavefront
   frontier search (:func:`~semexplore_gym.core.frontiers.detect_frontiers`) **on its explore
   costmap** (``search_on_costmap``): only cells of cost 0 are free, so frontiers hide within
   ``explore_costmap.inflation_radius_m`` (0.15 m) of walls, exactly as FE's search on its
@@ -31,7 +34,9 @@ planner (:mod:`semexplore_gym.core.dwa`), with move_base's failure handling:
 * **it does not check reachability before committing** (the paper names this as one reason FE
   is slow): an unreachable travel point costs planner patience plus recoveries before it is
   aborted. ``check_reachability=True`` skips frontiers whose travel point the planner cannot
-  reach (one Dijkstra from the robot per selection);
+  reach (one Dijkstra from the robot per selection), drops the committed goal as soon as the
+  map shows it next to a wall or a replan finds it unreachable, and replans as soon as the
+  path runs into a newly mapped wall;
 * aborted goals are blacklisted (travel points within ``blacklist_box_m`` are skipped); the
   blacklist is cleared when a goal succeeds (melodic ``FrontierPlugin``);
 * exploration is complete when no frontier is found ``no_frontier_retries + 1`` times in a row.
@@ -69,6 +74,7 @@ from semexplore_gym.core.grid_search import (
     CostmapParams,
     GridPath,
     NavfnParams,
+    cells_near_occupied,
     distance_field,
     geodesic_distance_m,
     inflate_costmap,
@@ -121,6 +127,10 @@ class MoveBaseParams:
         stand_still_speed_mps: A local-planner command slower than this in both v and
             ``stand_still_speed_mps / radius`` in omega counts as a failure (ROS DWA never
             samples such commands: TurtleBot3 ``min_trans_vel`` 0.11, ``min_rot_vel`` 1.37).
+        replan_on_blocked_path: Replan as soon as the rest of the path passes within the robot
+            radius of a newly mapped obstacle (move_base only replans when the local planner
+            fails, with ``planner_frequency`` 0, so a stale path through a wall first costs an
+            oscillation timeout and a recovery).
     """
 
     costmap: CostmapParams = field(
@@ -139,6 +149,7 @@ class MoveBaseParams:
     recovery_angular_speed_radps: float = 1.0
     max_recoveries: int = 2
     stand_still_speed_mps: float = 0.005
+    replan_on_blocked_path: bool = False
 
     def __post_init__(self) -> None:
         _check_positive(
@@ -214,6 +225,9 @@ class Navigator:
             "aborts": 0,
             "successes": 0,
         }
+        self.last_plan_failed = False
+        # Set by a policy to force replan_on_blocked_path (FE's check_reachability).
+        self.check_blocked = False
         self._reset_goal_state(0.0)
 
     def _reset_goal_state(self, now_s: float) -> None:
@@ -234,6 +248,14 @@ class Navigator:
         self.dwa.clear()
         self._reset_goal_state(now_s)
 
+    def abort(self) -> None:
+        """Give up the current goal now (status ABORTED), without patience or recoveries."""
+        if self.goal_xy_m is not None:
+            self.status = NavStatus.ABORTED
+            self.counters["aborts"] += 1
+            self.path = None
+            self.dwa.clear()
+
     def cancel(self) -> None:
         self.goal_xy_m = None
         self.path = None
@@ -253,6 +275,7 @@ class Navigator:
         if self.status not in (NavStatus.ACTIVE, NavStatus.RECOVERING) or self.goal_xy_m is None:
             return self._command(0.0, 0.0)
         prm = self.params
+        self.last_plan_failed = False
         if self.status == NavStatus.RECOVERING:
             if self._recovery_left_rad > 0.0:
                 w = min(prm.recovery_angular_speed_radps, self.limits[1])
@@ -271,7 +294,10 @@ class Navigator:
             and now_s - self._last_plan_s >= 1.0 / prm.planner_frequency_hz
         ):
             self._need_plan = True
-        if self._need_plan:
+        blocked = (prm.replan_on_blocked_path or self.check_blocked) and self._path_blocked(
+            pose, grid, geometry
+        )
+        if self._need_plan or blocked:
             t0 = time.perf_counter()
             path = self._plan(pose, grid, geometry)
             stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
@@ -279,7 +305,9 @@ class Navigator:
             self._last_plan_s = now_s
             self.counters["plans"] += 1
             if path is None:
+                self.last_plan_failed = True
                 self.counters["plan_failures"] += 1
+                self._need_plan = True
                 if self._plan_fail_since is None:
                     self._plan_fail_since = now_s
                 if now_s - self._plan_fail_since >= prm.planner_patience_s:
@@ -317,6 +345,21 @@ class Navigator:
             return self._command(0.0, 0.0)
         self._ctrl_fail_since = None
         return self._command(cmd.v_mps, cmd.omega_radps)
+
+    def _path_blocked(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> bool:
+        if self.path is None:
+            return False
+        rest = self.path.cells[self.dwa.progress_index + 1 :]
+        if len(rest) == 0:
+            return False
+        # Cells round the robot may be in the inscribed band on purpose (the planner's escape
+        # radius); only the path ahead of them counts.
+        x, y = geometry.grid_to_world(rest[:, 0], rest[:, 1])
+        skip = max(self.params.navfn.escape_radius_m, self.radius_m)
+        ahead = rest[np.hypot(x - pose[0], y - pose[1]) > skip]
+        if len(ahead) == 0:
+            return False
+        return bool(cells_near_occupied(grid, ahead, self.radius_m, geometry.resolution_m).any())
 
     def _plan(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> GridPath | None:
         costmap = inflate_costmap(grid, geometry.resolution_m, self.costmap_params)
@@ -358,6 +401,22 @@ class Navigator:
         return self.velocity
 
 
+def _warm_up_kernels() -> None:
+    """Run every numba kernel once on a tiny map, so that loading or compiling them lands in
+    ``reset`` and not in the timing statistics of the first steps."""
+    grid = np.full((12, 12), FREE, dtype=np.uint8)
+    grid[:, 8:] = UNKNOWN
+    grid[0, :8] = OCCUPIED
+    geo = GridGeometry(0.05, 0.0, 0.0, 12, 12)
+    detect_frontiers(grid, geo, (0.1, 0.2))
+    costmap = inflate_costmap(grid, 0.05, CostmapParams())
+    plan_path(costmap, geo, (0.1, 0.3), (0.35, 0.35))
+    geodesic_distance_m(grid == FREE, geo, (0.1, 0.3))
+    dwa = DWAPlanner(DWAParams())
+    dwa.set_path(np.array([[0.1, 0.3], [0.35, 0.35]]))
+    dwa.compute((0.1, 0.3, 0.0), (0.0, 0.0), grid, geo, obstacle_points_m=np.array([[0.3, 0.5]]))
+
+
 class _FrontierBaseline(Policy):
     """Shared plumbing: reading obs/info, the navigator, actions, stats and overlay."""
 
@@ -392,6 +451,7 @@ class _FrontierBaseline(Policy):
                 f"robot limits and dt_s must be positive, got {self.max_v}, {self.max_w}, {self.dt_s}"
             )
         self.nav = Navigator(self._nav_params, self.radius_m, (self.max_v, self.max_w), self.dt_s)
+        _warm_up_kernels()
         self.now_s = 0.0
         self.frontiers = []
         self.blacklist = []
@@ -449,8 +509,9 @@ class FrontierExplorationParams:
     """ROS ``frontier_exploration`` (indigo explore_server + BoundedExploreLayer).
 
     Attributes:
-        frequency_hz: Frontier search / goal update rate (``frequency``, 2.0 in
-            ``global_map.launch``); 0 = wait until each goal ends before choosing the next.
+        frequency_hz: Frontier search / goal update rate (``frequency``); 0 (the server's
+            default) = wait until each goal ends before choosing the next. Its
+            ``global_map.launch`` uses 2.0.
         goal_aliasing_m: A new travel point is sent only if farther than 0.9 times this from
             the current goal (``goal_aliasing``, the launch sets it to the sensor range, 1.0).
         travel_point: ``"closest"`` (first-contact cell, FE's default), ``"middle"`` (FE's
@@ -462,14 +523,16 @@ class FrontierExplorationParams:
             than on the raw occupancy grid.
         explore_costmap: The explore costmap's inflation (``global_map.launch``: 0.15 m; ROS
             default ``cost_scaling_factor`` 10). Its inscribed radius becomes the robot radius.
-        check_reachability: Skip frontiers the global planner cannot reach (not in FE).
+        check_reachability: Skip frontiers the global planner cannot reach, abort a goal as
+            soon as it is next to a wall or planning to it fails, replan when the path is
+            blocked (none of this is in FE).
         blacklist_box_m: Travel points within this box half-size of an aborted goal are skipped
             (melodic ``blacklist_box_size`` 0.5).
         no_frontier_retries: Searches without a frontier tolerated before stopping (FE: 5).
         navigation: The move_base-like navigator.
     """
 
-    frequency_hz: float = 2.0
+    frequency_hz: float = 0.0
     goal_aliasing_m: float = 1.0
     travel_point: Literal["closest", "middle", "centroid"] = "closest"
     selection: Literal["euclidean", "bfs_order"] = "euclidean"
@@ -536,6 +599,8 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         )
         self._last_search_s = -math.inf
         self._moving = False
+        assert self.nav is not None
+        self.nav.check_blocked = self.params.check_reachability
 
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
         if self.nav is None:
@@ -584,7 +649,18 @@ class FrontierExplorationPolicy(_FrontierBaseline):
                     self._moving = True
                     self.counters["goals_sent"] += 1
 
+        if (
+            prm.check_reachability
+            and nav.goal_xy_m is not None
+            and self._goal_blocked(grid, nav.goal_xy_m)
+        ):
+            # The committed goal is now (next to) a wall: drop it before driving on.
+            nav.abort()
         v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
+        if prm.check_reachability and nav.last_plan_failed:
+            # The committed goal became unreachable on the updated map: drop it at once
+            # instead of waiting out planner patience and recoveries.
+            nav.abort()
         stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
         self.now_s += self.dt_s
         return self._action(v, w)
@@ -624,6 +700,11 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
         return candidates[0][1] if candidates else None
 
+    def _goal_blocked(self, grid: np.ndarray, goal: tuple[float, float]) -> bool:
+        r, c = self.geometry.world_to_grid(goal[0], goal[1])
+        cell = np.array([[int(r), int(c)]])
+        return bool(cells_near_occupied(grid, cell, self.radius_m, self.geometry.resolution_m)[0])
+
     def _travel_point(self, f: GridFrontier) -> tuple[float, float]:
         tp = self.params.travel_point
         if tp == "centroid":
@@ -634,10 +715,10 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         assert self.nav is not None
         costmap = inflate_costmap(grid, self.geometry.resolution_m, self.nav.costmap_params)
         cost = navfn_cell_costs(costmap, self.nav.params.navfn)
-        r, c = self.geometry.world_to_grid(pose[0], pose[1])
-        if not self.geometry.contains(r, c):
+        r_a, c_a = self.geometry.world_to_grid(pose[0], pose[1])
+        if not self.geometry.contains(r_a, c_a):
             return np.zeros(grid.shape, dtype=bool)
-        r, c = int(r), int(c)
+        r, c = int(r_a), int(c_a)
         # Same start handling as the planner (robot cell and escape radius are passable).
         if not np.isfinite(cost[r, c]):
             cost[r, c] = float(INSCRIBED_COST)
@@ -714,6 +795,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
     ) -> None:
         super().reset(obs, info, seed=seed)
         self._last_search_s = -math.inf
+        self._blacklist_hits = 0
         self._target_cell: tuple[int, int] | None = None
         self.path_length_m = math.inf
 
@@ -744,11 +826,13 @@ class NearestFrontierPolicy(_FrontierBaseline):
                 self._no_frontier_count += 1
                 nav.cancel()
                 if self._no_frontier_count > prm.no_frontier_retries:
-                    return self._finish(
-                        "no reachable frontier left"
-                        if not self.frontiers
-                        else "all frontiers blacklisted"
-                    )
+                    if self._blacklist_hits:
+                        reason = "all reachable frontiers blacklisted"
+                    elif self.frontiers:
+                        reason = "no reachable frontier left"
+                    else:
+                        reason = "no frontiers left"
+                    return self._finish(reason)
             else:
                 self._no_frontier_count = 0
                 nav.set_goal(goal, self.now_s)
@@ -794,6 +878,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
         self.frontiers = self._detect(grid, pose)
         stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
         self._target_cell = None
+        self._blacklist_hits = 0
         if not self.frontiers:
             return None
         t0 = time.perf_counter()
@@ -818,6 +903,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
                 math.dist((float(x), float(y)), b) <= self.params.blacklist_radius_m
                 for b in self.blacklist
             ):
+                self._blacklist_hits += 1
                 continue
             if best is None or d[i] < best[0]:
                 best = (float(d[i]), cell)

@@ -22,6 +22,12 @@ current LiDAR returns; a robot that is already closer than that may still rotate
 in the TurtleBot3 local costmap (``track_unknown_space: false``). The oscillation and twirling
 terms are not modelled; ROS's minimum-velocity filter is (``min_trans_speed_mps``).
 
+Settling: within ``min_trans_speed_mps * sim_time_s`` of the final goal every admissible
+trajectory would overshoot it, so there the filter and the nose and obstacle terms are dropped
+and a trajectory is scored by where the robot will be after one control period (its distance
+to the goal); the collision test still applies. Without this the robot parks a few centimetres
+short of goals near walls (ROS then oscillates until a recovery).
+
 The chosen command is always within ``[min_linear_speed_mps, max_linear_speed_mps]`` and
 ``[-max_angular_speed_radps, max_angular_speed_radps]``; with no valid trajectory it is (0, 0).
 """
@@ -61,7 +67,8 @@ class DWAParams:
             not considered, so the robot never creeps or stands still (TB3 ``min_trans_vel``
             0.11; 0 disables the filter). Unlike ROS, where a robot at rest cannot reach
             ``min_rot_vel`` within one period and so cannot turn in place, turning at the
-            fastest reachable rate is allowed.
+            fastest reachable rate is allowed, and the filter is lifted within
+            ``min_trans_speed_mps * sim_time_s`` of the final goal so the robot can settle on it.
         min_rot_speed_radps: See ``min_trans_speed_mps`` (TB3 ``min_rot_vel`` 1.37).
         linear_samples: Number of v samples (``vx_samples`` 20).
         angular_samples: Number of omega samples (``vth_samples`` 40).
@@ -70,8 +77,9 @@ class DWAParams:
         occdist_scale: Weight of the obstacle cost (0.02).
         forward_point_distance_m: Look-ahead of the alignment point (0.325).
         robot_radius_m: Robot radius.
-        clearance_margin_m: Added to the radius in the collision test; obstacle distances are
-            measured between cell centres, so half a cell keeps the robot off the wall surface.
+        clearance_margin_m: Added to the radius in the collision test. Obstacle distances are
+            measured to occupied cell centres, which may lie up to half a cell diagonal (0.035 m
+            at 0.05 m cells) off the wall surface; 0.04 m covers that and the rollout sampling.
         inflation_radius_m: Reach of the obstacle cost.
         cost_scaling_factor: Decay rate of the obstacle cost, 1/m.
         local_window_m: Side of the square local costmap around the robot (TB3: 3 m).
@@ -95,7 +103,7 @@ class DWAParams:
     occdist_scale: float = 0.02
     forward_point_distance_m: float = 0.325
     robot_radius_m: float = 0.105
-    clearance_margin_m: float = 0.025
+    clearance_margin_m: float = 0.04
     inflation_radius_m: float = 0.2
     cost_scaling_factor: float = 10.0
     local_window_m: float = 3.0
@@ -196,6 +204,11 @@ class DWAPlanner:
     def path_m(self) -> np.ndarray:
         return self._path
 
+    @property
+    def progress_index(self) -> int:
+        """Index of the path point the robot was last nearest to (the path behind is done)."""
+        return self._progress
+
     def set_path(self, path_m: npt.ArrayLike) -> None:
         """Track a new global path ``(K, 2)`` (K >= 1) in world metres."""
         p = np.asarray(path_m, dtype=np.float64)
@@ -238,6 +251,12 @@ class DWAPlanner:
         if p.shape[0] < 3 or not np.isfinite(p[:3]).all():
             raise ValueError(f"pose must be a finite (x, y, yaw), got {pose!r}")
         x0, y0, yaw0 = float(p[0]), float(p[1]), float(p[2])
+        if np.shape(grid) != geometry.shape:
+            raise ValueError(
+                f"grid shape {np.shape(grid)} does not match geometry {geometry.shape}"
+            )
+        if not all(math.isfinite(float(v)) for v in velocity[:2]):
+            raise ValueError(f"velocity must be a finite (v, omega), got {velocity!r}")
         if self._path.shape[0] == 0:
             return DWACommand(0.0, 0.0, True, True, 0.0, np.array([[x0, y0]]))
         goal = self._path[-1]
@@ -266,7 +285,11 @@ class DWAPlanner:
             grid, geometry, x0, y0, prm.local_window_m, obstacle_points_m
         )
         local_path, local_goal = self._local_path(x0, y0, wx0, wy0, prm.local_window_m)
-        near_goal = math.hypot(goal[0] - x0, goal[1] - y0) <= prm.forward_point_distance_m
+        to_goal = math.hypot(goal[0] - x0, goal[1] - y0)
+        near_goal = to_goal <= prm.forward_point_distance_m
+        # Within one horizon at the minimum speed of the final goal the filter is lifted, or every
+        # admissible trajectory would overshoot a goal the robot can no longer settle on.
+        settling = to_goal <= prm.min_trans_speed_mps * prm.sim_time_s
         path_field, goal_field, front_field = _distance_maps(
             clear, wx0, wy0, res, local_path, (x0, y0), prm
         )
@@ -287,7 +310,13 @@ class DWAPlanner:
             wy0,
             res,
             prm.forward_point_distance_m,
-            not near_goal,
+            # 2: alignment and goal-front terms; 1: goal front only (near the goal, as ROS);
+            # 0: settling, score the position after one control period (a nose aimed beyond a
+            # goal by a wall, or a horizon end beyond it, would pin the robot short of it).
+            0 if settling else (1 if near_goal else 2),
+            max(1, int(round(prm.control_period_s / (prm.sim_time_s / n_steps)))),
+            float(local_goal[0]),
+            float(local_goal[1]),
             prm.robot_radius_m + prm.clearance_margin_m,
             prm.path_distance_bias,
             prm.goal_distance_bias,
@@ -295,8 +324,8 @@ class DWAPlanner:
             prm.robot_radius_m,
             prm.inflation_radius_m,
             prm.cost_scaling_factor,
-            prm.min_trans_speed_mps,
-            prm.min_rot_speed_radps,
+            0.0 if settling else prm.min_trans_speed_mps,
+            0.0 if settling else prm.min_rot_speed_radps,
             # A robot too slow to reach min_rot_speed within one period may still turn in place
             # at the fastest rate it can reach (ROS would declare failure and run a recovery).
             min(prm.min_rot_speed_radps, float(np.abs(ws).max())),
@@ -350,7 +379,7 @@ def _local_clearance(
     y0: float,
     window_m: float,
     points: npt.ArrayLike | None,
-) -> tuple[np.ndarray, float, float]:
+) -> tuple[np.ndarray, np.ndarray, float, float]:
     res = geometry.resolution_m
     n = int(math.ceil(window_m / res))
     r_c, c_c = geometry.world_to_grid(x0, y0)
@@ -404,20 +433,42 @@ def _distance_maps(
     cost[clear <= 0.0] = np.inf
 
     def cells(points: np.ndarray) -> np.ndarray:
-        rc = np.column_stack(
-            [np.floor((points[:, 1] - wy0) / res), np.floor((points[:, 0] - wx0) / res)]
-        ).astype(np.int64)
-        rc = rc[((rc >= 0) & (rc < n)).all(axis=1)]
-        return np.unique(rc, axis=0) if len(rc) else rc
+        r = np.floor((points[:, 1] - wy0) / res).astype(np.int64)
+        c = np.floor((points[:, 0] - wx0) / res).astype(np.int64)
+        ok = (r >= 0) & (r < n) & (c >= 0) & (c < n)
+        return r[ok] * n + c[ok]  # flat indices; duplicates are harmless
 
-    path_rc = cells(local_path)
-    if len(path_rc) == 0:
+    def flood(sources: np.ndarray, start_cost: np.ndarray | None = None) -> np.ndarray:
+        rc = np.column_stack([sources // n, sources % n])
+        return distance_field(cost, rc, start_cost)[0]
+
+    def flood_from_point(p: np.ndarray) -> np.ndarray | None:
+        # Seed the 3 x 3 cells round the point with their exact distance to it, so that with
+        # bilinear lookups the field is close to Euclidean near the point, not cell-quantised.
+        r0 = int(np.floor((p[1] - wy0) / res))
+        c0 = int(np.floor((p[0] - wx0) / res))
+        rr, cc = np.mgrid[r0 - 1 : r0 + 2, c0 - 1 : c0 + 2]
+        ok = (rr >= 0) & (rr < n) & (cc >= 0) & (cc < n)
+        rr, cc = rr[ok], cc[ok]
+        if len(rr) == 0:
+            return None
+        idx = rr * n + cc
+        keep = np.isfinite(cost.ravel()[idx])
+        if not keep.any():
+            return None
+        idx, rr, cc = idx[keep], rr[keep], cc[keep]
+        d0 = np.hypot(wx0 + (cc + 0.5) * res - p[0], wy0 + (rr + 0.5) * res - p[1])
+        return flood(idx, d0)
+
+    path_idx = cells(local_path)
+    if len(path_idx) == 0:
         inf = np.full((n, n), np.inf)
         return inf, inf, inf
-    path_field, _ = distance_field(cost, path_rc)
+    path_field = flood(path_idx)
     goal = local_path[-1]
-    goal_rc = cells(goal[None, :])
-    goal_field, _ = distance_field(cost, goal_rc if len(goal_rc) else path_rc[-1:])
+    goal_field = flood_from_point(goal)
+    if goal_field is None:
+        goal_field = flood(path_idx[-1:])
     # ROS aims the nose at a point beyond the local goal, along the robot-to-goal direction, so
     # the robot centre can settle on the goal itself (goal_front_costs).
     d = np.array([goal[0] - robot_xy[0], goal[1] - robot_xy[1]])
@@ -425,9 +476,11 @@ def _distance_maps(
     front_field = goal_field
     if norm > 1e-9:
         front = goal + prm.forward_point_distance_m * d / norm
-        front_rc = cells(front[None, :])
-        if len(front_rc) and cost[front_rc[0, 0], front_rc[0, 1]] == res:
-            front_field, _ = distance_field(cost, front_rc)
+        front_idx = cells(front[None, :])
+        if len(front_idx) and cost.ravel()[front_idx[0]] == res:
+            shifted = flood_from_point(front)
+            if shifted is not None:
+                front_field = shifted
     return path_field, goal_field, front_field
 
 
@@ -459,7 +512,10 @@ def _evaluate(
     wy0,
     res,
     fwd,
-    use_alignment,
+    front_mode,
+    ctrl_steps,
+    gx,
+    gy,
     min_clear,
     path_bias,
     goal_bias,
@@ -492,10 +548,15 @@ def _evaluate(
             yaw = yaw0
             lowest = np.inf
             ok = True
-            for _ in range(n_steps):
+            xc = x0
+            yc = y0
+            for k in range(n_steps):
                 x += v * math.cos(yaw) * dt
                 y += v * math.sin(yaw) * dt
                 yaw += w * dt
+                if k + 1 == ctrl_steps:
+                    xc = x
+                    yc = y
                 r = int(math.floor((y - wy0) / res))
                 c = int(math.floor((x - wx0) / res))
                 if r < 0 or r >= n or c < 0 or c >= n:
@@ -534,8 +595,17 @@ def _evaluate(
                 occ = 0.0
             else:
                 occ = math.floor(252.0 * math.exp(-scaling * (lowest - inscribed)))
-            cost = 0.5 * path_bias * (pd_end + (pd_front if use_alignment else 0.0))
-            cost += 0.5 * goal_bias * (gd_end + gd_front)
+            if front_mode == 2:
+                cost = 0.5 * path_bias * (pd_end + pd_front) + 0.5 * goal_bias * (gd_end + gd_front)
+            elif front_mode == 1:
+                cost = 0.5 * path_bias * pd_end + 0.5 * goal_bias * (gd_end + gd_front)
+            else:
+                # Settling: where the robot will be after this control period, as near the goal
+                # as possible (the horizon's end point would overshoot at any admissible speed).
+                # The obstacle cost is left out, or a goal in the inflated band next to a wall
+                # could never be reached; the clearance test still applies.
+                occ = 0.0
+                cost = goal_bias * math.hypot(xc - gx, yc - gy)
             cost += occ_scale * occ
             if cost < best_cost - 1e-12:
                 best_cost = cost
@@ -546,12 +616,27 @@ def _evaluate(
 
 @njit(cache=True, inline="always")
 def _lookup(field, x, y, wx0, wy0, res):  # pragma: no cover - numba
+    """Bilinear interpolation between cell centres; the nearest cell where a corner is inf."""
     n = field.shape[0]
     r = int(math.floor((y - wy0) / res))
     c = int(math.floor((x - wx0) / res))
     if r < 0 or r >= n or c < 0 or c >= n:
         return np.inf
-    return field[r, c]
+    fy = (y - wy0) / res - 0.5
+    fx = (x - wx0) / res - 0.5
+    r0 = int(math.floor(fy))
+    c0 = int(math.floor(fx))
+    if r0 < 0 or c0 < 0 or r0 + 1 >= n or c0 + 1 >= n:
+        return field[r, c]
+    a = field[r0, c0]
+    b = field[r0, c0 + 1]
+    cc = field[r0 + 1, c0]
+    d = field[r0 + 1, c0 + 1]
+    if not (a < np.inf and b < np.inf and cc < np.inf and d < np.inf):
+        return field[r, c]
+    ty = fy - r0
+    tx = fx - c0
+    return (a * (1 - tx) + b * tx) * (1 - ty) + (cc * (1 - tx) + d * tx) * ty
 
 
 @njit(cache=True, inline="always")

@@ -27,6 +27,7 @@ and FE's ``middle`` field actually holds the *Euclidean-nearest* cell (``nearest
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -134,42 +135,37 @@ def detect_frontiers(
         raise ValueError(f"min_frontier_cells must be >= 1, got {min_frontier_cells!r}")
     conv = _convention_code(cell_convention)
     rx, ry = _xy(robot_xy_m)
-    row, col = geometry.world_to_grid(rx, ry)
-    row, col = int(row), int(col)
+    row_a, col_a = geometry.world_to_grid(rx, ry)
+    row, col = int(row_a), int(col_a)
     if not geometry.contains(row, col):
         raise ValueError(
             f"robot position ({rx:.3f}, {ry:.3f}) m is outside the grid (cell ({row}, {col}) of shape {a.shape})"
         )
     cells, starts, n = _wfd_kernel(np.ascontiguousarray(a), row, col, conv)
-    res = geometry.resolution_m
+    stats = _frontier_stats(
+        cells, starts, geometry.origin_x_m, geometry.origin_y_m, geometry.resolution_m, rx, ry
+    )
     frontiers: list[GridFrontier] = []
     for k in range(n):
-        fc = cells[starts[k] : starts[k + 1]]
-        if fc.shape[0] < min_frontier_cells:
+        s0, s1 = int(starts[k]), int(starts[k + 1])
+        if s1 - s0 < min_frontier_cells:
             continue
-        frontiers.append(_describe(fc, k, geometry, rx, ry, res))
+        fc = cells[s0:s1]
+        cx, cy, i_near, i_mid, d_near = stats[k]
+        i_near, i_mid = s0 + int(i_near), s0 + int(i_mid)
+        frontiers.append(
+            GridFrontier(
+                cells=fc,
+                size=s1 - s0,
+                centroid_m=(float(cx), float(cy)),
+                initial_cell=(int(fc[0, 0]), int(fc[0, 1])),
+                nearest_cell=(int(cells[i_near, 0]), int(cells[i_near, 1])),
+                middle_cell=(int(cells[i_mid, 0]), int(cells[i_mid, 1])),
+                min_distance_m=float(d_near),
+                discovery_index=k,
+            )
+        )
     return frontiers
-
-
-def _describe(
-    fc: np.ndarray, index: int, geometry: GridGeometry, rx: float, ry: float, res: float
-) -> GridFrontier:
-    xs = geometry.origin_x_m + (fc[:, 1] + 0.5) * res
-    ys = geometry.origin_y_m + (fc[:, 0] + 0.5) * res
-    cx, cy = float(xs.mean()), float(ys.mean())
-    d_robot = np.hypot(xs - rx, ys - ry)
-    i_near = int(np.argmin(d_robot))
-    i_mid = int(np.argmin(np.hypot(xs - cx, ys - cy)))
-    return GridFrontier(
-        cells=fc.copy(),
-        size=int(fc.shape[0]),
-        centroid_m=(cx, cy),
-        initial_cell=(int(fc[0, 0]), int(fc[0, 1])),
-        nearest_cell=(int(fc[i_near, 0]), int(fc[i_near, 1])),
-        middle_cell=(int(fc[i_mid, 0]), int(fc[i_mid, 1])),
-        min_distance_m=float(d_robot[i_near]),
-        discovery_index=index,
-    )
 
 
 def _convention_code(cell_convention: str) -> int:
@@ -321,3 +317,44 @@ def _grow(grid, r0, c0, conv, flag, out, n_out, inner, d8r, d8c):  # pragma: no 
                 inner[it] = nr * w + nc
                 it += 1
     return n_out
+
+
+@njit(cache=True)
+def _frontier_stats(cells, starts, ox, oy, res, rx, ry):  # pragma: no cover - numba
+    """Per frontier: centroid x, y, offsets of the robot-nearest and centroid-nearest cells, and
+    the robot distance of the nearest one."""
+    n = starts.shape[0] - 1
+    out = np.empty((n, 5))
+    for k in range(n):
+        s0 = starts[k]
+        s1 = starts[k + 1]
+        sx = 0.0
+        sy = 0.0
+        best_d = np.inf
+        best_i = 0
+        for i in range(s0, s1):
+            x = ox + (cells[i, 1] + 0.5) * res
+            y = oy + (cells[i, 0] + 0.5) * res
+            sx += x
+            sy += y
+            d = math.hypot(x - rx, y - ry)
+            if d < best_d:
+                best_d = d
+                best_i = i - s0
+        cx = sx / (s1 - s0)
+        cy = sy / (s1 - s0)
+        mid_d = np.inf
+        mid_i = 0
+        for i in range(s0, s1):
+            x = ox + (cells[i, 1] + 0.5) * res
+            y = oy + (cells[i, 0] + 0.5) * res
+            d = math.hypot(x - cx, y - cy)
+            if d < mid_d:
+                mid_d = d
+                mid_i = i - s0
+        out[k, 0] = cx
+        out[k, 1] = cy
+        out[k, 2] = best_i
+        out[k, 3] = mid_i
+        out[k, 4] = best_d
+    return out

@@ -13,8 +13,8 @@ LETHAL_COST         254    an occupied cell
 NO_INFORMATION      255    unknown (only with ``track_unknown_space``; else unknown is free)
 ==================  =====  ===================================================================
 
-where ``d`` is the distance between cell centres to the nearest occupied cell (from
-``scipy.ndimage.distance_transform_edt``). As in ROS, unknown cells keep 255 unless they are
+where ``d`` is the distance between cell centres to the nearest occupied cell (stamped round
+each occupied cell out to the inflation radius, as ``costmap_2d`` does). As in ROS, unknown cells keep 255 unless they are
 within the inscribed radius of an obstacle (then 253/254), or ``inflate_unknown`` is set.
 
 **Navfn-like planner**: ROS ``navfn`` turns the costmap into per-cell traversal costs
@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 from numba import njit
-from scipy import ndimage
 
 from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
 
@@ -50,6 +49,7 @@ __all__ = [
     "CostmapParams",
     "GridPath",
     "NavfnParams",
+    "cells_near_occupied",
     "distance_field",
     "extract_path",
     "geodesic_distance_m",
@@ -178,12 +178,18 @@ def inflate_costmap(
     a = validate_encoded_grid(grid)
     if not (math.isfinite(resolution_m) and resolution_m > 0):
         raise ValueError(f"resolution_m must be a positive number, got {resolution_m!r}")
-    occupied = a == OCCUPIED
-    if occupied.any():
-        dist_m = ndimage.distance_transform_edt(~occupied) * resolution_m
-    else:
-        dist_m = np.full(a.shape, np.inf)
-    cost = inflation_cost(dist_m, params)
+    # Distances matter only out to the inflation radius (beyond it the cost is 0), so stamp a
+    # disc round each occupied cell, as costmap_2d does, instead of a full distance transform:
+    # the work scales with the number of obstacle cells, not with the map.
+    # The cost falls with distance, so the highest stamped cost is the cost of the nearest one.
+    k = int(math.floor(params.inflation_radius_m / resolution_m + 1e-9))
+    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
+    d_m = np.hypot(dr, dc).ravel() * resolution_m
+    disc = d_m <= params.inflation_radius_m + 1e-12
+    stamp_cost = inflation_cost(d_m[disc], params)
+    offsets = np.column_stack([dr.ravel()[disc], dc.ravel()[disc]]).astype(np.int64)
+    occ_r, occ_c = np.nonzero(a == OCCUPIED)
+    cost = _stamp_costs(a.shape[0], a.shape[1], occ_r, occ_c, offsets, stamp_cost)
     if params.track_unknown_space:
         unknown = a == UNKNOWN
         # ROS keeps NO_INFORMATION unless inflation makes the cell (nearly) lethal.
@@ -192,6 +198,40 @@ def inflate_costmap(
         )
         cost[keep] = NO_INFORMATION
     return cost
+
+
+def cells_near_occupied(
+    grid: npt.ArrayLike, cells: npt.ArrayLike, radius_m: float, resolution_m: float
+) -> np.ndarray:
+    """Which of ``cells`` lie within ``radius_m`` (centre to centre) of an OCCUPIED cell.
+
+    A cheap local test (no distance transform of the whole grid), e.g. to notice that a planned
+    path or a goal has become blocked after a map update.
+
+    Args:
+        grid: Encoded occupancy grid ``(H, W)``.
+        cells: ``(K, 2)`` ``(row, col)``; cells outside the grid count as blocked.
+        radius_m: Test radius (the inscribed radius for "the robot cannot stand here").
+        resolution_m: Cell size.
+
+    Returns:
+        ``(K,)`` bool.
+    """
+    a = np.asarray(grid)
+    rc = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    k = int(math.floor(radius_m / resolution_m + 1e-9))
+    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
+    disk = (dr**2 + dc**2) * resolution_m**2 <= radius_m**2 + 1e-12
+    dr, dc = dr[disk], dc[disk]
+    rr = rc[:, 0:1] + dr[None, :]
+    cc = rc[:, 1:2] + dc[None, :]
+    h, w = a.shape
+    inside = (rr >= 0) & (rr < h) & (cc >= 0) & (cc < w)
+    occ = np.zeros(rr.shape, dtype=bool)
+    occ[inside] = a[rr[inside], cc[inside]] == OCCUPIED
+    out = occ.any(axis=1)
+    out |= ~((rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w))
+    return out
 
 
 def navfn_cell_costs(costmap: npt.ArrayLike, params: NavfnParams = NavfnParams()) -> np.ndarray:
@@ -294,14 +334,18 @@ def shortest_path_cells(
 
 
 def distance_field(
-    cell_cost: npt.ArrayLike, start_rc: tuple[int, int] | npt.ArrayLike
+    cell_cost: npt.ArrayLike,
+    start_rc: tuple[int, int] | npt.ArrayLike,
+    start_cost: npt.ArrayLike | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Dijkstra from one cell (or several, all at distance 0) to all cells.
+    """Dijkstra from one cell (or several) to all cells.
 
     Args:
         cell_cost: ``(H, W)`` float cost of entering each cell; ``inf``/NaN = impassable.
         start_rc: ``(row, col)`` source, or a ``(K, 2)`` array of sources (K >= 1). Sources may
             themselves be impassable.
+        start_cost: Optional ``(K,)`` initial distances of the sources (default 0), e.g. the
+            sub-cell distance from a point to the centres of the cells round it.
 
     Returns:
         ``(dist, parent)``: ``(H, W)`` float64 least cost (``inf`` unreachable) and ``(H, W)``
@@ -312,12 +356,23 @@ def distance_field(
     src = np.asarray(start_rc)
     if src.ndim == 2:
         if src.shape[0] < 1 or src.shape[1] != 2:
-            raise ValueError(f"start_rc must be (row, col) or a (K, 2) array, got shape {src.shape}")
+            raise ValueError(
+                f"start_rc must be (row, col) or a (K, 2) array, got shape {src.shape}"
+            )
         rcs = [_rc(tuple(p), cost.shape, "start_rc") for p in src.tolist()]
     else:
         rcs = [_rc(start_rc, cost.shape, "start_rc")]  # type: ignore[arg-type]
     starts = np.array([r * w + c for r, c in rcs], dtype=np.int64)
     dist = np.full(h * w, np.inf)
+    if start_cost is not None:
+        sc = np.asarray(start_cost, dtype=np.float64).ravel()
+        if sc.shape[0] != len(starts) or not (np.isfinite(sc).all() and (sc >= 0).all()):
+            raise ValueError(
+                f"start_cost must be {len(starts)} finite values >= 0, got {start_cost!r}"
+            )
+        # The smallest initial cost wins for a repeated source.
+        order = np.argsort(-sc)
+        dist[starts[order]] = sc[order]
     parent = np.full(h * w, -1, dtype=np.int64)
     _search(cost, starts, -1, 0.0, dist, parent)
     return dist.reshape(h, w), parent.reshape(h, w)
@@ -422,38 +477,37 @@ def _xy(p: npt.ArrayLike, name: str) -> tuple[float, float]:
 
 
 @njit(cache=True)
-def _sift_up(heap, pos, prio, i):  # pragma: no cover - numba
-    item = heap[i]
-    key = prio[item]
+def _sift_up(heap, hkey, pos, i, item, key):  # pragma: no cover - numba
+    # Keys live beside the items in the heap array (no indirection), for cache locality.
     while i > 0:
         p = (i - 1) >> 1
-        up = heap[p]
-        if prio[up] <= key:
+        if hkey[p] <= key:
             break
-        heap[i] = up
-        pos[up] = i
+        heap[i] = heap[p]
+        hkey[i] = hkey[p]
+        pos[heap[i]] = i
         i = p
     heap[i] = item
+    hkey[i] = key
     pos[item] = i
 
 
 @njit(cache=True)
-def _sift_down(heap, pos, prio, size, i):  # pragma: no cover - numba
-    item = heap[i]
-    key = prio[item]
+def _sift_down(heap, hkey, pos, size, i, item, key):  # pragma: no cover - numba
     while True:
         child = 2 * i + 1
         if child >= size:
             break
-        if child + 1 < size and prio[heap[child + 1]] < prio[heap[child]]:
+        if child + 1 < size and hkey[child + 1] < hkey[child]:
             child += 1
-        down = heap[child]
-        if key <= prio[down]:
+        if key <= hkey[child]:
             break
-        heap[i] = down
-        pos[down] = i
+        heap[i] = heap[child]
+        hkey[i] = hkey[child]
+        pos[heap[i]] = i
         i = child
     heap[i] = item
+    hkey[i] = key
     pos[item] = i
 
 
@@ -461,7 +515,8 @@ def _sift_down(heap, pos, prio, size, i):  # pragma: no cover - numba
 def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - numba
     """Dijkstra (h_weight = 0) or A* (octile heuristic * h_weight) on an indexed binary heap.
 
-    ``starts`` are flat source indices (all at distance 0). Fills dist/parent (flat) in place;
+    ``starts`` are flat source indices, at the distance preset in ``dist`` if finite, else 0.
+    Fills dist/parent (flat) in place;
     stops when ``goal`` (flat index, -1 = none) is settled. Each cell is in the heap at most
     once (decrease-key through ``pos``), so memory stays O(cells).
     """
@@ -476,25 +531,22 @@ def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - n
     # pos: -1 never queued, -2 settled, else index in the heap.
     pos = np.full(n, -1, dtype=np.int64)
     heap = np.empty(n, dtype=np.int64)
-    prio = np.empty(n, dtype=np.float64)
+    hkey = np.empty(n, dtype=np.float64)
     size = 0
     for i in range(starts.shape[0]):
         st = starts[i]
         if pos[st] == -1:
-            dist[st] = 0.0
-            prio[st] = 0.0
-            heap[size] = st
-            pos[st] = size
+            # A source keeps a finite distance the caller preset (a sub-cell offset), else 0.
+            if not dist[st] < np.inf:
+                dist[st] = 0.0
             size += 1
-            _sift_up(heap, pos, prio, size - 1)
+            _sift_up(heap, hkey, pos, size - 1, st, dist[st])
     while size > 0:
         u = heap[0]
         size -= 1
         pos[u] = -2
         if size > 0:
-            heap[0] = heap[size]
-            pos[heap[0]] = 0
-            _sift_down(heap, pos, prio, size, 0)
+            _sift_down(heap, hkey, pos, size, 0, heap[size], hkey[size])
         if u == goal:
             break
         ur = u // w
@@ -527,14 +579,11 @@ def _search(cost, starts, goal, h_weight, dist, parent):  # pragma: no cover - n
                     lo = min(ddr, ddc)
                     hi = max(ddr, ddc)
                     pri = nd + h_weight * ((hi - lo) + sqrt2 * lo)
-                prio[v] = pri
                 if pv == -1:
-                    heap[size] = v
-                    pos[v] = size
                     size += 1
-                    _sift_up(heap, pos, prio, size - 1)
+                    _sift_up(heap, hkey, pos, size - 1, v, pri)
                 else:
-                    _sift_up(heap, pos, prio, pv)
+                    _sift_up(heap, hkey, pos, pv, v, pri)
 
 
 @njit(cache=True)
@@ -549,4 +598,20 @@ def _backtrack(parent, goal):  # pragma: no cover - numba
     for i in range(n - 1, -1, -1):
         out[i] = v
         v = parent[v]
+    return out
+
+
+@njit(cache=True)
+def _stamp_costs(h, w, occ_r, occ_c, offsets, stamp_cost):  # pragma: no cover - numba
+    """Max over occupied cells of the cost stamped at each disc offset (uint8, 0 elsewhere)."""
+    out = np.zeros((h, w), dtype=np.uint8)
+    n_off = offsets.shape[0]
+    for i in range(occ_r.shape[0]):
+        r0 = occ_r[i]
+        c0 = occ_c[i]
+        for j in range(n_off):
+            r = r0 + offsets[j, 0]
+            c = c0 + offsets[j, 1]
+            if 0 <= r < h and 0 <= c < w and stamp_cost[j] > out[r, c]:
+                out[r, c] = stamp_cost[j]
     return out

@@ -14,6 +14,7 @@ from semexplore_gym.core.grid_search import (
     NO_INFORMATION,
     CostmapParams,
     NavfnParams,
+    cells_near_occupied,
     distance_field,
     geodesic_distance_m,
     inflate_costmap,
@@ -202,3 +203,21 @@ def test_distance_field_from_several_sources() -> None:
     cost = np.ones((1, 7))
     dist, _ = distance_field(cost, np.array([[0, 0], [0, 6]]))
     assert dist[0].tolist() == [0, 1, 2, 3, 2, 1, 0]
+
+
+def test_cells_near_occupied() -> None:
+    grid = np.full((5, 7), FREE, dtype=np.uint8)
+    grid[2, 3] = OCCUPIED
+    cells = np.array([[2, 3], [2, 5], [2, 6], [0, 3], [4, 4], [9, 9]])
+    out = cells_near_occupied(grid, cells, radius_m=0.1, resolution_m=0.05)
+    # 0 m, 0.10 m (on the radius), 0.15 m, 0.10 m, sqrt(5)*0.05 = 0.11 m, outside the grid.
+    assert out.tolist() == [True, True, False, True, False, True]
+
+
+def test_distance_field_with_initial_source_costs() -> None:
+    cost = np.ones((1, 5))
+    dist, _ = distance_field(cost, np.array([[0, 0], [0, 4]]), start_cost=np.array([0.3, 2.5]))
+    # Column 4 keeps its own start cost (2.5 < 0.3 + 4); column 3 gets min(0.3 + 3, 2.5 + 1).
+    assert dist[0].tolist() == pytest.approx([0.3, 1.3, 2.3, 3.3, 2.5])
+    with pytest.raises(ValueError, match="start_cost"):
+        distance_field(cost, np.array([[0, 0]]), start_cost=np.array([-1.0]))

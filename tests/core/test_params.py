@@ -42,7 +42,9 @@ def test_wrong_type_is_named(value) -> None:
 
 
 def test_overrides_parse_yaml_scalars() -> None:
-    data = merge_overrides({"inner": {"n": 1}}, ["inner.speed_mps=0.5", "inner.flag=true", "name=abc"])
+    data = merge_overrides(
+        {"inner": {"n": 1}}, ["inner.speed_mps=0.5", "inner.flag=true", "name=abc"]
+    )
     assert from_dict(Outer, data) == Outer(Inner(0.5, 1, True), "abc")
     with pytest.raises(ConfigError, match="key.path=value"):
         merge_overrides({}, ["novalue"])
