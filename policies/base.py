@@ -45,7 +45,9 @@ class Policy(abc.ABC):
         self.last_stats: StepStats = StepStats()
         self.rng: np.random.Generator = np.random.default_rng()
 
-    def reset(self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None) -> None:
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
         """Start a new episode. All randomness of the policy flows from ``seed``."""
         self.done = False
         self.stop_reason = ""

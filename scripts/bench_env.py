@@ -31,7 +31,9 @@ def bench_steps(world: str, n_steps: int) -> dict[str, float]:
 
     import semexplore_gym  # noqa: F401
 
-    env = gym.make("SemanticExplore-v0", world=world, config={"episode": {"max_time_s": 1e9}}).unwrapped
+    env = gym.make(
+        "SemanticExplore-v0", world=world, config={"episode": {"max_time_s": 1e9}}
+    ).unwrapped
     env.reset(seed=0)
     rng = np.random.default_rng(0)
     actions = rng.uniform(-1, 1, size=(n_steps, 2)).astype(np.float32)
@@ -51,13 +53,21 @@ def bench_steps(world: str, n_steps: int) -> dict[str, float]:
     scan = env.lidar.scan(x, y, yaw, env.np_random)
     t0 = time.perf_counter()
     for _ in range(2000):
-        env.grid.integrate_scan(x, y, yaw, env.lidar.beam_angles_rad, scan, env.config.lidar.max_range_m)
+        env.grid.integrate_scan(
+            x, y, yaw, env.lidar.beam_angles_rad, scan, env.config.lidar.max_range_m
+        )
     map_ms = (time.perf_counter() - t0) / 2000 * 1e3
     t0 = time.perf_counter()
     for a in actions[:2000]:
         env.sim.step(float(a[0]) * 0.22, float(a[1]) * 2.84, 0.2)
     phys_ms = (time.perf_counter() - t0) / 2000 * 1e3
-    return {"steps_per_s": n_steps / dt, "ms_per_step": dt / n_steps * 1e3, "scan_ms": scan_ms, "map_ms": map_ms, "physics_ms": phys_ms}
+    return {
+        "steps_per_s": n_steps / dt,
+        "ms_per_step": dt / n_steps * 1e3,
+        "scan_ms": scan_ms,
+        "map_ms": map_ms,
+        "physics_ms": phys_ms,
+    }
 
 
 def bench_lidar_vs_pymunk(world: str, n_scans: int = 300) -> dict[str, float]:
@@ -89,7 +99,12 @@ def bench_lidar_vs_pymunk(world: str, n_scans: int = 300) -> dict[str, float]:
     for i in range(reps):
         cast_scan(index, *poses[i % 64], angles, 3.5)
     ours = (time.perf_counter() - t0) / reps
-    return {"pymunk_ms": pm * 1e3, "ours_ms": ours * 1e3, "speedup": pm / ours, "n_segments": w.n_segments}
+    return {
+        "pymunk_ms": pm * 1e3,
+        "ours_ms": ours * 1e3,
+        "speedup": pm / ours,
+        "n_segments": w.n_segments,
+    }
 
 
 def bench_memory(world: str, n_envs: int) -> dict[str, float]:
@@ -111,7 +126,9 @@ def bench_memory(world: str, n_envs: int) -> dict[str, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("--world", default="maze1")
     p.add_argument("--steps", type=int, default=20000)
     p.add_argument("--envs", type=int, default=16)

@@ -11,11 +11,44 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # For each layer: module prefixes it must never import.
 FORBIDDEN = {
-    "semexplore_gym/core": ["gymnasium", "pymunk", "semexplore_gym.sim", "semexplore_gym.envs", "semexplore_gym.wrappers", "semexplore_gym.rendering", "semexplore_gym.cli", "semexplore_gym.evaluation", "policies", "torch", "stable_baselines3", "matplotlib", "pygame"],
-    "semexplore_gym/sim": ["gymnasium", "semexplore_gym.envs", "semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
-    "semexplore_gym/envs": ["semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
+    "semexplore_gym/core": [
+        "gymnasium",
+        "pymunk",
+        "semexplore_gym.sim",
+        "semexplore_gym.envs",
+        "semexplore_gym.wrappers",
+        "semexplore_gym.rendering",
+        "semexplore_gym.cli",
+        "semexplore_gym.evaluation",
+        "policies",
+        "torch",
+        "stable_baselines3",
+        "matplotlib",
+        "pygame",
+    ],
+    "semexplore_gym/sim": [
+        "gymnasium",
+        "semexplore_gym.envs",
+        "semexplore_gym.wrappers",
+        "semexplore_gym.cli",
+        "semexplore_gym.evaluation",
+        "policies",
+    ],
+    "semexplore_gym/envs": [
+        "semexplore_gym.wrappers",
+        "semexplore_gym.cli",
+        "semexplore_gym.evaluation",
+        "policies",
+    ],
     "semexplore_gym/wrappers": ["semexplore_gym.cli", "semexplore_gym.evaluation", "policies"],
-    "policies": ["pymunk", "semexplore_gym.sim", "semexplore_gym.envs", "semexplore_gym.wrappers", "semexplore_gym.cli", "semexplore_gym.evaluation"],
+    "policies": [
+        "pymunk",
+        "semexplore_gym.sim",
+        "semexplore_gym.envs",
+        "semexplore_gym.wrappers",
+        "semexplore_gym.cli",
+        "semexplore_gym.evaluation",
+    ],
 }
 
 

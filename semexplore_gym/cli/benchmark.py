@@ -35,23 +35,53 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--worlds", required=True, help="comma-separated world spellings; 'maze:seed=*' uses each run's seed")
-    p.add_argument("--policies", default="semantic,frontier,nearest", help="comma-separated policy specs (default: %(default)s)")
-    p.add_argument("--runs", type=int, default=10, help="seeds per (world, policy) (default: %(default)s)")
+    p.add_argument(
+        "--worlds",
+        required=True,
+        help="comma-separated world spellings; 'maze:seed=*' uses each run's seed",
+    )
+    p.add_argument(
+        "--policies",
+        default="semantic,frontier,nearest",
+        help="comma-separated policy specs (default: %(default)s)",
+    )
+    p.add_argument(
+        "--runs", type=int, default=10, help="seeds per (world, policy) (default: %(default)s)"
+    )
     p.add_argument("--seed0", type=int, default=0, help="first seed (default: %(default)s)")
-    p.add_argument("--out", required=True, help="output directory; rerunning the same command resumes")
-    p.add_argument("--max-time-s", type=float, default=None, help="stop each mission after this simulated time")
+    p.add_argument(
+        "--out", required=True, help="output directory; rerunning the same command resumes"
+    )
+    p.add_argument(
+        "--max-time-s", type=float, default=None, help="stop each mission after this simulated time"
+    )
     p.add_argument("--config", default=None, help="env config: preset name or YAML path")
-    p.add_argument("--workers", type=int, default=1, help="missions in parallel (default: %(default)s)")
-    p.add_argument("--backend", choices=("process", "ray"), default="process", help="parallel backend (default: %(default)s)")
-    p.add_argument("--ray-address", default=None, help="existing Ray cluster address ('auto'); default starts a local one")
+    p.add_argument(
+        "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
+    )
+    p.add_argument(
+        "--backend",
+        choices=("process", "ray"),
+        default="process",
+        help="parallel backend (default: %(default)s)",
+    )
+    p.add_argument(
+        "--ray-address",
+        default=None,
+        help="existing Ray cluster address ('auto'); default starts a local one",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
     return p
 
 
 def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds, run_benchmark, write_manifest
+    from semexplore_gym.evaluation.harness import (
+        expand_tasks,
+        parse_seeds,
+        run_benchmark,
+        write_manifest,
+    )
     from semexplore_gym.evaluation.report import write_plots, write_summary
 
     worlds = _split_worlds(args.worlds)
@@ -63,14 +93,45 @@ def run(args: argparse.Namespace) -> int:
     for p in policies:
         if p.partition(":")[0] not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
-    tasks = expand_tasks(worlds, policies, seeds, max_time_s=args.max_time_s, env_config=args.config)
+    tasks = expand_tasks(
+        worlds, policies, seeds, max_time_s=args.max_time_s, env_config=args.config
+    )
     from pathlib import Path
 
     Path(args.out).mkdir(parents=True, exist_ok=True)
-    write_manifest(args.out, {"command": " ".join(shlex.quote(a) for a in sys.argv), "worlds": worlds, "policies": policies, "seeds": seeds, "max_time_s": args.max_time_s, "config": args.config, "workers": args.workers, "backend": args.backend})
-    res = run_benchmark(tasks, args.out, workers=args.workers, backend=args.backend, ray_address=args.ray_address, progress=not args.no_progress)
+    write_manifest(
+        args.out,
+        {
+            "command": " ".join(shlex.quote(a) for a in sys.argv),
+            "worlds": worlds,
+            "policies": policies,
+            "seeds": seeds,
+            "max_time_s": args.max_time_s,
+            "config": args.config,
+            "workers": args.workers,
+            "backend": args.backend,
+        },
+    )
+    res = run_benchmark(
+        tasks,
+        args.out,
+        workers=args.workers,
+        backend=args.backend,
+        ray_address=args.ray_address,
+        progress=not args.no_progress,
+    )
     summary = write_summary(args.out)
     plots = [] if args.no_plots else write_plots(args.out)
-    print(json.dumps({"ran": res["ran"], "skipped": res["skipped"], "failed": len(res["failed"]), "summary": str(summary), "plots": [str(p) for p in plots]}))
+    print(
+        json.dumps(
+            {
+                "ran": res["ran"],
+                "skipped": res["skipped"],
+                "failed": len(res["failed"]),
+                "summary": str(summary),
+                "plots": [str(p) for p in plots],
+            }
+        )
+    )
     print(Path(summary).read_text())
     return 1 if res["failed"] else 0

@@ -12,9 +12,14 @@ import numpy as np
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("show-world", help="draw a world (walls, free space, start pose) to a PNG")
-    p.add_argument("world", help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json")
+    p.add_argument(
+        "world",
+        help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json",
+    )
     p.add_argument("--out", required=True, help="output PNG path")
-    p.add_argument("--seed", type=int, default=0, help="seed for procedural worlds and start sampling")
+    p.add_argument(
+        "--seed", type=int, default=0, help="seed for procedural worlds and start sampling"
+    )
     p.add_argument("--json", action="store_true", help="print facts about the world as JSON")
     return p
 
@@ -37,10 +42,19 @@ def run(args: argparse.Namespace) -> int:
 
     g = base.map_geometry
     pose = base.sim.pose
-    reach = reachable_free_mask(world, g, pose[:2], base.config.robot.radius_m, base.config.robot.radius_m + 0.01)
+    reach = reachable_free_mask(
+        world, g, pose[:2], base.config.robot.radius_m, base.config.robot.radius_m + 0.01
+    )
     grid = np.where(reach, FREE, OCCUPIED).astype(np.uint8)
     grid[~reach] = 128
-    snap = RenderSnapshot(map=grid, geometry=g, segments_m=world.segments_m, pose=pose, radius_m=base.config.robot.radius_m, text=f"{world.name}")
+    snap = RenderSnapshot(
+        map=grid,
+        geometry=g,
+        segments_m=world.segments_m,
+        pose=pose,
+        radius_m=base.config.robot.radius_m,
+        text=f"{world.name}",
+    )
     frame = Renderer(g, max_size_px=900).draw(snap)
     from PIL import Image
 
@@ -59,7 +73,10 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(facts))
     else:
-        print(f"{world.name}: {facts['size_m'][0]} x {facts['size_m'][1]} m, {world.n_segments} wall segments, "
-              f"map {g.height}x{g.width} at {g.resolution_m} m, reachable {facts['reachable_area_m2']:.1f} m^2 -> {args.out}", file=sys.stdout)
+        print(
+            f"{world.name}: {facts['size_m'][0]} x {facts['size_m'][1]} m, {world.n_segments} wall segments, "
+            f"map {g.height}x{g.width} at {g.resolution_m} m, reachable {facts['reachable_area_m2']:.1f} m^2 -> {args.out}",
+            file=sys.stdout,
+        )
     env.close()
     return 0

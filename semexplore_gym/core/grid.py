@@ -51,15 +51,25 @@ class GridGeometry:
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.resolution_m) and self.resolution_m > 0):
-            raise ValueError(f"resolution_m must be a positive finite number, got {self.resolution_m!r}")
+            raise ValueError(
+                f"resolution_m must be a positive finite number, got {self.resolution_m!r}"
+            )
         if not (np.isfinite(self.origin_x_m) and np.isfinite(self.origin_y_m)):
-            raise ValueError(f"grid origin must be finite, got ({self.origin_x_m!r}, {self.origin_y_m!r})")
+            raise ValueError(
+                f"grid origin must be finite, got ({self.origin_x_m!r}, {self.origin_y_m!r})"
+            )
         if int(self.height) <= 0 or int(self.width) <= 0:
             raise ValueError(f"grid shape must be positive, got ({self.height!r}, {self.width!r})")
 
     @classmethod
     def covering(
-        cls, xmin_m: float, ymin_m: float, xmax_m: float, ymax_m: float, resolution_m: float, margin_m: float = 0.0
+        cls,
+        xmin_m: float,
+        ymin_m: float,
+        xmax_m: float,
+        ymax_m: float,
+        resolution_m: float,
+        margin_m: float = 0.0,
     ) -> GridGeometry:
         """The smallest grid of ``resolution_m`` cells covering a box plus ``margin_m`` on each side."""
         if not resolution_m > 0:
@@ -86,13 +96,21 @@ class GridGeometry:
             self.origin_y_m + self.height * self.resolution_m,
         )
 
-    def world_to_grid(self, x_m: npt.ArrayLike, y_m: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    def world_to_grid(
+        self, x_m: npt.ArrayLike, y_m: npt.ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(row, col) integer indices of the cells containing world points (may be out of range)."""
-        col = np.floor((np.asarray(x_m, dtype=np.float64) - self.origin_x_m) / self.resolution_m).astype(np.int64)
-        row = np.floor((np.asarray(y_m, dtype=np.float64) - self.origin_y_m) / self.resolution_m).astype(np.int64)
+        col = np.floor(
+            (np.asarray(x_m, dtype=np.float64) - self.origin_x_m) / self.resolution_m
+        ).astype(np.int64)
+        row = np.floor(
+            (np.asarray(y_m, dtype=np.float64) - self.origin_y_m) / self.resolution_m
+        ).astype(np.int64)
         return row, col
 
-    def grid_to_world(self, row: npt.ArrayLike, col: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    def grid_to_world(
+        self, row: npt.ArrayLike, col: npt.ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray]:
         """World (x, y) in metres of cell centres."""
         x = self.origin_x_m + (np.asarray(col, dtype=np.float64) + 0.5) * self.resolution_m
         y = self.origin_y_m + (np.asarray(row, dtype=np.float64) + 0.5) * self.resolution_m
@@ -114,7 +132,13 @@ class GridGeometry:
 
     @classmethod
     def from_dict(cls, d: dict) -> GridGeometry:
-        return cls(float(d["resolution_m"]), float(d["origin_x_m"]), float(d["origin_y_m"]), int(d["height"]), int(d["width"]))
+        return cls(
+            float(d["resolution_m"]),
+            float(d["origin_x_m"]),
+            float(d["origin_y_m"]),
+            int(d["height"]),
+            int(d["width"]),
+        )
 
 
 def from_ros_values(grid: npt.ArrayLike) -> np.ndarray:
@@ -152,7 +176,9 @@ def validate_encoded_grid(grid: npt.ArrayLike, name: str = "grid") -> np.ndarray
     if a.ndim != 2:
         raise ValueError(f"{name} must be 2-D (rows, cols), got shape {a.shape}")
     if a.dtype != np.uint8:
-        raise TypeError(f"{name} must have dtype uint8 (UNKNOWN={UNKNOWN}, FREE={FREE}, OCCUPIED={OCCUPIED}), got {a.dtype}")
+        raise TypeError(
+            f"{name} must have dtype uint8 (UNKNOWN={UNKNOWN}, FREE={FREE}, OCCUPIED={OCCUPIED}), got {a.dtype}"
+        )
     if a.size == 0:
         raise ValueError(f"{name} is empty (shape {a.shape})")
     valid = (a == UNKNOWN) | (a == FREE) | (a == OCCUPIED)
@@ -183,6 +209,8 @@ def parse_ascii_grid(text: str) -> np.ndarray:
             raise ValueError(f"ASCII grid line {i} has length {len(ln)}, expected {width}")
         for j, ch in enumerate(ln):
             if ch not in table:
-                raise ValueError(f"ASCII grid character {ch!r} at line {i}, column {j} is not one of '#', '.', '?'")
+                raise ValueError(
+                    f"ASCII grid character {ch!r} at line {i}, column {j} is not one of '#', '.', '?'"
+                )
             out[i, j] = table[ch]
     return out[::-1].copy()

@@ -60,7 +60,10 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
         if origin is tuple and args and args[-1] is not Ellipsis:
             if len(args) != len(value):
                 raise ConfigError(f"{path}: expected {len(args)} items, got {len(value)}")
-            return tuple(_coerce(v, a, f"{path}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
+            return tuple(
+                _coerce(v, a, f"{path}[{i}]")
+                for i, (v, a) in enumerate(zip(value, args, strict=True))
+            )
         inner = args[0] if args else Any
         seq = [_coerce(v, inner, f"{path}[{i}]") for i, v in enumerate(value)]
         return tuple(seq) if origin is tuple else seq
@@ -119,7 +122,9 @@ def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -
     for key, value in data.items():
         path = f"{_prefix}.{key}" if _prefix else str(key)
         if key not in names:
-            raise ConfigError(f"unknown config key {path!r}; valid keys here: {', '.join(sorted(names))}")
+            raise ConfigError(
+                f"unknown config key {path!r}; valid keys here: {', '.join(sorted(names))}"
+            )
         kwargs[key] = _coerce(value, hints[key], path)
     try:
         return cls(**kwargs)
@@ -189,5 +194,7 @@ def load_yaml(path: str | os.PathLike) -> dict[str, Any]:
     if data is None:
         return {}
     if not isinstance(data, dict):
-        raise ConfigError(f"{str(p)!r} must contain a mapping at top level, got {type(data).__name__}")
+        raise ConfigError(
+            f"{str(p)!r} must contain a mapping at top level, got {type(data).__name__}"
+        )
     return data

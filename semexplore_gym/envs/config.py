@@ -57,7 +57,9 @@ class EpisodeParams:
         if not (0 < self.coverage_goal <= 1):
             raise ValueError(f"episode.coverage_goal must be in (0, 1], got {self.coverage_goal!r}")
         if self.start_clearance_margin_m < 0:
-            raise ValueError(f"episode.start_clearance_margin_m must be >= 0, got {self.start_clearance_margin_m!r}")
+            raise ValueError(
+                f"episode.start_clearance_margin_m must be >= 0, got {self.start_clearance_margin_m!r}"
+            )
         if self.start_pose is not None and not all(math.isfinite(v) for v in self.start_pose):
             raise ValueError(f"episode.start_pose must be finite, got {self.start_pose!r}")
 
@@ -83,7 +85,9 @@ PRESETS: dict[str, dict[str, Any]] = {
 }
 
 
-def load_env_config(config: EnvConfig | str | os.PathLike | dict | None = None, overrides: list[str] | None = None) -> EnvConfig:
+def load_env_config(
+    config: EnvConfig | str | os.PathLike | dict | None = None, overrides: list[str] | None = None
+) -> EnvConfig:
     """Resolve ``config`` (None, a preset name, a YAML path, a dict or an EnvConfig) plus overrides.
 
     Args:
@@ -111,8 +115,12 @@ def load_env_config(config: EnvConfig | str | os.PathLike | dict | None = None, 
         elif text.endswith((".yaml", ".yml")) or os.sep in text or Path(text).exists():
             data = load_yaml(text)
         else:
-            raise ConfigError(f"unknown config {text!r}: not a preset ({', '.join(PRESETS)}) nor a .yaml file")
+            raise ConfigError(
+                f"unknown config {text!r}: not a preset ({', '.join(PRESETS)}) nor a .yaml file"
+            )
     else:
-        raise ConfigError(f"config must be None, a preset name, a YAML path, a dict or an EnvConfig; got {type(config).__name__}")
+        raise ConfigError(
+            f"config must be None, a preset name, a YAML path, a dict or an EnvConfig; got {type(config).__name__}"
+        )
     data = merge_overrides(data, overrides or [])
     return from_dict(EnvConfig, data)

@@ -15,12 +15,15 @@ from semexplore_gym.core.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.odometry import OdometryDrift
 from semexplore_gym.core.raycast import SegmentIndex
 from semexplore_gym.core.worlds import make_world
-from semexplore_gym.core.worlds.start import reachable_free_mask, sample_start_pose, validate_start_pose
+from semexplore_gym.core.worlds.start import (
+    reachable_free_mask,
+    sample_start_pose,
+    validate_start_pose,
+)
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.envs.config import EnvConfig, load_env_config
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
-
 
 PROCEDURAL_FAMILIES = ("maze", "office", "cave")
 
@@ -115,14 +118,20 @@ class SemanticExploreEnv(gym.Env):
     ) -> None:
         super().__init__()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}")
+            raise ValueError(
+                f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}"
+            )
         self.render_mode = render_mode
         self.config: EnvConfig = load_env_config(config, overrides)
         cfg = self.config
         self.world_spec = world
         self._randomise_world = _is_unseeded_procedural(world)
-        self.world: World = world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
-        self.map_geometry: GridGeometry = GridGeometry.covering(*self.world.bounds_m, cfg.mapping.resolution_m, cfg.mapping.margin_m)
+        self.world: World = (
+            world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
+        )
+        self.map_geometry: GridGeometry = GridGeometry.covering(
+            *self.world.bounds_m, cfg.mapping.resolution_m, cfg.mapping.margin_m
+        )
         n_cells = self.map_geometry.height * self.map_geometry.width
         if n_cells > 40_000_000:
             raise ValueError(
@@ -136,8 +145,14 @@ class SemanticExploreEnv(gym.Env):
         self.observation_space = spaces.Dict(
             {
                 "map": spaces.Box(0, 255, shape=(h, w), dtype=np.uint8),
-                "pose": spaces.Box(np.array([-big, -big, -np.pi], dtype=np.float32), np.array([big, big, np.pi], dtype=np.float32), dtype=np.float32),
-                "scan": spaces.Box(0.0, cfg.lidar.max_range_m, shape=(cfg.lidar.n_beams,), dtype=np.float32),
+                "pose": spaces.Box(
+                    np.array([-big, -big, -np.pi], dtype=np.float32),
+                    np.array([big, big, np.pi], dtype=np.float32),
+                    dtype=np.float32,
+                ),
+                "scan": spaces.Box(
+                    0.0, cfg.lidar.max_range_m, shape=(cfg.lidar.n_beams,), dtype=np.float32
+                ),
             }
         )
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
@@ -193,7 +208,9 @@ class SemanticExploreEnv(gym.Env):
         return pose_t  # type: ignore[return-value]
 
     # ------------------------------------------------------------------- API
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
         if self._randomise_world and (self._started or seed is not None):
             world_seed = int(self.np_random.integers(0, 2**31 - 1))
@@ -205,7 +222,9 @@ class SemanticExploreEnv(gym.Env):
         pose = self._choose_start(options)
         cfg = self.config
         self.sim.reset(pose)
-        reach = reachable_free_mask(self.world, self.map_geometry, pose[:2], cfg.robot.radius_m, cfg.robot.radius_m + 0.01)
+        reach = reachable_free_mask(
+            self.world, self.map_geometry, pose[:2], cfg.robot.radius_m, cfg.robot.radius_m + 0.01
+        )
         self._n_reachable = max(1, int(reach.sum()))
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping, count_mask=reach)
         self.odometry.reset(pose)
@@ -220,7 +239,9 @@ class SemanticExploreEnv(gym.Env):
             self.render()
         return self._obs(), info
 
-    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+    def step(
+        self, action: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         v_mps, w_radps = self._scale_action(action)
         cfg = self.config
         before = self.sim.pose
@@ -229,7 +250,9 @@ class SemanticExploreEnv(gym.Env):
         self.sim_time_s += cfg.episode.dt_s
         self.path_length_m += math.hypot(after[0] - before[0], after[1] - before[1])
         self._trajectory.append((after[0], after[1]))
-        self._est_pose = self.odometry.update(before, after, self.np_random) if self._odometry_noisy else after
+        self._est_pose = (
+            self.odometry.update(before, after, self.np_random) if self._odometry_noisy else after
+        )
         n_free_before = self.grid.n_free_cells
         self._scan = self._sense_and_map()
         new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
@@ -254,9 +277,13 @@ class SemanticExploreEnv(gym.Env):
             try:
                 a = np.asarray(action, dtype=np.float64).reshape(-1)
             except (TypeError, ValueError) as e:
-                raise ValueError(f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}") from e
+                raise ValueError(
+                    f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}"
+                ) from e
             if a.shape != (2,):
-                raise ValueError(f"action must have shape (2,), got shape {np.shape(action)}: {action!r}")
+                raise ValueError(
+                    f"action must have shape (2,), got shape {np.shape(action)}: {action!r}"
+                )
             a0, a1 = float(a[0]), float(a[1])
         if not (math.isfinite(a0) and math.isfinite(a1)):
             raise ValueError(f"action contains NaN or inf: {action!r}")
@@ -270,7 +297,9 @@ class SemanticExploreEnv(gym.Env):
         x, y, yaw = self.sim.pose
         scan = self.lidar.scan(x, y, yaw, self.np_random)
         ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
-        self.grid.integrate_scan(ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m)
+        self.grid.integrate_scan(
+            ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m
+        )
         return scan
 
     def _obs(self) -> dict[str, np.ndarray]:
@@ -321,7 +350,9 @@ class SemanticExploreEnv(gym.Env):
 
     def render(self) -> np.ndarray | None:
         if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human' to gym.make")
+            gym.logger.warn(
+                "render() called without a render_mode; pass render_mode='rgb_array' or 'human' to gym.make"
+            )
             return None
         from semexplore_gym.rendering.renderer import Renderer
 

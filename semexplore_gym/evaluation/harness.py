@@ -136,7 +136,11 @@ def run_task(task: Task) -> dict[str, Any]:
         "explored_area_m2": res.explored_area_m2,
         "steps": res.steps,
     }
-    return {"row": row, "trace": np.asarray(res.coverage_trace, dtype=np.float64), "trajectory": np.asarray(res.trajectory)}
+    return {
+        "row": row,
+        "trace": np.asarray(res.coverage_trace, dtype=np.float64),
+        "trajectory": np.asarray(res.trajectory),
+    }
 
 
 def read_runs(path: str | os.PathLike) -> list[dict[str, Any]]:
@@ -176,7 +180,9 @@ class ResultWriter:
             with self.csv_path.open(newline="") as f:
                 header = next(csv.reader(f), [])
             if tuple(header) != CSV_COLUMNS:
-                raise ValueError(f"{self.csv_path} has columns {header}, expected {list(CSV_COLUMNS)}; use a new --out directory")
+                raise ValueError(
+                    f"{self.csv_path} has columns {header}, expected {list(CSV_COLUMNS)}; use a new --out directory"
+                )
         self._f = self.csv_path.open("a", newline="")
         self._w = csv.DictWriter(self._f, fieldnames=list(CSV_COLUMNS))
         if new:
@@ -188,7 +194,14 @@ class ResultWriter:
         stem = task_stem(row["world"], row["policy"], int(row["seed"]))
         # Trace and trajectory first: a row in runs.csv promises they exist.
         trace_path = self.out / "traces" / f"{stem}.csv"
-        np.savetxt(trace_path, record["trace"], delimiter=",", header="sim_time_s,coverage,explored_area_m2", comments="", fmt="%.6g")
+        np.savetxt(
+            trace_path,
+            record["trace"],
+            delimiter=",",
+            header="sim_time_s,coverage,explored_area_m2",
+            comments="",
+            fmt="%.6g",
+        )
         np.save(self.out / "trajectories" / f"{stem}.npy", record["trajectory"])
         self._w.writerow({k: ("" if row.get(k) is None else row[k]) for k in CSV_COLUMNS})
         self._f.flush()
@@ -198,7 +211,9 @@ class ResultWriter:
         self._f.close()
 
 
-def _run_sequential(tasks: list[Task], fn: Callable[[Task], dict[str, Any]]) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
+def _run_sequential(
+    tasks: list[Task], fn: Callable[[Task], dict[str, Any]]
+) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
     for t in tasks:
         try:
             yield t, fn(t)
@@ -206,7 +221,9 @@ def _run_sequential(tasks: list[Task], fn: Callable[[Task], dict[str, Any]]) -> 
             yield t, e
 
 
-def _run_processes(tasks: list[Task], workers: int) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
+def _run_processes(
+    tasks: list[Task], workers: int
+) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
     import concurrent.futures as cf
     import multiprocessing as mp
 
@@ -222,14 +239,20 @@ def _run_processes(tasks: list[Task], workers: int) -> Iterable[tuple[Task, dict
                 yield t, e
 
 
-def _run_ray(tasks: list[Task], address: str | None, workers: int) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
+def _run_ray(
+    tasks: list[Task], address: str | None, workers: int
+) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
     try:
         import ray
     except ImportError as e:
         raise ImportError('--backend ray needs Ray: pip install "semexplore-gym[ray]"') from e
     started = False
     if not ray.is_initialized():
-        kwargs: dict[str, Any] = {"address": address} if address else {"num_cpus": max(1, workers), "include_dashboard": False}
+        kwargs: dict[str, Any] = (
+            {"address": address}
+            if address
+            else {"num_cpus": max(1, workers), "include_dashboard": False}
+        )
         ray.init(ignore_reinit_error=True, log_to_driver=False, **kwargs)
         started = True
     try:
@@ -286,7 +309,14 @@ def run_benchmark(
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(tasks), initial=skipped, desc="missions", unit="mission", file=sys.stderr, dynamic_ncols=True)
+        bar = tqdm(
+            total=len(tasks),
+            initial=skipped,
+            desc="missions",
+            unit="mission",
+            file=sys.stderr,
+            dynamic_ncols=True,
+        )
     try:
         if backend == "ray":
             stream = _run_ray(todo, ray_address, workers)
@@ -297,7 +327,9 @@ def run_benchmark(
         for task, result in stream:
             if isinstance(result, BaseException):
                 failed.append((task.key, f"{type(result).__name__}: {result}"))
-                print(f"mission {task.key} failed: {type(result).__name__}: {result}", file=sys.stderr)
+                print(
+                    f"mission {task.key} failed: {type(result).__name__}: {result}", file=sys.stderr
+                )
             else:
                 writer.write(result)
                 ran += 1

@@ -34,7 +34,10 @@ SUMMARY_METRICS: tuple[tuple[str, str], ...] = (
 
 
 def _values(rows: list[dict[str, Any]], key: str) -> np.ndarray:
-    return np.array([r[key] for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))], dtype=np.float64)
+    return np.array(
+        [r[key] for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))],
+        dtype=np.float64,
+    )
 
 
 def _median_iqr(v: np.ndarray) -> str:
@@ -62,15 +65,26 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     if not rows:
         raise ValueError(f"no finished missions in {out / 'runs.csv'}")
     groups = group_runs(rows)
-    lines = ["# Benchmark summary", "", f"{len(rows)} missions from `{out / 'runs.csv'}`. Cells: median [IQR].", ""]
+    lines = [
+        "# Benchmark summary",
+        "",
+        f"{len(rows)} missions from `{out / 'runs.csv'}`. Cells: median [IQR].",
+        "",
+    ]
     for world, by_policy in groups.items():
         lines += [f"## {world}", ""]
-        header = "| policy | n | self-stopped | " + " | ".join(label for _, label in SUMMARY_METRICS) + " |"
+        header = (
+            "| policy | n | self-stopped | "
+            + " | ".join(label for _, label in SUMMARY_METRICS)
+            + " |"
+        )
         lines += [header, "|" + "---|" * (3 + len(SUMMARY_METRICS))]
         for policy, rs in by_policy.items():
             stopped = sum(1 for r in rs if r["self_stopped"])
             cells = [_median_iqr(_values(rs, key)) for key, _ in SUMMARY_METRICS]
-            lines.append(f"| {policy} | {len(rs)} | {stopped}/{len(rs)} | " + " | ".join(cells) + " |")
+            lines.append(
+                f"| {policy} | {len(rs)} | {stopped}/{len(rs)} | " + " | ".join(cells) + " |"
+            )
         lines.append("")
         if reference in by_policy and len(by_policy) > 1:
             lines += [
@@ -87,14 +101,36 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
                     continue
                 other_rows = {r["seed"]: r for r in rs}
                 seeds = sorted(set(ref_rows) & set(other_rows))
-                for key, label in (("mission_time_s", "mission time"), ("mean_map_generation_ms", "map generation ms"), ("mean_global_planning_ms", "global planning ms")):
-                    a = np.array([ref_rows[s][key] for s in seeds if ref_rows[s][key] is not None and other_rows[s][key] is not None], dtype=float)
-                    b = np.array([other_rows[s][key] for s in seeds if ref_rows[s][key] is not None and other_rows[s][key] is not None], dtype=float)
+                for key, label in (
+                    ("mission_time_s", "mission time"),
+                    ("mean_map_generation_ms", "map generation ms"),
+                    ("mean_global_planning_ms", "global planning ms"),
+                ):
+                    a = np.array(
+                        [
+                            ref_rows[s][key]
+                            for s in seeds
+                            if ref_rows[s][key] is not None and other_rows[s][key] is not None
+                        ],
+                        dtype=float,
+                    )
+                    b = np.array(
+                        [
+                            other_rows[s][key]
+                            for s in seeds
+                            if ref_rows[s][key] is not None and other_rows[s][key] is not None
+                        ],
+                        dtype=float,
+                    )
                     if a.size == 0:
                         lines.append(f"| {other} | {label} | – | – | – |")
                         continue
                     ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
-                    p = mannwhitneyu(a, b, alternative="two-sided").pvalue if a.size >= 2 and not (np.all(a == a[0]) and np.array_equal(a, b)) else float("nan")
+                    p = (
+                        mannwhitneyu(a, b, alternative="two-sided").pvalue
+                        if a.size >= 2 and not (np.all(a == a[0]) and np.array_equal(a, b))
+                        else float("nan")
+                    )
                     wins = int(np.sum(a < b))
                     lines.append(f"| {other} | {label} | {ratio:.2f} | {p:.3g} | {wins}/{a.size} |")
             lines.append("")
@@ -130,7 +166,7 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
 
     # 1. Explored free area over time, mean and min-max band.
     fig, axes = plt.subplots(1, len(worlds), figsize=(5.2 * len(worlds), 4), squeeze=False)
-    for ax, world in zip(axes[0], worlds):
+    for ax, world in zip(axes[0], worlds, strict=True):
         for policy, rs in groups[world].items():
             traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
             if not traces:
@@ -139,7 +175,9 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
             grid = np.linspace(0.0, max(t_end, 1e-6), 300)
             # After a mission ends its area stays at its final value.
             ys = np.stack([np.interp(grid, t[:, 0], t[:, 2]) for t in traces])
-            ax.plot(grid, ys.mean(axis=0), color=colours[policy], label=f"{policy} (n={len(traces)})")
+            ax.plot(
+                grid, ys.mean(axis=0), color=colours[policy], label=f"{policy} (n={len(traces)})"
+            )
             ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
         ax.set_title(world)
         ax.set_xlabel("time (s)")
@@ -152,16 +190,30 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     # 2-4. Box plots per world: mission time, map-generation time, global-planning time.
     for key, ylabel, name in (
         ("mission_time_s", "mission time (s)", "mission_time.png"),
-        ("mean_map_generation_ms", "map generation / frontier detection (ms per update)", "map_generation_time.png"),
-        ("mean_global_planning_ms", "global navigation planning (ms per plan)", "global_planning_time.png"),
+        (
+            "mean_map_generation_ms",
+            "map generation / frontier detection (ms per update)",
+            "map_generation_time.png",
+        ),
+        (
+            "mean_global_planning_ms",
+            "global navigation planning (ms per plan)",
+            "global_planning_time.png",
+        ),
     ):
         fig, axes = plt.subplots(1, len(worlds), figsize=(4.2 * len(worlds), 4), squeeze=False)
-        for ax, world in zip(axes[0], worlds):
+        for ax, world in zip(axes[0], worlds, strict=True):
             names = list(groups[world])
             data = [_values(groups[world][p], key) for p in names]
             ax.boxplot([d if d.size else np.array([np.nan]) for d in data], tick_labels=names)
             for i, d in enumerate(data):
-                ax.scatter(np.full(d.size, i + 1) + np.linspace(-0.08, 0.08, max(d.size, 1))[: d.size], d, s=10, color=colours[names[i]], zorder=3)
+                ax.scatter(
+                    np.full(d.size, i + 1) + np.linspace(-0.08, 0.08, max(d.size, 1))[: d.size],
+                    d,
+                    s=10,
+                    color=colours[names[i]],
+                    zorder=3,
+                )
             ax.set_title(world)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3, axis="y")
@@ -173,10 +225,14 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     return paths
 
 
-def _trajectory_figure(out: Path, groups: Any, worlds: list[str], policies: list[str], colours: dict, plt: Any) -> Path:
+def _trajectory_figure(
+    out: Path, groups: Any, worlds: list[str], policies: list[str], colours: dict, plt: Any
+) -> Path:
     from semexplore_gym.core.worlds import make_world
 
-    fig, axes = plt.subplots(len(worlds), len(policies), figsize=(3.6 * len(policies), 3.6 * len(worlds)), squeeze=False)
+    fig, axes = plt.subplots(
+        len(worlds), len(policies), figsize=(3.6 * len(policies), 3.6 * len(worlds)), squeeze=False
+    )
     for i, world in enumerate(worlds):
         for j, policy in enumerate(policies):
             ax = axes[i][j]
@@ -201,7 +257,10 @@ def _trajectory_figure(out: Path, groups: Any, worlds: list[str], policies: list
                 ax.plot(traj[:, 0], traj[:, 1], color=colours[policy], lw=1.2)
                 ax.plot(traj[0, 0], traj[0, 1], "o", color="green", ms=5)
                 ax.plot(traj[-1, 0], traj[-1, 1], "s", color="red", ms=5)
-            ax.set_title(f"{world} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}", fontsize=8)
+            ax.set_title(
+                f"{world} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}",
+                fontsize=8,
+            )
     fig.tight_layout()
     return _save(fig, out / "trajectories.png")
 

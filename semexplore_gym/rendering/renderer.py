@@ -64,8 +64,15 @@ class Renderer:
     def __init__(self, geometry: GridGeometry, max_size_px: int = 720) -> None:
         self.geometry = geometry
         h, w = geometry.shape
-        self.px_per_cell = max(1.0, min(8.0, max_size_px / max(h, w))) if max(h, w) <= max_size_px else max_size_px / max(h, w)
-        self.size_px = (max(1, int(round(w * self.px_per_cell))), max(1, int(round(h * self.px_per_cell))))
+        self.px_per_cell = (
+            max(1.0, min(8.0, max_size_px / max(h, w)))
+            if max(h, w) <= max_size_px
+            else max_size_px / max(h, w)
+        )
+        self.size_px = (
+            max(1, int(round(w * self.px_per_cell))),
+            max(1, int(round(h * self.px_per_cell))),
+        )
         self._window: Any = None
         self._clock: Any = None
 
@@ -104,9 +111,13 @@ class Renderer:
         if len(snap.segments_m):
             a = self.world_to_px(snap.segments_m[:, 0:2])
             b = self.world_to_px(snap.segments_m[:, 2:4])
-            for (u0, v0), (u1, v1) in zip(a, b):
+            for (u0, v0), (u1, v1) in zip(a, b, strict=True):
                 draw.line([(u0, v0), (u1, v1)], fill=(60, 90, 220, 90), width=lw)
-        if snap.scan is not None and snap.beam_angles_rad is not None and snap.sensor_pose is not None:
+        if (
+            snap.scan is not None
+            and snap.beam_angles_rad is not None
+            and snap.sensor_pose is not None
+        ):
             sx, sy, syaw = snap.sensor_pose
             r = np.where(snap.scan > 0, snap.scan, np.nan)
             ang = syaw + snap.beam_angles_rad
@@ -114,33 +125,52 @@ class Renderer:
             ok = np.isfinite(ends).all(axis=1)
             origin = self.world_to_px(np.array([[sx, sy]]))[0]
             hit = ok & (snap.scan < snap.max_range_m)
-            for (u, v), is_hit in zip(self.world_to_px(ends[ok]), hit[ok]):
+            for (u, v), is_hit in zip(self.world_to_px(ends[ok]), hit[ok], strict=True):
                 draw.line([tuple(origin), (u, v)], fill=(255, 140, 0, 40), width=1)
                 if is_hit:
                     draw.point((u, v), fill=(230, 60, 0, 255))
         for path in ov.get("paths_m", []) or []:
             p = np.asarray(path, dtype=np.float64)
             if p.ndim == 2 and len(p) >= 2:
-                draw.line([tuple(q) for q in self.world_to_px(p)], fill=(160, 40, 200, 230), width=max(2, lw + 1))
+                draw.line(
+                    [tuple(q) for q in self.world_to_px(p)],
+                    fill=(160, 40, 200, 230),
+                    width=max(2, lw + 1),
+                )
         marker = max(3.0, self.px_per_cell * 1.5)
         for pt in ov.get("frontiers_m", []) or []:
             u, v = self.world_to_px(np.asarray(pt, dtype=np.float64)[:2])[0]
-            draw.ellipse([u - marker, v - marker, u + marker, v + marker], outline=(0, 140, 60, 255), width=2)
+            draw.ellipse(
+                [u - marker, v - marker, u + marker, v + marker], outline=(0, 140, 60, 255), width=2
+            )
         for pt in ov.get("points_m", []) or []:
             u, v = self.world_to_px(np.asarray(pt, dtype=np.float64)[:2])[0]
-            draw.rectangle([u - marker / 2, v - marker / 2, u + marker / 2, v + marker / 2], fill=(40, 40, 200, 200))
+            draw.rectangle(
+                [u - marker / 2, v - marker / 2, u + marker / 2, v + marker / 2],
+                fill=(40, 40, 200, 200),
+            )
         if ov.get("goal_m") is not None:
             u, v = self.world_to_px(np.asarray(ov["goal_m"], dtype=np.float64)[:2])[0]
             m = marker * 1.5
             draw.line([(u - m, v - m), (u + m, v + m)], fill=(200, 0, 160, 255), width=3)
             draw.line([(u - m, v + m), (u + m, v - m)], fill=(200, 0, 160, 255), width=3)
         if snap.trajectory_m is not None and len(snap.trajectory_m) >= 2:
-            draw.line([tuple(q) for q in self.world_to_px(snap.trajectory_m)], fill=(0, 120, 255, 200), width=max(1, lw))
+            draw.line(
+                [tuple(q) for q in self.world_to_px(snap.trajectory_m)],
+                fill=(0, 120, 255, 200),
+                width=max(1, lw),
+            )
         x, y, yaw = snap.pose
-        (u, v), = self.world_to_px(np.array([[x, y]]))
+        ((u, v),) = self.world_to_px(np.array([[x, y]]))
         rpx = snap.radius_m / self.geometry.resolution_m * self.px_per_cell
-        draw.ellipse([u - rpx, v - rpx, u + rpx, v + rpx], fill=(0, 90, 200, 220), outline=(0, 0, 0, 255))
-        draw.line([(u, v), (u + rpx * 1.6 * math.cos(yaw), v - rpx * 1.6 * math.sin(yaw))], fill=(255, 255, 255, 255), width=2)
+        draw.ellipse(
+            [u - rpx, v - rpx, u + rpx, v + rpx], fill=(0, 90, 200, 220), outline=(0, 0, 0, 255)
+        )
+        draw.line(
+            [(u, v), (u + rpx * 1.6 * math.cos(yaw), v - rpx * 1.6 * math.sin(yaw))],
+            fill=(255, 255, 255, 255),
+            width=2,
+        )
         lines = [t for t in (snap.text, ov.get("text", "")) if t]
         for i, t in enumerate(lines):
             draw.text((4, 4 + 12 * i), t, fill=(0, 0, 0, 255))
@@ -153,7 +183,9 @@ class Renderer:
         except ImportError as e:  # pragma: no cover - depends on the optional extra
             from gymnasium.error import DependencyNotInstalled
 
-            raise DependencyNotInstalled('render_mode="human" needs pygame: pip install "semexplore-gym[render]"') from e
+            raise DependencyNotInstalled(
+                'render_mode="human" needs pygame: pip install "semexplore-gym[render]"'
+            ) from e
         if self._window is None:
             pygame.init()
             pygame.display.init()
@@ -173,4 +205,3 @@ class Renderer:
             pygame.display.quit()
             pygame.quit()
             self._window = None
-

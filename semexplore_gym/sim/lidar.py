@@ -39,13 +39,19 @@ class LidarParams:
         if not (math.isfinite(self.max_range_m) and self.max_range_m > 0):
             raise ValueError(f"lidar.max_range_m must be positive, got {self.max_range_m!r}")
         if not (0 <= self.min_range_m < self.max_range_m):
-            raise ValueError(f"lidar.min_range_m must be in [0, max_range_m), got {self.min_range_m!r}")
+            raise ValueError(
+                f"lidar.min_range_m must be in [0, max_range_m), got {self.min_range_m!r}"
+            )
         if not (self.range_noise_std_m >= 0 and math.isfinite(self.range_noise_std_m)):
-            raise ValueError(f"lidar.range_noise_std_m must be >= 0, got {self.range_noise_std_m!r}")
+            raise ValueError(
+                f"lidar.range_noise_std_m must be >= 0, got {self.range_noise_std_m!r}"
+            )
         if not (0 <= self.dropout_prob < 1):
             raise ValueError(f"lidar.dropout_prob must be in [0, 1), got {self.dropout_prob!r}")
         if math.hypot(self.mount_x_m, self.mount_y_m) > 0.5:
-            raise ValueError(f"lidar mount offset ({self.mount_x_m}, {self.mount_y_m}) m is implausibly far from the robot centre")
+            raise ValueError(
+                f"lidar mount offset ({self.mount_x_m}, {self.mount_y_m}) m is implausibly far from the robot centre"
+            )
 
     @property
     def angle_increment_rad(self) -> float:
@@ -71,7 +77,11 @@ class Lidar:
     def sensor_pose(self, x_m: float, y_m: float, yaw_rad: float) -> tuple[float, float, float]:
         p = self.params
         c, s = math.cos(yaw_rad), math.sin(yaw_rad)
-        return (x_m + c * p.mount_x_m - s * p.mount_y_m, y_m + s * p.mount_x_m + c * p.mount_y_m, yaw_rad)
+        return (
+            x_m + c * p.mount_x_m - s * p.mount_y_m,
+            y_m + s * p.mount_x_m + c * p.mount_y_m,
+            yaw_rad,
+        )
 
     def scan(self, x_m: float, y_m: float, yaw_rad: float, rng: np.random.Generator) -> np.ndarray:
         """Ranges (float32, metres) from the robot pose: 0 = invalid, ``max_range_m`` = no return."""

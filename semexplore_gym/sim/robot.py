@@ -45,12 +45,21 @@ class RobotParams:
     max_turn_torque_nm: float = 20.0
 
     def __post_init__(self) -> None:
-        for name in ("radius_m", "mass_kg", "max_linear_speed_mps", "max_angular_speed_radps", "max_drive_force_n", "max_turn_torque_nm"):
+        for name in (
+            "radius_m",
+            "mass_kg",
+            "max_linear_speed_mps",
+            "max_angular_speed_radps",
+            "max_drive_force_n",
+            "max_turn_torque_nm",
+        ):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"robot.{name} must be a positive finite number, got {v!r}")
         if self.max_linear_speed_mps > 5.0:
-            raise ValueError(f"robot.max_linear_speed_mps={self.max_linear_speed_mps} is beyond what the physics is tuned for (<= 5 m/s)")
+            raise ValueError(
+                f"robot.max_linear_speed_mps={self.max_linear_speed_mps} is beyond what the physics is tuned for (<= 5 m/s)"
+            )
 
 
 @dataclass(frozen=True)
@@ -78,13 +87,19 @@ class PhysicsParams:
 
     def __post_init__(self) -> None:
         if not (0 < self.max_substep_travel_m <= 0.05):
-            raise ValueError(f"physics.max_substep_travel_m must be in (0, 0.05] m, got {self.max_substep_travel_m!r}")
+            raise ValueError(
+                f"physics.max_substep_travel_m must be in (0, 0.05] m, got {self.max_substep_travel_m!r}"
+            )
         if self.max_substeps < 1:
             raise ValueError(f"physics.max_substeps must be >= 1, got {self.max_substeps!r}")
         if not (0 <= self.collision_slop_m < 0.05):
-            raise ValueError(f"physics.collision_slop_m must be in [0, 0.05) m, got {self.collision_slop_m!r}")
+            raise ValueError(
+                f"physics.collision_slop_m must be in [0, 0.05) m, got {self.collision_slop_m!r}"
+            )
         if self.solver_iterations < 1:
-            raise ValueError(f"physics.solver_iterations must be >= 1, got {self.solver_iterations!r}")
+            raise ValueError(
+                f"physics.solver_iterations must be >= 1, got {self.solver_iterations!r}"
+            )
 
 
 class RobotSim:
@@ -153,7 +168,9 @@ class RobotSim:
         def _separate(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
             self._touching = max(0, self._touching - 1)
 
-        space.on_collision(ROBOT_COLLISION_TYPE, WALL_COLLISION_TYPE, begin=_begin, separate=_separate)
+        space.on_collision(
+            ROBOT_COLLISION_TYPE, WALL_COLLISION_TYPE, begin=_begin, separate=_separate
+        )
         self.space = space
         self.body = body
         self.control = control
@@ -220,7 +237,9 @@ class RobotSim:
         if dt_s != self._substep_dt_key:
             travel = self.robot_params.max_linear_speed_mps * dt_s
             pp = self.physics_params
-            self._substeps = min(pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m)))
+            self._substeps = min(
+                pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m))
+            )
             self._substep_dt_key = dt_s
         return self._substeps
 

@@ -65,8 +65,18 @@ def test_observation_contents_after_reset() -> None:
     assert (obs["map"] == OCCUPIED).sum() > 10
     assert obs["scan"].shape == (360,)
     assert 0 < info["coverage"] < 0.5
-    assert info["explored_area_m2"] == pytest.approx((obs["map"] == FREE).sum() * g["resolution_m"] ** 2)
-    for key in ("robot", "lidar", "dt_s", "collisions", "sim_time_s", "path_length_m", "reward_terms"):
+    assert info["explored_area_m2"] == pytest.approx(
+        (obs["map"] == FREE).sum() * g["resolution_m"] ** 2
+    )
+    for key in (
+        "robot",
+        "lidar",
+        "dt_s",
+        "collisions",
+        "sim_time_s",
+        "path_length_m",
+        "reward_terms",
+    ):
         assert key in info
 
 
@@ -79,7 +89,10 @@ def test_same_seed_same_trajectory_and_different_seed_differs() -> None:
 
 
 def test_noise_and_dropouts_are_seeded() -> None:
-    cfg = {"lidar": {"range_noise_std_m": 0.01, "dropout_prob": 0.05}, "odometry": {"trans_from_trans": 0.05}}
+    cfg = {
+        "lidar": {"range_noise_std_m": 0.01, "dropout_prob": 0.05},
+        "odometry": {"trans_from_trans": 0.05},
+    }
     e1, e2 = _make(config=cfg), _make(config=cfg)
     o1, _ = e1.reset(seed=11)
     o2, _ = e2.reset(seed=11)
@@ -113,7 +126,7 @@ def test_reward_terms_sum_to_reward_and_new_area_is_positive_while_exploring() -
 def test_truncates_at_max_time() -> None:
     env = _make(config={"episode": {"max_time_s": 2.0}})
     env.reset(seed=0)
-    for i in range(10):
+    for i in range(10):  # noqa: B007 (i is checked after the loop)
         *_, term, trunc, info = env.step(np.zeros(2, np.float32))
         if trunc:
             break
@@ -152,7 +165,13 @@ def test_render_rgb_array_shape_and_overlay() -> None:
     base = env.unwrapped
     h, w = base.map_geometry.shape
     x, y, _ = base.sim.pose
-    base.set_overlay({"goal_m": (x + 1.0, y), "paths_m": [np.array([[x, y], [x + 1.0, y]])], "area_types": np.zeros((h, w), np.int16)})
+    base.set_overlay(
+        {
+            "goal_m": (x + 1.0, y),
+            "paths_m": [np.array([[x, y], [x + 1.0, y]])],
+            "area_types": np.zeros((h, w), np.int16),
+        }
+    )
     frame2 = env.render()
     assert frame2.shape == frame.shape and not np.array_equal(frame, frame2)
 
@@ -179,7 +198,9 @@ def test_procedural_world_without_seed_changes_each_reset_with_fixed_shape() -> 
     seg1, shape1 = env.world.segments_m.copy(), env.map_geometry.shape
     env.reset(seed=2)
     assert env.map_geometry.shape == shape1
-    assert not (seg1.shape == env.world.segments_m.shape and np.allclose(seg1, env.world.segments_m))
+    assert not (
+        seg1.shape == env.world.segments_m.shape and np.allclose(seg1, env.world.segments_m)
+    )
     env.reset(seed=1)
     assert np.array_equal(seg1, env.world.segments_m)
 
@@ -220,6 +241,8 @@ def test_malformed_yaml_and_missing_image_give_clear_errors(tmp_path) -> None:
     with pytest.raises(ValueError, match="bad.yaml"):
         _make(world=str(bad))
     missing = tmp_path / "m.yaml"
-    missing.write_text("image: nothere.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    missing.write_text(
+        "image: nothere.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
     with pytest.raises(FileNotFoundError, match="nothere.pgm"):
         _make(world=str(missing))

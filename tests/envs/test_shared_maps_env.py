@@ -29,10 +29,12 @@ def test_env_runs_on_shared_map(path: Path) -> None:
     except ValueError as e:
         # Only an outdoor map hundreds of metres wide may refuse the default 5 cm grid.
         assert "mapping.resolution_m" in str(e), str(e)
-        env = gym.make("SemanticExplore-v0", world=str(path), config={"mapping": {"resolution_m": 0.5}})
+        env = gym.make(
+            "SemanticExplore-v0", world=str(path), config={"mapping": {"resolution_m": 0.5}}
+        )
     obs, info = env.reset(seed=0)
     assert (obs["map"] == FREE).sum() > 0
     for _ in range(5):
-        obs, *_ , info = env.step(np.array([0.5, 0.2], np.float32))
+        obs, *_, info = env.step(np.array([0.5, 0.2], np.float32))
     assert 0.0 < info["coverage"] <= 1.0
     assert info["collisions"] <= 1

@@ -13,15 +13,30 @@ from semexplore_gym.evaluation.harness import read_runs
 @pytest.mark.slow
 def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
     out = tmp_path / "bench"
-    argv = ["benchmark", "--worlds", "maze1,maze:seed=*,size_m=4", "--policies", "semantic,frontier,nearest",
-            "--runs", "2", "--max-time-s", "40", "--out", str(out), "--no-progress"]
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze1,maze:seed=*,size_m=4",
+        "--policies",
+        "semantic,frontier,nearest",
+        "--runs",
+        "2",
+        "--max-time-s",
+        "40",
+        "--out",
+        str(out),
+        "--no-progress",
+    ]
     assert main(argv) == 0
     report = json.loads(capsys.readouterr().out.splitlines()[0])
     assert report["ran"] == 12 and report["failed"] == 0
     rows = read_runs(out / "runs.csv")
     assert len(rows) == 12
     assert {(r["world"], r["policy"], r["seed"]) for r in rows} == {
-        (w, p, s) for w in ("maze1", "maze:seed=*,size_m=4") for p in ("semantic", "frontier", "nearest") for s in (0, 1)
+        (w, p, s)
+        for w in ("maze1", "maze:seed=*,size_m=4")
+        for p in ("semantic", "frontier", "nearest")
+        for s in (0, 1)
     }
     for r in rows:
         assert 0.0 < r["coverage"] <= 1.0
@@ -29,7 +44,13 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
     summary = (out / "summary.md").read_text()
     for world in ("maze1", "maze:seed=*,size_m=4"):
         assert f"## {world}" in summary
-    for name in ("explored_area.png", "mission_time.png", "map_generation_time.png", "global_planning_time.png", "trajectories.png"):
+    for name in (
+        "explored_area.png",
+        "mission_time.png",
+        "map_generation_time.png",
+        "global_planning_time.png",
+        "trajectories.png",
+    ):
         assert (out / name).exists()
     # Same command again: everything is skipped.
     assert main(argv) == 0
@@ -40,8 +61,25 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
 def test_ray_backend_runs_two_missions(tmp_path, capsys) -> None:
     pytest.importorskip("ray")
     out = tmp_path / "ray"
-    argv = ["benchmark", "--worlds", "maze:seed=*,size_m=4", "--policies", "semantic", "--runs", "2",
-            "--max-time-s", "20", "--out", str(out), "--backend", "ray", "--workers", "2", "--no-progress", "--no-plots"]
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze:seed=*,size_m=4",
+        "--policies",
+        "semantic",
+        "--runs",
+        "2",
+        "--max-time-s",
+        "20",
+        "--out",
+        str(out),
+        "--backend",
+        "ray",
+        "--workers",
+        "2",
+        "--no-progress",
+        "--no-plots",
+    ]
     assert main(argv) == 0
     rows = read_runs(out / "runs.csv")
     assert sorted(r["seed"] for r in rows) == [0, 1]

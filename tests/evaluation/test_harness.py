@@ -7,7 +7,13 @@ import csv
 import numpy as np
 import pytest
 
-from semexplore_gym.evaluation.harness import CSV_COLUMNS, Task, expand_tasks, read_runs, run_benchmark
+from semexplore_gym.evaluation.harness import (
+    CSV_COLUMNS,
+    Task,
+    expand_tasks,
+    read_runs,
+    run_benchmark,
+)
 from semexplore_gym.evaluation.report import write_plots, write_summary
 
 
@@ -19,10 +25,22 @@ def _fake(task: Task) -> dict:
     t = np.linspace(0, t_end, 50)
     cov = np.minimum(1.0, t / t_end)
     row = {
-        "world": task.world, "policy": task.policy, "seed": task.seed, "mission_time_s": t_end, "coverage": 0.99,
-        "self_stopped": True, "stop_reason": "no frontier left", "path_length_m": t_end * 0.2, "collisions": 0,
-        "T90_s": 0.9 * t_end, "T99_s": None, "mean_map_generation_ms": 2.0 if task.policy == "semantic" else 5.0,
-        "mean_global_planning_ms": 1.0, "wall_time_s": 0.1, "explored_area_m2": 40.0, "steps": 500,
+        "world": task.world,
+        "policy": task.policy,
+        "seed": task.seed,
+        "mission_time_s": t_end,
+        "coverage": 0.99,
+        "self_stopped": True,
+        "stop_reason": "no frontier left",
+        "path_length_m": t_end * 0.2,
+        "collisions": 0,
+        "T90_s": 0.9 * t_end,
+        "T99_s": None,
+        "mean_map_generation_ms": 2.0 if task.policy == "semantic" else 5.0,
+        "mean_global_planning_ms": 1.0,
+        "wall_time_s": 0.1,
+        "explored_area_m2": 40.0,
+        "steps": 500,
     }
     traj = np.stack([np.linspace(0.5, 3, 20), np.linspace(0.5, 3, 20), np.zeros(20)], axis=1)
     return {"row": row, "trace": np.stack([t, cov, 40 * cov], axis=1), "trajectory": traj}
@@ -32,7 +50,10 @@ def test_expand_tasks_is_paired_and_validated() -> None:
     tasks = expand_tasks(["maze1", "maze2"], ["semantic", "frontier"], [0, 1])
     assert len(tasks) == 8
     for s in (0, 1):
-        assert {t.policy for t in tasks if t.seed == s and t.world == "maze1"} == {"semantic", "frontier"}
+        assert {t.policy for t in tasks if t.seed == s and t.world == "maze1"} == {
+            "semantic",
+            "frontier",
+        }
     assert Task("maze:seed=*,size_m=5", "semantic", 7).resolved_world == "maze:seed=7,size_m=5"
     with pytest.raises(ValueError, match="runs"):
         expand_tasks(["maze1"], ["semantic"], [])
@@ -78,10 +99,21 @@ def test_summary_compares_reference_with_each_baseline(tmp_path) -> None:
 
 
 def test_plots_are_written(tmp_path) -> None:
-    run_benchmark(expand_tasks(["maze1", "maze2"], ["semantic", "frontier"], [0, 1]), tmp_path, progress=False, task_fn=_fake)
+    run_benchmark(
+        expand_tasks(["maze1", "maze2"], ["semantic", "frontier"], [0, 1]),
+        tmp_path,
+        progress=False,
+        task_fn=_fake,
+    )
     paths = write_plots(tmp_path)
     names = {p.name for p in paths}
-    assert names == {"explored_area.png", "mission_time.png", "map_generation_time.png", "global_planning_time.png", "trajectories.png"}
+    assert names == {
+        "explored_area.png",
+        "mission_time.png",
+        "map_generation_time.png",
+        "global_planning_time.png",
+        "trajectories.png",
+    }
     for p in paths:
         assert p.stat().st_size > 5000
 
@@ -89,4 +121,6 @@ def test_plots_are_written(tmp_path) -> None:
 def test_csv_with_other_columns_is_refused(tmp_path) -> None:
     (tmp_path / "runs.csv").write_text("a,b\n1,2\n")
     with pytest.raises(ValueError, match="columns"):
-        run_benchmark(expand_tasks(["maze1"], ["semantic"], [0]), tmp_path, progress=False, task_fn=_fake)
+        run_benchmark(
+            expand_tasks(["maze1"], ["semantic"], [0]), tmp_path, progress=False, task_fn=_fake
+        )

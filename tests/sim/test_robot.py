@@ -12,11 +12,15 @@ from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams, RobotSim, nearest_wall_distance_m
 
-BOX = np.array([[0, 0, 4, 0], [4, 0, 4, 4], [4, 4, 0, 4], [0, 4, 0, 0], [2, 0, 2, 1.5]], dtype=float)
+BOX = np.array(
+    [[0, 0, 4, 0], [4, 0, 4, 4], [4, 4, 0, 4], [0, 4, 0, 0], [2, 0, 2, 1.5]], dtype=float
+)
 
 
 def _world() -> World:
-    return World("box", BOX, (0.0, 0.0, 4.0, 4.0), np.ones((80, 80), bool), GridGeometry(0.05, 0, 0, 80, 80))
+    return World(
+        "box", BOX, (0.0, 0.0, 4.0, 4.0), np.ones((80, 80), bool), GridGeometry(0.05, 0, 0, 80, 80)
+    )
 
 
 def test_free_drive_follows_the_exact_arc() -> None:
@@ -55,7 +59,11 @@ def test_no_penetration_over_10000_random_max_speed_steps(speed_mps: float) -> N
     min_clear = math.inf
     for _ in range(10_000):
         turn = rng.uniform(-1, 1)
-        sim.step(speed_mps * (1.0 if rng.random() < 0.7 else -1.0), turn * rp.max_angular_speed_radps, 0.2)
+        sim.step(
+            speed_mps * (1.0 if rng.random() < 0.7 else -1.0),
+            turn * rp.max_angular_speed_radps,
+            0.2,
+        )
         x, y, _ = sim.pose
         assert 0.0 < x < 4.0 and 0.0 < y < 4.0, f"robot left the box at {(x, y)}"
         min_clear = min(min_clear, nearest_wall_distance_m(BOX, x, y))
@@ -76,7 +84,9 @@ def test_pickle_round_trip_keeps_state() -> None:
     assert clone.pose == pytest.approx(sim.pose, abs=1e-9)
 
 
-@pytest.mark.parametrize("field,value", [("radius_m", 0.0), ("max_linear_speed_mps", float("nan")), ("mass_kg", -1.0)])
+@pytest.mark.parametrize(
+    "field,value", [("radius_m", 0.0), ("max_linear_speed_mps", float("nan")), ("mass_kg", -1.0)]
+)
 def test_bad_robot_params_name_the_field(field: str, value: float) -> None:
     with pytest.raises(ValueError, match=field):
         RobotParams(**{field: value})

@@ -157,7 +157,11 @@ class TopometricMap:
         n = 0
         for oid in self.areas[intersection_id].opening_ids:
             for aid in self.openings[oid].area_ids:
-                if aid >= 0 and aid != intersection_id and self.areas[aid].type == AreaType.FRONTIER_PATHWAY:
+                if (
+                    aid >= 0
+                    and aid != intersection_id
+                    and self.areas[aid].type == AreaType.FRONTIER_PATHWAY
+                ):
                     n += 1
         return n
 
@@ -174,6 +178,20 @@ class TopometricMap:
         d2 = (cells[:, 0] - r) ** 2 + (cells[:, 1] - c) ** 2
         rr, cc = cells[int(np.argmin(d2))]
         return int(self.area_ids[rr, cc])
+
+    def area_type_raster(self) -> np.ndarray:
+        """``(H, W)`` int16 raster of :class:`AreaType` values (-1 where no area): the env overlay."""
+        if not self.areas:
+            return np.full(self.area_ids.shape, -1, dtype=np.int16)
+        top = max(self.areas) + 2
+        lut = np.full(top, -1, dtype=np.int16)
+        for a in self.areas.values():
+            lut[a.id + 1] = int(a.type)
+        return lut[np.clip(self.area_ids, -1, top - 2) + 1]
+
+    def frontier_of_area(self, area_id: int) -> list[Frontier]:
+        """The frontiers of one frontier pathway (usually one)."""
+        return [f for f in self.frontiers if f.area_id == area_id]
 
     def counts(self) -> dict[str, int]:
         return {
