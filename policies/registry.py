@@ -99,8 +99,19 @@ def policy_factories() -> dict[str, Factory]:
     }
 
 
+def strip_label(spec: str) -> str:
+    """``"semantic[tuned]"`` -> ``"semantic"``; a spec without a label is returned stripped."""
+    spec = spec.strip()
+    if spec.endswith("]") and "[" in spec:
+        spec = spec[: spec.rindex("[")].strip()
+    return spec
+
+
 def make_policy(spec: str, **overrides: Any) -> Policy:
     """Create a policy from ``spec`` (``"name"`` or ``"name:argument"``).
+
+    A trailing ``[label]`` (``"semantic[tuned]"``) only names a variant in benchmark tables;
+    it is stripped before the policy is built (the variant comes from ``overrides``).
 
     Raises:
         ValueError: unknown name, a bad argument, or a bad parameter override (``ConfigError``
@@ -108,7 +119,8 @@ def make_policy(spec: str, **overrides: Any) -> Policy:
     """
     if not isinstance(spec, str) or not spec.strip():
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
-    name, _, arg = spec.strip().partition(":")
+    spec = strip_label(spec)
+    name, _, arg = spec.partition(":")
     factories = policy_factories()
     if name not in factories:
         raise ValueError(

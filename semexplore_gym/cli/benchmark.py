@@ -87,11 +87,11 @@ def run(args: argparse.Namespace) -> int:
     worlds = _split_worlds(args.worlds)
     policies = _split(args.policies)
     seeds = parse_seeds(args.runs, args.seed0)
-    from policies.registry import policy_factories
+    from policies.registry import policy_factories, strip_label
 
     known = policy_factories()
     for p in policies:
-        if p.partition(":")[0] not in known:
+        if strip_label(p).partition(":")[0] not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
     tasks = expand_tasks(
         worlds, policies, seeds, max_time_s=args.max_time_s, env_config=args.config

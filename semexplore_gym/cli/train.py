@@ -2,7 +2,11 @@
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
-a BC/DAgger model (``ppo.init_from``). Every run directory gets ``model.zip``, the resolved
+a BC/DAgger model (``ppo.init_from``). With ``env.env_id`` set to a macro-action env
+(``SemanticExploreFrontier-v0``, ``SemanticExploreWeights-v0``) ``ppo`` and ``maskable_ppo``
+(sb3-contrib ``MaskablePPO``, using the env's ``action_masks``) train an MLP on that env's own
+observation instead (``env.macro`` holds its ``MacroParams`` fields, ``env.expert`` overrides of
+the driving expert's parameters). Every run directory gets ``model.zip``, the resolved
 ``config.yaml``, ``args.json`` (arguments and command line), TensorBoard logs (CSV when
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
 """
@@ -24,17 +28,26 @@ import yaml
 
 from semexplore_gym.core.params import ConfigError, from_dict, load_yaml, merge_overrides, to_dict
 
-ALGOS = ("bc", "dagger", "ppo")
+ALGOS = ("bc", "dagger", "ppo", "maskable_ppo")
+#: The base env id; any other ``env.env_id`` is a macro-action env with its own observation.
+BASE_ENV_ID = "SemanticExplore-v0"
 
 
 # ------------------------------------------------------------------------ config
 @dataclass(frozen=True)
 class EnvSection:
-    """The env to train in: world spec, env config (preset, path or None) and overrides."""
+    """The env to train in: id, world spec, env config (preset, path or None) and overrides.
 
+    ``macro`` (``MacroParams`` fields) and ``expert`` (driver parameter overrides) are passed to
+    the macro-action env ids only.
+    """
+
+    env_id: str = BASE_ENV_ID
     world: str = "maze:size_m=5"
     config: str | None = None
     overrides: tuple[str, ...] = ()
+    macro: dict[str, Any] = field(default_factory=dict)
+    expert: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -174,12 +187,34 @@ def _egocentric_params(cfg: TrainConfig) -> Any:
     )
 
 
+def _is_macro(cfg: TrainConfig) -> bool:
+    return cfg.env.env_id != BASE_ENV_ID
+
+
+def _make_macro_env(cfg: TrainConfig) -> Any:
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401  (registers the env ids)
+
+    return gym.make(
+        cfg.env.env_id,
+        world=cfg.env.world,
+        config=cfg.env.config,
+        overrides=list(cfg.env.overrides),
+        macro=dict(cfg.env.macro),
+        expert=dict(cfg.env.expert),
+    )
+
+
 def _make_wrapped_env(cfg: TrainConfig, max_episode_steps: int | None = None) -> Any:
     from gymnasium.wrappers import TimeLimit
 
     from semexplore_gym.wrappers.egocentric import EgocentricObservation
 
-    env = EgocentricObservation(_make_raw_env(cfg), params=_egocentric_params(cfg))
+    if _is_macro(cfg):
+        env = _make_macro_env(cfg)
+    else:
+        env = EgocentricObservation(_make_raw_env(cfg), params=_egocentric_params(cfg))
     if max_episode_steps:
         env = TimeLimit(env, max_episode_steps=max_episode_steps)
     return env
@@ -194,12 +229,27 @@ def _policy_kwargs(cfg: TrainConfig) -> dict[str, Any]:
     }
 
 
-def _new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None) -> Any:
-    from stable_baselines3 import PPO
-
+def _new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None, algo: str = "ppo") -> Any:
     pc = cfg.ppo
-    return PPO(
-        "MultiInputPolicy",
+    if algo == "maskable_ppo":
+        if not _is_macro(cfg):
+            raise ValueError(
+                f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
+            )
+        from sb3_contrib import MaskablePPO as algo_cls
+    else:
+        from stable_baselines3 import PPO as algo_cls
+    if _is_macro(cfg):
+        policy_name = "MlpPolicy"
+        kwargs: dict[str, Any] = {
+            "net_arch": {"pi": list(cfg.policy.net_arch), "vf": list(cfg.policy.net_arch)}
+        }
+        if algo != "maskable_ppo":
+            kwargs["log_std_init"] = cfg.policy.log_std_init
+    else:
+        policy_name, kwargs = "MultiInputPolicy", _policy_kwargs(cfg)
+    return algo_cls(
+        policy_name,
         vec_env,
         learning_rate=pc.learning_rate,
         n_steps=pc.n_steps,
@@ -207,7 +257,7 @@ def _new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None) -> Any
         n_epochs=pc.n_epochs,
         gamma=pc.gamma,
         ent_coef=pc.ent_coef,
-        policy_kwargs=_policy_kwargs(cfg),
+        policy_kwargs=kwargs,
         tensorboard_log=tensorboard_log,
         seed=cfg.seed,
         device="cpu",
@@ -336,7 +386,11 @@ def _train_ppo(cfg: TrainConfig, args: argparse.Namespace, out: Path) -> dict[st
 
     params = _egocentric_params(cfg)
     vec_env = _vec_env(cfg)
-    model = _new_ppo(cfg, vec_env, str(out / "tb"))
+    model = _new_ppo(cfg, vec_env, str(out / "tb"), algo=args.algo)
+    if cfg.ppo.init_from and _is_macro(cfg):
+        raise ValueError(
+            f"ppo.init_from (a BC/DAgger model) only fits the egocentric env, not env.env_id={cfg.env.env_id!r}"
+        )
     if cfg.ppo.init_from:
         init_policy, init_params = load_model(cfg.ppo.init_from)
         if init_params != params:
@@ -350,10 +404,14 @@ def _train_ppo(cfg: TrainConfig, args: argparse.Namespace, out: Path) -> dict[st
     model.learn(
         total_timesteps=cfg.ppo.total_timesteps,
         progress_bar=not args.no_progress,
-        tb_log_name="ppo",
+        tb_log_name=args.algo,
     )
     metrics = {"ppo_s": time.perf_counter() - t0, "timesteps": int(model.num_timesteps)}
-    _save_model(model, out / "model.zip", params, "ppo")
+    if _is_macro(cfg):
+        # Not an egocentric-observation model: no tag, it is loaded with the algorithm's own load().
+        model.save(str(out / "model.zip"))
+    else:
+        _save_model(model, out / "model.zip", params, "ppo")
     vec_env.close()
     return metrics
 
@@ -361,7 +419,12 @@ def _train_ppo(cfg: TrainConfig, args: argparse.Namespace, out: Path) -> dict[st
 # ---------------------------------------------------------------------- CLI glue
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("train", help="train a learning agent (behaviour cloning, DAgger or PPO)")
-    p.add_argument("--algo", required=True, choices=ALGOS, help="bc, dagger or ppo")
+    p.add_argument(
+        "--algo",
+        required=True,
+        choices=ALGOS,
+        help="bc, dagger, ppo or maskable_ppo (macro-action envs)",
+    )
     p.add_argument("--config", default=None, help="agent config YAML (configs/agents/*.yml)")
     p.add_argument("--out", required=True, help="run directory (created)")
     p.add_argument(
@@ -404,6 +467,14 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(str(e)) from e
     if cfg.torch_threads < 1:
         raise ValueError(f"torch_threads must be >= 1, got {cfg.torch_threads!r}")
+    if args.algo == "maskable_ppo" and not _is_macro(cfg):
+        raise ValueError(
+            f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
+        )
+    if args.algo in ("bc", "dagger") and _is_macro(cfg):
+        raise ValueError(
+            f"--algo {args.algo} trains on the egocentric env only, not env.env_id={cfg.env.env_id!r}"
+        )
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yaml").write_text(yaml.safe_dump(to_dict(cfg), sort_keys=False))
@@ -423,7 +494,7 @@ def run(args: argparse.Namespace) -> int:
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
     t0 = time.perf_counter()
-    if args.algo == "ppo":
+    if args.algo in ("ppo", "maskable_ppo"):
         metrics = _train_ppo(cfg, args, out)  # SB3's own logger writes out/tb/ppo_N
     else:
         log = ScalarLogger(out / "tb" / args.algo)

@@ -1,0 +1,325 @@
+"""``semexplore compare-weights``: paper vs tuned planner weights, with a semantic-term ablation.
+
+1. Tune ``w_v``, ``w_p``, ``w_I`` (``--tune-field``: also ``f_g``, ``f_o``, ``f_l``) with Optuna
+   TPE on the training worlds x training seeds (objective: mean of
+   ``mission_time_s + penalty_s * max(0, target_coverage - coverage)``). The study is kept in
+   ``OUT/tuning/study.sqlite`` and every trial in ``OUT/tuning/trials.jsonl``.
+2. Run every weight set on the test worlds x test seeds through the benchmark harness
+   (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` and the ablations
+   of the paper weights ``semantic[paper,w_p=0]``, ``semantic[paper,w_I=0]``,
+   ``semantic[paper,w_p=w_I=0]``.
+3. Write ``OUT/compare.md`` and ``OUT/compare.csv`` (median mission time, coverage, score,
+   Mann-Whitney U p-value of each set's mission times against the paper's) and
+   ``OUT/mission_times.png`` (box plot per weight set). ``OUT/weights.json`` has every set.
+
+Test seeds start at ``--test-seed0`` (default 1000) so ``seed=*`` procedural test worlds are
+disjoint from the training ones. Example::
+
+    semexplore compare-weights --train-worlds 'maze:seed=*,size_m=4' \\
+        --test-worlds 'maze:seed=*,size_m=4' --trials 20 --runs 5 --max-time-s 120 --out runs/cw
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import shlex
+import sys
+from pathlib import Path
+from typing import Any
+
+PAPER = "semantic[paper]"
+TUNED = "semantic[tuned]"
+
+
+def _split_worlds(text: str) -> list[str]:
+    from semexplore_gym.cli.benchmark import _split_worlds as split
+
+    return split(text)
+
+
+def weight_sets(tuned: dict[str, float]) -> dict[str, dict[str, float]]:
+    """Label -> dotted overrides: paper, tuned and the ablations of the paper's semantic terms."""
+    from policies.weight_tuning import PAPER_WEIGHTS
+
+    return {
+        PAPER: dict(PAPER_WEIGHTS),
+        TUNED: {**PAPER_WEIGHTS, **tuned},
+        "semantic[paper,w_p=0]": {**PAPER_WEIGHTS, "cost.w_p": 0.0},
+        "semantic[paper,w_I=0]": {**PAPER_WEIGHTS, "cost.w_i": 0.0},
+        "semantic[paper,w_p=w_I=0]": {**PAPER_WEIGHTS, "cost.w_p": 0.0, "cost.w_i": 0.0},
+    }
+
+
+def summarise(
+    rows: list[dict[str, Any]], labels: list[str], target_coverage: float, penalty_s: float
+) -> list[dict[str, Any]]:
+    """One table row per label: medians, completion rate, score and p-values vs the paper.
+
+    ``p_value_vs_paper`` compares mission times, ``p_value_score_vs_paper`` the scores
+    (``mission_score``: time plus the missing-coverage penalty; informative when missions hit the
+    time limit), both with a two-sided Mann-Whitney U test against ``semantic[paper]``.
+    """
+    import numpy as np
+    from scipy.stats import mannwhitneyu
+
+    from policies.weight_tuning import mission_score
+
+    def score(r: dict[str, Any]) -> float:
+        return mission_score(
+            float(r["mission_time_s"]), float(r["coverage"]), target_coverage, penalty_s
+        )
+
+    def p_value(a: np.ndarray, b: np.ndarray) -> float:
+        if not len(a) or not len(b):
+            return math.nan
+        if np.ptp(np.concatenate([a, b])) == 0:
+            return 1.0  # all values tied: scipy warns and returns nan
+        return float(mannwhitneyu(a, b, alternative="two-sided").pvalue)
+
+    by_label: dict[str, list[dict[str, Any]]] = {lab: [] for lab in labels}
+    for r in rows:
+        if r["policy"] in by_label:
+            by_label[r["policy"]].append(r)
+    paper_rows = by_label.get(PAPER, [])
+    ref_times = np.array([float(r["mission_time_s"]) for r in paper_rows])
+    ref_scores = np.array([score(r) for r in paper_rows])
+    table = []
+    for lab in labels:
+        rs = by_label[lab]
+        times = np.array([float(r["mission_time_s"]) for r in rs])
+        cov = np.array([float(r["coverage"]) for r in rs])
+        scores = np.array([score(r) for r in rs])
+        nan = math.nan
+        table.append(
+            {
+                "weights": lab,
+                "n": len(rs),
+                "median_mission_time_s": float(np.median(times)) if len(rs) else nan,
+                "median_coverage": float(np.median(cov)) if len(rs) else nan,
+                "mean_coverage": float(np.mean(cov)) if len(rs) else nan,
+                "completed_fraction": float(np.mean(cov >= target_coverage)) if len(rs) else nan,
+                "mean_score": float(np.mean(scores)) if len(rs) else nan,
+                "p_value_vs_paper": nan if lab == PAPER else p_value(times, ref_times),
+                "p_value_score_vs_paper": nan if lab == PAPER else p_value(scores, ref_scores),
+            }
+        )
+    return table
+
+
+def write_table(
+    out: Path, table: list[dict[str, Any]], sets: dict[str, dict[str, float]]
+) -> tuple[Path, Path]:
+    """``compare.csv`` and ``compare.md`` from :func:`summarise` rows."""
+    cols = list(table[0])
+    csv_path = out / "compare.csv"
+    with csv_path.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols)
+        w.writeheader()
+        w.writerows(table)
+
+    def fmt(v: Any) -> str:
+        if isinstance(v, float):
+            return "-" if math.isnan(v) else f"{v:.4g}"
+        return str(v)
+
+    lines = [
+        "| " + " | ".join(cols) + " |",
+        "|" + "---|" * len(cols),
+        *("| " + " | ".join(fmt(r[c]) for c in cols) + " |" for r in table),
+        "",
+        "Weights:",
+        "",
+        *(
+            f"- `{lab}`: " + ", ".join(f"{k}={v:.4g}" for k, v in ws.items())
+            for lab, ws in sets.items()
+        ),
+        "",
+    ]
+    md_path = out / "compare.md"
+    md_path.write_text("\n".join(lines))
+    return csv_path, md_path
+
+
+def write_boxplot(out: Path, rows: list[dict[str, Any]], labels: list[str]) -> Path:
+    """Box plot of mission times per weight set (``mission_times.png``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = [[float(r["mission_time_s"]) for r in rows if r["policy"] == lab] for lab in labels]
+    fig, ax = plt.subplots(figsize=(1.8 * len(labels) + 2, 4))
+    ax.boxplot(data, showmeans=True)
+    ax.set_xticks(range(1, len(labels) + 1))
+    ax.set_xticklabels([lab.removeprefix("semantic") for lab in labels], rotation=20, ha="right")
+    ax.set_ylabel("mission time (simulated s)")
+    ax.set_title("Mission time per weight set (test worlds)")
+    ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    path = out / "mission_times.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        "compare-weights",
+        help="tune the planner weights with Optuna and compare them with the paper's (and ablations)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "--train-worlds",
+        required=True,
+        help="comma-separated training worlds ('maze:seed=*,size_m=4')",
+    )
+    p.add_argument("--test-worlds", required=True, help="comma-separated test worlds")
+    p.add_argument("--out", required=True, help="output directory; rerunning resumes")
+    p.add_argument("--trials", type=int, default=20, help="Optuna trials (default: %(default)s)")
+    p.add_argument(
+        "--train-runs", type=int, default=2, help="seeds per training world (default: %(default)s)"
+    )
+    p.add_argument(
+        "--runs", type=int, default=5, help="seeds per test world (default: %(default)s)"
+    )
+    p.add_argument(
+        "--train-seed0", type=int, default=0, help="first training seed (default: %(default)s)"
+    )
+    p.add_argument(
+        "--test-seed0", type=int, default=1000, help="first test seed (default: %(default)s)"
+    )
+    p.add_argument(
+        "--max-time-s",
+        type=float,
+        default=300.0,
+        help="simulated time limit per mission (default: %(default)s)",
+    )
+    p.add_argument(
+        "--target-coverage",
+        type=float,
+        default=0.97,
+        help="coverage below this is penalised (default: %(default)s)",
+    )
+    p.add_argument(
+        "--penalty-s",
+        type=float,
+        default=600.0,
+        help="seconds per unit of missing coverage (default: %(default)s)",
+    )
+    p.add_argument(
+        "--tune-field", action="store_true", help="also tune the potential field's f_g, f_o, f_l"
+    )
+    p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
+    p.add_argument("--config", default=None, help="env config: preset name or YAML path")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.add_argument("--workers", type=int, default=1, help="test missions in parallel processes (default: %(default)s)")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    from policies.weight_tuning import (
+        PAPER_FIELD,
+        PAPER_WEIGHTS,
+        SearchSpace,
+        mission_objective,
+        tune_weights,
+    )
+    from semexplore_gym.evaluation.harness import (
+        expand_tasks,
+        parse_seeds,
+        read_runs,
+        run_benchmark,
+        write_manifest,
+    )
+
+    train_worlds = _split_worlds(args.train_worlds)
+    test_worlds = _split_worlds(args.test_worlds)
+    if not train_worlds or not test_worlds:
+        raise ValueError("--train-worlds and --test-worlds must each name at least one world")
+    train_seeds = parse_seeds(args.train_runs, args.train_seed0)
+    test_seeds = parse_seeds(args.runs, args.test_seed0)
+    overlap = set(train_seeds) & set(test_seeds)
+    if overlap and set(train_worlds) & set(test_worlds):
+        raise ValueError(
+            f"training and test (world, seed) pairs overlap on seeds {sorted(overlap)}; change --test-seed0"
+        )
+    if args.trials < 1:
+        raise ValueError(f"--trials must be >= 1, got {args.trials}")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_manifest(
+        out,
+        {
+            "command": " ".join(shlex.quote(a) for a in sys.argv),
+            **{k: v for k, v in vars(args).items() if not k.startswith("_")},
+        },
+    )
+
+    space = SearchSpace.with_field() if args.tune_field else SearchSpace()
+    start = {**PAPER_WEIGHTS, **(PAPER_FIELD if args.tune_field else {})}
+    objective = mission_objective(
+        train_worlds,
+        train_seeds,
+        args.max_time_s,
+        args.target_coverage,
+        args.penalty_s,
+        env_config=args.config,
+    )
+
+    def show(number: int, weights: dict[str, float], value: float) -> None:
+        if not args.no_progress:
+            ws = ", ".join(f"{k.split('.')[-1]}={v:.3g}" for k, v in weights.items())
+            print(f"trial {number}: {value:.2f} ({ws})", file=sys.stderr)
+
+    result = tune_weights(
+        objective,
+        args.trials,
+        space,
+        seed=args.seed,
+        enqueue=[start],
+        storage_path=out / "tuning" / "study.sqlite",
+        jsonl_path=out / "tuning" / "trials.jsonl",
+        on_trial=show,
+    )
+    sets = weight_sets(result.best_weights)
+    (out / "weights.json").write_text(
+        json.dumps({"sets": sets, "best_train_value": result.best_value}, indent=2)
+    )
+
+    tasks = []
+    for label, ws in sets.items():
+        tasks += expand_tasks(
+            test_worlds,
+            [label],
+            test_seeds,
+            max_time_s=args.max_time_s,
+            env_config=args.config,
+            policy_overrides=ws,
+        )
+    res = run_benchmark(
+        tasks, out / "test", workers=args.workers, progress=not args.no_progress
+    )
+    rows = read_runs(out / "test" / "runs.csv")
+    labels = list(sets)
+    table = summarise(rows, labels, args.target_coverage, args.penalty_s)
+    csv_path, md_path = write_table(out, table, sets)
+    plot = write_boxplot(out, rows, labels)
+    print(
+        json.dumps(
+            {
+                "trials": len(result.trials),
+                "best_train_value": result.best_value,
+                "tuned": result.best_weights,
+                "table": str(md_path),
+                "csv": str(csv_path),
+                "plot": str(plot),
+                "failed": len(res["failed"]),
+            }
+        )
+    )
+    print(md_path.read_text())
+    return 1 if res["failed"] else 0

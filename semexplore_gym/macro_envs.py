@@ -1,0 +1,80 @@
+"""Entry points of the macro-action env ids: base env + expert driver + macro wrapper.
+
+``SemanticExploreFrontier-v0`` (choose one of the top-K frontiers) and
+``SemanticExploreWeights-v0`` (choose the planner weights) need the scripted expert as their
+driver. Wrappers may not import ``policies`` and policies may not import envs or wrappers
+(STYLE.md layering), so this module, which sits outside the layers like ``cli`` and
+``evaluation``, is the one place that joins them. It is imported only by ``gym.make`` through
+the string entry points registered in :func:`semexplore_gym.register_envs`.
+
+Example::
+
+    import gymnasium as gym, semexplore_gym
+    env = gym.make("SemanticExploreFrontier-v0", world="maze:size_m=5", macro={"n_candidates": 6})
+    obs, info = env.reset(seed=0)
+    mask = env.get_wrapper_attr("action_masks")()
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from typing import Any
+
+from policies.config import build_params, nest_dotted
+from policies.macro_driver import ExpertDriver
+from policies.semantic_expert import SemanticExpertParams
+from semexplore_gym.core.params import from_dict
+from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+from semexplore_gym.wrappers.frontier_choice import FrontierChoice, MacroParams, PlannerWeights
+
+
+def _parts(
+    world: Any,
+    config: Any,
+    overrides: list[str] | None,
+    render_mode: str | None,
+    macro: MacroParams | Mapping[str, Any] | None,
+    expert: Mapping[str, Any] | None,
+) -> tuple[SemanticExploreEnv, ExpertDriver, MacroParams]:
+    env = SemanticExploreEnv(
+        world=world, config=config, overrides=overrides, render_mode=render_mode
+    )
+    params = macro if isinstance(macro, MacroParams) else from_dict(MacroParams, dict(macro or {}))
+    driver = ExpertDriver(build_params(SemanticExpertParams, nest_dotted(dict(expert or {}))))
+    return env, driver, params
+
+
+def make_frontier_choice_env(
+    world: str | os.PathLike | Any = "maze1",
+    config: Any = None,
+    overrides: list[str] | None = None,
+    render_mode: str | None = None,
+    macro: MacroParams | Mapping[str, Any] | None = None,
+    expert: Mapping[str, Any] | None = None,
+) -> FrontierChoice:
+    """``SemanticExploreFrontier-v0``: :class:`FrontierChoice` over ``SemanticExplore-v0``.
+
+    Args:
+        world, config, overrides, render_mode: As for ``SemanticExplore-v0``.
+        macro: :class:`MacroParams` or a mapping of its fields.
+        expert: Overrides of the driver's ``SemanticExpertParams`` (dotted or nested keys).
+    """
+    env, driver, params = _parts(world, config, overrides, render_mode, macro, expert)
+    return FrontierChoice(env, driver, params)
+
+
+def make_planner_weights_env(
+    world: str | os.PathLike | Any = "maze1",
+    config: Any = None,
+    overrides: list[str] | None = None,
+    render_mode: str | None = None,
+    macro: MacroParams | Mapping[str, Any] | None = None,
+    expert: Mapping[str, Any] | None = None,
+) -> PlannerWeights:
+    """``SemanticExploreWeights-v0``: :class:`PlannerWeights` over ``SemanticExplore-v0``.
+
+    Arguments as for :func:`make_frontier_choice_env`.
+    """
+    env, driver, params = _parts(world, config, overrides, render_mode, macro, expert)
+    return PlannerWeights(env, driver, params)

@@ -1,0 +1,65 @@
+"""``semexplore train`` on the macro-action env ids (maskable_ppo and ppo), tiny budgets."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from semexplore_gym.cli import main
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "agents"
+TINY = [
+    "--set", "env.world=maze:seed=0,size_m=4",
+    "--set", "env.overrides=[episode.max_time_s=30]",
+    "--set", "ppo.total_timesteps=8",
+    "--set", "ppo.n_steps=4",
+    "--set", "ppo.batch_size=4",
+    "--set", "ppo.n_epochs=1",
+    "--set", "env.macro.max_macro_time_s=2",
+    "--set", "env.macro.decision_period_s=2",
+    "--no-progress",
+]  # fmt: skip
+
+
+@pytest.fixture(autouse=True)
+def _one_thread() -> None:
+    import torch
+
+    torch.set_num_threads(1)
+
+
+@pytest.mark.parametrize(
+    ("algo", "config", "cls_name"),
+    [
+        ("maskable_ppo", "frontier_choice_maze.yml", "MaskablePPO"),
+        ("ppo", "planner_weights_maze.yml", "PPO"),
+    ],
+)
+def test_macro_training_runs_a_few_steps(
+    tmp_path: Path, algo: str, config: str, cls_name: str
+) -> None:
+    out = tmp_path / algo
+    assert (
+        main(["train", "--algo", algo, "--config", str(CONFIGS / config), "--out", str(out), *TINY])
+        == 0
+    )
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["timesteps"] == 8
+    if cls_name == "MaskablePPO":
+        from sb3_contrib import MaskablePPO as cls
+    else:
+        from stable_baselines3 import PPO as cls
+    model = cls.load(str(out / "model.zip"), device="cpu")
+    assert model.observation_space.shape == (8 * 8 + 4,)
+
+
+def test_macro_env_id_rejects_imitation_and_mask_needs_macro(tmp_path: Path) -> None:
+    cfg = str(CONFIGS / "planner_weights_maze.yml")
+    assert main(["train", "--algo", "bc", "--config", cfg, "--out", str(tmp_path / "a")]) == 2
+    cfg = str(CONFIGS / "ppo_maze.yml")
+    assert (
+        main(["train", "--algo", "maskable_ppo", "--config", cfg, "--out", str(tmp_path / "b")])
+        == 2
+    )
