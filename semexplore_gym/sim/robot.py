@@ -221,11 +221,12 @@ class RobotSim:
         # The pivot and gear joints have no positional bias: only the control body's velocities
         # matter; keeping it on the robot avoids a large lever arm in the pivot constraint.
         control.position = body.position
+        control.angular_velocity = angular_radps
+        space_step = self.space.step
         for _ in range(n):
             yaw = body.angle
             control.velocity = (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw))
-            control.angular_velocity = angular_radps
-            self.space.step(h)
+            space_step(h)
         self._suppress_begin = False
         new_collision = self._began
         if new_collision:
