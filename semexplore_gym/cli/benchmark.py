@@ -57,6 +57,18 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--config", default=None, help="env config: preset name or YAML path")
     p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="env config override, e.g. lidar.n_beams=180 (repeatable)",
+    )
+    p.add_argument(
+        "--random-start",
+        action="store_true",
+        help="sample each seed's start pose in free space (same for every policy)",
+    )
+    p.add_argument(
         "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
     )
     p.add_argument(
@@ -93,9 +105,12 @@ def run(args: argparse.Namespace) -> int:
     for p in policies:
         if strip_label(p).partition(":")[0] not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
-    tasks = expand_tasks(
-        worlds, policies, seeds, max_time_s=args.max_time_s, env_config=args.config
-    )
+    from semexplore_gym.core.params import to_dict
+    from semexplore_gym.envs.config import load_env_config
+
+    overrides = list(args.set) + (["episode.random_start=true"] if args.random_start else [])
+    env_config = load_env_config(args.config, overrides) if (args.config or overrides) else None
+    tasks = expand_tasks(worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config)
     from pathlib import Path
 
     Path(args.out).mkdir(parents=True, exist_ok=True)
@@ -108,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
             "seeds": seeds,
             "max_time_s": args.max_time_s,
             "config": args.config,
+            "env_config": to_dict(env_config) if env_config is not None else None,
             "workers": args.workers,
             "backend": args.backend,
         },

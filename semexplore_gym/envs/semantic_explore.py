@@ -230,6 +230,7 @@ class SemanticExploreEnv(gym.Env):
         self.odometry.reset(pose)
         self._est_pose = pose
         self.sim_time_s = 0.0
+        self._n_steps = 0
         self.path_length_m = 0.0
         self._trajectory: list[tuple[float, float]] = [(pose[0], pose[1])]
         self._overlay = {}
@@ -247,7 +248,9 @@ class SemanticExploreEnv(gym.Env):
         before = self.sim.pose
         new_collision = self.sim.step(v_mps, w_radps, cfg.episode.dt_s)
         after = self.sim.pose
-        self.sim_time_s += cfg.episode.dt_s
+        self._n_steps += 1
+        # From the step count, not a running sum, so 600 steps of 0.2 s are exactly 120 s.
+        self.sim_time_s = round(self._n_steps * cfg.episode.dt_s, 9)
         self.path_length_m += math.hypot(after[0] - before[0], after[1] - before[1])
         self._trajectory.append((after[0], after[1]))
         self._est_pose = (
