@@ -50,6 +50,8 @@ class MissionResult:
         path_length_m: Distance driven.
         collisions: Wall contacts begun during the mission.
         wall_time_s: Wall-clock time of the whole mission (reset, steps, planning, rendering).
+        cpu_time_s: CPU time of this process during the mission (equals the wall time on an
+            idle machine: everything runs in one thread; robust to other load).
         steps: Env steps taken.
         terminated: The env terminated (coverage goal reached).
         truncated: The env truncated, or ``max_time_s`` was reached.
@@ -75,6 +77,7 @@ class MissionResult:
     path_length_m: float
     collisions: int
     wall_time_s: float
+    cpu_time_s: float
     steps: int
     terminated: bool
     truncated: bool
@@ -107,6 +110,7 @@ class MissionResult:
             "path_length_m": round(float(self.path_length_m), 3),
             "collisions": int(self.collisions),
             "wall_time_s": round(float(self.wall_time_s), 3),
+            "cpu_time_s": round(float(self.cpu_time_s), 3),
             "steps": int(self.steps),
             "T90_s": self.t90_s,
             "T99_s": self.t99_s,
@@ -139,6 +143,7 @@ def run_mission(
     gif_every_s: float = 2.0,
     gif_fps: float = 10.0,
     reset_options: dict[str, Any] | None = None,
+    ignore_terminated: bool = False,
 ) -> MissionResult:
     """Run one mission of ``policy`` in ``env``.
 
@@ -153,6 +158,9 @@ def run_mission(
         gif_every_s: Simulated seconds between GIF frames.
         gif_fps: GIF playback frame rate.
         reset_options: ``options`` for ``env.reset``.
+        ignore_terminated: Keep going when the env terminates (its coverage goal is reached),
+            so that the mission lasts until the policy stops (or the time limit): the mission
+            time is then the policy's own. Truncation still ends the mission.
 
     Returns:
         The :class:`MissionResult`.
@@ -171,6 +179,7 @@ def run_mission(
         if not gif_every_s > 0:
             raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
     stage = dict.fromkeys(STAGES, 0.0)
+    cpu0 = time.process_time()
     wall0 = time.perf_counter()
     obs, info = env.reset(seed=seed, options=reset_options)
     t1 = time.perf_counter()
@@ -254,7 +263,7 @@ def run_mission(
                         mode=str(st.extra.get("mode", "")),
                         refresh=False,
                     )
-            if terminated or truncated or sim_t >= limit_s - 1e-9:
+            if (terminated and not ignore_terminated) or truncated or sim_t >= limit_s - 1e-9:
                 break
         if gif_path is not None:
             grab_frame()
@@ -264,7 +273,7 @@ def run_mission(
     sim_t = float(info["sim_time_s"])
     if policy.done:
         reason = policy.stop_reason or "policy done"
-    elif terminated:
+    elif terminated and not ignore_terminated:
         reason = "env terminated (coverage goal reached)"
     elif truncated:
         reason = "env truncated (episode time limit)"
@@ -276,6 +285,7 @@ def run_mission(
         save_gif(frames, gif_path, fps=gif_fps)
         stage["render"] += time.perf_counter() - t_save
         wall = time.perf_counter() - wall0
+    cpu = time.process_time() - cpu0
     return MissionResult(
         world=world_name,
         policy=policy.name,
@@ -288,6 +298,7 @@ def run_mission(
         path_length_m=float(info["path_length_m"]),
         collisions=int(info["collisions"]),
         wall_time_s=wall,
+        cpu_time_s=cpu,
         steps=steps,
         terminated=bool(terminated),
         truncated=bool(truncated or (not terminated and not policy.done)),
@@ -337,9 +348,11 @@ def _progress_bar(enabled: bool, total_s: float | None, world: str, policy: str)
     return tqdm(
         total=total_s,
         unit="sim s",
-        desc=f"{policy} on {world}",
+        desc=f"{policy} on {Path(world).name if os.sep in world else world}",
         file=sys.stderr,
         leave=False,
-        bar_format=None,
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} sim s [{elapsed}<{remaining}{postfix}]"
+        if total_s is not None
+        else "{desc}: {n:.0f} sim s [{elapsed}{postfix}]",
         dynamic_ncols=True,
     )

@@ -18,32 +18,44 @@ What the paper leaves open, and how this policy handles it (parameters in
 :class:`SemanticExpertParams`, all times in simulated seconds):
 
 * **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
-  ``goal_check_radius_m``): the map changes every step, but segmentation and search run only
-  every ``replan_period_s``, and at once when the goal is reached, when it vanishes (no
-  UNKNOWN cell is left within ``goal_check_radius_m`` of it: its frontier has been mapped),
-  when the path is used up, or when a recovery ends.
+  ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
+  segmentation and search run only every ``replan_period_s``, and at once when the goal is
+  reached, when it vanishes (no UNKNOWN cell is left within ``goal_check_radius_m`` of it: its
+  frontier has been mapped), when the path is used up, or when a recovery ends. A scheduled
+  replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
+  became known since the last one, e.g. while the robot crosses explored space.
 * **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
   pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
   old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
   cheaper by more than ``switch_margin`` (cost units of ``C``). This stops the robot from
   oscillating between near-equal frontiers.
-* **Narrow frontiers** (``min_frontier_width_m``): frontier openings narrower than this are
-  ignored; the segmentation's ``clearance_m = radius + clearance_margin_m`` already drops
-  passages the robot cannot follow.
+* **Narrow frontiers** (``min_frontier_width_m``, ``clearance_margin_m``): frontier openings
+  narrower than ``min_frontier_width_m`` are ignored; the segmentation's clearance
+  ``radius + clearance_margin_m`` already closes passages the robot cannot follow.
 * **Path entry check**: when the straight first leg from the robot to the map's path crosses
-  an occupied cell (the robot stands outside every area, e.g. in a corridor the map does not
-  cover yet), a grid BFS path with the robot's clearance leads to the path's start instead.
-* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_cells``,
-  ``fallback_reach_m``): while the topometric map has no usable frontier (no frontier pathway
-  yet, frontiers sealed by the segmentation), the robot drives to the nearest frontier that a
-  BFS with its clearance can reach (:mod:`semexplore_gym.core.reachable_frontiers`).
+  an occupied cell (the robot stands outside every area), a grid path with the robot's
+  clearance leads to the path instead.
+* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_m``,
+  ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
+  frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
+  space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
+  frontier a grid search with its clearance can reach
+  (:mod:`semexplore_gym.core.reachable_frontiers`), and keeps that goal while it lasts. Tiny
+  frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
+  inside of walls, pockets along them) are ignored.
 * **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
   replans found no frontier from either source.
+* **Potential-field local minima** (in :class:`PotentialFieldParams`): the lookahead point
+  ``G`` needs a sight line with the robot's clearance (``lookahead_clearance_m``), so the field
+  does not pull the robot onto wall ends at corners and doorways; a collision guard
+  (``safety_margin_m``, ``contact_margin_m``, ``braking_time_s``, ``map_guard_radius_m``) caps
+  the speed before any obstacle; guard steering (``guard_steer_max_rad``) turns the robot
+  towards the nearest open heading when the guard blocks the field's direction.
 * **Local-minimum escape** (``local_min_timeout_s``, ``escape_duration_s``,
   ``escape_repulsion_scale``): when the field has held the robot almost still (forward command
-  below 10 % of the maximum) for ``local_min_timeout_s`` (a doorway or dead end where
-  repulsion cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the
-  collision guard of the field still keeps the robot off the walls.
+  below 10 % of the maximum) for ``local_min_timeout_s`` (a dead end or doorway where repulsion
+  cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the collision
+  guard still keeps the robot off the walls.
 * **Stuck recovery** (``stuck_timeout_s``, ``stuck_radius_m``, ``progress_timeout_s``,
   ``progress_min_new_cells``, ``backoff_duration_s``, ``backoff_speed_fraction``): the robot is
   stuck when it stayed within ``stuck_radius_m`` for ``stuck_timeout_s`` while the map grew by
@@ -52,9 +64,11 @@ What the paper leaves open, and how this policy handles it (parameters in
   ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
   space when the way back is blocked), blacklists the goal and replans.
 * **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
-  blacklisted by recovery, or reached ``max_goal_reaches`` times without their frontier
+  blacklisted by a recovery, or reached ``max_goal_reaches`` times without their frontier
   disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
   the mission.
+
+``counters`` and ``events`` record how often each behaviour fired.
 """
 
 from __future__ import annotations
@@ -90,6 +104,7 @@ from semexplore_gym.core.reachable_frontiers import (
     grid_path_to,
     nearest_reachable_frontier,
 )
+from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.topometric.types import TopometricMap
 
 Segmenter = Callable[..., TopometricMap]
@@ -103,9 +118,13 @@ class SemanticExpertParams:
         cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (paper: 4, 0.2, 0.1).
         potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (paper: 30, 0.065, 1.5) and
             the command mapping.
+        segmentation: Parameters of ``segment_map`` (the robot clearance is not one of them).
         prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
         clearance_margin_m: Segmentation clearance is the robot radius plus this.
-        replan_period_s: Replanning period (segmentation + Algorithm 1).
+        replan_period_s: Period of the scheduled replans (segmentation + Algorithm 1).
+        resegment_min_new_m2: A scheduled replan re-segments the map only if at least this much
+            area became known since the last segmentation; otherwise it reruns Algorithm 1 on
+            the previous topometric map from the new pose.
         goal_reached_radius_m: The goal counts as reached within this distance.
         goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
             left within this distance of it.
@@ -113,7 +132,12 @@ class SemanticExpertParams:
         switch_margin: Another frontier replaces the current one only if cheaper by this much.
         min_frontier_width_m: Narrower frontier openings are ignored.
         grid_fallback: Use the grid BFS frontier while the topometric map offers none.
-        fallback_min_frontier_cells: Smallest frontier group the fallback considers (cells).
+        fallback_min_frontier_m: Smallest frontier group the fallback considers (its cell count
+            times the resolution, metres). Smaller groups are mostly leaks through gaps in
+            rasterised walls, which no robot can clear.
+        fallback_min_unknown_depth_m: The fallback ignores frontiers without unknown space at
+            least this far from every known cell next to them (the inside of thick walls seen
+            through gaps in their mapped faces, thin pockets along walls: no scan fills them).
         fallback_reach_m: The fallback's goal lies within this distance of the frontier.
         stop_confirmations: Consecutive replans without any frontier before stopping.
         local_min_timeout_s: Time almost still (forward command < 10 % of max) before escaping.
@@ -131,17 +155,20 @@ class SemanticExpertParams:
 
     cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
     potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
+    segmentation: SegmentationParams = field(default_factory=SegmentationParams)
     prune_by: Literal["opening", "area"] = "opening"
     clearance_margin_m: float = 0.05
-    replan_period_s: float = 1.0
+    replan_period_s: float = 2.0
+    resegment_min_new_m2: float = 0.1
     goal_reached_radius_m: float = 0.35
     goal_check_radius_m: float = 0.5
     commitment_radius_m: float = 1.0
     switch_margin: float = 0.5
     min_frontier_width_m: float = 0.25
     grid_fallback: bool = True
-    fallback_min_frontier_cells: int = 4
-    fallback_reach_m: float = 0.3
+    fallback_min_frontier_m: float = 0.35
+    fallback_min_unknown_depth_m: float = 0.2
+    fallback_reach_m: float = 0.1
     stop_confirmations: int = 2
     local_min_timeout_s: float = 3.0
     escape_duration_s: float = 4.0
@@ -176,6 +203,9 @@ class SemanticExpertParams:
             "commitment_radius_m",
             "switch_margin",
             "min_frontier_width_m",
+            "fallback_min_frontier_m",
+            "fallback_min_unknown_depth_m",
+            "resegment_min_new_m2",
             "fallback_reach_m",
             "escape_duration_s",
             "escape_repulsion_scale",
@@ -191,7 +221,6 @@ class SemanticExpertParams:
                 f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
             )
         for name in (
-            "fallback_min_frontier_cells",
             "stop_confirmations",
             "max_goal_reaches",
             "progress_min_new_cells",
@@ -207,6 +236,11 @@ class _Plan:
     path_m: np.ndarray
     candidate: FrontierCandidate | None
     progress: int = 0
+    arc_m: np.ndarray = field(default_factory=lambda: np.zeros(1))
+
+    def __post_init__(self) -> None:
+        seg = np.hypot(*np.diff(self.path_m, axis=0).T) if len(self.path_m) > 1 else np.zeros(0)
+        self.arc_m = np.concatenate(([0.0], np.cumsum(seg)))
 
 
 class SemanticExpertPolicy(Policy):
@@ -215,7 +249,7 @@ class SemanticExpertPolicy(Policy):
     Args:
         params: Parameters (default: the paper's weights and our robustness settings).
         segmenter: ``segment_map``-compatible callable ``(grid, geometry, clearance_m,
-            previous=...) -> TopometricMap``; default
+            params=..., previous=...) -> TopometricMap``; default
             :func:`semexplore_gym.core.topometric.segment_map`.
 
     Attributes (after ``reset``): ``tmap`` the last topometric map, ``candidates`` the scored
@@ -265,9 +299,10 @@ class SemanticExpertPolicy(Policy):
         self.tmap = None
         self.candidates = []
         self.mode = "idle"
-        self.events: list[tuple[float, str, str]] = []
+        self.events = []
         self.counters = {
             "replans": 0,
+            "segmentations": 0,
             "semantic_plans": 0,
             "fallback_plans": 0,
             "entry_detours": 0,
@@ -280,6 +315,8 @@ class SemanticExpertPolicy(Policy):
         self._time_s = 0.0
         self._plan: _Plan | None = None
         self._next_replan_s = 0.0
+        self._last_reason = ""
+        self._seg_known_cells = 0
         self._empty_replans = 0
         self._blacklist: list[tuple[float, float]] = []
         self._reaches: list[tuple[float, float, int]] = []
@@ -305,7 +342,8 @@ class SemanticExpertPolicy(Policy):
             self.last_stats = stats
             return np.zeros(2, dtype=np.float32)
         grid = obs["map"]
-        pose = tuple(float(v) for v in obs["pose"])
+        p = obs["pose"]
+        pose = (float(p[0]), float(p[1]), float(p[2]))
         scan = np.asarray(obs["scan"], dtype=np.float64)
         if self._angles is None or len(self._angles) != len(scan):
             self._angles = beam_angles_rad(len(scan))
@@ -348,19 +386,30 @@ class SemanticExpertPolicy(Policy):
         return action
 
     def _needs_replan(self, grid: np.ndarray, pose: tuple[float, float, float]) -> bool:
+        reason = self._replan_reason(grid, pose)
+        self._last_reason = reason
+        if reason:
+            self.counters[f"replan_{reason}"] = self.counters.get(f"replan_{reason}", 0) + 1
+        return bool(reason)
+
+    def _replan_reason(self, grid: np.ndarray, pose: tuple[float, float, float]) -> str:
         plan = self._plan
-        if plan is None or self._time_s >= self._next_replan_s - 1e-9:
-            return True
+        if plan is None:
+            return "no_plan"
+        if self._time_s >= self._next_replan_s - 1e-9:
+            return "period"
         if (
             math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
             <= self.params.goal_reached_radius_m
         ):
             self._register_reach(plan.goal_xy_m)
-            return True
+            return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
-            return True
+            return "path_done"
         # Goal vanished: no unknown cell is left near it (its frontier has been mapped).
-        return not self._unknown_near(grid, plan.goal_xy_m, self.params.goal_check_radius_m)
+        if not self._unknown_near(grid, plan.goal_xy_m, self.params.goal_check_radius_m):
+            return "goal_vanished"
+        return ""
 
     def _unknown_near(self, grid: np.ndarray, xy: tuple[float, float], radius_m: float) -> bool:
         g = self.geometry
@@ -378,11 +427,27 @@ class SemanticExpertPolicy(Policy):
         self._next_replan_s = self._time_s + prm.replan_period_s
         t0 = time.perf_counter()
         assert self._segmenter is not None
-        tmap = self._segmenter(grid, self.geometry, self.clearance_m, previous=self.tmap)
+        min_new = prm.resegment_min_new_m2 / self.geometry.resolution_m**2
+        segmented = (
+            self.tmap is None
+            or self._last_reason != "period"
+            or self._known_cells - self._seg_known_cells >= min_new
+        )
+        if segmented:
+            tmap = self._segmenter(
+                grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
+            )
+            self._seg_known_cells = self._known_cells
+            self.tmap = tmap
+            self._area_types = None
+            self.counters["segmentations"] += 1
+        else:
+            # Map-change gating: the map has hardly grown since the last segmentation (the
+            # robot drives through explored space): search the same map from the new pose.
+            assert self.tmap is not None
+            tmap = self.tmap
         t1 = time.perf_counter()
-        stats.map_generation_ms = (t1 - t0) * 1e3
-        self.tmap = tmap
-        self._area_types = None
+        stats.map_generation_ms = (t1 - t0) * 1e3 if segmented else 0.0
 
         cands, _ = search_frontier_paths(
             tmap,
@@ -398,9 +463,9 @@ class SemanticExpertPolicy(Policy):
         clearance: np.ndarray | None = None
         if cands:
             chosen = self._commit(cands)
-            path = chosen.path_m
-            if len(path) >= 2 and not segment_is_clear(
-                grid, self.geometry, pose[:2], tuple(path[1])
+            path: np.ndarray | None = chosen.path_m
+            if len(chosen.path_m) >= 2 and not segment_is_clear(
+                grid, self.geometry, pose[:2], tuple(chosen.path_m[1])
             ):
                 # The straight first leg crosses a wall: reach the map's path over the grid.
                 clearance = clearance_field_m(grid, self.geometry.resolution_m)
@@ -408,16 +473,13 @@ class SemanticExpertPolicy(Policy):
                     grid,
                     self.geometry,
                     pose[:2],
-                    tuple(path[1]),
+                    tuple(chosen.path_m[1]),
                     self.clearance_m,
                     clearance_field=clearance,
                 )
-                if detour is not None:
-                    path = np.vstack([detour, path[2:]])
-                    self.counters["entry_detours"] += 1
-                else:
-                    chosen = None  # type: ignore[assignment]
-            if chosen is not None:
+                path = None if detour is None else np.vstack([detour, chosen.path_m[2:]])
+                self.counters["entry_detours"] += int(detour is not None)
+            if path is not None:
                 new_plan = _Plan(
                     "semantic",
                     chosen.goal_xy_m,
@@ -427,15 +489,48 @@ class SemanticExpertPolicy(Policy):
         if new_plan is None and prm.grid_fallback:
             if clearance is None:
                 clearance = clearance_field_m(grid, self.geometry.resolution_m)
+            old = self._plan
+            if (
+                old is not None
+                and old.source == "fallback"
+                and not self._is_blacklisted(old.goal_xy_m)
+                and math.hypot(pose[0] - old.goal_xy_m[0], pose[1] - old.goal_xy_m[1])
+                > prm.goal_reached_radius_m
+                and self._unknown_near(grid, old.goal_xy_m, prm.goal_check_radius_m)
+            ):
+                # Goal commitment for the fallback too: keep driving to the same frontier while
+                # it is there and reachable, rather than to whichever is nearest right now.
+                path = grid_path_to(
+                    grid,
+                    self.geometry,
+                    pose[:2],
+                    old.goal_xy_m,
+                    self.clearance_m,
+                    clearance_field=clearance,
+                )
+                if path is not None:
+                    new_plan = _Plan(
+                        "fallback",
+                        old.goal_xy_m,
+                        resample_polyline(path, self.geometry.resolution_m),
+                        None,
+                    )
+        if new_plan is None and prm.grid_fallback:
+            if clearance is None:
+                clearance = clearance_field_m(grid, self.geometry.resolution_m)
             found = nearest_reachable_frontier(
                 grid,
                 self.geometry,
                 pose[:2],
                 self.clearance_m,
-                min_frontier_cells=prm.fallback_min_frontier_cells,
+                min_frontier_cells=max(
+                    1, math.ceil(prm.fallback_min_frontier_m / self.geometry.resolution_m - 1e-9)
+                ),
+                min_unknown_depth_cells=prm.fallback_min_unknown_depth_m
+                / self.geometry.resolution_m,
                 reach_m=prm.fallback_reach_m,
                 excluded_xy_m=self._blacklist,
-                excluded_radius_m=prm.blacklist_radius_m,
+                excluded_radius_m=prm.blacklist_radius_m + prm.fallback_reach_m,
                 clearance_field=clearance,
             )
             if found is not None:
@@ -469,11 +564,18 @@ class SemanticExpertPolicy(Policy):
             )
             > prm.commitment_radius_m
         ):
-            # A new goal: measure progress towards it from scratch.
-            self._best_remaining_m = math.inf
             if old is not None:
                 self.counters["switches"] += 1
+            self._log("goal", f"{new_plan.source} {tuple(round(v, 2) for v in new_plan.goal_xy_m)}")
+        if old is None or old.source != new_plan.source:
+            self._log(
+                new_plan.source,
+                f"goal={new_plan.goal_xy_m}, {len(self.candidates)} semantic frontier(s)",
+            )
         self._plan = new_plan
+        # Progress is measured along each new path from its start (the robot's position): a
+        # replanned route may be longer than the rest of the old one without anything being wrong.
+        self._best_remaining_m = self._remaining_m(new_plan)
         self.mode = new_plan.source
         self.counters["semantic_plans" if new_plan.source == "semantic" else "fallback_plans"] += 1
 
@@ -542,8 +644,7 @@ class SemanticExpertPolicy(Policy):
             plan.progress = lo + i
 
     def _remaining_m(self, plan: _Plan) -> float:
-        rest = plan.path_m[plan.progress :]
-        return float(np.hypot(*np.diff(rest, axis=0).T).sum()) if len(rest) > 1 else 0.0
+        return float(plan.arc_m[-1] - plan.arc_m[plan.progress])
 
     # ------------------------------------------------------------------ stuck handling
     def _watch_progress(self, pose: tuple[float, float, float]) -> None:
@@ -591,11 +692,13 @@ class SemanticExpertPolicy(Policy):
         self._best_remaining_m = math.inf
         self._still_s = 0.0
 
-    def _recovery_command(self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray) -> tuple[float, float]:
+    def _recovery_command(
+        self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
+    ) -> tuple[float, float]:
         assert self._angles is not None
         lim = self.limits
         pf = self.params.potential_field
-        near = nearby_obstacle_points(grid, self.geometry, pose, max(pf.map_guard_radius_m, 0.3))
+        near = nearby_obstacle_points(grid, self.geometry, pose, pf.map_guard_radius_m)
         back = front_free_distance(
             scan,
             self._angles,
@@ -615,7 +718,9 @@ class SemanticExpertPolicy(Policy):
             return 0.0, self._recovery_turn * 0.5 * lim.max_angular_speed_radps
         k = int(np.argmax(np.where(ok, scan, -1.0)))
         ang = math.atan2(math.sin(self._angles[k]), math.cos(self._angles[k]))
-        return 0.0, float(np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps))
+        return 0.0, float(
+            np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps)
+        )
 
     def _blacklist_goal(self) -> None:
         plan = self._plan

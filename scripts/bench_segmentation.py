@@ -28,7 +28,11 @@ GRIDFAST_REFERENCE_MS = {200: 3.2, 400: 16.5, 800: 122.0, 1600: 2362.0}
 
 
 def corridor_grid(
-    size: int, rng: np.random.Generator, corridor_cells: int = 10, spacing_cells: int = 50, block_prob: float = 0.2
+    size: int,
+    rng: np.random.Generator,
+    corridor_cells: int = 10,
+    spacing_cells: int = 50,
+    block_prob: float = 0.2,
 ) -> np.ndarray:
     """A ``size x size`` encoded grid of crossing corridors with random blockages."""
     g = np.full((size, size), OCCUPIED, dtype=np.uint8)
@@ -57,13 +61,26 @@ def corridor_grid(
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[200, 400, 800, 1600], help="grid sizes in cells")
-    ap.add_argument("--repeats", type=int, default=7, help="timed runs per size (the median is reported)")
+    ap.add_argument(
+        "--sizes", type=int, nargs="+", default=[200, 400, 800, 1600], help="grid sizes in cells"
+    )
+    ap.add_argument(
+        "--repeats", type=int, default=7, help="timed runs per size (the median is reported)"
+    )
     ap.add_argument("--seed", type=int, default=0, help="seed of the random blockages")
     ap.add_argument("--resolution", type=float, default=0.05, help="cell size in metres")
-    ap.add_argument("--clearance", type=float, default=0.155, help="robot radius + margin in metres")
-    ap.add_argument("--block-prob", type=float, default=0.2, help="probability that a corridor segment is blocked")
-    ap.add_argument("--stages", action="store_true", help="also print the median time of each stage")
+    ap.add_argument(
+        "--clearance", type=float, default=0.155, help="robot radius + margin in metres"
+    )
+    ap.add_argument(
+        "--block-prob",
+        type=float,
+        default=0.2,
+        help="probability that a corridor segment is blocked",
+    )
+    ap.add_argument(
+        "--stages", action="store_true", help="also print the median time of each stage"
+    )
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error("--repeats must be >= 1")
@@ -71,8 +88,12 @@ def main(argv: list[str] | None = None) -> int:
     params = SegmentationParams()
     rng = np.random.default_rng(args.seed)
     # warm-up: numba kernels are compiled (or loaded from the cache) on the first call
-    segment_map(corridor_grid(120, np.random.default_rng(0)), args.resolution, args.clearance, params)
-    print("| map (cells) | intersections | pathways | dead ends | frontier pathways | openings | median ms | GRID-FAST C++ ms |")
+    segment_map(
+        corridor_grid(120, np.random.default_rng(0)), args.resolution, args.clearance, params
+    )
+    print(
+        "| map (cells) | intersections | pathways | dead ends | frontier pathways | openings | median ms | GRID-FAST C++ ms |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     stage_rows = []
     for size in args.sizes:

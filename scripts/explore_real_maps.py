@@ -128,8 +128,15 @@ def main(argv: list[str] | None = None) -> int:
             )
             try:
                 policy = make_policy(args.policy or cfg.policy or "semantic", **dict(kwargs))
+                # The mission lasts until the policy stops (or the time limit), not until the
+                # env's coverage goal.
                 res = run_mission(
-                    env, policy, seed=args.seed, max_time_s=args.max_time_s, progress=args.progress
+                    env,
+                    policy,
+                    seed=args.seed,
+                    max_time_s=args.max_time_s,
+                    progress=args.progress,
+                    ignore_terminated=True,
                 )
             finally:
                 env.close()

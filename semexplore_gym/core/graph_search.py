@@ -23,7 +23,9 @@ Algorithm 1 finds the paths to all frontiers in one search:
   ahead, turn round behind the robot and so dodge the angle cost.
 * The search list is a stack: the **last** element is expanded first.
 * A path is discontinued when it reaches a node already reached at a lower or equal cost (the
-  ``A_cost`` array). By default ``A_cost`` has one slot per *opening*: an area is entered through
+  ``A_cost`` array; the paper's strict ``<`` would let equal-cost paths cycle over zero-length
+  edges), and a popped path is dropped when its last node has since been reached more cheaply
+  (the same condition, applied late). By default ``A_cost`` has one slot per *opening*: an area is entered through
   one of its openings, and the cost of leaving it depends on which one, so per-opening pruning
   keeps the search exact (it returns the cheapest path to every frontier). ``prune_by="area"``
   keeps one slot per area as the paper's pseudocode reads; it prunes more and can lose the
@@ -318,7 +320,8 @@ def search_frontier_paths(
 def _polyline_length(poly: np.ndarray) -> float:
     if len(poly) < 2:
         return 0.0
-    return float(np.hypot(*np.diff(poly, axis=0).T).sum())
+    d = poly[1:] - poly[:-1]
+    return float(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).sum())
 
 
 def _wrap_angle(a: float) -> float:
@@ -383,9 +386,11 @@ def project_onto_polyline(
 def _dedupe(poly: np.ndarray, tol_m: float = 1e-6) -> np.ndarray:
     if len(poly) < 2:
         return poly
-    keep = np.ones(len(poly), dtype=bool)
-    keep[1:] = np.hypot(*np.diff(poly, axis=0).T) > tol_m
-    return poly[keep]
+    d = poly[1:] - poly[:-1]
+    keep = np.empty(len(poly), dtype=bool)
+    keep[0] = True
+    keep[1:] = (np.abs(d[:, 0]) > tol_m) | (np.abs(d[:, 1]) > tol_m)
+    return poly if keep.all() else poly[keep]
 
 
 def _oriented(
@@ -393,8 +398,12 @@ def _oriented(
 ) -> np.ndarray:
     """``path_m`` ordered so that it starts at the end nearer ``start_xy`` (ties: ``end_xy`` decides)."""
     p = np.asarray(path_m, dtype=np.float64).reshape(-1, 2)
-    d_fwd = math.hypot(*(p[0] - start_xy)) + math.hypot(*(p[-1] - end_xy))
-    d_rev = math.hypot(*(p[-1] - start_xy)) + math.hypot(*(p[0] - end_xy))
+    x0, y0 = float(p[0, 0]), float(p[0, 1])
+    x1, y1 = float(p[-1, 0]), float(p[-1, 1])
+    sx, sy = float(start_xy[0]), float(start_xy[1])
+    ex, ey = float(end_xy[0]), float(end_xy[1])
+    d_fwd = math.hypot(x0 - sx, y0 - sy) + math.hypot(x1 - ex, y1 - ey)
+    d_rev = math.hypot(x1 - sx, y1 - sy) + math.hypot(x0 - ex, y0 - ey)
     return p if d_fwd <= d_rev else p[::-1].copy()
 
 
@@ -452,4 +461,4 @@ def _assemble(
     for j, k in enumerate(path.edges):
         parts.append(_edge_polyline(tmap, k, path.nodes[j]))
     parts.append(np.asarray([goal_xy], dtype=np.float64))
-    return _dedupe(np.vstack(parts))
+    return _dedupe(np.concatenate(parts, axis=0))

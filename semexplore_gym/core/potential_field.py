@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+from numba import njit
 
 from semexplore_gym.core.grid import OCCUPIED, GridGeometry
 from semexplore_gym.core.line_of_sight import farthest_visible_index
@@ -49,15 +50,26 @@ class PotentialFieldParams:
         min_lookahead_m: Floor of the lookahead radius.
         max_lookahead_m: Ceiling of the lookahead radius.
         lookahead_clearance_m: Line of sight to ``G`` also needs no obstacle cell within this
-            distance of the segment (0: the segment itself only).
+            distance of the segment (0: the segment itself only), so that the robot's body, not
+            only its centre, passes: aiming past a wall end at less than this would cut the
+            corner onto it (see :func:`select_lookahead` for the fall-back tiers).
         heading_gain_per_s: ``omega = gain * angle(F)`` (rad/s per rad).
         turn_in_place_rad: Above this angle between heading and ``F`` the robot only turns.
         safety_margin_m: Clearance kept beyond the robot radius by the collision guard.
         contact_margin_m: Points already within the safety margin stop the robot only when it
             would pass closer than the radius plus this (it may pass close to corners). Keep
             the radius plus this above the LiDAR's minimum range so passing points stay seen.
-        map_guard_radius_m: The guard also treats OCCUPIED map cells within this distance as
-            obstacles (walls inside the LiDAR's minimum range); 0 disables.
+        map_guard_radius_m: The guard also treats the centres of OCCUPIED map cells within this
+            distance as obstacles: walls inside the LiDAR's minimum range are invisible to the
+            scan. Keep it small (mapped cells sit up to half a cell nearer than the wall); 0
+            disables.
+        guard_steer_max_rad: Guard steering: when the way along ``F`` is blocked within the
+            braking distance (at least ``guard_steer_min_free_m``), the robot aims at the nearest
+            open heading within this angle of ``F`` (searched in ``guard_steer_step_rad``
+            steps); 0 disables. It resolves the deadlock of a field pulling the robot straight
+            onto a wall end that the guard does not let it pass.
+        guard_steer_step_rad: See ``guard_steer_max_rad``.
+        guard_steer_min_free_m: See ``guard_steer_max_rad``.
         braking_time_s: The guard allows ``v <= free_distance / braking_time_s``.
     """
 
@@ -67,16 +79,29 @@ class PotentialFieldParams:
     reference_n_beams: int = 360
     min_lookahead_m: float = 0.3
     max_lookahead_m: float = 3.0
-    lookahead_clearance_m: float = 0.1
+    lookahead_clearance_m: float = 0.15
     heading_gain_per_s: float = 2.5
     turn_in_place_rad: float = 1.0
     safety_margin_m: float = 0.04
     contact_margin_m: float = 0.025
-    map_guard_radius_m: float = 0.3
+    map_guard_radius_m: float = 0.15
+    guard_steer_max_rad: float = 1.6
+    guard_steer_step_rad: float = 0.1
+    guard_steer_min_free_m: float = 0.1
     braking_time_s: float = 0.6
 
     def __post_init__(self) -> None:
-        for name in ("f_g", "f_o", "f_l", "lookahead_clearance_m", "safety_margin_m", "contact_margin_m", "map_guard_radius_m"):
+        for name in (
+            "f_g",
+            "f_o",
+            "f_l",
+            "lookahead_clearance_m",
+            "safety_margin_m",
+            "contact_margin_m",
+            "map_guard_radius_m",
+            "guard_steer_max_rad",
+            "guard_steer_min_free_m",
+        ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -86,6 +111,7 @@ class PotentialFieldParams:
             "heading_gain_per_s",
             "turn_in_place_rad",
             "braking_time_s",
+            "guard_steer_step_rad",
         ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
@@ -165,12 +191,52 @@ def field_force(
 
     ``repulsion_scale`` multiplies ``f_o`` (1 = the paper's field).
     """
-    ok = valid_beams(scan_m, max_range_m)
-    f_o = params.f_o * params.reference_n_beams / len(scan_m) * repulsion_scale
-    inv = np.where(ok, 1.0 / np.where(ok, scan_m, 1.0), 0.0)
-    fx = params.f_g * math.cos(goal_angle_rad) - f_o * float(inv @ np.cos(angles_rad))
-    fy = params.f_g * math.sin(goal_angle_rad) - f_o * float(inv @ np.sin(angles_rad))
-    return fx, fy
+    scan = np.ascontiguousarray(scan_m, dtype=np.float64)
+    a = np.ascontiguousarray(angles_rad, dtype=np.float64)
+    f_o = params.f_o * params.reference_n_beams / len(scan) * repulsion_scale
+    fx, fy = _force(
+        scan, np.cos(a), np.sin(a), float(max_range_m), float(goal_angle_rad), params.f_g, f_o
+    )
+    return float(fx), float(fy)
+
+
+def obstacle_points(
+    scan_m: np.ndarray,
+    angles_rad: np.ndarray,
+    max_range_m: float,
+    extra_points_xy: np.ndarray | None = None,
+) -> np.ndarray:
+    """``(K, 2)`` obstacle points in the robot frame: the scan's returns plus ``extra_points_xy``."""
+    scan = np.ascontiguousarray(scan_m, dtype=np.float64)
+    a = np.ascontiguousarray(angles_rad, dtype=np.float64)
+    px, py = _scan_points(scan, np.cos(a), np.sin(a), float(max_range_m))
+    pts = np.column_stack([px, py])
+    if extra_points_xy is not None and len(extra_points_xy):
+        pts = np.vstack([pts, extra_points_xy])
+    return pts
+
+
+def free_distance_along(
+    points_xy: np.ndarray,
+    heading_rad: float,
+    half_width_m: float,
+    contact_half_width_m: float | None = None,
+) -> float:
+    """Distance the robot can drive straight along ``heading_rad`` (robot frame) before an obstacle
+    point enters its swept corridor of half-width ``half_width_m``; inf when nothing is in the way.
+
+    With ``contact_half_width_m`` (the robot radius plus a little), a point that is already inside
+    the ``half_width_m`` corridor but passes beside the robot farther than
+    ``contact_half_width_m`` does not stop it (it only passes close, e.g. a wall end at a corner);
+    a point nearer the centre line limits the travel to where it would touch.
+    """
+    pts = np.ascontiguousarray(points_xy, dtype=np.float64).reshape(-1, 2)
+    hard = -1.0 if contact_half_width_m is None else float(contact_half_width_m)
+    return float(
+        _free_along(
+            pts[:, 0].copy(), pts[:, 1].copy(), float(heading_rad), float(half_width_m), hard
+        )
+    )
 
 
 def front_free_distance(
@@ -182,65 +248,30 @@ def front_free_distance(
     contact_half_width_m: float | None = None,
     extra_points_xy: np.ndarray | None = None,
 ) -> float:
-    """Distance the robot can drive straight (forward, or backward) before an obstacle point
-    enters its swept corridor of half-width ``half_width_m``; inf when nothing is in the way.
-
-    The obstacle points are the scan's returns plus ``extra_points_xy`` (``(K, 2)`` in the robot
-    frame, e.g. mapped walls too close for the LiDAR's minimum range). With
-    ``contact_half_width_m`` (the robot radius plus a little), a point that is already inside
-    the ``half_width_m`` corridor but passes beside the robot farther than
-    ``contact_half_width_m`` does not stop it (it only passes close, e.g. a wall end at a corner);
-    a point nearer the centre line limits the travel to where it would touch.
-    """
-    ok = valid_beams(scan_m, max_range_m)
-    x = scan_m[ok] * np.cos(angles_rad[ok])
-    y = scan_m[ok] * np.sin(angles_rad[ok])
-    if extra_points_xy is not None and len(extra_points_xy):
-        x = np.concatenate([x, extra_points_xy[:, 0]])
-        y = np.concatenate([y, extra_points_xy[:, 1]])
-    if backwards:
-        x = -x
-    hit = (x > 0.0) & (np.abs(y) < half_width_m)
-    if not hit.any():
-        return math.inf
-    xh = x[hit]
-    yh = y[hit]
-    free = xh - np.sqrt(half_width_m**2 - yh**2)
-    if contact_half_width_m is not None:
-        inside = free < 0.0
-        if inside.any():
-            hard = np.abs(yh) < contact_half_width_m
-            contact = xh - np.sqrt(np.maximum(contact_half_width_m**2 - yh**2, 0.0))
-            free = np.where(inside, np.where(hard, contact, np.inf), free)
-    return float(max(0.0, free.min()))
+    """:func:`free_distance_along` the heading (or backwards) for the scan's returns plus
+    ``extra_points_xy`` (``(K, 2)`` robot frame, e.g. mapped walls inside the LiDAR's minimum range)."""
+    pts = obstacle_points(scan_m, angles_rad, max_range_m, extra_points_xy)
+    return free_distance_along(
+        pts, math.pi if backwards else 0.0, half_width_m, contact_half_width_m
+    )
 
 
 def nearby_obstacle_points(
     grid: np.ndarray, geometry: GridGeometry, pose: tuple[float, float, float], radius_m: float
 ) -> np.ndarray:
-    """OCCUPIED cells within ``radius_m`` of the robot as ``(K, 2)`` points in the robot frame.
-
-    Each cell is represented by the point of its square nearest the robot, so the points are
-    never farther than the mapped wall.
-    """
-    x, y, yaw = pose
-    res = geometry.resolution_m
-    r0, c0 = (int(v) for v in geometry.world_to_grid(x - radius_m, y - radius_m))
-    r1, c1 = (int(v) for v in geometry.world_to_grid(x + radius_m, y + radius_m))
-    r0, c0 = max(r0, 0), max(c0, 0)
-    r1, c1 = min(r1, geometry.height - 1), min(c1, geometry.width - 1)
-    if r0 > r1 or c0 > c1:
-        return np.empty((0, 2))
-    rows, cols = np.nonzero(grid[r0 : r1 + 1, c0 : c1 + 1] == OCCUPIED)
-    if len(rows) == 0:
-        return np.empty((0, 2))
-    lo_x = geometry.origin_x_m + (cols + c0) * res
-    lo_y = geometry.origin_y_m + (rows + r0) * res
-    px = np.clip(x, lo_x, lo_x + res) - x
-    py = np.clip(y, lo_y, lo_y + res) - y
-    keep = px * px + py * py <= radius_m * radius_m
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.column_stack([c * px[keep] + s * py[keep], -s * px[keep] + c * py[keep]])
+    """Centres of the OCCUPIED cells within ``radius_m`` of the robot, ``(K, 2)`` in the robot frame."""
+    x, y, yaw = (float(v) for v in pose)
+    px, py = _map_points(
+        grid,
+        geometry.origin_x_m,
+        geometry.origin_y_m,
+        geometry.resolution_m,
+        x,
+        y,
+        yaw,
+        float(radius_m),
+    )
+    return np.column_stack([px, py])
 
 
 def resample_polyline(poly: npt.ArrayLike, step_m: float) -> np.ndarray:
@@ -269,14 +300,17 @@ def select_lookahead(
     geometry: GridGeometry,
     start_index: int = 0,
     clearance_m: float = 0.0,
+    robot_clearance_m: float = math.inf,
 ) -> tuple[int, bool]:
     """Index of ``G`` in ``path_m`` (points at most about a cell apart), and whether it is visible.
 
     ``G`` is the farthest point at or after ``start_index`` within ``radius_m`` of the robot and
     in line of sight on ``grid`` (unknown cells do not block; obstacles within ``clearance_m`` of
-    the sight line do; if no point passes with the clearance, a thin sight line is enough). If
-    there is none, the nearest visible point after ``start_index``, else the nearest point (not
-    visible).
+    the sight line do). Beside a wall every sight line fails the clearance, so the test is
+    repeated with the robot's own clearance ``robot_clearance_m`` less a cell (the sight line may
+    not pass closer to a wall than the robot already is), then with a thin line. If no point
+    within the radius passes, the nearest visible point after ``start_index``, else the nearest
+    point (not visible).
     """
     n = len(path_m)
     if n == 0:
@@ -285,9 +319,8 @@ def select_lookahead(
     pts = path_m[start:]
     dist = np.hypot(pts[:, 0] - robot_xy_m[0], pts[:, 1] - robot_xy_m[1])
     inside = dist <= radius_m + 1e-9
-    # First with the clearance; beside a wall (closer than the clearance) every sight line
-    # fails it, so then with a thin line.
-    tiers = (clearance_m, 0.0) if clearance_m > 0.0 else (0.0,)
+    own = min(clearance_m, robot_clearance_m - geometry.resolution_m)
+    tiers = tuple(c for c in (clearance_m, own) if c > 0.0) + (0.0,)
     if inside.any():
         for clr in tiers:
             i = farthest_visible_index(grid, geometry, robot_xy_m, pts, inside, clr)
@@ -298,7 +331,9 @@ def select_lookahead(
     # farthest_visible_index scans from the back, so reversing tries the nearest point first.
     near = np.ascontiguousarray(pts[order[::-1]])
     for clr in tiers:
-        j = farthest_visible_index(grid, geometry, robot_xy_m, near, np.ones(len(near), dtype=bool), clr)
+        j = farthest_visible_index(
+            grid, geometry, robot_xy_m, near, np.ones(len(near), dtype=bool), clr
+        )
         if j >= 0:
             return start + int(order[::-1][j]), True
     return start + int(order[0]), False
@@ -347,23 +382,46 @@ def potential_field_command(
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(yaw)):
         raise ValueError(f"pose must be finite, got {pose!r}")
 
-    angles = beam_angles_rad(len(scan))
-    ok = valid_beams(scan, limits.max_range_m)
-    l_min = float(scan[ok].min()) if ok.any() else math.inf
+    n = len(scan)
+    angles = beam_angles_rad(n)
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    l_min = float(_min_valid(scan, limits.max_range_m))
     lookahead = min(max(p.f_l * l_min, p.min_lookahead_m), p.max_lookahead_m)
     gi, visible = select_lookahead(
-        path, (x, y), lookahead, grid, geometry, start_index, p.lookahead_clearance_m
+        path, (x, y), lookahead, grid, geometry, start_index, p.lookahead_clearance_m, l_min
     )
     gx, gy = float(path[gi, 0]), float(path[gi, 1])
     goal_angle = _wrap(math.atan2(gy - y, gx - x) - yaw)
     if math.hypot(gx - x, gy - y) < 1e-6:
         goal_angle = 0.0
-    fx, fy = field_force(scan, angles, goal_angle, p, limits.max_range_m, repulsion_scale)
-
-    near = nearby_obstacle_points(grid, geometry, (x, y, yaw), p.map_guard_radius_m) if p.map_guard_radius_m > 0 else None
-    v, omega, front = force_to_velocity(fx, fy, scan, angles, limits, p, near)
+    f_o = p.f_o * p.reference_n_beams / n * repulsion_scale
+    fx, fy = _force(scan, cos_a, sin_a, limits.max_range_m, goal_angle, p.f_g, f_o)
+    px, py = _scan_points(scan, cos_a, sin_a, limits.max_range_m)
+    if p.map_guard_radius_m > 0:
+        mx, my = _map_points(
+            grid,
+            geometry.origin_x_m,
+            geometry.origin_y_m,
+            geometry.resolution_m,
+            x,
+            y,
+            yaw,
+            p.map_guard_radius_m,
+        )
+        if len(mx):
+            px = np.concatenate((px, mx))
+            py = np.concatenate((py, my))
+    v, omega, front = _to_velocity(fx, fy, px, py, *_guard_args(limits, p))
     return PotentialFieldCommand(
-        v, omega, (gx, gy), int(gi), bool(visible), (fx, fy), l_min, lookahead, front
+        float(v),
+        float(omega),
+        (gx, gy),
+        int(gi),
+        bool(visible),
+        (float(fx), float(fy)),
+        l_min,
+        lookahead,
+        float(front),
     )
 
 
@@ -384,26 +442,170 @@ def force_to_velocity(
     Returns:
         ``(v_mps, omega_radps, front_free_m)``.
     """
-    phi = math.atan2(fy, fx) if (fx != 0.0 or fy != 0.0) else 0.0
-    omega = max(
-        -limits.max_angular_speed_radps,
-        min(limits.max_angular_speed_radps, params.heading_gain_per_s * phi),
+    pts = obstacle_points(scan, angles, limits.max_range_m, extra_points_xy)
+    v, omega, front = _to_velocity(
+        float(fx),
+        float(fy),
+        np.ascontiguousarray(pts[:, 0]),
+        np.ascontiguousarray(pts[:, 1]),
+        *_guard_args(limits, params),
     )
-    if abs(phi) > params.turn_in_place_rad:
-        v = 0.0
-    else:
-        v = limits.max_linear_speed_mps * max(0.0, math.cos(phi))
-    front = front_free_distance(
-        scan,
-        angles,
-        limits.max_range_m,
+    return float(v), float(omega), float(front)
+
+
+def _guard_args(limits: RobotLimits, params: PotentialFieldParams) -> tuple[float, ...]:
+    return (
         limits.radius_m + params.safety_margin_m,
-        contact_half_width_m=limits.radius_m + params.contact_margin_m,
-        extra_points_xy=extra_points_xy,
+        limits.radius_m + params.contact_margin_m,
+        params.guard_steer_max_rad,
+        params.guard_steer_step_rad,
+        max(params.guard_steer_min_free_m, limits.max_linear_speed_mps * params.braking_time_s),
+        params.turn_in_place_rad,
+        params.heading_gain_per_s,
+        limits.max_linear_speed_mps,
+        limits.max_angular_speed_radps,
+        params.braking_time_s,
     )
-    v = min(v, front / params.braking_time_s)
-    return float(v), float(omega), front
 
 
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+# --- numba kernels ----------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _force(scan, cos_a, sin_a, max_range, goal_angle, f_g, f_o):  # pragma: no cover - numba
+    sx = 0.0
+    sy = 0.0
+    for i in range(scan.shape[0]):
+        r = scan[i]
+        if r > 0.0 and r < max_range:
+            sx += cos_a[i] / r
+            sy += sin_a[i] / r
+    return f_g * math.cos(goal_angle) - f_o * sx, f_g * math.sin(goal_angle) - f_o * sy
+
+
+@njit(cache=True)
+def _free_along(px, py, heading, soft, hard):  # pragma: no cover - numba
+    # See free_distance_along; hard < 0 means no contact rule.
+    c = math.cos(heading)
+    s = math.sin(heading)
+    best = math.inf
+    soft2 = soft * soft
+    hard2 = hard * hard
+    for i in range(px.shape[0]):
+        x = c * px[i] + s * py[i]
+        if x <= 0.0:
+            continue
+        y = -s * px[i] + c * py[i]
+        ay = abs(y)
+        if ay >= soft:
+            continue
+        free = x - math.sqrt(soft2 - y * y)
+        if free < 0.0 and hard >= 0.0:
+            if ay >= hard:
+                continue
+            free = x - math.sqrt(max(hard2 - y * y, 0.0))
+        if free < best:
+            best = free
+    return max(best, 0.0)
+
+
+@njit(cache=True)
+def _to_velocity(
+    fx,
+    fy,
+    px,
+    py,
+    soft,
+    hard,
+    steer_max,
+    steer_step,
+    need,
+    turn_in_place,
+    gain,
+    vmax,
+    wmax,
+    braking,
+):  # pragma: no cover - numba
+    phi = math.atan2(fy, fx) if (fx != 0.0 or fy != 0.0) else 0.0
+    front = _free_along(px, py, 0.0, soft, hard)
+    if steer_max > 0.0 and abs(phi) <= turn_in_place:
+        # Guard steering: the way along F is blocked within the braking distance: aim at the
+        # nearest open heading, alternating sides.
+        if _free_along(px, py, phi, soft, hard) < need:
+            n = int(steer_max / steer_step + 1e-9)
+            found = False
+            for k in range(1, n + 1):
+                for sign in (1.0, -1.0):
+                    cand = phi + sign * k * steer_step
+                    if _free_along(px, py, cand, soft, hard) >= need:
+                        phi = cand
+                        found = True
+                        break
+                if found:
+                    break
+    omega = max(-wmax, min(wmax, gain * phi))
+    if abs(phi) > turn_in_place:
+        v = 0.0
+    else:
+        v = vmax * max(0.0, math.cos(phi))
+    v = min(v, front / braking)
+    return v, omega, front
+
+
+@njit(cache=True)
+def _min_valid(scan, max_range):  # pragma: no cover - numba
+    best = math.inf
+    for i in range(scan.shape[0]):
+        r = scan[i]
+        if r > 0.0 and r < max_range and r < best:
+            best = r
+    return best
+
+
+@njit(cache=True)
+def _scan_points(scan, cos_a, sin_a, max_range):  # pragma: no cover - numba
+    n = 0
+    for i in range(scan.shape[0]):
+        if scan[i] > 0.0 and scan[i] < max_range:
+            n += 1
+    px = np.empty(n)
+    py = np.empty(n)
+    k = 0
+    for i in range(scan.shape[0]):
+        r = scan[i]
+        if r > 0.0 and r < max_range:
+            px[k] = r * cos_a[i]
+            py[k] = r * sin_a[i]
+            k += 1
+    return px, py
+
+
+@njit(cache=True)
+def _map_points(grid, ox, oy, res, x, y, yaw, radius):  # pragma: no cover - numba
+    h, w = grid.shape
+    r0 = max(int(math.floor((y - radius - oy) / res)), 0)
+    r1 = min(int(math.floor((y + radius - oy) / res)), h - 1)
+    c0 = max(int(math.floor((x - radius - ox) / res)), 0)
+    c1 = min(int(math.floor((x + radius - ox) / res)), w - 1)
+    c = math.cos(yaw)
+    s = math.sin(yaw)
+    cap = max(0, (r1 - r0 + 1) * (c1 - c0 + 1))
+    px = np.empty(cap)
+    py = np.empty(cap)
+    k = 0
+    for r in range(r0, r1 + 1):
+        for cc in range(c0, c1 + 1):
+            if grid[r, cc] != OCCUPIED:
+                continue
+            dx = ox + (cc + 0.5) * res - x
+            dy = oy + (r + 0.5) * res - y
+            if dx * dx + dy * dy > radius * radius:
+                continue
+            px[k] = c * dx + s * dy
+            py[k] = -s * dx + c * dy
+            k += 1
+    return px[:k], py[:k]

@@ -8,8 +8,11 @@ frontier found here; and it stops only when neither source has one.
 A frontier cell is a FREE cell with an UNKNOWN 4-neighbour; frontier cells are grouped
 8-connected and groups smaller than ``min_frontier_cells`` are ignored. The robot may use FREE
 cells at least ``clearance_m`` from every OCCUPIED cell (UNKNOWN cells do not count as
-obstacles, so the free cells beside a frontier stay usable). The goal is the first such cell
-met by an 8-connected BFS from the robot that lies within ``reach_m`` of a kept frontier cell.
+obstacles, so the free cells beside a frontier stay usable). The goal is the nearest (by path
+cost) usable cell within ``reach_m`` of a kept frontier cell, found by an 8-connected Dijkstra
+search from the robot. A step costs its length times ``1 + wall_cost * max(0, 1 - d / d_pref)``
+with ``d`` the cell's distance to the nearest wall and ``d_pref = clearance_m + prefer_extra_m``,
+so paths keep to the middle of corridors instead of hugging the usable region's edge.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, vali
 
 @dataclass(frozen=True)
 class ReachableFrontier:
-    """The BFS-nearest reachable frontier.
+    """The nearest reachable frontier (by the search's path cost).
 
     Attributes:
         goal_xy_m: Centre of the goal cell (a usable cell within ``reach_m`` of the frontier).
@@ -54,9 +57,18 @@ def clearance_field_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
     return ndimage.distance_transform_edt(~occupied) * float(resolution_m)
 
 
-def frontier_groups(grid: np.ndarray, min_frontier_cells: int) -> tuple[np.ndarray, int]:
-    """Label 8-connected groups of frontier cells (FREE with an UNKNOWN 4-neighbour) of at least
-    ``min_frontier_cells`` cells. Returns ``(labels, n)``; label 0 is "not a kept frontier"."""
+def frontier_groups(
+    grid: np.ndarray, min_frontier_cells: int, min_unknown_depth_cells: float = 0.0
+) -> tuple[np.ndarray, int]:
+    """Label 8-connected groups of frontier cells (FREE with an UNKNOWN 4-neighbour).
+
+    A group is kept when it has at least ``min_frontier_cells`` cells and, with
+    ``min_unknown_depth_cells > 0``, when unknown space at least that deep lies next to it: an
+    UNKNOWN cell at least ``min_unknown_depth_cells`` from every known cell, within
+    ``min_unknown_depth_cells + 2`` cells of the group. This rejects unknown slivers no scan can
+    ever fill: the inside of thick walls seen through gaps in their mapped faces, pockets along
+    walls. Returns ``(labels, n)``; label 0 is "not a kept frontier".
+    """
     free = grid == FREE
     unknown = grid == UNKNOWN
     near_unknown = np.zeros_like(free)
@@ -70,6 +82,21 @@ def frontier_groups(grid: np.ndarray, min_frontier_cells: int) -> tuple[np.ndarr
         return labels, 0
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     keep = sizes >= max(1, int(min_frontier_cells))
+    if min_unknown_depth_cells > 0 and keep[1:].any():
+        # Depth of unknown cells: distance to the nearest known cell. The grid is padded with
+        # unknown so that unknown space running off the map counts as deep.
+        pad = int(math.ceil(min_unknown_depth_cells)) + 2
+        padded = np.pad(unknown, pad, constant_values=True)
+        deep = ndimage.distance_transform_edt(padded) >= min_unknown_depth_cells
+        if deep.any():
+            near_deep = (ndimage.distance_transform_edt(~deep) <= min_unknown_depth_cells + 2.0)[
+                pad:-pad, pad:-pad
+            ]
+            ok = np.zeros(n + 1, dtype=bool)
+            ok[np.unique(labels[cells & near_deep])] = True
+            keep &= ok
+        else:
+            keep[:] = False
     keep[0] = False
     remap = np.zeros(n + 1, dtype=labels.dtype)
     remap[keep] = np.arange(1, int(keep.sum()) + 1)
@@ -83,11 +110,14 @@ def nearest_reachable_frontier(
     clearance_m: float,
     min_frontier_cells: int = 3,
     reach_m: float = 0.3,
+    min_unknown_depth_cells: float = 0.0,
     excluded_xy_m: Sequence[tuple[float, float]] = (),
     excluded_radius_m: float = 0.5,
     clearance_field: np.ndarray | None = None,
+    wall_cost: float = 4.0,
+    prefer_extra_m: float = 0.15,
 ) -> ReachableFrontier | None:
-    """BFS from the robot to the nearest usable cell next to a frontier.
+    """Search from the robot to the nearest usable cell next to a frontier.
 
     Args:
         grid: Encoded occupancy grid (uint8).
@@ -96,11 +126,15 @@ def nearest_reachable_frontier(
             search starts from the nearest usable cell within 0.5 m.
         clearance_m: Minimum distance from usable cells to OCCUPIED cells.
         min_frontier_cells: Smaller frontier groups are ignored.
+        min_unknown_depth_cells: Frontier groups without unknown space this deep (in cells)
+            next to them are ignored (see :func:`frontier_groups`).
         reach_m: A goal cell lies within this distance of a frontier cell.
         excluded_xy_m: Frontier cells within ``excluded_radius_m`` of these points are ignored
             (the expert's blacklist).
         excluded_radius_m: See ``excluded_xy_m``.
         clearance_field: A precomputed :func:`clearance_field_m` of ``grid`` (optional).
+        wall_cost: Extra step cost near walls (see the module docstring); 0 gives shortest paths.
+        prefer_extra_m: Cells farther than ``clearance_m + prefer_extra_m`` from walls cost no extra.
 
     Returns:
         The :class:`ReachableFrontier`, or None when no frontier can be reached.
@@ -119,7 +153,7 @@ def nearest_reachable_frontier(
         if not (math.isfinite(value) and value >= 0.0):
             raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     res = geometry.resolution_m
-    labels, n = frontier_groups(g, min_frontier_cells)
+    labels, n = frontier_groups(g, min_frontier_cells, min_unknown_depth_cells)
     if n == 0:
         return None
     if len(excluded_xy_m):
@@ -133,13 +167,11 @@ def nearest_reachable_frontier(
             return None
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
     usable = (g == FREE) & (dist >= clearance_m - 1e-9)
-    if reach_m > 0:
-        near = ndimage.distance_transform_edt(labels == 0) * res <= reach_m + 1e-9
-    else:
-        near = labels > 0
+    near = _dilate(labels > 0, reach_m / res) if reach_m > 0 else labels > 0
     goal_mask = usable & near
 
-    path = _search_path(g, geometry, usable, goal_mask, start_xy_m)
+    cost = _step_cost(dist, usable, clearance_m, wall_cost, prefer_extra_m)
+    path = _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
     if path is None:
         return None
     gr, gc = (int(v) for v in geometry.world_to_grid(path[-1, 0], path[-1, 1]))
@@ -167,8 +199,10 @@ def grid_path_to(
     clearance_m: float,
     goal_radius_m: float = 0.15,
     clearance_field: np.ndarray | None = None,
+    wall_cost: float = 4.0,
+    prefer_extra_m: float = 0.15,
 ) -> np.ndarray | None:
-    """BFS path over usable cells (see the module docstring) from ``start_xy_m`` to a usable cell
+    """Path over usable cells (see the module docstring) from ``start_xy_m`` to a usable cell
     within ``goal_radius_m`` of ``goal_xy_m``; ``(K, 2)`` world polyline, or None if unreachable."""
     g = validate_encoded_grid(grid)
     if g.shape != geometry.shape:
@@ -192,13 +226,40 @@ def grid_path_to(
     goal_mask &= usable
     if not goal_mask.any():
         return None
-    return _search_path(g, geometry, usable, goal_mask, start_xy_m)
+    cost = _step_cost(dist, usable, clearance_m, wall_cost, prefer_extra_m)
+    return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
+
+
+def _step_cost(
+    dist: np.ndarray,
+    usable: np.ndarray,
+    clearance_m: float,
+    wall_cost: float,
+    prefer_extra_m: float,
+) -> np.ndarray:
+    if not (
+        math.isfinite(wall_cost)
+        and wall_cost >= 0.0
+        and math.isfinite(prefer_extra_m)
+        and prefer_extra_m >= 0.0
+    ):
+        raise ValueError(
+            f"wall_cost and prefer_extra_m must be finite and >= 0, got {wall_cost!r}, {prefer_extra_m!r}"
+        )
+    pref = clearance_m + prefer_extra_m
+    if pref > 0.0 and wall_cost > 0.0:
+        penalty = np.clip(1.0 - np.minimum(dist, 1e9) / pref, 0.0, 1.0)
+        cost = 1.0 + wall_cost * penalty
+    else:
+        cost = np.ones(dist.shape)
+    return np.where(usable, cost, np.inf)
 
 
 def _search_path(
     g: np.ndarray,
     geometry: GridGeometry,
     usable: np.ndarray,
+    cost: np.ndarray,
     goal_mask: np.ndarray,
     start_xy_m: tuple[float, float],
 ) -> np.ndarray | None:
@@ -213,7 +274,7 @@ def _search_path(
         if found[0] < 0:
             return None
         sr, sc = found
-    goal, parent = _bfs(usable, goal_mask, sr, sc)
+    goal, parent = _dijkstra(cost, goal_mask, sr, sc)
     if goal < 0:
         return None
     cells = []
@@ -228,20 +289,49 @@ def _search_path(
 
 
 @njit(cache=True)
-def _bfs(usable, goal_mask, sr, sc):  # pragma: no cover - numba
-    h, w = usable.shape
-    parent = np.full(h * w, -2, dtype=np.int64)
-    queue = np.empty(h * w, dtype=np.int64)
+def _dijkstra(cost, goal_mask, sr, sc):  # pragma: no cover - numba
+    # 8-connected Dijkstra on cell costs (inf = blocked); stops at the first goal cell settled.
+    h, w = cost.shape
+    n = h * w
+    dist = np.full(n, np.inf)
+    parent = np.full(n, -2, dtype=np.int64)
+    done = np.zeros(n, dtype=np.bool_)
+    heap_k = np.empty(n // 4 + 16, dtype=np.float64)
+    heap_v = np.empty(n // 4 + 16, dtype=np.int64)
     start = sr * w + sc
+    dist[start] = 0.0
     parent[start] = -1
-    queue[0] = start
-    head = 0
-    tail = 1
+    heap_k[0] = 0.0
+    heap_v[0] = start
+    size = 1
     drs = (-1, 1, 0, 0, -1, -1, 1, 1)
     dcs = (0, 0, -1, 1, -1, 1, -1, 1)
-    while head < tail:
-        k = queue[head]
-        head += 1
+    diag = math.sqrt(2.0)
+    while size > 0:
+        d = heap_k[0]
+        k = heap_v[0]
+        size -= 1
+        if size > 0:
+            # Pop: move the last item to the root and sift down.
+            lk = heap_k[size]
+            lv = heap_v[size]
+            i = 0
+            while True:
+                j = 2 * i + 1
+                if j >= size:
+                    break
+                if j + 1 < size and heap_k[j + 1] < heap_k[j]:
+                    j += 1
+                if heap_k[j] >= lk:
+                    break
+                heap_k[i] = heap_k[j]
+                heap_v[i] = heap_v[j]
+                i = j
+            heap_k[i] = lk
+            heap_v[i] = lv
+        if done[k]:
+            continue
+        done[k] = True
         r = k // w
         c = k % w
         if goal_mask[r, c]:
@@ -249,18 +339,65 @@ def _bfs(usable, goal_mask, sr, sc):  # pragma: no cover - numba
         for m in range(8):
             rr = r + drs[m]
             cc = c + dcs[m]
-            if rr < 0 or rr >= h or cc < 0 or cc >= w or not usable[rr, cc]:
+            if rr < 0 or rr >= h or cc < 0 or cc >= w:
                 continue
-            # No cutting corners between two unusable cells.
-            if m >= 4 and not (usable[r, cc] and usable[rr, c]):
+            cn = cost[rr, cc]
+            if not math.isfinite(cn):
                 continue
+            step = 1.0
+            if m >= 4:
+                # No cutting corners between two blocked cells.
+                if not (math.isfinite(cost[r, cc]) and math.isfinite(cost[rr, c])):
+                    continue
+                step = diag
             kk = rr * w + cc
-            if parent[kk] != -2:
-                continue
-            parent[kk] = k
-            queue[tail] = kk
-            tail += 1
+            nd = d + step * 0.5 * (cost[r, c] + cn)
+            if nd < dist[kk]:
+                dist[kk] = nd
+                parent[kk] = k
+                # Push (growing the heap when full) and sift up.
+                if size == len(heap_k):
+                    grown_k = np.empty(2 * size, dtype=np.float64)
+                    grown_v = np.empty(2 * size, dtype=np.int64)
+                    grown_k[:size] = heap_k
+                    grown_v[:size] = heap_v
+                    heap_k = grown_k
+                    heap_v = grown_v
+                i = size
+                size += 1
+                while i > 0:
+                    p = (i - 1) // 2
+                    if heap_k[p] <= nd:
+                        break
+                    heap_k[i] = heap_k[p]
+                    heap_v[i] = heap_v[p]
+                    i = p
+                heap_k[i] = nd
+                heap_v[i] = kk
     return -1, parent
+
+
+@njit(cache=True)
+def _dilate(mask, radius_cells):  # pragma: no cover - numba
+    # Cells whose centre is within radius_cells of a True cell's centre.
+    h, w = mask.shape
+    out = mask.copy()
+    k = int(math.floor(radius_cells + 1e-9))
+    r2 = radius_cells * radius_cells + 1e-9
+    for r in range(h):
+        for c in range(w):
+            if not mask[r, c]:
+                continue
+            for dr in range(-k, k + 1):
+                rr = r + dr
+                if rr < 0 or rr >= h:
+                    continue
+                for dc in range(-k, k + 1):
+                    cc = c + dc
+                    if cc < 0 or cc >= w or dr * dr + dc * dc > r2:
+                        continue
+                    out[rr, cc] = True
+    return out
 
 
 @njit(cache=True)

@@ -125,10 +125,15 @@ def test_collision_guard_stops_before_a_wall_ahead():
     assert free == pytest.approx(0.2 - 0.145, abs=1e-9)
     grid, geom = open_grid()
     path = resample_polyline([[0.0, 0.0], [2.0, 0.0]], 0.05)
-    p = PotentialFieldParams(f_o=0.0)  # no repulsion: only the guard slows the robot
+    # No repulsion and no guard steering: only the guard slows the robot.
+    p = PotentialFieldParams(f_o=0.0, guard_steer_max_rad=0.0)
     cmd = potential_field_command(scan, (0.0, 0.0, 0.0), path, grid, geom, LIMITS, p)
-    assert cmd.v_mps == pytest.approx(0.055 / 0.6)
-    touching = wall_scan(360, [(0.0, 0.14)])
+    assert cmd.v_mps == pytest.approx(0.055 / 0.6) and cmd.omega_radps == 0.0
+    # Inside the safety margin the robot may at most creep up to the contact margin (0.13 m).
+    near = wall_scan(360, [(0.0, 0.14)])
+    v_near = potential_field_command(near, (0.0, 0.0, 0.0), path, grid, geom, LIMITS, p).v_mps
+    assert 0.0 <= v_near <= 0.01 / 0.6 + 1e-12
+    touching = wall_scan(360, [(0.0, 0.13)])
     assert (
         potential_field_command(touching, (0.0, 0.0, 0.0), path, grid, geom, LIMITS, p).v_mps == 0.0
     )
@@ -136,6 +141,73 @@ def test_collision_guard_stops_before_a_wall_ahead():
     assert (
         front_free_distance(scan, beam_angles_rad(360), MAX_RANGE, 0.145, backwards=True)
         == math.inf
+    )
+
+
+def test_wall_end_beside_the_robot_is_passed_not_hit():
+    angles = beam_angles_rad(360)
+    # A single obstacle point (a wall end) beside the robot, 0.14 m to the left and 0.025 m
+    # ahead: inside the safety margin (0.145) but clear of contact (0.13): it may drive past.
+    scan = np.full(360, MAX_RANGE)
+    scan[80] = 0.14 / math.sin(math.radians(80))
+    assert (
+        front_free_distance(scan, angles, MAX_RANGE, 0.145, contact_half_width_m=0.13) == math.inf
+    )
+    assert front_free_distance(scan, angles, MAX_RANGE, 0.145) == 0.0
+    # Farther ahead, 0.11 m to the side: the guard stops the robot where the point would enter
+    # the safety margin.
+    scan[:] = MAX_RANGE
+    scan[38] = math.hypot(0.14, 0.11)
+    free = front_free_distance(scan, angles, MAX_RANGE, 0.145, contact_half_width_m=0.13)
+    x, y = scan[38] * math.cos(math.radians(38)), scan[38] * math.sin(math.radians(38))
+    assert free == pytest.approx(x - math.sqrt(0.145**2 - y**2))
+    # Already inside the margin and 0.12 m to the side (< 0.13): it would touch, no travel.
+    scan[:] = MAX_RANGE
+    scan[70] = 0.12 / math.sin(math.radians(70))
+    assert front_free_distance(scan, angles, MAX_RANGE, 0.145, contact_half_width_m=0.13) == 0.0
+
+
+def test_guard_steering_turns_away_from_a_blocking_wall_end():
+    grid, geom = open_grid()
+    path = resample_polyline([[0.0, 0.0], [2.0, 0.0]], 0.05)
+    scan = np.full(360, MAX_RANGE)
+    scan[20] = math.hypot(0.2, 0.07)  # a point 0.2 m ahead, 0.07 m to the left
+    p = PotentialFieldParams(f_o=0.0)
+    cmd = potential_field_command(scan, (0.0, 0.0, 0.0), path, grid, geom, LIMITS, p)
+    assert cmd.omega_radps < 0.0  # turns right, away from the point
+    stuck = potential_field_command(
+        scan,
+        (0.0, 0.0, 0.0),
+        path,
+        grid,
+        geom,
+        LIMITS,
+        PotentialFieldParams(f_o=0.0, guard_steer_max_rad=0.0),
+    )
+    assert stuck.omega_radps == 0.0
+
+
+def test_mapped_walls_inside_the_lidar_minimum_range_stop_the_robot():
+    # The LiDAR reads nothing (the wall is inside its 0.12 m minimum range), the map shows it.
+    grid, geom = open_grid()
+    grid = grid.copy()
+    row, col = geom.world_to_grid(0.12, 0.0)
+    grid[int(row) - 2 : int(row) + 3, int(col)] = 0
+    path = resample_polyline([[0.0, 0.0], [1.0, 0.0]], 0.05)
+    blind = np.zeros(360)
+    cmd = potential_field_command(
+        blind,
+        (0.0, 0.0, 0.0),
+        path,
+        grid,
+        geom,
+        LIMITS,
+        PotentialFieldParams(guard_steer_max_rad=0.0),
+    )
+    assert cmd.v_mps == 0.0
+    off = PotentialFieldParams(guard_steer_max_rad=0.0, map_guard_radius_m=0.0)
+    assert (
+        potential_field_command(blind, (0.0, 0.0, 0.0), path, grid, geom, LIMITS, off).v_mps > 0.2
     )
 
 

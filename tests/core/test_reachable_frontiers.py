@@ -103,3 +103,37 @@ def test_start_next_to_a_wall_and_validation():
         nearest_reachable_frontier(grid, geom, (0.25, 0.35), clearance_m=-0.1)
     with pytest.raises(ValueError, match="shape"):
         nearest_reachable_frontier(grid, GridGeometry(0.1, 0.0, 0.0, 3, 3), (0.25, 0.35), 0.2)
+
+
+POCKET = """
+##############
+#............#
+#............#
+#..###.###...#
+#..#?????#...#
+#..#######...#
+#............#
+##############
+"""
+
+
+def test_thin_unknown_pockets_can_be_ignored():
+    grid = parse_ascii_grid(POCKET)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    # The only frontier cell is the gap in the pocket's top wall; the pocket is one cell thick.
+    labels, n = frontier_groups(grid, 1)
+    assert n == 1 and labels[4, 6] > 0
+    assert frontier_groups(grid, 1, min_unknown_depth_cells=1.0)[1] == 1
+    assert frontier_groups(grid, 1, min_unknown_depth_cells=1.5)[1] == 0
+    # Unknown space running off the grid's edge is deep.
+    edge = grid.copy()
+    edge[3, 0] = 128
+    labels, n = frontier_groups(edge, 1, min_unknown_depth_cells=4.0)
+    assert n == 1 and labels[3, 1] > 0
+    assert (
+        nearest_reachable_frontier(
+            grid, geom, (0.25, 0.25), 0.05, 1, 0.2, min_unknown_depth_cells=2.0
+        )
+        is None
+    )
+    assert nearest_reachable_frontier(grid, geom, (0.25, 0.25), 0.05, 1, 0.2) is not None

@@ -241,3 +241,71 @@ def test_area_type_raster_maps_ids_to_types():
     r = area_type_raster(tm)
     assert (r[tm.area_ids == 0] == int(AreaType.FRONTIER_PATHWAY)).all()
     assert (r[tm.area_ids < 0] == -1).all()
+
+
+# --- whole missions in the env -------------------------------------------------------------------
+
+
+def _mission(world: str, seed: int = 0, max_time_s: float = 1200.0):
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401
+    from policies.rollout import run_mission
+
+    env = gym.make("SemanticExplore-v0", world=world)
+    try:
+        # ignore_terminated: the env stops at 99 % coverage; the expert must stop by itself.
+        return run_mission(
+            env,
+            SemanticExpertPolicy(),
+            seed=seed,
+            max_time_s=max_time_s,
+            progress=False,
+            ignore_terminated=True,
+        )
+    finally:
+        env.close()
+
+
+def _check_mission(res) -> None:
+    assert res.self_stopped, (
+        f"{res.world}: did not stop by itself ({res.stop_reason}, coverage {res.coverage:.3f})"
+    )
+    assert res.stop_reason.startswith("no frontier left")
+    assert res.coverage >= 0.97, f"{res.world}: coverage {res.coverage:.3f}"
+    assert res.collisions == 0, f"{res.world}: {res.collisions} collisions"
+    assert res.mission_time_s < 1200.0
+
+
+@pytest.mark.parametrize("world", ["maze1", "maze2"])
+def test_expert_explores_the_paper_mazes(world):
+    res = _mission(world)
+    _check_mission(res)
+    # The expert plans with the topometric map for most of the mission.
+    assert res.policy_counters["semantic_plans"] > res.policy_counters["fallback_plans"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "world",
+    [
+        "maze:seed=1",
+        "maze:seed=2",
+        "maze:seed=3,braid=0.3",
+        "office:seed=1,size_m=12",
+        "office:seed=2,size_m=12",
+        "office:seed=2",
+        "cave:seed=1",
+        "cave:seed=2",
+        "cave:seed=3",
+    ],
+)
+def test_expert_explores_procedural_worlds(world):
+    _check_mission(_mission(world))
+
+
+def test_expert_mission_is_deterministic():
+    a = _mission("maze1", seed=4, max_time_s=60.0)
+    b = _mission("maze1", seed=4, max_time_s=60.0)
+    assert a.steps == 300
+    np.testing.assert_array_equal(a.trajectory, b.trajectory)

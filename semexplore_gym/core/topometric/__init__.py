@@ -2,6 +2,22 @@
 
 from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.topometric.segmentation import segment_map
-from semexplore_gym.core.topometric.types import Area, AreaType, Frontier, GraphEdge, Opening, TopometricMap
+from semexplore_gym.core.topometric.types import (
+    Area,
+    AreaType,
+    Frontier,
+    GraphEdge,
+    Opening,
+    TopometricMap,
+)
 
-__all__ = ["Area", "AreaType", "Frontier", "GraphEdge", "Opening", "SegmentationParams", "TopometricMap", "segment_map"]
+__all__ = [
+    "Area",
+    "AreaType",
+    "Frontier",
+    "GraphEdge",
+    "Opening",
+    "SegmentationParams",
+    "TopometricMap",
+    "segment_map",
+]

@@ -20,7 +20,7 @@ OCCUPIED_V = 0
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scan_grid(enc: np.ndarray) -> tuple[int, int, int, int, int]:
     """One pass: index of the first value outside the encoding (-1 if none) and the free bbox.
 
@@ -50,7 +50,7 @@ def scan_grid(enc: np.ndarray) -> tuple[int, int, int, int, int]:
     return -1, rmin, rmax, cmin, cmax
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _flood_blob(work, state, stack, blob, start, value, max_cells):
     """Collect the 8-connected blob of ``value`` at ``start``; returns its size or -1 if too big."""
     H, W = work.shape
@@ -91,63 +91,125 @@ def _flood_blob(work, state, stack, blob, start, value, max_cells):
     return n_blob
 
 
-@njit(cache=True)
-def filter_small_blobs(work: np.ndarray, max_speck_cells: int, max_hole_cells: int) -> int:
+@njit(cache=True, error_model="numpy")
+def _try_blob(work, state, stack, blob, j, max_speck_cells, max_hole_cells) -> int:
+    """Examine the blob at non-free cell ``j`` (next to free space); rewrite it if it is small."""
+    H, W = work.shape
+    wf = work.ravel()
+    v = wf[j]
+    limit = max_speck_cells if v == OCCUPIED_V else max_hole_cells
+    if limit <= 0:
+        state[j] = 1
+        return 0
+    n_blob = _flood_blob(work, state, stack, blob, j, v, limit)
+    if n_blob < 0:
+        return 0
+    all_free = True
+    for t in range(n_blob):
+        q = blob[t]
+        qr = q // W
+        qc = q - qr * W
+        for er in range(-1, 2):
+            for ec in range(-1, 2):
+                if state[q + er * W + ec] != 2 and work[qr + er, qc + ec] != FREE_V:
+                    all_free = False
+    new_v = -1
+    if all_free:
+        new_v = FREE_V
+    elif v == UNKNOWN_V:
+        new_v = OCCUPIED_V
+    changed = 0
+    for t in range(n_blob):
+        q = blob[t]
+        state[q] = 1
+        if new_v >= 0:
+            wf[q] = new_v
+            changed += 1
+    return changed
+
+
+@njit(cache=True, error_model="numpy")
+def filter_small_blobs(
+    work: np.ndarray, max_speck_cells: int, max_hole_cells: int
+) -> tuple[int, np.ndarray]:
     """Erase occupied specks and close unknown holes next to free cells, in place.
 
     An 8-connected OCCUPIED blob of at most ``max_speck_cells`` not touching the array edge whose
     neighbours are all FREE becomes FREE. An UNKNOWN blob of at most ``max_hole_cells`` not
-    touching the edge becomes FREE when its neighbours are all FREE, OCCUPIED otherwise.
-    Returns the number of cells changed.
+    touching the edge becomes FREE when its neighbours are all FREE, OCCUPIED otherwise. Blobs
+    are found from their cells that are 4-adjacent to a free cell.
+
+    Returns the number of cells changed and the free cells that had an UNKNOWN 4-neighbour
+    before filtering (frontier candidates, to be re-checked).
     """
     H, W = work.shape
-    if max_speck_cells <= 0 and max_hole_cells <= 0:
-        return 0
     state = np.zeros(H * W, np.uint8)  # 1 = big/edge blob or handled, 2 = current blob
-    mx = max(max_speck_cells, max_hole_cells)
+    mx = max(max_speck_cells, max_hole_cells, 1)
     stack = np.empty(8 * (mx + 2), np.int64)
     blob = np.empty(mx + 1, np.int64)
     changed = 0
     wf = work.ravel()
+    flag = np.empty(W, np.uint8)
+    fcand = np.empty(1024, np.int64)
+    n_f = 0
     for r in range(1, H - 1):
+        base = r * W
+        # stage 1 (branch-free, vectorisable): where does free-ness change to the right or above?
+        for c in range(W - 1):
+            i = base + c
+            xf = wf[i] == FREE_V
+            flag[c] = (xf != (wf[i + 1] == FREE_V)) | (xf != (wf[i + W] == FREE_V))
         for c in range(1, W - 1):
-            if work[r, c] != FREE_V:
+            if not flag[c]:
                 continue
-            i = r * W + c
-            for dr in range(-1, 2):
-                for dc in range(-1, 2):
-                    j = i + dr * W + dc
-                    v = wf[j]
-                    if v == FREE_V or state[j] != 0:
+            i = base + c
+            x = wf[i]
+            xf = x == FREE_V
+            for t in range(3):
+                if t == 0:
+                    if xf:
                         continue
-                    limit = max_speck_cells if v == OCCUPIED_V else max_hole_cells
-                    if limit <= 0:
-                        state[j] = 1
+                    j = i
+                    nb = wf[i + 1] if wf[i + 1] == FREE_V else wf[i + W]
+                elif t == 1:
+                    if xf == (wf[i + 1] == FREE_V):
                         continue
-                    n_blob = _flood_blob(work, state, stack, blob, j, v, limit)
-                    if n_blob < 0:
+                    j = i + 1 if xf else i
+                    nb = wf[i + 1]
+                else:
+                    if xf == (wf[i + W] == FREE_V):
                         continue
-                    all_free = True
-                    for t in range(n_blob):
-                        q = blob[t]
-                        qr = q // W
-                        qc = q - qr * W
-                        for er in range(-1, 2):
-                            for ec in range(-1, 2):
-                                if state[q + er * W + ec] != 2 and work[qr + er, qc + ec] != FREE_V:
-                                    all_free = False
-                    new_v = -1
-                    if all_free:
-                        new_v = FREE_V
-                    elif v == UNKNOWN_V:
-                        new_v = OCCUPIED_V
-                    for t in range(n_blob):
-                        q = blob[t]
-                        state[q] = 1
-                        if new_v >= 0:
-                            wf[q] = new_v
-                            changed += 1
-    return changed
+                    j = i + W if xf else i
+                    nb = wf[i + W]
+                # frontier candidate: the free cell of a free/unknown pair
+                if t > 0 and (x == UNKNOWN_V or nb == UNKNOWN_V):
+                    fc = i if xf else (i + 1 if t == 1 else i + W)
+                    if n_f >= fcand.size:
+                        grown = np.empty(2 * fcand.size, np.int64)
+                        grown[:n_f] = fcand[:n_f]
+                        fcand = grown
+                    fcand[n_f] = fc
+                    n_f += 1
+                if t > 0 and not xf:
+                    continue  # the non-free cell of this pair is i itself, handled by t == 0
+                if state[j] != 0:
+                    continue
+                if wf[j] == OCCUPIED_V:
+                    if max_speck_cells <= 0:
+                        continue
+                    # a speck of at most k cells leaves each of its cells >= 9 - k free neighbours
+                    nf = 0
+                    for dr in range(-1, 2):
+                        for dc in range(-1, 2):
+                            if wf[j + dr * W + dc] == FREE_V:
+                                nf += 1
+                    if nf < 9 - max_speck_cells:
+                        state[j] = 1  # then no blob through j is small enough
+                        continue
+                elif max_hole_cells <= 0:
+                    continue
+                changed += _try_blob(work, state, stack, blob, j, max_speck_cells, max_hole_cells)
+    return changed, np.unique(fcand[:n_f])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -155,9 +217,12 @@ def filter_small_blobs(work: np.ndarray, max_speck_cells: int, max_hole_cells: i
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
-def _fh_run(grow, a, b, f, v, z, drow, crow, min_clear_cells):
-    """Lower envelope of parabolas over the free run [a, b) of one row (blocked at a-1 and b)."""
+@njit(cache=True, error_model="numpy")
+def _fh_run(grow, a, b, f, v, z, crow, min_clear_cells, base, clist, n_c):
+    """Lower envelope of parabolas over the free run [a, b) of one row (blocked at a-1 and b).
+
+    Reads the column distances of the run from ``grow`` and overwrites them with the clearance.
+    """
     n = b - a + 2  # positions 0..n-1 are columns a-1..b
     f[0] = 0.0
     f[n - 1] = 0.0
@@ -186,53 +251,84 @@ def _fh_run(grow, a, b, f, v, z, drow, crow, min_clear_cells):
             k += 1
         p = v[k]
         d = np.sqrt((q - p) * (q - p) + f[p]) - 0.5
-        drow[a + q - 1] = d
+        grow[a + q - 1] = d
         if d >= min_clear_cells:
             crow[a + q - 1] = 1
+            clist[n_c] = base + a + q - 1
+            n_c += 1
+    return n_c
 
 
-@njit(cache=True)
-def clearance_field(free: np.ndarray, min_clear_cells: float) -> tuple[np.ndarray, np.ndarray]:
-    """Exact Euclidean clearance of free cells and the configuration space.
-
-    ``dcell`` is the distance from a cell centre to the nearest non-free cell centre minus half
-    a cell (the distance to that cell's edge; outside the array counts as non-free; 0 on non-free
-    cells). ``cspace`` is ``free & dcell >= min_clear_cells``. The row pass of Felzenszwalb and
-    Huttenlocher's transform runs over free runs only: the blocked cell ending a run is closer
-    than any column beyond it.
-    """
-    H, W = free.shape
-    g = np.empty((H, W), np.int32)
+@njit(cache=True, error_model="numpy")
+def _column_distances(work: np.ndarray) -> np.ndarray:
+    """Per column, cells to the nearest non-free cell (outside the array counts as non-free)."""
+    H, W = work.shape
+    g = np.empty((H, W), np.float32)
     for c in range(W):
-        g[0, c] = 1 if free[0, c] else 0
+        g[0, c] = 1.0 if work[0, c] == FREE_V else 0.0
     for r in range(1, H):
         for c in range(W):
-            g[r, c] = g[r - 1, c] + 1 if free[r, c] else 0
+            g[r, c] = g[r - 1, c] + 1.0 if work[r, c] == FREE_V else 0.0
     for c in range(W):
-        if g[H - 1, c] > 1:
-            g[H - 1, c] = 1
+        if g[H - 1, c] > 1.0:
+            g[H - 1, c] = 1.0
     for r in range(H - 2, -1, -1):
         for c in range(W):
-            up = g[r + 1, c] + 1
+            up = g[r + 1, c] + 1.0
             if up < g[r, c]:
                 g[r, c] = up
-    dcell = np.zeros((H, W), np.float32)
+    return g
+
+
+@njit(cache=True, error_model="numpy")
+def _row_envelopes(
+    work: np.ndarray, g: np.ndarray, min_clear_cells: float
+) -> tuple[np.ndarray, np.ndarray, int]:
+    H, W = work.shape
+    n_free = 0
+    wf = work.ravel()
+    for i in range(H * W):
+        n_free += wf[i] == FREE_V
     cspace = np.zeros((H, W), np.uint8)
+    clist = np.empty(n_free + 1, np.int32)
+    n_c = 0
     f = np.empty(W + 2, np.float64)
     v = np.empty(W + 2, np.int64)
     z = np.empty(W + 3, np.float64)
     for r in range(H):
-        row = free[r]
+        row = work[r]
+        grow = g[r]
         c = 0
         while c < W:
-            if not row[c]:
+            if row[c] != FREE_V:
+                grow[
+                    c
+                ] = -1.0  # no clearance test can accept a blocked cell, even with zero clearance
                 c += 1
                 continue
             a = c
-            while c < W and row[c]:
+            while c < W and row[c] == FREE_V:
                 c += 1
-            _fh_run(g[r], a, c, f, v, z, dcell[r], cspace[r], min_clear_cells)
-    return dcell, cspace
+            n_c = _fh_run(grow, a, c, f, v, z, cspace[r], min_clear_cells, r * W, clist, n_c)
+    return cspace, clist[:n_c], n_free
+
+
+def clearance_field(
+    work: np.ndarray, min_clear_cells: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Exact Euclidean clearance of the free cells of an encoded grid and the configuration space.
+
+    ``dcell`` (float32) is the distance from a cell centre to the nearest non-free cell centre
+    minus half a cell (the distance to that cell's edge; outside the array counts as non-free;
+    -1 on non-free cells). ``cspace`` (uint8) is ``free & dcell >= min_clear_cells``; its cells are
+    also listed (sorted flat indices), with the number of free cells. The row pass
+    of Felzenszwalb and Huttenlocher's transform runs over free runs only: the blocked cell
+    ending a run is closer than any column beyond it. (Two kernels: one kernel holding both
+    passes compiles to a much slower column pass.)
+    """
+    g = _column_distances(work)
+    cspace, clist, n_free = _row_envelopes(work, g, float(min_clear_cells))
+    return g, cspace, clist, n_free
 
 
 # ----------------------------------------------------------------------------------------------
@@ -240,7 +336,7 @@ def clearance_field(free: np.ndarray, min_clear_cells: float) -> tuple[np.ndarra
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _zs_ok(img: np.ndarray, r: int, c: int, sub: int) -> bool:
     p2 = int(img[r - 1, c])
     p3 = int(img[r - 1, c + 1])
@@ -279,7 +375,7 @@ def _zs_ok(img: np.ndarray, r: int, c: int, sub: int) -> bool:
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _mdeg(img: np.ndarray, r: int, c: int) -> int:
     """Degree of a pixel under m-adjacency (diagonals count only without a shared 4-neighbour)."""
     up = img[r + 1, c] != 0
@@ -298,7 +394,7 @@ def _mdeg(img: np.ndarray, r: int, c: int) -> int:
     return n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
     """Remove simple pixels of m-degree >= 3 (junction blobs) in place; returns the kept pixels."""
     H, W = img.shape
@@ -326,7 +422,7 @@ def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _zs_tables() -> np.ndarray:
     """Deletability of a pixel by its 8-neighbour code (bit k = P(k+2), P2 = row-1), per mode.
 
@@ -345,42 +441,39 @@ def _zs_tables() -> np.ndarray:
     return t
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _code(f: np.ndarray, i: int, W: int) -> int:
     return (
-        int(f[i - W])
-        | (int(f[i - W + 1]) << 1)
-        | (int(f[i + 1]) << 2)
-        | (int(f[i + W + 1]) << 3)
-        | (int(f[i + W]) << 4)
-        | (int(f[i + W - 1]) << 5)
-        | (int(f[i - 1]) << 6)
-        | (int(f[i - W - 1]) << 7)
+        (int(f[i - W]) & 1)
+        | ((int(f[i - W + 1]) & 1) << 1)
+        | ((int(f[i + 1]) & 1) << 2)
+        | ((int(f[i + W + 1]) & 1) << 3)
+        | ((int(f[i + W]) & 1) << 4)
+        | ((int(f[i + W - 1]) & 1) << 5)
+        | ((int(f[i - 1]) & 1) << 6)
+        | ((int(f[i - W - 1]) & 1) << 7)
     )
 
 
-@njit(cache=True)
-def thin(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Zhang-Suen thinning with a work list and a sequential re-check (keeps 2x2 blocks connected).
+@njit(cache=True, error_model="numpy")
+def thin(img: np.ndarray, allfg: np.ndarray) -> np.ndarray:
+    """Zhang-Suen thinning in place, with a work list and a sequential re-check.
 
-    ``mask`` is uint8 0/1 with an empty border. Returns the skeleton image (uint8 0/1) and the
-    flat indices of its pixels. Junction blobs are reduced afterwards (see :func:`reduce_blobs`).
+    ``img`` is uint8 0/1 with an empty border; it becomes the skeleton. The re-check keeps 2x2
+    blocks connected. ``allfg`` lists its foreground pixels (sorted). Junction blobs are reduced
+    afterwards (:func:`reduce_blobs`). Returns the sorted flat indices of the skeleton pixels.
     """
-    img = mask.copy()
     H, W = img.shape
     f = img.ravel()
     tab = _zs_tables()
-    n_fg = 0
-    for i in range(H * W):
-        if f[i]:
-            n_fg += 1
-    cand = np.empty(n_fg + 1, np.int64)
-    nxt = np.empty(n_fg + 1, np.int64)
-    marked = np.empty(n_fg + 1, np.int64)
-    flag = np.zeros(H * W, np.uint8)
+    n_fg = allfg.size
+    cand = np.empty(n_fg + 1, np.int32)
+    nxt = np.empty(n_fg + 1, np.int32)
+    marked = np.empty(n_fg + 1, np.int32)
     n = 0
-    for i in range(W, H * W - W):
-        if f[i] and _code(f, i, W) != 255:
+    for k in range(n_fg):
+        i = allfg[k]
+        if _code(f, i, W) != 255:
             cand[n] = i
             n += 1
     while n > 0:
@@ -389,42 +482,40 @@ def thin(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             m = 0
             for k in range(n):
                 i = cand[k]
-                if f[i] and tab[sub, _code(f, i, W)]:
+                if f[i] & 1 and tab[sub, _code(f, i, W)]:
                     marked[m] = i
                     m += 1
             if sub == 1:
                 for k in range(nn):
                     i = nxt[k]
-                    if f[i] and tab[sub, _code(f, i, W)]:
+                    if f[i] & 1 and tab[sub, _code(f, i, W)]:
                         marked[m] = i
                         m += 1
             for k in range(m):
                 i = marked[k]
-                if f[i] and tab[sub, _code(f, i, W)]:
+                if f[i] & 1 and tab[sub, _code(f, i, W)]:
                     f[i] = 0
                     for dr in range(-1, 2):
                         for dc in range(-1, 2):
                             j = i + dr * W + dc
-                            if f[j] and flag[j] == 0:
-                                flag[j] = 1
+                            if f[j] == 1:  # foreground, not yet queued (bit 2 marks queued)
+                                f[j] = 3
                                 nxt[nn] = j
                                 nn += 1
         for k in range(nn):
-            flag[nxt[k]] = 0
+            f[nxt[k]] &= 1
             cand[k] = nxt[k]
         n = nn
     cnt = 0
-    for i in range(H * W):
-        if f[i]:
-            cnt += 1
+    for k in range(n_fg):
+        cnt += f[allfg[k]]
     px = np.empty(cnt, np.int64)
     cnt = 0
-    for i in range(H * W):
-        if f[i]:
-            px[cnt] = i
+    for k in range(n_fg):
+        if f[allfg[k]]:
+            px[cnt] = allfg[k]
             cnt += 1
-    px = reduce_blobs(img, px)
-    return img, px
+    return reduce_blobs(img, px)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -432,7 +523,7 @@ def thin(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _mnbrs(sk: np.ndarray, W: int, i: int, out: np.ndarray) -> int:
     r = i // W
     c = i - r * W
@@ -468,7 +559,7 @@ def _mnbrs(sk: np.ndarray, W: int, i: int, out: np.ndarray) -> int:
     return n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndarray):
     """Nodes (clusters of pixels whose m-degree is not 2) and edges (chains of degree-2 pixels).
 
@@ -602,7 +693,7 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def splice_pass_nodes(n_nodes, node_deg, node_off, node_px, ne, edge_a, edge_b, edge_off, edge_px):
     """Join the two edges of every degree-2 node (a junction blob with only two exits) into one.
 
@@ -700,20 +791,102 @@ def splice_pass_nodes(n_nodes, node_deg, node_off, node_px, ne, edge_a, edge_b, 
         new_b[nn] = last_node
         nn += 1
         new_off[nn] = p
-    return alive, nn, new_a[:nn].copy(), new_b[:nn].copy(), new_off[: nn + 1].copy(), new_px[:p].copy()
+    return (
+        alive,
+        nn,
+        new_a[:nn].copy(),
+        new_b[:nn].copy(),
+        new_off[: nn + 1].copy(),
+        new_px[:p].copy(),
+    )
 
 
-@njit(cache=True)
-def spur_pixels(W, node_rep, node_r, node_deg, node_off, node_px, ne, edge_a, edge_b, edge_off, edge_px, dcell, spur_ratio, min_depth_cells):
-    """Pixels of the branches to prune: junction-to-endpoint edges that barely leave the junction disk.
+@njit(cache=True, error_model="numpy")
+def _has_plateau(edge_px, first, n, step, dflat, W, lim, min_len):
+    """Whether a branch (walked from ``first`` by ``step`` for ``n`` pixels) has a corridor stretch.
+
+    A corridor stretch keeps its clearance within [0.75 m, m] with ``m <= lim`` over a length of at
+    least ``min_len + 0.5 m``: a dead-end corridor or closet has one, a room corner (a wedge
+    whose clearance changes steadily along the branch) has none. Two pointers with monotonic
+    deques of the window's maximum and minimum.
+    """
+    if n < 2:
+        return False
+    dq_max = np.empty(n, np.int64)
+    dq_min = np.empty(n, np.int64)
+    h_max = 0
+    t_max = 0
+    h_min = 0
+    t_min = 0
+    cum = np.empty(n, np.float64)
+    cum[0] = 0.0
+    i = 0
+    for k in range(n):
+        q = edge_px[first + k * step]
+        if k > 0:
+            p = edge_px[first + (k - 1) * step]
+            dr = abs(q // W - p // W)
+            dc = abs(q % W - p % W)
+            cum[k] = cum[k - 1] + (1.4142135623730951 if dr + dc == 2 else float(dr + dc))
+        dk = dflat[q]
+        while t_max > h_max and dflat[edge_px[first + dq_max[t_max - 1] * step]] <= dk:
+            t_max -= 1
+        dq_max[t_max] = k
+        t_max += 1
+        while t_min > h_min and dflat[edge_px[first + dq_min[t_min - 1] * step]] >= dk:
+            t_min -= 1
+        dq_min[t_min] = k
+        t_min += 1
+        while True:
+            mx = dflat[edge_px[first + dq_max[h_max] * step]]
+            mn = dflat[edge_px[first + dq_min[h_min] * step]]
+            if mn >= 0.75 * mx or i >= k:
+                break
+            i += 1
+            if dq_max[h_max] < i:
+                h_max += 1
+            if dq_min[h_min] < i:
+                h_min += 1
+        mx = dflat[edge_px[first + dq_max[h_max] * step]]
+        if mx <= lim and cum[k] - cum[i] + 1.0 >= min_len + 0.5 * mx:
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy")
+def spur_pixels(
+    W,
+    node_rep,
+    node_r,
+    node_deg,
+    node_off,
+    node_px,
+    ne,
+    edge_a,
+    edge_b,
+    edge_off,
+    edge_px,
+    dcell,
+    spur_ratio,
+    min_depth_cells,
+    neck_ratio,
+):
+    """Pixels of the branches to prune: junction-to-end edges that barely leave the junction disk.
 
     A branch protrudes ``|E - J| + d(E) - r_J`` beyond the junction's inscribed disk (E the end
     node, J the junction, d the clearance); it is pruned when that is below
-    ``spur_ratio * r_J + min_depth_cells``.
+    ``spur_ratio * r_J + min_depth_cells`` *and* it has no corridor stretch narrower than
+    ``neck_ratio * r_J`` (see :func:`_has_plateau`): a dead-end corridor or closet leaving a big
+    room is kept however big the room, a room corner is not. When pruning would leave a junction with fewer than
+    two branches, its most protruding branch is kept: the junction then dissolves and that
+    branch is judged again, as part of the longer branch it continues, in the next round
+    (otherwise a dead end broken by a noise junction is eaten piece by piece).
     """
     dflat = dcell.ravel()
-    out = np.empty(edge_px.size + node_px.size + 1, np.int64)
-    n = 0
+    n_nodes = node_rep.size
+    protr = np.full(ne, -1e300)
+    below = np.zeros(n_nodes, np.int64)
+    keep = np.full(n_nodes, -1, np.int64)
     for e in range(ne):
         a = edge_a[e]
         b = edge_b[e]
@@ -729,15 +902,41 @@ def spur_pixels(W, node_rep, node_r, node_deg, node_off, node_px, ne, edge_a, ed
         cj = node_rep[j] - rj * W
         rt = node_rep[t] // W
         ct = node_rep[t] - rt * W
-        dist = np.sqrt((rj - rt) ** 2 + (cj - ct) ** 2)
-        protr = dist + dflat[node_rep[t]] - node_r[j]
-        if protr < spur_ratio * node_r[j] + min_depth_cells:
-            for k in range(edge_off[e], edge_off[e + 1]):
-                out[n] = edge_px[k]
-                n += 1
-            for k in range(node_off[t], node_off[t + 1]):
-                out[n] = node_px[k]
-                n += 1
+        pr = np.sqrt((rj - rt) ** 2 + (cj - ct) ** 2) + dflat[node_rep[t]] - node_r[j]
+        if pr < spur_ratio * node_r[j] + min_depth_cells:
+            step = -1 if t == b else 1
+            first = edge_off[e + 1] - 1 if t == b else edge_off[e]
+            if _has_plateau(
+                edge_px,
+                first,
+                edge_off[e + 1] - edge_off[e],
+                step,
+                dflat,
+                W,
+                neck_ratio * node_r[j],
+                min_depth_cells,
+            ):
+                continue
+            protr[e] = pr
+            below[j] += 1
+            if keep[j] < 0 or pr > protr[keep[j]]:
+                keep[j] = e
+    out = np.empty(edge_px.size + node_px.size + 1, np.int64)
+    n = 0
+    for e in range(ne):
+        if protr[e] == -1e300:
+            continue
+        a = edge_a[e]
+        j = a if node_deg[a] >= 3 else edge_b[e]
+        t = edge_b[e] if j == a else a
+        if node_deg[j] - below[j] <= 1 and keep[j] == e:
+            continue
+        for k in range(edge_off[e], edge_off[e + 1]):
+            out[n] = edge_px[k]
+            n += 1
+        for k in range(node_off[t], node_off[t + 1]):
+            out[n] = node_px[k]
+            n += 1
     return out[:n].copy()
 
 
@@ -746,7 +945,7 @@ def spur_pixels(W, node_rep, node_r, node_deg, node_off, node_px, ne, edge_a, ed
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _uf_find(parent: np.ndarray, x: int) -> int:
     while parent[x] != x:
         parent[x] = parent[parent[x]]
@@ -754,7 +953,7 @@ def _uf_find(parent: np.ndarray, x: int) -> int:
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _uf_union(parent: np.ndarray, a: int, b: int) -> None:
     ra = _uf_find(parent, a)
     rb = _uf_find(parent, b)
@@ -765,7 +964,7 @@ def _uf_union(parent: np.ndarray, a: int, b: int) -> None:
             parent[ra] = rb
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _best_opening(edge_px, lo, i0, i1, step, dflat, W, weight):
     """Index in [i0, i1] (walking by ``step``) minimising 2*d + weight*distance from i0."""
     best = i0
@@ -792,21 +991,21 @@ def _best_opening(edge_px, lo, i0, i1, step, dflat, W, weight):
     return best
 
 
-@njit(cache=True)
-def _march(free, r0, c0, ur, uc, max_t, step):
+@njit(cache=True, error_model="numpy")
+def _march(work, r0, c0, ur, uc, max_t, step):
     """Distance along (ur, uc) from point (r0, c0) to the first non-free sample (max_t + 1 if none)."""
-    H, W = free.shape
+    H, W = work.shape
     t = step
     while t <= max_t:
         r = int(np.floor(r0 + t * ur))
         c = int(np.floor(c0 + t * uc))
-        if r < 0 or c < 0 or r >= H or c >= W or not free[r, c]:
+        if r < 0 or c < 0 or r >= H or c >= W or work[r, c] != FREE_V:
             return t
         t += step
     return max_t + 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _edge_normal(edge_px, lo, L, idx, W):
     """Angle (radians, in (row, col) space) of the normal to an edge at pixel ``idx``."""
     i0 = max(idx - 3, 0)
@@ -820,8 +1019,8 @@ def _edge_normal(edge_px, lo, L, idx, W):
     return np.arctan2(tr, tc) + np.pi / 2.0
 
 
-@njit(cache=True)
-def _chord(free, r, c, base, n_angles, max_angle, max_t, step):
+@njit(cache=True, error_model="numpy")
+def _chord(work, r, c, base, n_angles, max_angle, max_t, step):
     """Shortest chord through cell (r, c) within ``max_angle`` of ``base``: (length, ur, uc, t1, t2)."""
     pr = r + 0.5
     pc = c + 0.5
@@ -834,10 +1033,10 @@ def _chord(free, r, c, base, n_angles, max_angle, max_t, step):
         ang = base + max_angle * a / max(n_angles, 1)
         ur = np.sin(ang)
         uc = np.cos(ang)
-        t1 = _march(free, pr, pc, ur, uc, max_t, step)
+        t1 = _march(work, pr, pc, ur, uc, max_t, step)
         if t1 >= best:
             continue
-        t2 = _march(free, pr, pc, -ur, -uc, max_t, step)
+        t2 = _march(work, pr, pc, -ur, -uc, max_t, step)
         tot = t1 + t2
         if tot < best - 1e-9:
             best = tot
@@ -848,9 +1047,23 @@ def _chord(free, r, c, base, n_angles, max_angle, max_t, step):
     return best, bur, buc, bt1, bt2
 
 
-@njit(cache=True)
-def _refine_opening(free, dflat, edge_px, lo, L, i0, lo_lim, hi_lim, W, max_angle, weight):
+@njit(cache=True, error_model="numpy")
+def _refine_opening(work, dflat, edge_px, lo, L, i0, lo_lim, hi_lim, W, max_angle, weight):
     """Index near ``i0`` in [lo_lim, hi_lim] minimising chord length + weight * offset."""
+    q0 = edge_px[lo + i0]
+    r0 = q0 // W
+    ln0 = _chord(
+        work,
+        r0,
+        q0 - r0 * W,
+        _edge_normal(edge_px, lo, L, i0, W),
+        2,
+        max_angle,
+        4.0 * dflat[q0] + 6.0,
+        0.5,
+    )[0]
+    if ln0 <= 2.0 * dflat[q0] + 3.0:
+        return i0  # the chord is as short as the inscribed circle allows: not at a mouth
     best = i0
     best_cost = 1e300
     k = int(3 + 0.5 * dflat[edge_px[lo + i0]])
@@ -861,7 +1074,7 @@ def _refine_opening(free, dflat, edge_px, lo, L, i0, lo_lim, hi_lim, W, max_angl
         r = q // W
         c = q - r * W
         base = _edge_normal(edge_px, lo, L, i, W)
-        ln = _chord(free, r, c, base, 2, max_angle, 4.0 * dflat[q] + 6.0, 0.5)[0]
+        ln = _chord(work, r, c, base, 2, max_angle, 4.0 * dflat[q] + 6.0, 0.5)[0]
         cost = ln + weight * abs(i - i0)
         if cost < best_cost - 1e-9:
             best_cost = cost
@@ -869,8 +1082,25 @@ def _refine_opening(free, dflat, edge_px, lo, L, i0, lo_lim, hi_lim, W, max_angl
     return best
 
 
-@njit(cache=True)
-def place_openings(W, n_nodes, node_rep, node_r, node_deg, ne, edge_a, edge_b, edge_off, edge_px, dcell, free, mouth_ratio, weight, min_path_px, max_angle):
+@njit(cache=True, error_model="numpy")
+def place_openings(
+    W,
+    n_nodes,
+    node_rep,
+    node_r,
+    node_deg,
+    ne,
+    edge_a,
+    edge_b,
+    edge_off,
+    edge_px,
+    dcell,
+    work,
+    mouth_ratio,
+    weight,
+    min_path_px,
+    max_angle,
+):
     """Decide, per edge, whether it is inside an intersection core or where its openings lie.
 
     Returns ``(internal, open_a, open_b)``: ``open_a[e]`` is the index in the edge's pixel list
@@ -930,8 +1160,12 @@ def place_openings(W, n_nodes, node_rep, node_r, node_deg, ne, edge_a, edge_b, e
             if ob - oa < 2:
                 internal[e] = True
                 continue
-            oa = _refine_opening(free, dflat, edge_px, lo, L, oa, exit_a, min(mid, ob - 2), W, max_angle, 0.25)
-            ob = _refine_opening(free, dflat, edge_px, lo, L, ob, max(mid + 1, oa + 2), exit_b, W, max_angle, 0.25)
+            oa = _refine_opening(
+                work, dflat, edge_px, lo, L, oa, exit_a, min(mid, ob - 2), W, max_angle, 0.25
+            )
+            ob = _refine_opening(
+                work, dflat, edge_px, lo, L, ob, max(mid + 1, oa + 2), exit_b, W, max_angle, 0.25
+            )
             open_a[e] = oa
             open_b[e] = ob
         elif ja:
@@ -940,19 +1174,37 @@ def place_openings(W, n_nodes, node_rep, node_r, node_deg, ne, edge_a, edge_b, e
                 internal[e] = True
                 continue
             oa = _best_opening(edge_px, lo, exit_a, limit, 1, dflat, W, weight)
-            open_a[e] = _refine_opening(free, dflat, edge_px, lo, L, oa, exit_a, limit, W, max_angle, 0.25)
+            open_a[e] = _refine_opening(
+                work, dflat, edge_px, lo, L, oa, exit_a, limit, W, max_angle, 0.25
+            )
         elif jb:
             limit = 1
             if exit_b < limit:
                 internal[e] = True
                 continue
             ob = _best_opening(edge_px, lo, exit_b, limit, -1, dflat, W, weight)
-            open_b[e] = _refine_opening(free, dflat, edge_px, lo, L, ob, limit, exit_b, W, max_angle, 0.25)
+            open_b[e] = _refine_opening(
+                work, dflat, edge_px, lo, L, ob, limit, exit_b, W, max_angle, 0.25
+            )
     return internal, open_a, open_b
 
 
-@njit(cache=True)
-def build_regions(n_nodes, alive, node_off, node_px, ne, edge_a, edge_b, edge_off, edge_px, internal, open_a, open_b, lab):
+@njit(cache=True, error_model="numpy")
+def build_regions(
+    n_nodes,
+    alive,
+    node_off,
+    node_px,
+    ne,
+    edge_a,
+    edge_b,
+    edge_off,
+    edge_px,
+    internal,
+    open_a,
+    open_b,
+    lab,
+):
     """Union-find over nodes and edge middles; writes region labels of skeleton pixels into ``lab``.
 
     Returns ``(n_regions, node_region, mid_region)`` and the opening table
@@ -1033,7 +1285,16 @@ def build_regions(n_nodes, alive, node_off, node_px, ne, edge_a, edge_b, edge_of
             op_core[k] = rb
             op_far[k] = rm
             k += 1
-    return n_reg, region[:n_nodes].copy(), region[n_nodes:].copy(), op_px, op_edge, op_idx, op_core, op_far
+    return (
+        n_reg,
+        region[:n_nodes].copy(),
+        region[n_nodes:].copy(),
+        op_px,
+        op_edge,
+        op_idx,
+        op_core,
+        op_far,
+    )
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1041,18 +1302,22 @@ def build_regions(n_nodes, alive, node_off, node_px, ne, edge_a, edge_b, edge_of
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
-def opening_chords(free, dcell, op_px, op_edge, op_idx, edge_off, edge_px, barrier, n_angles, max_angle_rad):
+@njit(cache=True, error_model="numpy")
+def opening_chords(
+    work, dcell, op_px, op_edge, op_idx, edge_off, edge_px, lab, n_angles, max_angle_rad
+):
     """Shortest wall-to-wall chord through each opening pixel, roughly across its edge.
 
-    Marks the chord's free cells in ``barrier`` (value = opening index + 1) and returns the
-    endpoints ``(n, 4)`` as (row0, col0, row1, col1) in fractional cell units (cell centre at
-    +0.5) and the widths in cells.
+    Marks the chord's unlabelled free cells in ``lab`` with ``-(2 + opening index)`` (a barrier
+    for region growing) and returns the endpoints ``(n, 4)`` as (row0, col0, row1, col1) in
+    fractional cell units (cell centre at +0.5), the widths in cells and the marked cells.
     """
-    H, W = free.shape
+    H, W = work.shape
     n = op_px.size
     ends = np.empty((n, 4), np.float64)
     width = np.empty(n, np.float64)
+    marked = np.empty(64 + 8 * n, np.int64)
+    n_marked = 0
     step = 0.25
     for k in range(n):
         i = op_px[k]
@@ -1065,7 +1330,7 @@ def opening_chords(free, dcell, op_px, op_edge, op_idx, edge_off, edge_px, barri
         max_t = 4.0 * dcell[r, c] + 6.0
         pr = r + 0.5
         pc = c + 0.5
-        best, bur, buc, bt1, bt2 = _chord(free, r, c, base, n_angles, max_angle_rad, max_t, step)
+        best, bur, buc, bt1, bt2 = _chord(work, r, c, base, n_angles, max_angle_rad, max_t, step)
         e1 = min(bt1, max_t) - step * 0.5
         e2 = min(bt2, max_t) - step * 0.5
         ends[k, 0] = pr + e1 * bur
@@ -1073,15 +1338,23 @@ def opening_chords(free, dcell, op_px, op_edge, op_idx, edge_off, edge_px, barri
         ends[k, 2] = pr - e2 * bur
         ends[k, 3] = pc - e2 * buc
         width[k] = e1 + e2
+        code = -(2 + k)
         t = -e2
-        while t <= e1:
+        while t <= e1 + 1e-9:
             rr = int(np.floor(pr + t * bur))
             cc = int(np.floor(pc + t * buc))
-            if rr >= 0 and cc >= 0 and rr < H and cc < W and free[rr, cc]:
-                barrier[rr * W + cc] = k + 1
+            if rr >= 0 and cc >= 0 and rr < H and cc < W and work[rr, cc] == FREE_V:
+                j = rr * W + cc
+                if lab[j] == -1:
+                    lab[j] = code
+                    if n_marked >= marked.size:
+                        grown = np.empty(marked.size * 2, np.int64)
+                        grown[:n_marked] = marked[:n_marked]
+                        marked = grown
+                    marked[n_marked] = j
+                    n_marked += 1
             t += step
-        barrier[i] = k + 1
-    return ends, width
+    return ends, width, marked[:n_marked].copy()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1089,171 +1362,333 @@ def opening_chords(free, dcell, op_px, op_edge, op_idx, edge_off, edge_px, barri
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
-def region_centres(px, lab, dcell, n_reg):
-    """Per region, the skeleton pixel with the largest clearance (-1 if the region has none)."""
+@njit(cache=True, error_model="numpy")
+def region_centres(px, lab, dcell, n_reg, W):
+    """Per region, a central skeleton pixel far from walls (-1 if the region has none).
+
+    Maximises ``d(p) - 0.5 |p - m|`` over the region's skeleton pixels, with ``m`` their mean:
+    the most open point, pulled towards the middle of large areas.
+    """
     dflat = dcell.ravel()
-    best = np.full(n_reg, -1, np.int64)
-    bd = np.full(n_reg, -1.0, np.float64)
+    sr = np.zeros(n_reg, np.float64)
+    sc = np.zeros(n_reg, np.float64)
+    cnt = np.zeros(n_reg, np.float64)
     for k in range(px.size):
         i = px[k]
         g = lab[i]
-        if g >= 0 and dflat[i] > bd[g]:
-            bd[g] = dflat[i]
-            best[g] = i
+        if g >= 0:
+            sr[g] += i // W
+            sc[g] += i % W
+            cnt[g] += 1.0
+    for g in range(n_reg):
+        if cnt[g] > 0:
+            sr[g] /= cnt[g]
+            sc[g] /= cnt[g]
+    best = np.full(n_reg, -1, np.int64)
+    bs = np.full(n_reg, -1e300, np.float64)
+    for k in range(px.size):
+        i = px[k]
+        g = lab[i]
+        if g >= 0:
+            score = dflat[i] - 0.5 * np.sqrt((i // W - sr[g]) ** 2 + (i % W - sc[g]) ** 2)
+            if score > bs[g]:
+                bs[g] = score
+                best[g] = i
     return best
 
 
-@njit(cache=True)
-def grow_regions(W, sk, px, roots, lab, cspace, free, barrier, op_core, max_out_depth, parent, depth):
+@njit(cache=True, error_model="numpy")
+def _row_sweep(W, H, lab, st, w_flat, q, tail, max_d, left, rest, counts):
+    """Give unlabelled free cells the label of the nearest labelled cell in their row.
+
+    Sources are cells labelled before the sweep, at most ``max_d`` cells away through free
+    cells that are not chords; a cell's parent (``st``) is its source. Free unlabelled cells
+    left over are appended to ``rest`` (grown as needed); returns ``(tail, rest, n_rest)``.
+    """
+    n_rest = 0
+    for line in range(1, H - 1):
+        base = line * W
+        src = -1
+        for k in range(W):  # nearest source before k
+            i = base + k
+            if w_flat[i] != FREE_V:
+                src = -1
+                continue
+            g = lab[i]
+            if g >= 0:
+                src = k
+            elif g != -1:
+                src = -1
+            left[k] = src
+        src = -1
+        for k in range(
+            W - 1, -1, -1
+        ):  # nearest source after k; cells labelled here are not sources
+            i = base + k
+            if w_flat[i] != FREE_V:
+                src = -1
+                continue
+            g = lab[i]
+            if g >= 0:
+                src = k
+            elif g != -1:
+                src = -1
+            else:
+                best = -1
+                bd = max_d + 1
+                if left[k] >= 0 and k - left[k] < bd:
+                    best = left[k]
+                    bd = k - left[k]
+                if src >= 0 and src - k < bd:
+                    best = src
+                if best >= 0:
+                    j = base + best
+                    g = lab[j]
+                    lab[i] = g
+                    counts[g] += 1
+                    st[i] = j
+                    q[tail] = i
+                    tail += 1
+                else:
+                    if n_rest >= rest.size:
+                        grown = np.empty(2 * rest.size, np.int32)
+                        grown[:n_rest] = rest[:n_rest]
+                        rest = grown
+                    rest[n_rest] = i
+                    n_rest += 1
+    return tail, rest, n_rest
+
+
+@njit(cache=True, error_model="numpy")
+def grow_regions(
+    W,
+    sk,
+    px,
+    st,
+    roots,
+    lab,
+    dcell,
+    min_clear,
+    work,
+    max_out_depth,
+    chord_cells,
+    op_core,
+    n_reg,
+    n_free,
+):
     """Label every reachable free cell with a region and build one shortest-path tree per region.
 
-    1. BFS over each region's skeleton pixels (8-neighbours, same label) from its root.
-    2. BFS from all skeleton pixels over C-space cells (4-neighbours), never crossing a chord.
-    3. BFS from C-space over the other free cells, at most ``max_out_depth`` steps.
-    Chord cells get the label of the opening's core region. ``parent``/``depth`` describe the
-    trees (parent -1 at roots). Returns the number of labelled cells.
+    1. BFS over each region's skeleton pixels (8-neighbours, same label) from its root: the
+       skeleton tree, kept compactly by skeleton index (``sk_par``, ``sk_dep``).
+    2. BFS from all skeleton pixels over C-space cells (4-neighbours), never into barriers.
+    3. A row sweep gives the other free cells the label of the nearest labelled cell in their
+       row (at most ``max_out_depth`` cells away, not across walls or chords); a layered BFS
+       over the cells still unlabelled finishes (room corners, cells beside the C-space ends).
+    Chord cells then take the label of their opening's core region when they touch a labelled
+    cell. On return ``st`` holds, for skeleton pixels, their skeleton index and, for other
+    labelled cells, the parent cell towards the skeleton (-1 for chord cells).
+
+    Returns ``(sk_par, sk_dep, cells, counts)``: the labelled cells and cells per region.
     """
     H = sk.shape[0]
-    N = H * W
-    n_free = 0
-    for r in range(H):
-        for c in range(W):
-            if free[r, c]:
-                n_free += 1
-    q = np.empty(n_free + px.size + 1, np.int64)
+    n_px = px.size
     sk_flat = sk.ravel()
-    cs_flat = cspace.ravel()
-    fr_flat = free.ravel()
+    d_flat = dcell.ravel()
+    w_flat = work.ravel()
+    for k in range(n_px):
+        st[px[k]] = k
+    sk_par = np.full(n_px, -1, np.int32)
+    sk_dep = np.full(n_px, -1, np.int32)
+    qs = np.empty(n_px + 1, np.int32)
     head = 0
     tail = 0
     for g in range(roots.size):
         rt = roots[g]
         if rt >= 0:
-            parent[rt] = -1
-            depth[rt] = 0
-            q[tail] = rt
+            k = st[rt]
+            sk_dep[k] = 0
+            qs[tail] = k
             tail += 1
-    # 1. skeleton trees (skeleton pixels carry their labels already; -1 marks opening pixels)
-    seen = np.zeros(N, np.uint8)
-    for t in range(tail):
-        seen[q[t]] = 1
-    while head < tail:
-        i = q[head]
-        head += 1
-        g = lab[i]
-        for dr in range(-1, 2):
-            for dc in range(-1, 2):
-                j = i + dr * W + dc
-                if sk_flat[j] and seen[j] == 0 and lab[j] == g:
-                    seen[j] = 1
-                    parent[j] = i
-                    depth[j] = depth[i] + 1
-                    q[tail] = j
-                    tail += 1
-    # skeleton pixels not reached from a root (should not happen) become roots themselves
-    for k in range(px.size):
-        i = px[k]
-        if lab[i] >= 0 and seen[i] == 0:
-            seen[i] = 1
-            parent[i] = -1
-            depth[i] = 0
-            q[tail] = i
+    scan = 0
+    while True:
+        while head < tail:
+            k = qs[head]
+            head += 1
+            i = px[k]
+            g = lab[i]
+            for dr in range(-1, 2):
+                for dc in range(-1, 2):
+                    j = i + dr * W + dc
+                    if sk_flat[j] and lab[j] == g:
+                        kj = st[j]
+                        if sk_dep[kj] < 0:
+                            sk_dep[kj] = sk_dep[k] + 1
+                            sk_par[kj] = k
+                            qs[tail] = kj
+                            tail += 1
+        # skeleton pixels not reached from their root (not expected) start trees of their own
+        extra = False
+        while scan < n_px:
+            k = scan
+            scan += 1
+            if sk_dep[k] < 0 and lab[px[k]] >= 0:
+                sk_dep[k] = 0
+                qs[tail] = k
+                tail += 1
+                extra = True
+                break
+        if not extra:
+            break
+    q = np.empty(n_free + 1, np.int32)
+    counts = np.zeros(n_reg, np.int64)
+    tail = 0
+    for k in range(n_px):
+        g = lab[px[k]]
+        if g >= 0:
+            q[tail] = px[k]
             tail += 1
-    # 2. C-space, seeded by all skeleton pixels
+            counts[g] += 1
     head = 0
-    n_lab = tail
     while head < tail:
         i = q[head]
         head += 1
         g = lab[i]
         for t in range(4):
             j = i + (W if t == 0 else (-W if t == 1 else (1 if t == 2 else -1)))
-            if cs_flat[j] and lab[j] < 0 and barrier[j] == 0 and sk_flat[j] == 0:
+            if lab[j] == -1 and d_flat[j] >= min_clear and sk_flat[j] == 0:
                 lab[j] = g
-                parent[j] = i
-                depth[j] = depth[i] + 1
+                counts[g] += 1
+                st[j] = i
                 q[tail] = j
                 tail += 1
-    # 3. the rest of free space, depth-limited from C-space
-    out_d = np.zeros(N, np.int32)
-    head = 0
-    while head < tail:
-        i = q[head]
-        head += 1
-        g = lab[i]
-        if out_d[i] >= max_out_depth:
+    # 3. the rest of free space: nearest labelled C-space cell along the row, then the column,
+    # within max_out_depth cells and without crossing walls or chords. Each such cell's parent
+    # (st) is that C-space cell, so the robot's anchor for it is one step away.
+    left = np.empty(W, np.int64)
+    tail, rest, n_rest = _row_sweep(
+        W, H, lab, st, w_flat, q, tail, max_out_depth, left, np.empty(4096, np.int32), counts
+    )
+    # what the rows did not reach (room corners, cells above or below the C-space): a layered
+    # BFS over those cells only, from their labelled 4-neighbours
+    head = tail
+    for t in range(n_rest):
+        i = rest[t]
+        if lab[i] != -1:
             continue
-        for t in range(4):
-            j = i + (W if t == 0 else (-W if t == 1 else (1 if t == 2 else -1)))
-            if fr_flat[j] and lab[j] < 0 and barrier[j] == 0:
-                lab[j] = g
-                parent[j] = i
-                depth[j] = depth[i] + 1
-                out_d[j] = out_d[i] + 1
+        for u in range(4):
+            j = i + (W if u == 0 else (-W if u == 1 else (1 if u == 2 else -1)))
+            if lab[j] >= 0:
+                lab[i] = lab[j]
+                counts[lab[j]] += 1
+                st[i] = j
+                q[tail] = i
+                tail += 1
+                break
+    layer_end = tail
+    layer = 1
+    while head < tail and layer < max_out_depth:
+        i = q[head]
+        head += 1
+        for u in range(4):
+            j = i + (W if u == 0 else (-W if u == 1 else (1 if u == 2 else -1)))
+            if lab[j] == -1 and w_flat[j] == FREE_V:
+                lab[j] = lab[i]
+                counts[lab[i]] += 1
+                st[j] = i
                 q[tail] = j
                 tail += 1
+        if head == layer_end:
+            layer += 1
+            layer_end = tail
     n_lab = tail
-    # chord cells: the side of the opening's core region (only where the chord touches that region)
-    for r in range(1, H - 1):
-        for c in range(1, W - 1):
-            i = r * W + c
-            b = barrier[i]
-            if b > 0 and fr_flat[i] and lab[i] < 0:
-                g = op_core[b - 1]
-                ok = False
-                for t in range(4):
-                    j = i + (W if t == 0 else (-W if t == 1 else (1 if t == 2 else -1)))
-                    if lab[j] >= 0 and barrier[j] == 0:
-                        ok = True
-                if ok:
-                    lab[i] = g
-                    parent[i] = -1
-                    depth[i] = 0
-                    n_lab += 1
-    return n_lab
+    # chord cells join the core side of their opening where they touch labelled cells
+    extra_cells = np.empty(chord_cells.size, np.int32)
+    touching = np.zeros(chord_cells.size, np.bool_)
+    n_extra = 0
+    for t in range(chord_cells.size):
+        i = chord_cells[t]
+        if lab[i] > -2:
+            continue
+        ok = False
+        for u in range(4):
+            j = i + (W if u == 0 else (-W if u == 1 else (1 if u == 2 else -1)))
+            if lab[j] >= 0:
+                ok = True
+        extra_cells[n_extra] = i
+        touching[n_extra] = ok
+        n_extra += 1
+    for t in range(n_extra):
+        i = extra_cells[t]
+        if not touching[t]:
+            lab[i] = -1
+            continue
+        g = op_core[-lab[i] - 2]
+        lab[i] = g
+        if sk_flat[i] == 0:
+            st[i] = -1
+        counts[g] += 1
+    cells = np.empty(n_lab + n_extra, np.int32)
+    cells[:n_lab] = q[:n_lab]
+    m = n_lab
+    for t in range(n_extra):
+        if lab[extra_cells[t]] >= 0:
+            cells[m] = extra_cells[t]
+            m += 1
+    return sk_par, sk_dep, cells[:m].copy(), counts
 
 
-@njit(cache=True)
-def frontier_cells(W, work, lab):
+@njit(cache=True, error_model="numpy")
+def _bsearch(a, x):
+    lo = 0
+    hi = a.size
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if a[mid] < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    if lo < a.size and a[lo] == x:
+        return lo
+    return -1
+
+
+@njit(cache=True, error_model="numpy")
+def frontier_cells(W, work, lab, cand):
     """Labelled free cells with an UNKNOWN 4-neighbour, clustered 8-connectedly.
 
-    Returns (cells, cluster id per cell, outward row/col offset sums per cell).
+    ``cand`` (sorted) are candidates from the filter pass; they are re-checked here.
+    Returns (sorted frontier cells, cluster id per cell, outward row/col offset sums, n clusters).
     """
-    H = work.shape[0]
     wf = work.ravel()
     n = 0
-    for r in range(1, H - 1):
-        for c in range(1, W - 1):
-            i = r * W + c
-            if lab[i] >= 0 and wf[i] == FREE_V:
-                if wf[i + W] == UNKNOWN_V or wf[i - W] == UNKNOWN_V or wf[i + 1] == UNKNOWN_V or wf[i - 1] == UNKNOWN_V:
-                    n += 1
-    cells = np.empty(n, np.int64)
+    fc = np.empty(cand.size, np.int64)
+    for t in range(cand.size):
+        i = cand[t]
+        if (
+            lab[i] >= 0
+            and wf[i] == FREE_V
+            and (
+                wf[i + W] == UNKNOWN_V
+                or wf[i - W] == UNKNOWN_V
+                or wf[i + 1] == UNKNOWN_V
+                or wf[i - 1] == UNKNOWN_V
+            )
+        ):
+            fc[n] = i
+            n += 1
+    fc = fc[:n]
     orow = np.zeros(n, np.int64)
     ocol = np.zeros(n, np.int64)
-    mark = np.full(H * W, -1, np.int32)
-    n = 0
-    for r in range(1, H - 1):
-        for c in range(1, W - 1):
-            i = r * W + c
-            if lab[i] >= 0 and wf[i] == FREE_V:
-                dr = 0
-                dc = 0
-                if wf[i + W] == UNKNOWN_V:
-                    dr += 1
-                if wf[i - W] == UNKNOWN_V:
-                    dr -= 1
-                if wf[i + 1] == UNKNOWN_V:
-                    dc += 1
-                if wf[i - 1] == UNKNOWN_V:
-                    dc -= 1
-                if wf[i + W] == UNKNOWN_V or wf[i - W] == UNKNOWN_V or wf[i + 1] == UNKNOWN_V or wf[i - 1] == UNKNOWN_V:
-                    cells[n] = i
-                    orow[n] = dr
-                    ocol[n] = dc
-                    mark[i] = n
-                    n += 1
+    for k in range(n):
+        i = fc[k]
+        if wf[i + W] == UNKNOWN_V:
+            orow[k] += 1
+        if wf[i - W] == UNKNOWN_V:
+            orow[k] -= 1
+        if wf[i + 1] == UNKNOWN_V:
+            ocol[k] += 1
+        if wf[i - 1] == UNKNOWN_V:
+            ocol[k] -= 1
     cluster = np.full(n, -1, np.int64)
     stack = np.empty(n + 1, np.int64)
     n_cl = 0
@@ -1267,20 +1702,216 @@ def frontier_cells(W, work, lab):
         while top > 0:
             top -= 1
             m = stack[top]
-            i = cells[m]
+            i = fc[m]
             for dr in range(-1, 2):
                 for dc in range(-1, 2):
-                    j = i + dr * W + dc
-                    mm = mark[j]
+                    mm = _bsearch(fc, i + dr * W + dc)
                     if mm >= 0 and cluster[mm] < 0:
                         cluster[mm] = n_cl
                         stack[top] = mm
                         top += 1
         n_cl += 1
-    return cells, cluster, orow, ocol, n_cl
+    return fc, cluster, orow, ocol, n_cl
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def scatter_labels(out, lab, lut, W, r0, c0):
+    """``out[r + r0, c + c0] = lut[lab[r * W + c]]`` for labelled work-grid cells inside ``out``."""
+    H0, W0 = out.shape
+    Hw = lab.size // W
+    ra = max(0, -r0)
+    rb = min(Hw, H0 - r0)
+    ca = max(0, -c0)
+    cb = min(W, W0 - c0)
+    for r in range(ra, rb):
+        base = r * W
+        orow = out[r + r0]
+        for c in range(ca, cb):
+            g = lab[base + c]
+            if g >= 0:
+                orow[c + c0] = lut[g]
+
+
+@njit(cache=True, error_model="numpy")
+def _group_width(fc, sel, W):
+    """Extent (cells) of frontier cells ``fc[sel]`` along their principal axis, and its data."""
+    m = sel.size
+    mr = 0.0
+    mc = 0.0
+    for t in range(m):
+        i = fc[sel[t]]
+        mr += i // W
+        mc += i % W
+    mr /= m
+    mc /= m
+    srr = 0.0
+    scc = 0.0
+    src = 0.0
+    for t in range(m):
+        i = fc[sel[t]]
+        dr = i // W - mr
+        dc = i % W - mc
+        srr += dr * dr
+        scc += dc * dc
+        src += dr * dc
+    theta = 0.5 * np.arctan2(2.0 * src, scc - srr)
+    ct = np.cos(theta)
+    sn = np.sin(theta)
+    proj = np.empty(m, np.float64)
+    t0 = 0
+    t1 = 0
+    for t in range(m):
+        i = fc[sel[t]]
+        proj[t] = (i % W - mc) * ct + (i // W - mr) * sn
+        if proj[t] < proj[t0]:
+            t0 = t
+        if proj[t] > proj[t1]:
+            t1 = t
+    return proj[t1] - proj[t0] + 1.0, t0, t1, mr, mc, proj
+
+
+@njit(cache=True, error_model="numpy")
+def frontier_groups(
+    W, work, lab, st, sk, dcell, min_clear, fc, cluster, orow, ocol, n_cl, min_w, depth_cells, n_reg
+):
+    """Frontiers from clustered frontier cells: split by area when each part is wide enough.
+
+    A cluster seen from several areas is split into its per-area parts when every kept part is
+    at least ``min_w`` cells wide; if no part is, the whole cluster goes to the area holding
+    most of it. A group is a frontier when it is ``min_w`` wide, a C-space target is reachable
+    from one of its cells nearest its centroid, and ``depth_cells`` of unknown space lie behind it.
+
+    Returns per frontier: region, width (cells), end cells (r0, c0, r1, c1), middle cell, target.
+    """
+    n = fc.size
+    key = cluster * (n_reg + 1) + lab[fc]
+    order = np.argsort(key, kind="mergesort")
+    out_reg = np.empty(n + 1, np.int64)
+    out_w = np.empty(n + 1, np.float64)
+    out_end = np.empty((n + 1, 4), np.float64)
+    out_mid = np.empty(n + 1, np.int64)
+    out_anchor = np.empty(n + 1, np.int64)
+    n_out = 0
+    start = 0
+    while start < n:
+        k = cluster[order[start]]
+        stop = start
+        while stop < n and cluster[order[stop]] == k:
+            stop += 1
+        # parts by region inside [start, stop)
+        part_lo = np.empty(stop - start + 1, np.int64)
+        part_hi = np.empty(stop - start + 1, np.int64)
+        n_part = 0
+        t = start
+        while t < stop:
+            g = lab[fc[order[t]]]
+            u = t
+            while u < stop and lab[fc[order[u]]] == g:
+                u += 1
+            part_lo[n_part] = t
+            part_hi[n_part] = u
+            n_part += 1
+            t = u
+        groups_lo = np.empty(n_part, np.int64)
+        groups_hi = np.empty(n_part, np.int64)
+        groups_reg = np.empty(n_part, np.int64)
+        n_g = 0
+        if n_part == 1:
+            groups_lo[0] = start
+            groups_hi[0] = stop
+            groups_reg[0] = lab[fc[order[start]]]
+            n_g = 1
+        else:
+            biggest = 0
+            for pp in range(n_part):
+                if part_hi[pp] - part_lo[pp] > part_hi[biggest] - part_lo[biggest]:
+                    biggest = pp
+                wdt = _group_width(fc, order[part_lo[pp] : part_hi[pp]], W)[0]
+                if wdt + 1e-9 >= min_w:
+                    groups_lo[n_g] = part_lo[pp]
+                    groups_hi[n_g] = part_hi[pp]
+                    groups_reg[n_g] = lab[fc[order[part_lo[pp]]]]
+                    n_g += 1
+            if n_g == 0:
+                groups_lo[0] = start
+                groups_hi[0] = stop
+                groups_reg[0] = lab[fc[order[part_lo[biggest]]]]
+                n_g = 1
+        for gg in range(n_g):
+            sel = order[groups_lo[gg] : groups_hi[gg]]
+            region = groups_reg[gg]
+            wdt, t0, t1, mr, mc, proj = _group_width(fc, sel, W)
+            if wdt + 1e-9 < min_w:
+                continue
+            m = sel.size
+            dist = np.empty(m, np.float64)
+            for t in range(m):
+                i = fc[sel[t]]
+                dist[t] = (i // W - mr) ** 2 + (i % W - mc) ** 2
+            by_centre = np.argsort(dist)
+            anchor = -1
+            mid = -1
+            for t in range(min(m, 32)):
+                cell = fc[sel[by_centre[t]]]
+                a = anchor_of(st, sk, dcell, min_clear, cell, 64)
+                if a >= 0 and lab[a] == region:
+                    anchor = a
+                    mid = cell
+                    break
+            if anchor < 0:
+                continue
+            vr = 0.0
+            vc = 0.0
+            for t in range(m):
+                vr += orow[sel[t]]
+                vc += ocol[sel[t]]
+            nrm = np.sqrt(vr * vr + vc * vc)
+            if nrm == 0.0:
+                vr = float(mid // W - anchor // W)
+                vc = float(mid % W - anchor % W)
+                nrm = np.sqrt(vr * vr + vc * vc)
+            if nrm > 0.0:
+                ur = vr / nrm
+                uc = vc / nrm
+                sp = np.sort(proj)
+                ok = False
+                for qq in range(3):
+                    if qq == 0:
+                        cell = mid
+                    else:
+                        target = sp[(m * qq) // 4] if qq == 1 else sp[(3 * m) // 4]
+                        bt = 0
+                        for t in range(m):
+                            if abs(proj[t] - target) < abs(proj[bt] - target):
+                                bt = t
+                        cell = fc[sel[bt]]
+                    if unknown_depth_ok(work, cell // W, cell % W, ur, uc, depth_cells):
+                        ok = True
+                        break
+                if not ok:
+                    continue
+            e0 = fc[sel[t0]]
+            e1 = fc[sel[t1]]
+            out_reg[n_out] = region
+            out_w[n_out] = wdt
+            out_end[n_out, 0] = e0 // W
+            out_end[n_out, 1] = e0 % W
+            out_end[n_out, 2] = e1 // W
+            out_end[n_out, 3] = e1 % W
+            out_mid[n_out] = mid
+            out_anchor[n_out] = anchor
+            n_out += 1
+        start = stop
+    return (
+        out_reg[:n_out].copy(),
+        out_w[:n_out].copy(),
+        out_end[:n_out].copy(),
+        out_mid[:n_out].copy(),
+        out_anchor[:n_out].copy(),
+    )
+
+
+@njit(cache=True, error_model="numpy")
 def unknown_depth_ok(work, r, c, ur, uc, depth_cells):
     """True if marching from cell (r, c) along (ur, uc) crosses ``depth_cells`` of unknown space."""
     H, W = work.shape
@@ -1304,41 +1935,68 @@ def unknown_depth_ok(work, r, c, ur, uc, depth_cells):
     return seen_unknown >= depth_cells
 
 
-@njit(cache=True)
-def chain_to_tree(parent, cspace_flat, cell, max_len):
-    """Follow parents from ``cell`` until the first C-space cell; returns (anchor, ok)."""
+@njit(cache=True, error_model="numpy")
+def anchor_of(st, sk, dcell, min_clear, cell, max_len):
+    """First C-space cell on the parent chain of ``cell`` (-1 if the chain breaks first)."""
+    sk_flat = sk.ravel()
+    d_flat = dcell.ravel()
     i = cell
     for _ in range(max_len):
-        if cspace_flat[i]:
-            return i, True
-        p = parent[i]
+        if d_flat[i] >= min_clear or sk_flat[i]:
+            return i
+        p = st[i]
         if p < 0:
-            return i, bool(cspace_flat[i])
+            return -1
         i = p
-    return i, False
+    return -1
 
 
-@njit(cache=True)
-def far_skeleton_pixel(W, sk, lab, start, label):
-    """The skeleton pixel of region ``label`` farthest (in BFS steps) from ``start``."""
-    H = sk.shape[0]
+@njit(cache=True, error_model="numpy")
+def far_skeleton_pixels(W, sk, px, st, lab, starts):
+    """For each start cell, the skeleton pixel of its region farthest from it (BFS steps).
+
+    A start that is not a skeleton pixel is first followed down its parent chain.
+    """
     sk_flat = sk.ravel()
-    # small local BFS with a hash-free visited set: use a dictionary-free array over the bbox
-    q = [start]
-    seen = {start: 0}
-    head = 0
-    far = start
-    while head < len(q):
-        i = q[head]
-        head += 1
+    n_px = px.size
+    stamp = np.full(n_px, -1, np.int32)
+    q = np.empty(n_px + 1, np.int32)
+    out = np.empty(starts.size, np.int64)
+    for s in range(starts.size):
+        i = starts[s]
+        guard = 0
+        while not sk_flat[i] and guard < 1000000:
+            i = st[i]
+            guard += 1
+            if i < 0:
+                break
+        if i < 0:
+            out[s] = starts[s]
+            continue
+        g = lab[i]
+        k0 = st[i]
+        head = 0
+        tail = 0
+        q[tail] = k0
+        tail += 1
+        stamp[k0] = s
         far = i
-        for dr in range(-1, 2):
-            for dc in range(-1, 2):
-                j = i + dr * W + dc
-                if j >= 0 and j < H * W and sk_flat[j] and lab[j] == label and j not in seen:
-                    seen[j] = 1
-                    q.append(j)
-    return far
+        while head < tail:
+            k = q[head]
+            head += 1
+            c = px[k]
+            far = c
+            for dr in range(-1, 2):
+                for dc in range(-1, 2):
+                    j = c + dr * W + dc
+                    if sk_flat[j] and lab[j] == g:
+                        kj = st[j]
+                        if stamp[kj] != s:
+                            stamp[kj] = s
+                            q[tail] = kj
+                            tail += 1
+        out[s] = far
+    return out
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1346,88 +2004,104 @@ def far_skeleton_pixel(W, sk, lab, start, label):
 # ----------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
-def tree_paths(parent, depth, starts, ends, pre, post):
-    """Tree path from ``starts[k]`` to ``ends[k]`` (through their lowest common ancestor).
+@njit(cache=True, error_model="numpy")
+def _down_to_skeleton(st, sk_flat, cell, buf):
+    """Cells from ``cell`` along parents down to its skeleton pixel (inclusive) into ``buf``."""
+    n = 0
+    i = cell
+    while i >= 0:
+        if n >= buf.size:
+            return -1
+        buf[n] = i
+        n += 1
+        if sk_flat[i]:
+            return n
+        i = st[i]
+    return -1
 
-    ``pre[k]`` / ``post[k]`` (>= 0) are cells prepended / appended. Returns flat cells + offsets;
-    an empty path (different trees) yields just the end points.
+
+@njit(cache=True, error_model="numpy")
+def tree_paths(sk, px, st, sk_par, sk_dep, starts, ends, pre, post):
+    """Path from ``starts[k]`` to ``ends[k]`` through their region's tree.
+
+    Each end climbs its parent chain to the skeleton; the two skeleton pixels are joined through
+    their lowest common ancestor in the skeleton tree. ``pre[k]`` / ``post[k]`` (>= 0) are cells
+    prepended / appended. Returns flat cells and offsets.
     """
+    sk_flat = sk.ravel()
     n = starts.size
     off = np.zeros(n + 1, np.int64)
-    total = 0
-    for k in range(n):
-        a = starts[k]
-        b = ends[k]
-        da = depth[a]
-        db = depth[b]
-        ln = 0
-        while da > db:
-            a = parent[a]
-            da -= 1
-            ln += 1
-        while db > da:
-            b = parent[b]
-            db -= 1
-            ln += 1
-        while a != b and a >= 0 and b >= 0:
-            a = parent[a]
-            b = parent[b]
-            ln += 2
-        total += ln + 3
-    out = np.empty(total, np.int64)
-    tmp = np.empty(0, np.int64)
+    cap = 1024
+    out = np.empty(cap, np.int64)
+    bufa = np.empty(4096, np.int64)
+    bufb = np.empty(4096, np.int64)
+    tmp = np.empty(1024, np.int64)
     p = 0
     for k in range(n):
+        na = _down_to_skeleton(st, sk_flat, starts[k], bufa)
+        nb = _down_to_skeleton(st, sk_flat, ends[k], bufb)
+        # worst case length of this path
+        if na < 0 or nb < 0:
+            need = 4
+        else:
+            ka = st[bufa[na - 1]]
+            kb = st[bufb[nb - 1]]
+            need = na + nb + sk_dep[ka] + sk_dep[kb] + 4
+        if p + need > cap:
+            while p + need > cap:
+                cap *= 2
+            grown = np.empty(cap, np.int64)
+            grown[:p] = out[:p]
+            out = grown
         if pre[k] >= 0:
             out[p] = pre[k]
             p += 1
-        a = starts[k]
-        b = ends[k]
-        da = depth[a]
-        db = depth[b]
-        # climb a to the LCA writing forward, climb b collecting backwards
-        la = 0
-        aa = a
-        bb = b
-        dda = da
-        ddb = db
-        while dda > ddb:
-            aa = parent[aa]
-            dda -= 1
-        while ddb > dda:
-            bb = parent[bb]
-            ddb -= 1
-        while aa != bb and aa >= 0 and bb >= 0:
-            aa = parent[aa]
-            bb = parent[bb]
-        lca = aa if aa == bb else -1
-        x = a
-        while x != lca and x >= 0:
-            out[p] = x
+        if na < 0 or nb < 0:
+            out[p] = starts[k]
             p += 1
-            la += 1
-            x = parent[x]
-        if lca >= 0:
-            out[p] = lca
+            out[p] = ends[k]
             p += 1
-        # b side
-        cnt = 0
-        x = b
-        while x != lca and x >= 0:
-            cnt += 1
-            x = parent[x]
-        if tmp.size < cnt:
-            tmp = np.empty(cnt * 2 + 4, np.int64)
-        x = b
-        m = 0
-        while x != lca and x >= 0:
-            tmp[m] = x
-            m += 1
-            x = parent[x]
-        for t in range(m - 1, -1, -1):
-            out[p] = tmp[t]
-            p += 1
+        else:
+            for t in range(na - 1):
+                out[p] = bufa[t]
+                p += 1
+            a = ka
+            b = kb
+            da = sk_dep[a]
+            db = sk_dep[b]
+            while da > db:
+                out[p] = px[a]
+                p += 1
+                a = sk_par[a]
+                da -= 1
+            m = 0
+            if tmp.size < db + 2:
+                tmp = np.empty(2 * db + 4, np.int64)
+            while db > da:
+                tmp[m] = px[b]
+                m += 1
+                b = sk_par[b]
+                db -= 1
+            while a != b and a >= 0 and b >= 0:
+                out[p] = px[a]
+                p += 1
+                if tmp.size < m + 2:
+                    grown = np.empty(2 * tmp.size, np.int64)
+                    grown[:m] = tmp[:m]
+                    tmp = grown
+                tmp[m] = px[b]
+                m += 1
+                a = sk_par[a]
+                b = sk_par[b]
+            if a == b and a >= 0:
+                out[p] = px[a]
+                p += 1
+            for t in range(m - 1, -1, -1):
+                out[p] = tmp[t]
+                p += 1
+            for t in range(nb - 2, -1, -1):
+                out[p] = bufb[t]
+                p += 1
         if post[k] >= 0:
             out[p] = post[k]
             p += 1
@@ -1435,8 +2109,8 @@ def tree_paths(parent, depth, starts, ends, pre, post):
     return out[:p].copy(), off
 
 
-@njit(cache=True)
-def _line_ok(W, r0, c0, r1, c1, cs_flat, lab, barrier, region):
+@njit(cache=True, error_model="numpy")
+def _line_ok(W, r0, c0, r1, c1, d_flat, min_clear, lab, region, first, last):
     dr = r1 - r0
     dc = c1 - c0
     n = max(abs(dr), abs(dc)) * 2
@@ -1446,24 +2120,30 @@ def _line_ok(W, r0, c0, r1, c1, cs_flat, lab, barrier, region):
         rr = int(np.floor(r0 + 0.5 + dr * s / n))
         cc = int(np.floor(c0 + 0.5 + dc * s / n))
         i = rr * W + cc
-        if not cs_flat[i]:
-            return False
-        if lab[i] != region and barrier[i] == 0:
+        if i == first or i == last:
+            continue
+        if d_flat[i] < min_clear or lab[i] != region:
             return False
     return True
 
 
-@njit(cache=True)
-def smooth_paths(W, cells, off, regions, cs_flat, lab, barrier, max_seg_cells, res_m):
-    """Greedy line-of-sight shortcuts inside each path's region and C-space.
+@njit(cache=True, error_model="numpy")
+def smooth_paths(W, cells, off, regions, dcell, min_clear, lab, tol_cells, res_m):
+    """Simplify each tree path (Douglas-Peucker, ``tol_cells``) keeping every segment in C-space.
 
-    Returns vertex cells (flat), offsets and lengths in metres. A path of one cell is doubled.
+    A segment that would leave the path's region or the configuration space is split at its
+    farthest point, whatever the tolerance. Returns vertex cells (flat), offsets and lengths in
+    metres; a path of one cell is doubled.
     """
+    d_flat = dcell.ravel()
     n = off.size - 1
     out = np.empty(cells.size + 2 * n, np.int64)
     ooff = np.zeros(n + 1, np.int64)
     lengths = np.zeros(n, np.float64)
+    keep = np.zeros(cells.size, np.uint8)
+    stack = np.empty(2 * cells.size + 2, np.int64)
     p = 0
+    tol2 = tol_cells * tol_cells
     for k in range(n):
         lo = off[k]
         hi = off[k + 1]
@@ -1471,37 +2151,104 @@ def smooth_paths(W, cells, off, regions, cs_flat, lab, barrier, max_seg_cells, r
         if m == 0:
             ooff[k + 1] = p
             continue
-        g = regions[k]
-        out[p] = cells[lo]
-        p += 1
         if m == 1:
             out[p] = cells[lo]
-            p += 1
+            out[p + 1] = cells[lo]
+            p += 2
             ooff[k + 1] = p
             continue
-        i = 0
-        length = 0.0
-        while i < m - 1:
-            a = cells[lo + i]
+        g = regions[k]
+        first = cells[lo]
+        last = cells[hi - 1]
+        keep[lo] = 1
+        keep[hi - 1] = 1
+        top = 0
+        stack[top] = lo
+        stack[top + 1] = hi - 1
+        top += 2
+        while top > 0:
+            top -= 2
+            i0 = stack[top]
+            i1 = stack[top + 1]
+            if i1 - i0 < 2:
+                continue
+            a = cells[i0]
+            b = cells[i1]
             ar = a // W
             ac = a - ar * W
-            j = i + 1
-            while j + 1 < m:
-                b = cells[lo + j + 1]
-                br = b // W
-                bc = b - br * W
-                if max_seg_cells > 0 and (br - ar) ** 2 + (bc - ac) ** 2 > max_seg_cells * max_seg_cells:
-                    break
-                if not _line_ok(W, ar, ac, br, bc, cs_flat, lab, barrier, g):
-                    break
-                j += 1
-            b = cells[lo + j]
             br = b // W
             bc = b - br * W
-            length += np.sqrt((br - ar) ** 2 + (bc - ac) ** 2)
-            out[p] = b
-            p += 1
-            i = j
+            dr = float(br - ar)
+            dc = float(bc - ac)
+            den = dr * dr + dc * dc
+            worst = -1.0
+            wi = i0 + 1
+            for i in range(i0 + 1, i1):
+                q = cells[i]
+                qr = q // W
+                qc = q - qr * W
+                if den > 0:
+                    cr = (qr - ar) * dc - (qc - ac) * dr
+                    dist2 = cr * cr / den
+                else:
+                    dist2 = float((qr - ar) ** 2 + (qc - ac) ** 2)
+                if dist2 > worst:
+                    worst = dist2
+                    wi = i
+            if worst > tol2 or not _line_ok(
+                W, ar, ac, br, bc, d_flat, min_clear, lab, g, first, last
+            ):
+                keep[wi] = 1
+                stack[top] = i0
+                stack[top + 1] = wi
+                stack[top + 2] = wi
+                stack[top + 3] = i1
+                top += 4
+        length = 0.0
+        prev = -1
+        for i in range(lo, hi):
+            if keep[i]:
+                keep[i] = 0
+                c = cells[i]
+                if prev >= 0:
+                    pr = prev // W
+                    pc = prev - pr * W
+                    cr = c // W
+                    length += np.sqrt((cr - pr) ** 2 + (c - cr * W - pc) ** 2)
+                out[p] = c
+                p += 1
+                prev = c
         lengths[k] = length * res_m
         ooff[k + 1] = p
     return out[:p].copy(), ooff, lengths
+
+
+@njit(cache=True, error_model="numpy")
+def join_legs(xy, off, legs_a, legs_b):
+    """Concatenate leg ``a`` with the reverse of leg ``b`` (minus its last point) per pair.
+
+    Legs are slices ``xy[off[i]:off[i + 1]]`` ending at a shared point (an intersection centre).
+    Returns flat points and offsets.
+    """
+    n = legs_a.size
+    total = 0
+    for k in range(n):
+        a = legs_a[k]
+        b = legs_b[k]
+        total += (off[a + 1] - off[a]) + (off[b + 1] - off[b]) - 1
+    out = np.empty((max(total, 0), 2), np.float64)
+    ooff = np.zeros(n + 1, np.int64)
+    p = 0
+    for k in range(n):
+        a = legs_a[k]
+        b = legs_b[k]
+        for i in range(off[a], off[a + 1]):
+            out[p, 0] = xy[i, 0]
+            out[p, 1] = xy[i, 1]
+            p += 1
+        for i in range(off[b + 1] - 2, off[b] - 1, -1):
+            out[p, 0] = xy[i, 0]
+            out[p, 1] = xy[i, 1]
+            p += 1
+        ooff[k + 1] = p
+    return out, ooff

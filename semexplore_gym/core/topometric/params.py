@@ -22,6 +22,10 @@ class SegmentationParams:
             less than ``spur_ratio * r + min_dead_end_depth_m`` beyond the junction's inscribed
             circle of radius ``r`` (room corners protrude about ``0.41 r``). Dimensionless.
         min_dead_end_depth_m: See ``spur_ratio``: the smallest dead end (niche) kept.
+        neck_ratio: A branch is also kept when it has a corridor stretch: clearance within 25 %
+            of its maximum ``m <= neck_ratio * r`` over at least ``min_dead_end_depth_m + m/2``
+            (a dead-end corridor or closet off a big room; a room corner, whose clearance
+            changes steadily along its branch, has none). Dimensionless.
         core_radius_ratio: An intersection's core is the inscribed circle of each of its
             junctions scaled by this factor; openings are searched outside it. Junctions whose
             cores overlap along the skeleton are merged into one intersection. Dimensionless.
@@ -32,12 +36,14 @@ class SegmentationParams:
         min_frontier_width_m: A frontier (reachable free cells next to unknown) must be at
             least this wide; ``None`` means the robot width ``2 * clearance``.
         min_frontier_depth_m: The unknown space behind a frontier must be at least this deep
-            (rejects unknown slivers along walls); ``None`` means ``clearance``.
+            (rejects unknown slivers along walls, where the robot could not go); ``None`` means
+            the robot width ``2 * clearance``.
         cover_depth_m: How far beyond the robot's configuration space the per-cell area raster
             extends (so room corners and wall-side cells get an area); ``None`` means
             ``2 * clearance + 2 cells``.
-        path_max_segment_m: Longest straight segment when paths are shortcut along lines of
-            sight inside their area (<= 0: no limit).
+        path_tolerance_m: Paths follow the area's skeleton and are simplified (Douglas-Peucker)
+            to within this distance of it; every simplified segment stays in the configuration
+            space of its area (0 keeps every cell).
         match_radius_m: Areas without cells (frontier pathways on an intersection wall) keep
             their id across updates when their frontier moved less than this.
         chord_search_deg: An opening is the shortest wall-to-wall chord through its skeleton
@@ -50,13 +56,14 @@ class SegmentationParams:
     max_hole_area_m2: float = 0.1
     spur_ratio: float = 0.5
     min_dead_end_depth_m: float = 0.25
+    neck_ratio: float = 0.7
     core_radius_ratio: float = 1.0
     opening_distance_weight: float = 0.5
     min_pathway_length_m: float = 0.1
     min_frontier_width_m: float | None = None
     min_frontier_depth_m: float | None = None
     cover_depth_m: float | None = None
-    path_max_segment_m: float = 2.0
+    path_tolerance_m: float = 0.1
     match_radius_m: float = 0.5
     chord_search_deg: float = 40.0
     max_prune_iterations: int = 8
@@ -69,22 +76,30 @@ class SegmentationParams:
                 if not isinstance(v, bool):
                     raise TypeError(f"SegmentationParams.keep_debug must be a bool, got {v!r}")
                 continue
-            if v is None and f.name in ("min_frontier_width_m", "min_frontier_depth_m", "cover_depth_m"):
+            if v is None and f.name in (
+                "min_frontier_width_m",
+                "min_frontier_depth_m",
+                "cover_depth_m",
+            ):
                 continue
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise TypeError(f"SegmentationParams.{f.name} must be a number, got {v!r}")
             if not math.isfinite(v):
                 raise ValueError(f"SegmentationParams.{f.name} must be finite, got {v!r}")
-            if f.name == "path_max_segment_m":
-                continue
             if v < 0:
                 raise ValueError(f"SegmentationParams.{f.name} must be >= 0, got {v!r}")
         if self.core_radius_ratio <= 0:
-            raise ValueError(f"SegmentationParams.core_radius_ratio must be > 0, got {self.core_radius_ratio!r}")
+            raise ValueError(
+                f"SegmentationParams.core_radius_ratio must be > 0, got {self.core_radius_ratio!r}"
+            )
         if not 0 <= self.chord_search_deg <= 80:
-            raise ValueError(f"SegmentationParams.chord_search_deg must be in [0, 80], got {self.chord_search_deg!r}")
+            raise ValueError(
+                f"SegmentationParams.chord_search_deg must be in [0, 80], got {self.chord_search_deg!r}"
+            )
         if int(self.max_prune_iterations) != self.max_prune_iterations:
-            raise ValueError(f"SegmentationParams.max_prune_iterations must be an integer, got {self.max_prune_iterations!r}")
+            raise ValueError(
+                f"SegmentationParams.max_prune_iterations must be an integer, got {self.max_prune_iterations!r}"
+            )
 
     @classmethod
     def from_dict(cls, d: dict) -> SegmentationParams:
@@ -92,5 +107,7 @@ class SegmentationParams:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(d) - known)
         if unknown:
-            raise ValueError(f"unknown SegmentationParams key(s): {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+            raise ValueError(
+                f"unknown SegmentationParams key(s): {', '.join(unknown)}; known: {', '.join(sorted(known))}"
+            )
         return cls(**d)

@@ -14,18 +14,26 @@ Algorithm (a clearance-aware skeleton segmentation, in the spirit of GRID-FAST's
    a graph under m-adjacency: nodes are junction blobs and end points, edges are pixel chains.
 4. **Pruning.** A branch from a junction ``J`` (inscribed radius ``r``) to an end ``E`` is a spur
    when it protrudes less than ``spur_ratio * r + min_dead_end_depth_m`` beyond the inscribed
-   circle (``|E - J| + d(E) - r``): room corners (about ``0.41 r``), wall noise and shallow
-   niches go; real dead ends stay. Repeated until nothing changes.
+   circle (``|E - J| + d(E) - r``) *and* has no corridor stretch (clearance within 25 % of its
+   maximum ``m <= neck_ratio * r`` over ``min_dead_end_depth_m + m/2``): room corners (they
+   protrude about ``0.41 r``), wall noise and shallow niches go; dead-end corridors and closets
+   stay, however big the room they leave. A junction never loses all but one branch in a round
+   (its longest spur waits for the next round, judged as part of the branch it continues).
+   Repeated until nothing changes.
 5. **Intersections and openings.** Every edge end at a junction leaves the junction's core (its
    inscribed circle times ``core_radius_ratio``). When the cores of the two junctions of an edge
    overlap along it (less than ``min_pathway_length_m`` between them), the junctions merge into
    one intersection (a room's several skeleton junctions become one). Otherwise an opening is
    placed on the edge just outside the core, slid outwards to the narrowest point
-   (``2 d + opening_distance_weight * s`` minimal). The opening's segment is the shortest
-   wall-to-wall chord through that skeleton point (within ``chord_search_deg`` of the normal).
+   (``2 d + opening_distance_weight * s`` minimal) and, at a mouth where the chord is longer
+   than the inscribed width, moved a few pixels to the shortest chord (a door, not the room in
+   front of it). The opening's segment is the shortest wall-to-wall chord through that skeleton
+   point (within ``chord_search_deg`` of the normal); it is never narrower than the robot.
 6. **Regions.** Openings cut the skeleton into regions (union-find over nodes and edge pieces);
-   each region grows over ``C`` and then over the rest of free space (``cover_depth_m``), never
-   across an opening chord, giving a per-cell area raster and one shortest-path tree per region.
+   each region grows by BFS over ``C`` and then, by a row sweep and a short BFS, over the rest
+   of free space within ``cover_depth_m``, never across an opening chord: a per-cell area raster
+   and one shortest-path tree per region (skeleton tree from the region's centre, C-space cells
+   hanging from it).
 7. **Frontiers.** Labelled free cells 4-adjacent to unknown are clustered per region. A cluster
    at least ``min_frontier_width_m`` wide with at least ``min_frontier_depth_m`` of unknown behind
    it is a frontier; its target is the nearest configuration-space cell (where the robot can
@@ -35,7 +43,8 @@ Algorithm (a clearance-aware skeleton segmentation, in the spirit of GRID-FAST's
    (a *frontier pathway* when it is a frontier: a lone corridor or the robot's first scan). A
    frontier on an intersection's wall gets a zero-area frontier pathway, as in GRID-FAST.
 9. **Paths and graph.** Per area, paths follow its tree (skeleton and configuration space) and
-   are shortcut along lines of sight inside the area's ``C``: opening -> centre (intersections),
+   are simplified (Douglas-Peucker, ``path_tolerance_m``) with every segment kept inside the
+   area's ``C``: opening -> centre (intersections),
    opening -> opening (pathways), opening -> far end (dead ends). Graph edges join the openings
    of each area with metric lengths. ``p_l`` is the graph distance from a frontier to the nearest
    intersection; ``L_path`` the mean centre-to-centre length between adjacent intersections.
@@ -43,12 +52,15 @@ Algorithm (a clearance-aware skeleton segmentation, in the spirit of GRID-FAST's
     overlaps most (one-to-one, by position in the world frame), so ids are stable while the map
     grows; zero-area frontier pathways are matched by frontier position.
 
-Cost is linear in the number of cells (no pairwise loops over openings). See
-``scripts/bench_segmentation.py`` for measured times.
+Cost is linear in the number of cells (no pairwise loops over openings): numba kernels for the
+grid work, Python only to build the output records. See ``scripts/bench_segmentation.py`` for
+measured times. The kernels are compiled once per machine (numba cache); a new process loads
+them on its first call.
 """
 
 from __future__ import annotations
 
+import gc
 import heapq
 import math
 import time
@@ -57,12 +69,77 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, from_ros_values, validate_encoded_grid
+from semexplore_gym.core.grid import (
+    FREE,
+    OCCUPIED,
+    UNKNOWN,
+    GridGeometry,
+    from_ros_values,
+    validate_encoded_grid,
+)
 from semexplore_gym.core.topometric import _kernels as K
 from semexplore_gym.core.topometric.params import SegmentationParams
-from semexplore_gym.core.topometric.types import Area, AreaType, Frontier, GraphEdge, Opening, TopometricMap
+from semexplore_gym.core.topometric.types import (
+    Area,
+    AreaType,
+    Frontier,
+    GraphEdge,
+    Opening,
+    TopometricMap,
+)
 
 _MARGIN = 2
+_new = object.__new__
+_set = object.__setattr__
+
+
+# The generated ``__init__`` of a frozen dataclass assigns each field through
+# ``object.__setattr__``; for the thousands of records of a large map that is most of the
+# assembly time. These builders fill the instance dict directly. The records have no
+# ``__post_init__``, so the result is the same object (tests compare it with the constructor).
+def _opening(i, endpoints, mid, width, area_ids, frontier, anchor) -> Opening:
+    o = _new(Opening)
+    _set(
+        o,
+        "__dict__",
+        {
+            "id": i,
+            "endpoints_m": endpoints,
+            "midpoint_m": mid,
+            "width_m": width,
+            "area_ids": area_ids,
+            "is_frontier": frontier,
+            "anchor_m": anchor,
+        },
+    )
+    return o
+
+
+def _area(i, t, centre, opening_ids, paths, n_cells) -> Area:
+    o = _new(Area)
+    _set(
+        o,
+        "__dict__",
+        {
+            "id": i,
+            "type": t,
+            "centre_m": centre,
+            "opening_ids": opening_ids,
+            "paths_m": paths,
+            "n_cells": n_cells,
+        },
+    )
+    return o
+
+
+def _edge(a, b, area_id, length, path) -> GraphEdge:
+    o = _new(GraphEdge)
+    _set(
+        o,
+        "__dict__",
+        {"opening_a": a, "opening_b": b, "area_id": area_id, "length_m": length, "path_m": path},
+    )
+    return o
 
 
 # ----------------------------------------------------------------------------------------------
@@ -86,7 +163,9 @@ def _as_encoded_grid(grid: npt.ArrayLike) -> np.ndarray:
     return from_ros_values(a)
 
 
-def _as_geometry(geometry_or_resolution: GridGeometry | float, shape: tuple[int, int]) -> GridGeometry:
+def _as_geometry(
+    geometry_or_resolution: GridGeometry | float, shape: tuple[int, int]
+) -> GridGeometry:
     if isinstance(geometry_or_resolution, GridGeometry):
         g = geometry_or_resolution
         if g.shape != shape:
@@ -94,15 +173,21 @@ def _as_geometry(geometry_or_resolution: GridGeometry | float, shape: tuple[int,
         return g
     res = geometry_or_resolution
     if isinstance(res, bool) or not isinstance(res, (int, float, np.integer, np.floating)):
-        raise TypeError(f"geometry_or_resolution must be a GridGeometry or a resolution in metres, got {type(res).__name__}")
+        raise TypeError(
+            f"geometry_or_resolution must be a GridGeometry or a resolution in metres, got {type(res).__name__}"
+        )
     res = float(res)
     if not (math.isfinite(res) and res > 0):
-        raise ValueError(f"resolution_m must be a positive finite number, got {geometry_or_resolution!r}")
+        raise ValueError(
+            f"resolution_m must be a positive finite number, got {geometry_or_resolution!r}"
+        )
     return GridGeometry(res, 0.0, 0.0, shape[0], shape[1])
 
 
 def _check_clearance(clearance_m: float) -> float:
-    if isinstance(clearance_m, bool) or not isinstance(clearance_m, (int, float, np.integer, np.floating)):
+    if isinstance(clearance_m, bool) or not isinstance(
+        clearance_m, (int, float, np.integer, np.floating)
+    ):
         raise TypeError(f"clearance_m must be a number of metres, got {type(clearance_m).__name__}")
     c = float(clearance_m)
     if not (math.isfinite(c) and c >= 0):
@@ -154,10 +239,24 @@ def segment_map(
         raise TypeError(f"params must be a SegmentationParams, got {type(params).__name__}")
     if previous is not None and not isinstance(previous, TopometricMap):
         raise TypeError(f"previous must be a TopometricMap or None, got {type(previous).__name__}")
-    return _Segmenter(enc, geometry, clearance, params, previous, t_start).run()
+    # Thousands of small records are built at once: collector passes over them would cost more
+    # than the segmentation itself on large maps, so the collector is paused for the call.
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _Segmenter(enc, geometry, clearance, params, previous, t_start).run()
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
-def _empty_map(geometry: GridGeometry, clearance: float, previous: TopometricMap | None, t_start: float, stage_ms: dict) -> TopometricMap:
+def _empty_map(
+    geometry: GridGeometry,
+    clearance: float,
+    previous: TopometricMap | None,
+    t_start: float,
+    stage_ms: dict,
+) -> TopometricMap:
     next_id = _next_id_of(previous)
     return TopometricMap(
         geometry=geometry,
@@ -221,31 +320,46 @@ class _Segmenter:
         self.work = work
         H, W = work.shape
         self.H, self.W = H, W
-
         cell_area = res * res
-        K.filter_small_blobs(work, int(p.max_speckle_area_m2 / cell_area + 1e-9), int(p.max_hole_area_m2 / cell_area + 1e-9))
-        free = work == FREE
-        self.free = free
+        _, self.fcand = K.filter_small_blobs(
+            work,
+            int(p.max_speckle_area_m2 / cell_area + 1e-9),
+            int(p.max_hole_area_m2 / cell_area + 1e-9),
+        )
         self._lap("filter")
 
-        dcell, cs_u8 = K.clearance_field(free, self.clear_m / res - 1e-6)
-        cspace = cs_u8.view(np.bool_)
+        self.min_clear = self.clear_m / res - 1e-6
+        dcell, sk, c_list, n_free = K.clearance_field(work, self.min_clear)
         self.dcell = dcell
-        self.cspace = cspace
         self._lap("distance")
-        if not cspace.any():
-            return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
-
-        sk, px = K.thin(cs_u8)
+        if p.keep_debug:
+            self.cspace_debug = sk.astype(bool)
+        px = K.thin(sk, c_list)  # sk: C-space mask, thinned in place to the skeleton
         self._lap("skeleton")
+        if px.size == 0:
+            return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
 
         st = np.full(H * W, -1, dtype=np.int32)
         min_depth_cells = p.min_dead_end_depth_m / res
-        graph = None
         for _ in range(max(1, int(p.max_prune_iterations))):
             graph = self._extract(sk, px, dcell, st)
-            spur = K.spur_pixels(W, graph["rep"], graph["r"], graph["deg"], graph["noff"], graph["npx"], graph["ne"],
-                                 graph["ea"], graph["eb"], graph["eoff"], graph["epx"], dcell, p.spur_ratio, min_depth_cells)
+            spur = K.spur_pixels(
+                W,
+                graph["rep"],
+                graph["r"],
+                graph["deg"],
+                graph["noff"],
+                graph["npx"],
+                graph["ne"],
+                graph["ea"],
+                graph["eb"],
+                graph["eoff"],
+                graph["epx"],
+                dcell,
+                p.spur_ratio,
+                min_depth_cells,
+                p.neck_ratio,
+            )
             if spur.size == 0:
                 break
             sk.ravel()[spur] = 0
@@ -257,363 +371,460 @@ class _Segmenter:
         self._lap("graph")
 
         internal, open_a, open_b = K.place_openings(
-            W, graph["n"], graph["rep"], graph["r"], graph["deg"], graph["ne"], graph["ea"], graph["eb"], graph["eoff"],
-            graph["epx"], dcell, free, p.core_radius_ratio, p.opening_distance_weight,
-            max(2, int(round(p.min_pathway_length_m / res))), math.radians(p.chord_search_deg),
+            W,
+            graph["n"],
+            graph["rep"],
+            graph["r"],
+            graph["deg"],
+            graph["ne"],
+            graph["ea"],
+            graph["eb"],
+            graph["eoff"],
+            graph["epx"],
+            dcell,
+            work,
+            p.core_radius_ratio,
+            p.opening_distance_weight,
+            max(2, int(round(p.min_pathway_length_m / res))),
+            math.radians(p.chord_search_deg),
         )
         lab = np.full(H * W, -1, dtype=np.int32)
-        n_reg, node_reg, mid_reg, op_px, op_edge, op_idx, op_core, op_far = K.build_regions(
-            graph["n"], graph["alive"], graph["noff"], graph["npx"], graph["ne"], graph["ea"], graph["eb"], graph["eoff"],
-            graph["epx"], internal, open_a, open_b, lab,
+        n_reg, _node_reg, _mid_reg, op_px, op_edge, op_idx, op_core, op_far = K.build_regions(
+            graph["n"],
+            graph["alive"],
+            graph["noff"],
+            graph["npx"],
+            graph["ne"],
+            graph["ea"],
+            graph["eb"],
+            graph["eoff"],
+            graph["epx"],
+            internal,
+            open_a,
+            open_b,
+            lab,
         )
-        barrier = np.zeros(H * W, dtype=np.int32)
-        ends, widths = K.opening_chords(
-            free, dcell, op_px, op_edge, op_idx, graph["eoff"], graph["epx"], barrier, 4, math.radians(p.chord_search_deg)
+        ends, widths, chord_cells = K.opening_chords(
+            work,
+            dcell,
+            op_px,
+            op_edge,
+            op_idx,
+            graph["eoff"],
+            graph["epx"],
+            lab,
+            3,
+            math.radians(p.chord_search_deg),
         )
         self._lap("openings")
 
-        centres = K.region_centres(px, lab, dcell, n_reg)
-        parent = np.full(H * W, -1, dtype=np.int32)
-        depth = np.zeros(H * W, dtype=np.int32)
+        centres = K.region_centres(px, lab, dcell, n_reg, W)
         cover_m = p.cover_depth_m if p.cover_depth_m is not None else 2.0 * self.clear_m + 2.0 * res
-        K.grow_regions(W, sk, px, centres, lab, cspace, free, barrier, op_core, int(math.ceil(cover_m / res)), parent, depth)
-        self.lab, self.parent, self.depth, self.barrier = lab, parent, depth, barrier
+        sk_par, sk_dep, cells, counts = K.grow_regions(
+            W,
+            sk,
+            px,
+            st,
+            centres,
+            lab,
+            dcell,
+            self.min_clear,
+            work,
+            int(math.ceil(cover_m / res - 1e-9)),
+            chord_cells,
+            op_core,
+            n_reg,
+            n_free,
+        )
+        self.lab, self.st, self.sk_par, self.sk_dep, self.cells = lab, st, sk_par, sk_dep, cells
         self._lap("regions")
 
-        fronts = self._frontiers(n_reg)
+        self.n_reg = n_reg
+        fronts = self._frontiers()
         self._lap("frontiers")
 
         side_core, side_far = self._opening_sides(graph, op_edge, op_idx, open_a)
-        return self._assemble(n_reg, centres, op_px, op_core, op_far, ends, widths, side_core, side_far, fronts)
+        return self._assemble(
+            n_reg,
+            centres,
+            counts,
+            op_px,
+            op_core,
+            op_far,
+            ends,
+            widths,
+            side_core,
+            side_far,
+            fronts,
+        )
 
     # ------------------------------------------------------------------------------------------
     def _extract(self, sk, px, dcell, st) -> dict[str, Any]:
         (n, rep, r, deg, noff, npx, ne, ea, eb, eoff, epx) = K.extract_graph(sk, px, dcell, st)
         alive = np.ones(n, dtype=np.bool_)
         if ne and np.any(deg == 2):
-            alive, ne, ea, eb, eoff, epx = K.splice_pass_nodes(n, deg, noff, npx, ne, ea, eb, eoff, epx)
-            deg = np.zeros(n, dtype=np.int64)
-            np.add.at(deg, ea, 1)
-            np.add.at(deg, eb, 1)
-        return {"n": n, "rep": rep, "r": r, "deg": deg, "noff": noff, "npx": npx, "ne": ne, "ea": ea, "eb": eb,
-                "eoff": eoff, "epx": epx, "alive": alive}
+            alive, ne, ea, eb, eoff, epx = K.splice_pass_nodes(
+                n, deg, noff, npx, ne, ea, eb, eoff, epx
+            )
+            deg = np.bincount(ea, minlength=n) + np.bincount(eb, minlength=n)
+        return {
+            "n": n,
+            "rep": rep,
+            "r": r,
+            "deg": deg,
+            "noff": noff,
+            "npx": npx,
+            "ne": ne,
+            "ea": ea,
+            "eb": eb,
+            "eoff": eoff,
+            "epx": epx,
+            "alive": alive,
+        }
 
     def _opening_sides(self, graph, op_edge, op_idx, open_a):
-        """Region cells on either side of each opening pixel (core side, far side)."""
+        """Skeleton pixels on either side of each opening pixel (core side, far side)."""
         eoff, epx, ea, eb, rep = graph["eoff"], graph["epx"], graph["ea"], graph["eb"], graph["rep"]
-        n = op_edge.size
-        side_core = np.empty(n, dtype=np.int64)
-        side_far = np.empty(n, dtype=np.int64)
-        for k in range(n):
-            e = int(op_edge[k])
-            lo, hi = int(eoff[e]), int(eoff[e + 1])
-            i = int(op_idx[k])
-            at_a = open_a[e] == i
-            if at_a:
-                side_core[k] = epx[lo + i - 1] if i >= 1 else rep[ea[e]]
-                side_far[k] = epx[lo + i + 1]
-            else:
-                side_core[k] = epx[lo + i + 1] if lo + i + 1 < hi else rep[eb[e]]
-                side_far[k] = epx[lo + i - 1]
-        return side_core, side_far
+        lo = eoff[op_edge]
+        hi = eoff[op_edge + 1]
+        at_a = open_a[op_edge] == op_idx
+        pos = lo + op_idx
+        prev_px = epx[np.maximum(pos - 1, 0)]
+        next_px = epx[np.minimum(pos + 1, epx.size - 1)]
+        side_core = np.where(
+            at_a,
+            np.where(op_idx >= 1, prev_px, rep[ea[op_edge]]),
+            np.where(pos + 1 < hi, next_px, rep[eb[op_edge]]),
+        )
+        side_far = np.where(at_a, next_px, prev_px)
+        return side_core.astype(np.int64), side_far.astype(np.int64)
 
     # ------------------------------------------------------------------------------------------
-    def _frontiers(self, n_reg: int) -> list[dict]:
-        """Valid frontier groups: dicts with region, cells, width, endpoints, mid cell, anchor."""
+    def _frontiers(self) -> dict[str, np.ndarray]:
+        """Valid frontiers as arrays: region, width (cells), end cells, middle cell, target cell."""
         p = self.p
         res = self.res
-        W = self.W
-        lab = self.lab
-        cells, cluster, orow, ocol, n_cl = K.frontier_cells(W, self.work, lab)
-        if n_cl == 0:
-            return []
-        min_w_cells = (p.min_frontier_width_m if p.min_frontier_width_m is not None else 2.0 * self.clear_m) / res
-        depth_cells = (p.min_frontier_depth_m if p.min_frontier_depth_m is not None else self.clear_m) / res
-        regs = lab[cells].astype(np.int64)
-        order = np.argsort(cluster, kind="stable")
-        bounds = np.searchsorted(cluster[order], np.arange(n_cl + 1))
-        cs_flat = self.cspace.ravel()
-        out: list[dict] = []
-        for k in range(n_cl):
-            idx = order[bounds[k] : bounds[k + 1]]
-            if idx.size == 0:
-                continue
-            rk = regs[idx]
-            if rk.min() == rk.max():
-                groups = [(idx, int(rk[0]))]
-            else:
-                # a frontier seen from several areas: split it when each part is wide enough,
-                # else give all of it to the area holding most of it
-                parts = [(idx[rk == g], int(g)) for g in np.unique(rk)]
-                groups = [(q, g) for q, g in parts if _geom(cells[q], W)["width"] + 1e-9 >= min_w_cells]
-                if not groups:
-                    groups = [(idx, max(parts, key=lambda qg: len(qg[0]))[1])]
-            for gidx, region in groups:
-                self._frontier_from(gidx, region, cells, orow, ocol, min_w_cells, depth_cells, cs_flat, out)
-        return out
-
-    def _frontier_from(self, gidx, region, cells, orow, ocol, min_w_cells, depth_cells, cs_flat, out) -> None:
-        W = self.W
-        gc = cells[gidx]
-        geo = _geom(gc, W)
-        if geo["width"] + 1e-9 < min_w_cells:
-            return
-        vr = float(orow[gidx].sum())
-        vc = float(ocol[gidx].sum())
-        nrm = math.hypot(vr, vc)
-        # the target: the configuration-space cell that the frontier cell nearest the middle leads to
-        anchor = -1
-        mid = -1
-        for j in geo["by_centre"][:32]:
-            cell = int(gc[j])
-            a, ok = K.chain_to_tree(self.parent, cs_flat, cell, 10 * (self.H + self.W))
-            if ok and self.lab[a] == region:
-                anchor, mid = int(a), cell
-                break
-        if anchor < 0:
-            return
-        if nrm == 0.0:
-            mr, mc = divmod(mid, W)
-            ar, ac = divmod(anchor, W)
-            vr, vc = float(mr - ar), float(mc - ac)
-            nrm = math.hypot(vr, vc)
-        if nrm > 0.0:
-            ur, uc = vr / nrm, vc / nrm
-            starts = [mid, int(gc[geo["q1"]]), int(gc[geo["q3"]])]
-            if not any(K.unknown_depth_ok(self.work, s // W, s % W, ur, uc, depth_cells) for s in starts):
-                return
-        out.append({
-            "region": region,
-            "n": int(gidx.size),
-            "width_cells": geo["width"],
-            "ends": geo["ends"],
-            "mid_cell": mid,
-            "anchor": anchor,
-        })
+        fc, cluster, orow, ocol, n_cl = K.frontier_cells(self.W, self.work, self.lab, self.fcand)
+        min_w_cells = (
+            p.min_frontier_width_m if p.min_frontier_width_m is not None else 2.0 * self.clear_m
+        ) / res
+        depth_cells = (
+            p.min_frontier_depth_m if p.min_frontier_depth_m is not None else 2.0 * self.clear_m
+        ) / res
+        reg, wid, ends, mid, anchor = K.frontier_groups(
+            self.W,
+            self.work,
+            self.lab,
+            self.st,
+            self.sk,
+            self.dcell,
+            self.min_clear,
+            fc,
+            cluster,
+            orow,
+            ocol,
+            n_cl,
+            float(min_w_cells),
+            float(depth_cells),
+            int(self.n_reg),
+        )
+        return {"region": reg, "width": wid, "ends": ends, "mid": mid, "anchor": anchor}
 
     # ------------------------------------------------------------------------------------------
-    def _to_world(self, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Fractional work-grid (row, col) (cell centres at +0.5) to world metres."""
+    def _xy(self, rows, cols) -> np.ndarray:
+        """Fractional work-grid (row, col) (cell centres at +0.5) to world (x, y) metres, (n, 2)."""
         g = self.g
         x = g.origin_x_m + (np.asarray(cols, dtype=np.float64) + self.c0) * g.resolution_m
         y = g.origin_y_m + (np.asarray(rows, dtype=np.float64) + self.r0) * g.resolution_m
-        return x, y
+        return np.column_stack([np.atleast_1d(x), np.atleast_1d(y)])
 
-    def _cell_xy(self, cell: int) -> tuple[float, float]:
-        r, c = divmod(int(cell), self.W)
-        x, y = self._to_world(np.float64(r + 0.5), np.float64(c + 0.5))
-        return (float(x), float(y))
+    def _cells_xy(self, cells) -> np.ndarray:
+        r, c = np.divmod(np.asarray(cells, dtype=np.int64), self.W)
+        return self._xy(r + 0.5, c + 0.5)
 
-    def _assemble(self, n_reg, centres, op_px, op_core, op_far, ends, widths, side_core, side_far, fronts) -> TopometricMap:
+    def _assemble(
+        self, n_reg, centres, counts, op_px, op_core, op_far, ends, widths, side_core, side_far, fr
+    ) -> TopometricMap:
         p = self.p
         res = self.res
         W = self.W
         lab = self.lab
-        n_op = op_px.size
+        n_op = int(op_px.size)
+        INTER, PATH, DEAD, FRONT = (
+            int(AreaType.INTERSECTION),
+            int(AreaType.PATHWAY),
+            int(AreaType.DEAD_END),
+            int(AreaType.FRONTIER_PATHWAY),
+        )
 
-        # --- types ------------------------------------------------------------------------------
+        # --- types: frontiers count as openings -------------------------------------------------
+        f_reg = fr["region"]
         n_regular = np.bincount(op_core, minlength=n_reg) + np.bincount(op_far, minlength=n_reg)
-        f_reg = np.array([f["region"] for f in fronts], dtype=np.int64)
-        n_front = np.bincount(f_reg, minlength=n_reg) if f_reg.size else np.zeros(n_reg, dtype=np.int64)
+        n_front = np.bincount(f_reg, minlength=n_reg)
         total = n_regular + n_front
-        rtype = np.full(n_reg, int(AreaType.DEAD_END), dtype=np.int64)
-        rtype[total >= 3] = int(AreaType.INTERSECTION)
-        two = total == 2
-        rtype[two & (n_front >= 1)] = int(AreaType.FRONTIER_PATHWAY)
-        rtype[two & (n_front == 0)] = int(AreaType.PATHWAY)
-        rtype[(total == 1) & (n_front == 1)] = int(AreaType.FRONTIER_PATHWAY)
-        n_cells = np.bincount(lab[lab >= 0], minlength=n_reg)
+        rtype = np.full(n_reg, DEAD, dtype=np.int64)
+        rtype[total >= 3] = INTER
+        rtype[(total == 2) & (n_front >= 1)] = FRONT
+        rtype[(total == 2) & (n_front == 0)] = PATH
+        rtype[(total == 1) & (n_front == 1)] = FRONT
+        rtype_l = rtype.tolist()
 
-        # --- openings ---------------------------------------------------------------------------
-        # provisional area index: regions 0..n_reg-1, zero-area frontier pathways after them
-        er0, ec0 = self._to_world(ends[:, 0], ends[:, 1])
-        er1, ec1 = self._to_world(ends[:, 2], ends[:, 3])
-        op_rec: list[dict] = []  # provisional openings
-        for k in range(n_op):
-            op_rec.append({
-                "ends": np.array([[er0[k], ec0[k]], [er1[k], ec1[k]]]),
-                "width": float(widths[k] * res),
-                "areas": (int(op_core[k]), int(op_far[k])),
-                "frontier": False,
-                "anchor": int(op_px[k]),
-            })
+        # --- openings: chords 0..n_op-1, then per frontier a frontier opening, preceded by a twin
+        # (the mouth of a zero-area frontier pathway) when the frontier lies on an intersection
+        op_areas: list[tuple[int, int]] = list(zip(op_core.tolist(), op_far.tolist(), strict=True))
+        op_front_idx: list[int] = [-1] * n_op  # frontier index of the opening (-1 for chords)
+        op_is_front: list[bool] = [False] * n_op
         region_ops: list[list[int]] = [[] for _ in range(n_reg)]
-        for k in range(n_op):
-            region_ops[int(op_core[k])].append(k)
-            region_ops[int(op_far[k])].append(k)
-        zero_fp: list[dict] = []  # {"host": region, "twin": op, "front": op, "f": frontier}
-        region_fronts: list[list[tuple[int, dict]]] = [[] for _ in range(n_reg)]
-        front_of_op: dict[int, dict] = {}
-        for f in fronts:
-            g = f["region"]
-            (fr0, fc0), (fr1, fc1) = f["ends"]
-            wx0, wy0 = self._to_world(np.float64(fr0 + 0.5), np.float64(fc0 + 0.5))
-            wx1, wy1 = self._to_world(np.float64(fr1 + 0.5), np.float64(fc1 + 0.5))
-            seg = np.array([[float(wx0), float(wy0)], [float(wx1), float(wy1)]])
-            mx, my = self._cell_xy(f["mid_cell"])
-            geo = {"ends": seg, "width": float(f["width_cells"] * res), "anchor": f["anchor"], "mid": (mx, my)}
-            if rtype[g] == int(AreaType.INTERSECTION):
+        for k, (a0, a1) in enumerate(op_areas):
+            region_ops[a0].append(k)
+            region_ops[a1].append(k)
+        region_fronts: list[list[int]] = [[] for _ in range(n_reg)]
+        zero_fp: list[tuple[int, int, int]] = []  # (host region, twin opening, frontier opening)
+        for fi, g in enumerate(f_reg.tolist()):
+            if rtype_l[g] == INTER:
                 z = n_reg + len(zero_fp)
-                twin = len(op_rec)
-                op_rec.append({**geo, "areas": (g, z), "frontier": False})
-                fo = len(op_rec)
-                op_rec.append({**geo, "areas": (z, -1), "frontier": True})
+                twin, fo = len(op_areas), len(op_areas) + 1
+                op_areas += [(g, z), (z, -1)]
+                op_is_front += [False, True]
+                op_front_idx += [fi, fi]
                 region_ops[g].append(twin)
-                zero_fp.append({"host": g, "twin": twin, "front": fo, "f": f})
-                front_of_op[fo] = f
+                zero_fp.append((g, twin, fo))
             else:
-                fo = len(op_rec)
-                op_rec.append({**geo, "areas": (g, -1), "frontier": True})
-                region_fronts[g].append((fo, f))
-                front_of_op[fo] = f
+                fo = len(op_areas)
+                op_areas.append((g, -1))
+                op_is_front.append(True)
+                op_front_idx.append(fi)
+                region_fronts[g].append(fo)
         n_prov = n_reg + len(zero_fp)
+        n_all = len(op_areas)
+        f_anchor = fr["anchor"].tolist()
+        op_anchor = op_px.tolist() + [f_anchor[fi] for fi in op_front_idx[n_op:]]
 
-        # --- path requests ----------------------------------------------------------------------
-        starts: list[int] = []
-        ends_: list[int] = []
-        pre: list[int] = []
-        post: list[int] = []
-        preg: list[int] = []
-        keys: list[tuple[int, int]] = []  # (provisional area, opening) per request
-
-        def side(k: int, g: int) -> int:
-            return int(side_core[k]) if int(op_core[k]) == g else int(side_far[k])
-
-        def req(area: int, oid: int, s: int, e: int, a: int = -1, b: int = -1, reg: int | None = None) -> None:
-            starts.append(s)
-            ends_.append(e)
-            pre.append(a)
-            post.append(b)
-            preg.append(area if reg is None else reg)
-            keys.append((area, oid))
-
-        sk = self.sk
+        # --- path requests: (area, opening, start, end, pre, post) --------------------------------
+        req_area: list[int] = []
+        req_op: list[int] = []
+        req_s: list[int] = []
+        req_e: list[int] = []
+        req_pre: list[int] = []
+        req_post: list[int] = []
+        sc = side_core.tolist()
+        sf = side_far.tolist()
+        opx = op_px.tolist()
+        core = op_core.tolist()
+        far_req: list[
+            tuple[int, int, int]
+        ] = []  # (region, opening, start): far end found in a batch
         for g in range(n_reg):
-            t = rtype[g]
+            t = rtype_l[g]
             ops = region_ops[g]
-            frs = region_fronts[g]
-            root = int(centres[g])
-            if t == int(AreaType.INTERSECTION):
+            if t == INTER:
+                root = int(centres[g])
                 for k in ops:
-                    rec = op_rec[k]
+                    req_area.append(g)
+                    req_op.append(k)
+                    req_e.append(root)
+                    req_post.append(-1)
                     if k < n_op:
-                        req(g, k, side(k, g), root, a=int(op_px[k]))
+                        req_s.append(sc[k] if core[k] == g else sf[k])
+                        req_pre.append(opx[k])
                     else:
-                        req(g, k, rec["anchor"], root)
-            elif t == int(AreaType.PATHWAY):
+                        req_s.append(op_anchor[k])
+                        req_pre.append(-1)
+            elif t == PATH:
                 k1, k2 = ops
-                req(g, k1, side(k1, g), side(k2, g), a=int(op_px[k1]), b=int(op_px[k2]))
-                req(g, k2, side(k2, g), side(k1, g), a=int(op_px[k2]), b=int(op_px[k1]))
-            elif t == int(AreaType.FRONTIER_PATHWAY):
+                s1 = sc[k1] if core[k1] == g else sf[k1]
+                s2 = sc[k2] if core[k2] == g else sf[k2]
+                req_area += [g, g]
+                req_op += [k1, k2]
+                req_s += [s1, s2]
+                req_e += [s2, s1]
+                req_pre += [opx[k1], opx[k2]]
+                req_post += [opx[k2], opx[k1]]
+            elif t == FRONT:
+                frs = region_fronts[g]
                 if ops:
-                    k = ops[0]
-                    fo, f = frs[0]
-                    req(g, k, side(k, g), f["anchor"], a=int(op_px[k]))
-                    req(g, fo, f["anchor"], side(k, g), b=int(op_px[k]))
+                    k, fo = ops[0], frs[0]
+                    s1 = sc[k] if core[k] == g else sf[k]
+                    req_area += [g, g]
+                    req_op += [k, fo]
+                    req_s += [s1, op_anchor[fo]]
+                    req_e += [op_anchor[fo], s1]
+                    req_pre += [opx[k], -1]
+                    req_post += [-1, opx[k]]
                 elif len(frs) == 2:
-                    (fo1, f1), (fo2, f2) = frs
-                    req(g, fo1, f1["anchor"], f2["anchor"])
-                    req(g, fo2, f2["anchor"], f1["anchor"])
+                    fo1, fo2 = frs
+                    req_area += [g, g]
+                    req_op += [fo1, fo2]
+                    req_s += [op_anchor[fo1], op_anchor[fo2]]
+                    req_e += [op_anchor[fo2], op_anchor[fo1]]
+                    req_pre += [-1, -1]
+                    req_post += [-1, -1]
                 else:
-                    fo, f = frs[0]
-                    seed = _seed_of(self.parent, sk.ravel(), f["anchor"])
-                    far = K.far_skeleton_pixel(W, sk, lab, seed, g) if seed >= 0 else f["anchor"]
-                    req(g, fo, f["anchor"], int(far))
-            elif ops:  # dead end with its opening
+                    far_req.append((g, frs[0], op_anchor[frs[0]]))
+            elif ops:
                 k = ops[0]
-                s = side(k, g)
-                far = K.far_skeleton_pixel(W, sk, lab, s, g)
-                req(g, k, s, int(far), a=int(op_px[k]))
-        if starts:
-            cells, off = K.tree_paths(self.parent, self.depth, np.array(starts, np.int64), np.array(ends_, np.int64),
-                                      np.array(pre, np.int64), np.array(post, np.int64))
-            max_seg = p.path_max_segment_m / res if p.path_max_segment_m > 0 else 0.0
-            vcells, voff, vlen = K.smooth_paths(W, cells, off, np.array(preg, np.int64), self.cspace.ravel(), lab,
-                                                self.barrier, max_seg, res)
-            vr, vc = np.divmod(vcells, W)
-            vx, vy = self._to_world(vr + 0.5, vc + 0.5)
-            vxy = np.column_stack([vx, vy])
+                far_req.append((g, k, sc[k] if core[k] == g else sf[k]))
+        if far_req:
+            far = K.far_skeleton_pixels(
+                W, self.sk, self.px, self.st, lab, np.array([q[2] for q in far_req], np.int64)
+            )
+            for (g, k, s), e in zip(far_req, far.tolist(), strict=True):
+                req_area.append(g)
+                req_op.append(k)
+                req_s.append(s)
+                req_e.append(e)
+                req_pre.append(opx[k] if k < n_op else -1)
+                req_post.append(-1)
+        n_req = len(req_area)
+        if n_req:
+            cells, off = K.tree_paths(
+                self.sk,
+                self.px,
+                self.st,
+                self.sk_par,
+                self.sk_dep,
+                np.array(req_s, np.int64),
+                np.array(req_e, np.int64),
+                np.array(req_pre, np.int64),
+                np.array(req_post, np.int64),
+            )
+            vcells, voff, vlen = K.smooth_paths(
+                W,
+                cells,
+                off,
+                np.array(req_area, np.int64),
+                self.dcell,
+                self.min_clear,
+                lab,
+                max(p.path_tolerance_m / res, 0.0),
+                res,
+            )
+            vxy = self._cells_xy(vcells)
         else:
             voff = np.zeros(1, np.int64)
             vlen = np.zeros(0)
             vxy = np.zeros((0, 2))
-        paths: dict[tuple[int, int], tuple[np.ndarray, float]] = {}
-        for j, key in enumerate(keys):
-            paths[key] = (vxy[voff[j] : voff[j + 1]], float(vlen[j]))
-        for z in zero_fp:
-            a = self._cell_xy(z["f"]["anchor"])
-            pt = np.array([a, a])
-            paths[(n_reg + zero_fp.index(z), z["twin"])] = (pt, 0.0)
-            paths[(n_reg + zero_fp.index(z), z["front"])] = (pt, 0.0)
+        vlen_l = vlen.tolist()
+        voff_l = voff.tolist()
+        pieces = [vxy[voff_l[j] : voff_l[j + 1]] for j in range(n_req)]
+        area_paths: list[dict[int, np.ndarray]] = [{} for _ in range(n_prov)]
+        path_len: dict[tuple[int, int], float] = {}
+        for j in range(n_req):
+            area_paths[req_area[j]][req_op[j]] = pieces[j]
+            path_len[(req_area[j], req_op[j])] = vlen_l[j]
+        # --- coordinates ------------------------------------------------------------------------
+        anchor_xy = self._cells_xy(np.array(op_anchor, np.int64)) if n_all else np.zeros((0, 2))
+        for zi, (_g, twin, fo) in enumerate(zero_fp):
+            pt = np.repeat(anchor_xy[fo : fo + 1], 2, axis=0)
+            area_paths[n_reg + zi] = {twin: pt, fo: pt}
+            path_len[(n_reg + zi, twin)] = 0.0
+            path_len[(n_reg + zi, fo)] = 0.0
+        centre_cells = np.concatenate(
+            [centres, np.array([f_anchor[op_front_idx[fo]] for (_g, _t, fo) in zero_fp], np.int64)]
+        )
+        centre_xy = self._cells_xy(centre_cells)
+        ends_xy = np.zeros((n_all, 2, 2))
+        mids = np.zeros((n_all, 2))
+        widths_m = np.zeros(n_all)
+        if n_op:
+            ends_xy[:n_op, 0] = self._xy(ends[:, 0], ends[:, 1])
+            ends_xy[:n_op, 1] = self._xy(ends[:, 2], ends[:, 3])
+            mids[:n_op] = ends_xy[:n_op].mean(axis=1)
+            widths_m[:n_op] = widths * res
+        if n_all > n_op:
+            fidx = np.array(op_front_idx[n_op:], np.int64)
+            fe = fr["ends"][fidx]
+            ends_xy[n_op:, 0] = self._xy(fe[:, 0] + 0.5, fe[:, 1] + 0.5)
+            ends_xy[n_op:, 1] = self._xy(fe[:, 2] + 0.5, fe[:, 3] + 0.5)
+            mids[n_op:] = self._cells_xy(fr["mid"][fidx])
+            widths_m[n_op:] = fr["width"][fidx] * res
 
         # --- identities -------------------------------------------------------------------------
-        centre_xy: list[tuple[float, float]] = []
-        for g in range(n_reg):
-            centre_xy.append(self._cell_xy(int(centres[g])) if centres[g] >= 0 else (float("nan"), float("nan")))
-        for z in zero_fp:
-            centre_xy.append(self._cell_xy(z["f"]["anchor"]))
-        prov_type = np.concatenate([rtype, np.full(len(zero_fp), int(AreaType.FRONTIER_PATHWAY), np.int64)])
+        prov_type = np.concatenate([rtype, np.full(len(zero_fp), FRONT, np.int64)])
         ids, next_id = self._match_ids(n_reg, n_prov, centre_xy, prov_type)
+        ids_l = ids.tolist()
         self._lap("paths")
 
-        # --- objects ----------------------------------------------------------------------------
+        # --- records ----------------------------------------------------------------------------
+        mids_l = mids.tolist()
+        anchors_l = anchor_xy.tolist()
+        widths_l = widths_m.tolist()
+        ends_list = list(ends_xy)
         openings: list[Opening] = []
-        for k, rec in enumerate(op_rec):
-            a0, a1 = rec["areas"]
-            ids_pair = (int(ids[a0]), int(ids[a1]) if a1 >= 0 else -1)
-            e = rec["ends"]
-            if rec["frontier"] or k >= n_op:
-                mid = rec["mid"]
-            else:
-                mid = (float((e[0, 0] + e[1, 0]) / 2.0), float((e[0, 1] + e[1, 1]) / 2.0))
-            openings.append(Opening(
-                id=k, endpoints_m=e, midpoint_m=mid, width_m=rec["width"], area_ids=ids_pair,
-                is_frontier=bool(rec["frontier"]), anchor_m=self._cell_xy(rec["anchor"]),
-            ))
-        area_ops: list[list[int]] = [list(region_ops[g]) + [fo for fo, _ in region_fronts[g]] for g in range(n_reg)]
-        for z in zero_fp:
-            area_ops.append([z["twin"], z["front"]])
+        for k in range(n_all):
+            a0, a1 = op_areas[k]
+            openings.append(
+                _opening(
+                    k,
+                    ends_list[k],
+                    tuple(mids_l[k]),
+                    widths_l[k],
+                    (ids_l[a0], ids_l[a1] if a1 >= 0 else -1),
+                    op_is_front[k],
+                    tuple(anchors_l[k]),
+                )
+            )
+        area_ops: list[list[int]] = [region_ops[g] + region_fronts[g] for g in range(n_reg)]
+        area_ops += [[twin, fo] for (_g, twin, fo) in zero_fp]
+        counts_l = counts.tolist()
+        centre_l = centre_xy.tolist()
+        type_of = {t: AreaType(t) for t in (INTER, PATH, DEAD, FRONT)}
+        ptype = prov_type.tolist()
         areas: dict[int, Area] = {}
         for a in range(n_prov):
-            pm = {k: paths[(a, k)][0] for k in area_ops[a] if (a, k) in paths}
-            areas[int(ids[a])] = Area(
-                id=int(ids[a]), type=AreaType(int(prov_type[a])), centre_m=centre_xy[a],
-                opening_ids=tuple(int(k) for k in area_ops[a]), paths_m=pm,
-                n_cells=int(n_cells[a]) if a < n_reg else 0,
+            areas[ids_l[a]] = _area(
+                ids_l[a],
+                type_of[ptype[a]],
+                tuple(centre_l[a]),
+                tuple(area_ops[a]),
+                area_paths[a],
+                counts_l[a] if a < n_reg else 0,
             )
 
+        # graph edges; intersection edges join every pair of legs at the centre, in one batch
+        req_index = {key: j for j, key in enumerate(zip(req_area, req_op, strict=True))}
+        pair_a: list[int] = []
+        pair_b: list[int] = []
+        pair_meta: list[tuple[int, int, int, float]] = []
         edges: list[GraphEdge] = []
         for a in range(n_prov):
-            t = prov_type[a]
             ops = area_ops[a]
-            aid = int(ids[a])
-            if t == int(AreaType.INTERSECTION):
+            aid = ids_l[a]
+            if ptype[a] == INTER:
+                legs = [req_index[(a, k)] for k in ops]
                 for i in range(len(ops)):
-                    pa, la = paths[(a, ops[i])]
                     for j in range(i + 1, len(ops)):
-                        pb, lb = paths[(a, ops[j])]
-                        edges.append(GraphEdge(ops[i], ops[j], aid, la + lb, np.concatenate((pa, pb[-2::-1]))))
-            elif len(ops) == 2 and (a, ops[0]) in paths:
-                pa, la = paths[(a, ops[0])]
-                edges.append(GraphEdge(ops[0], ops[1], aid, la, pa))
+                        pair_a.append(legs[i])
+                        pair_b.append(legs[j])
+                        pair_meta.append((ops[i], ops[j], aid, vlen_l[legs[i]] + vlen_l[legs[j]]))
+            elif len(ops) == 2 and ops[0] in area_paths[a]:
+                edges.append(
+                    _edge(ops[0], ops[1], aid, path_len[(a, ops[0])], area_paths[a][ops[0]])
+                )
+        if pair_a:
+            jxy, joff = K.join_legs(
+                vxy, voff, np.array(pair_a, np.int64), np.array(pair_b, np.int64)
+            )
+            joff_l = joff.tolist()
+            jpieces = [jxy[joff_l[k] : joff_l[k + 1]] for k in range(len(pair_a))]
+            for k, (oa, ob, aid, ln) in enumerate(pair_meta):
+                edges.append(_edge(oa, ob, aid, ln, jpieces[k]))
 
-        frontiers = self._frontier_objects(op_rec, areas, ids, paths, region_fronts, zero_fp, n_reg, edges, openings)
-        l_path = _mean_intersection_path(areas, openings, paths, ids)
+        frontiers = self._frontier_objects(
+            ids_l, path_len, region_fronts, zero_fp, n_reg, edges, openings, op_areas, ptype
+        )
+        l_path = _mean_intersection_path(path_len, n_prov, area_ops, op_areas, ptype)
 
+        # --- raster -----------------------------------------------------------------------------
         area_raster = np.full(self.g.shape, -1, dtype=np.int32)
-        lut = np.concatenate(([-1], ids[:n_reg])).astype(np.int32)
-        sub = lut[lab.reshape(self.H, self.W) + 1]
-        H0, W0 = self.g.shape
-        sr0, sr1 = max(self.r0, 0), min(self.r0 + self.H, H0)
-        sc0, sc1 = max(self.c0, 0), min(self.c0 + self.W, W0)
-        area_raster[sr0:sr1, sc0:sc1] = sub[sr0 - self.r0 : sr1 - self.r0, sc0 - self.c0 : sc1 - self.c0]
+        K.scatter_labels(area_raster, lab, ids[:n_reg].astype(np.int32), W, self.r0, self.c0)
         self._lap("assemble")
         extras: dict[str, Any] = {"next_area_id": next_id, "stage_ms": self.stage_ms}
         if p.keep_debug:
             srow, scol = np.divmod(self.px, W)
             extras["skeleton_cells"] = np.column_stack([srow + self.r0, scol + self.c0])
             extras["filtered_grid_crop"] = (self.r0, self.c0, self.work.copy())
-            extras["cspace_crop"] = (self.r0, self.c0, self.cspace.copy())
+            extras["cspace_crop"] = (self.r0, self.c0, self.cspace_debug)
         return TopometricMap(
             geometry=self.g,
             area_ids=area_raster,
@@ -628,30 +839,35 @@ class _Segmenter:
         )
 
     # ------------------------------------------------------------------------------------------
-    def _frontier_objects(self, op_rec, areas, ids, paths, region_fronts, zero_fp, n_reg, edges, openings) -> list[Frontier]:
-        """Frontier records with the nearest intersection and ``p_l`` (graph distance to it)."""
+    def _frontier_objects(
+        self, ids_l, path_len, region_fronts, zero_fp, n_reg, edges, openings, op_areas, ptype
+    ) -> list[Frontier]:
+        """Frontier records with the nearest intersection and ``p_l`` (graph distance to it).
+
+        Works on provisional area indices (``op_areas``, ``ptype``); ids are mapped at the end.
+        """
+        items: list[tuple[int, int]] = [(g, fo) for g in range(n_reg) for fo in region_fronts[g]]
+        items += [(n_reg + zi, fo) for zi, (_g, _twin, fo) in enumerate(zero_fp)]
+        if not items:
+            return []
+        inter = int(AreaType.INTERSECTION)
+        prov_of = {aid: a for a, aid in enumerate(ids_l)}
         adj: dict[int, list[tuple[int, float]]] = {}
         for e in edges:
-            if areas[e.area_id].type == AreaType.INTERSECTION:
+            if ptype[prov_of[e.area_id]] == inter:
                 continue
             adj.setdefault(e.opening_a, []).append((e.opening_b, e.length_m))
             adj.setdefault(e.opening_b, []).append((e.opening_a, e.length_m))
 
         def intersection_of(oid: int) -> int | None:
-            for aid in openings[oid].area_ids:
-                if aid >= 0 and areas[aid].type == AreaType.INTERSECTION:
-                    return aid
+            for a in op_areas[oid]:
+                if a >= 0 and ptype[a] == inter:
+                    return a
             return None
 
         out: list[Frontier] = []
-        items: list[tuple[int, int, dict]] = []  # (provisional area, frontier opening, f)
-        for g in range(n_reg):
-            for fo, f in region_fronts[g]:
-                items.append((g, fo, f))
-        for zi, z in enumerate(zero_fp):
-            items.append((n_reg + zi, z["front"], z["f"]))
-        for a, fo, f in items:
-            # Dijkstra from the frontier until an opening on an intersection is reached
+        for a, fo in items:
+            # Dijkstra from the frontier until an opening of an intersection is reached
             dist = {fo: 0.0}
             heap = [(0.0, fo)]
             found: tuple[int, float] | None = None
@@ -659,9 +875,9 @@ class _Segmenter:
                 d, u = heapq.heappop(heap)
                 if d > dist.get(u, math.inf):
                     continue
-                iid = intersection_of(u)
-                if iid is not None:
-                    found = (iid, d)
+                ia = intersection_of(u)
+                if ia is not None:
+                    found = (ids_l[ia], d)
                     break
                 for v, w in adj.get(u, ()):
                     nd = d + w
@@ -669,14 +885,12 @@ class _Segmenter:
                         dist[v] = nd
                         heapq.heappush(heap, (nd, v))
             if found is not None:
-                iid, p_l = found[0], found[1]
+                iid, p_l = found
             else:
                 iid = None
-                p_l = paths[(a, fo)][1] if (a, fo) in paths else 0.0
-            out.append(Frontier(
-                area_id=int(ids[a]), opening_id=int(fo), midpoint_m=self._cell_xy(f["anchor"]),
-                width_m=float(f["width_cells"] * self.res), intersection_id=iid, path_length_m=float(p_l),
-            ))
+                p_l = path_len.get((a, fo), 0.0)
+            o = openings[fo]
+            out.append(Frontier(ids_l[a], fo, o.anchor_m, o.width_m, iid, float(p_l)))
         return out
 
     # ------------------------------------------------------------------------------------------
@@ -690,9 +904,8 @@ class _Segmenter:
             sel = self.px[self.lab[self.px] >= 0]
             if sel.size and n_reg:
                 g_new = self.lab[sel].astype(np.int64)
-                rr, cc = np.divmod(sel, self.W)
-                x, y = self._to_world(rr + 0.5, cc + 0.5)
-                pr, pc = prev.geometry.world_to_grid(x, y)
+                xy = self._cells_xy(sel)
+                pr, pc = prev.geometry.world_to_grid(xy[:, 0], xy[:, 1])
                 inside = prev.geometry.contains(pr, pc)
                 prev_id = np.full(sel.size, -1, dtype=np.int64)
                 prev_id[inside] = prev.area_ids[pr[inside], pc[inside]]
@@ -709,10 +922,14 @@ class _Segmenter:
                         ids[g] = pid
                         used.add(pid)
             # zero-area frontier pathways: nearest previous frontier pathway without cells
-            cand = [a for a in prev.areas.values() if a.type == AreaType.FRONTIER_PATHWAY and a.n_cells == 0 and a.id not in used]
-            r2 = self.p.match_radius_m ** 2
+            cand = [
+                a
+                for a in prev.areas.values()
+                if a.type == AreaType.FRONTIER_PATHWAY and a.n_cells == 0 and a.id not in used
+            ]
+            r2 = self.p.match_radius_m**2
             for a in range(n_reg, n_prov):
-                cx, cy = centre_xy[a]
+                cx, cy = float(centre_xy[a, 0]), float(centre_xy[a, 1])
                 best, bd = None, r2
                 for pa in cand:
                     if pa.id in used:
@@ -735,69 +952,29 @@ class _Segmenter:
 # ----------------------------------------------------------------------------------------------
 
 
-def _geom(cells: np.ndarray, W: int) -> dict:
-    """Extent of a set of cells along its principal axis: width (cells), end cells, order by centre."""
-    rr, cc = np.divmod(cells, W)
-    rr = rr.astype(np.float64)
-    cc = cc.astype(np.float64)
-    mr, mc = rr.mean(), cc.mean()
-    dr, dc = rr - mr, cc - mc
-    theta = 0.5 * math.atan2(2.0 * float((dr * dc).mean()), float((dc * dc).mean() - (dr * dr).mean()))
-    t = dc * math.cos(theta) + dr * math.sin(theta)
-    i0, i1 = int(np.argmin(t)), int(np.argmax(t))
-    width = float(t[i1] - t[i0]) + 1.0
-    ts = np.sort(t)
-    q1v = ts[len(ts) // 4]
-    q3v = ts[(3 * len(ts)) // 4]
-    return {
-        "width": width,
-        "ends": ((rr[i0], cc[i0]), (rr[i1], cc[i1])),
-        "by_centre": np.argsort(dr * dr + dc * dc, kind="stable"),
-        "q1": int(np.argmin(np.abs(t - q1v))),
-        "q3": int(np.argmin(np.abs(t - q3v))),
-    }
+def _mean_intersection_path(path_len, n_prov, area_ops, op_areas, ptype) -> float:
+    """``L_path``: mean centre-to-centre path length between adjacent intersections (nan if none).
 
-
-def _seed_of(parent: np.ndarray, sk_flat: np.ndarray, cell: int) -> int:
-    """The first skeleton pixel on the parent chain of ``cell`` (-1 if none)."""
-    i = int(cell)
-    for _ in range(1_000_000):
-        if sk_flat[i]:
-            return i
-        i = int(parent[i])
-        if i < 0:
-            return -1
-    return -1
-
-
-def _mean_intersection_path(areas: dict[int, Area], openings: list[Opening], paths, ids) -> float:
-    """``L_path``: mean centre-to-centre length between adjacent intersections."""
-    inter = {a.id for a in areas.values() if a.type == AreaType.INTERSECTION}
-    if len(inter) < 2:
+    Pairs are intersections joined by one pathway, or sharing an opening. Provisional indices.
+    """
+    inter = int(AreaType.INTERSECTION)
+    path = int(AreaType.PATHWAY)
+    if ptype.count(inter) < 2:
         return float("nan")
 
-    def leg(area_id: int, oid: int) -> float | None:
-        pm = areas[area_id].paths_m.get(oid)
-        if pm is None or len(pm) < 2:
-            return 0.0 if pm is not None else None
-        return float(np.hypot(*np.diff(pm, axis=0).T).sum())
+    def other(oid: int, a: int) -> int:
+        a0, a1 = op_areas[oid]
+        b = a1 if a0 == a else a0
+        return b if b >= 0 and b != a and ptype[b] == inter else -1
 
     lengths: list[float] = []
-    for a in areas.values():
-        if a.type == AreaType.PATHWAY and len(a.opening_ids) == 2:
-            o1, o2 = a.opening_ids
-            i1 = [x for x in openings[o1].area_ids if x != a.id and x in inter]
-            i2 = [x for x in openings[o2].area_ids if x != a.id and x in inter]
-            if i1 and i2:
-                mid = leg(a.id, o1)
-                l1 = leg(i1[0], o1)
-                l2 = leg(i2[0], o2)
-                if mid is not None and l1 is not None and l2 is not None:
-                    lengths.append(l1 + mid + l2)
-    for o in openings:
-        a0, a1 = o.area_ids
-        if a0 in inter and a1 in inter and a0 != a1:
-            l1, l2 = leg(a0, o.id), leg(a1, o.id)
-            if l1 is not None and l2 is not None:
-                lengths.append(l1 + l2)
+    for a in range(n_prov):
+        if ptype[a] == path and len(area_ops[a]) == 2:
+            o1, o2 = area_ops[a]
+            i1, i2 = other(o1, a), other(o2, a)
+            if i1 >= 0 and i2 >= 0:
+                lengths.append(path_len[(i1, o1)] + path_len[(a, o1)] + path_len[(i2, o2)])
+    for oid, (a0, a1) in enumerate(op_areas):
+        if a0 >= 0 and a1 >= 0 and a0 != a1 and ptype[a0] == inter and ptype[a1] == inter:
+            lengths.append(path_len[(a0, oid)] + path_len[(a1, oid)])
     return float(np.mean(lengths)) if lengths else float("nan")

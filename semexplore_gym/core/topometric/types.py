@@ -121,7 +121,9 @@ class TopometricMap:
 
     Attributes:
         geometry: The grid frame the map was computed on.
-        area_ids: ``(H, W)`` int32 raster, the area id of every reachable free cell, -1 elsewhere.
+        area_ids: ``(H, W)`` int32 raster, the area id of every reachable free cell, -1 elsewhere
+            (cells of occupied specks and unknown holes that the noise filter turned free count
+            as free).
         areas: Areas by id.
         openings: Openings, ``openings[i].id == i``.
         frontiers: One per frontier opening (one per frontier pathway, two for a lone corridor

@@ -1,0 +1,125 @@
+"""``semexplore explore``: arguments, JSON output, config files and overrides."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from semexplore_gym.cli import main
+from semexplore_gym.cli.explore import JSON_KEYS
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_explore_json_prints_the_documented_keys(capsys):
+    code = main(
+        [
+            "explore",
+            "--world",
+            "maze1",
+            "--policy",
+            "random",
+            "--seed",
+            "1",
+            "--max-time-s",
+            "3",
+            "--json",
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert tuple(out) == JSON_KEYS
+    assert out["mission_time_s"] == pytest.approx(3.0)
+    assert out["self_stopped"] is False and 0 < out["coverage"] <= 1
+
+
+def test_explore_text_output_with_paper_config(capsys):
+    cfg = REPO / "configs" / "expert" / "paper.yaml"
+    code = main(
+        [
+            "explore",
+            "--world",
+            "maze1",
+            "--config",
+            str(cfg),
+            "--set",
+            "cost.w_v=2",
+            "--max-time-s",
+            "2",
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "coverage" in text and "stop_reason" in text and "stage split" in text
+
+
+def test_explore_rejects_bad_keys_and_files(tmp_path, capsys):
+    assert (
+        main(
+            [
+                "explore",
+                "--world",
+                "maze1",
+                "--set",
+                "cost.w_x=2",
+                "--max-time-s",
+                "1",
+                "--no-progress",
+            ]
+        )
+        == 2
+    )
+    assert "cost.w_x" in capsys.readouterr().err
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("params:\n  potential_field:\n    f_q: 1\n")
+    assert (
+        main(
+            [
+                "explore",
+                "--world",
+                "maze1",
+                "--config",
+                str(bad),
+                "--max-time-s",
+                "1",
+                "--no-progress",
+            ]
+        )
+        == 2
+    )
+    assert "potential_field.f_q" in capsys.readouterr().err
+    top = tmp_path / "top.yaml"
+    top.write_text("robot:\n  radius_m: 0.1\n")
+    assert (
+        main(
+            [
+                "explore",
+                "--world",
+                "maze1",
+                "--config",
+                str(top),
+                "--max-time-s",
+                "1",
+                "--no-progress",
+            ]
+        )
+        == 2
+    )
+    assert "robot" in capsys.readouterr().err
+    assert (
+        main(
+            [
+                "explore",
+                "--world",
+                "maze1",
+                "--config",
+                str(tmp_path / "missing.yaml"),
+                "--no-progress",
+            ]
+        )
+        == 2
+    )

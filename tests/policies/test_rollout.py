@@ -1,0 +1,99 @@
+"""run_mission: the mission loop, its metrics and the GIF."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import semexplore_gym  # noqa: F401
+from policies.base import Policy, StepStats
+from policies.random_policy import RandomPolicy
+from policies.rollout import STAGES, run_mission, time_to_coverage
+
+
+class StopAfter(Policy):
+    """Drives straight and declares the mission over after ``n`` actions."""
+
+    name = "stop_after"
+
+    def __init__(self, n: int) -> None:
+        super().__init__()
+        self.n = n
+        self.calls = 0
+
+    def act(self, obs, info):
+        self.calls += 1
+        self.last_stats = StepStats(
+            map_generation_ms=1.0 if self.calls % 2 else 0.0, replanned=bool(self.calls % 2)
+        )
+        if self.calls > self.n:
+            self.done = True
+            self.stop_reason = "enough"
+        return np.array([0.2, 0.0], dtype=np.float32)
+
+
+@pytest.fixture(scope="module")
+def env():
+    e = gym.make("SemanticExplore-v0", world="maze1")
+    yield e
+    e.close()
+
+
+def test_mission_ends_when_the_policy_is_done(env):
+    pol = StopAfter(5)
+    res = run_mission(env, pol, seed=0, max_time_s=100.0, progress=False)
+    assert res.self_stopped and res.stop_reason == "enough"
+    assert res.steps == 5 and res.mission_time_s == pytest.approx(1.0)
+    assert len(res.coverage_trace) == 6 and res.trajectory.shape == (6, 3)
+    assert res.coverage_trace[-1][1] == pytest.approx(res.coverage)
+    assert res.n_replans == 3 and res.mean_map_generation_ms == pytest.approx(1.0)
+    assert set(res.stage_time_s) == set(STAGES) and res.stage_time_s["env_step"] > 0
+    assert res.path_length_m == pytest.approx(5 * 0.2 * 0.22 * 0.2, rel=0.05)
+    s = res.summary()
+    assert s["self_stopped"] is True and s["collisions"] == 0 and "T90_s" in s
+
+
+def test_max_time_and_random_policy_determinism(env):
+    a = run_mission(env, RandomPolicy(), seed=3, max_time_s=4.0, progress=False)
+    b = run_mission(env, RandomPolicy(), seed=3, max_time_s=4.0, progress=False)
+    assert not a.self_stopped and a.truncated and a.stop_reason.startswith("max_time_s")
+    assert a.steps == 20 and a.mission_time_s == pytest.approx(4.0)
+    np.testing.assert_array_equal(a.trajectory, b.trajectory)
+    with pytest.raises(ValueError, match="max_time_s"):
+        run_mission(env, RandomPolicy(), seed=0, max_time_s=0.0, progress=False)
+    with pytest.raises(ValueError, match="rgb_array"):
+        run_mission(env, RandomPolicy(), seed=0, max_time_s=1.0, progress=False, gif_path="x.gif")
+
+
+def test_on_step_and_gif(tmp_path):
+    e = gym.make("SemanticExplore-v0", world="maze1", render_mode="rgb_array")
+    seen = []
+    out = tmp_path / "m.gif"
+    res = run_mission(
+        e,
+        StopAfter(10),
+        seed=0,
+        max_time_s=100.0,
+        progress=False,
+        gif_path=out,
+        gif_every_s=0.6,
+        on_step=lambda i, *_: seen.append(i),
+    )
+    e.close()
+    assert seen == list(range(1, 11))
+    from PIL import Image
+
+    with Image.open(out) as im:
+        # first frame, every 0.6 s of 2 s (3 frames), and the final frame
+        assert im.n_frames == 5
+    assert res.stage_time_s["render"] > 0
+
+
+def test_time_to_coverage():
+    trace = [(0.0, 0.1, 1.0), (1.0, 0.5, 2.0), (2.0, 0.95, 3.0)]
+    assert time_to_coverage(trace, 0.9) == 2.0
+    assert time_to_coverage(trace, 0.99) is None
+    assert time_to_coverage(trace, 0.1) == 0.0 and not math.isnan(time_to_coverage(trace, 0.5))
