@@ -103,6 +103,8 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
                 seeds = sorted(set(ref_rows) & set(other_rows))
                 for key, label in (
                     ("mission_time_s", "mission time"),
+                    ("T90_s", "T90"),
+                    ("T99_s", "T99"),
                     ("mean_map_generation_ms", "map generation ms"),
                     ("mean_global_planning_ms", "global planning ms"),
                 ):
