@@ -104,6 +104,12 @@ def _check_positive(obj: Any, names: tuple[str, ...], allow_zero: bool = False) 
             )
 
 
+def _check_int_at_least(obj: Any, name: str, minimum: int) -> None:
+    v = getattr(obj, name)
+    if not (isinstance(v, int) and not isinstance(v, bool) and v >= minimum):
+        raise ValueError(f"{type(obj).__name__}.{name} must be an integer >= {minimum}, got {v!r}")
+
+
 @dataclass(frozen=True)
 class MoveBaseParams:
     """The move_base-like navigator shared by both baselines.
@@ -560,14 +566,8 @@ class FrontierExplorationParams:
             raise ValueError(
                 f"selection must be 'euclidean' or 'bfs_order', got {self.selection!r}"
             )
-        if not (isinstance(self.min_frontier_cells, int) and self.min_frontier_cells >= 1):
-            raise ValueError(
-                f"min_frontier_cells must be an integer >= 1, got {self.min_frontier_cells!r}"
-            )
-        if not (isinstance(self.no_frontier_retries, int) and self.no_frontier_retries >= 0):
-            raise ValueError(
-                f"no_frontier_retries must be an integer >= 0, got {self.no_frontier_retries!r}"
-            )
+        _check_int_at_least(self, "min_frontier_cells", 1)
+        _check_int_at_least(self, "no_frontier_retries", 0)
 
 
 class FrontierExplorationPolicy(_FrontierBaseline):
@@ -764,14 +764,8 @@ class NearestFrontierParams:
             raise ValueError(
                 f"cell_convention must be 'free' or 'unknown', got {self.cell_convention!r}"
             )
-        if not (isinstance(self.min_frontier_cells, int) and self.min_frontier_cells >= 1):
-            raise ValueError(
-                f"min_frontier_cells must be an integer >= 1, got {self.min_frontier_cells!r}"
-            )
-        if not (isinstance(self.no_frontier_retries, int) and self.no_frontier_retries >= 0):
-            raise ValueError(
-                f"no_frontier_retries must be an integer >= 0, got {self.no_frontier_retries!r}"
-            )
+        _check_int_at_least(self, "min_frontier_cells", 1)
+        _check_int_at_least(self, "no_frontier_retries", 0)
 
 
 class NearestFrontierPolicy(_FrontierBaseline):
