@@ -35,6 +35,13 @@ AREA_COLOURS: dict[int, tuple[int, int, int]] = {
 }
 
 
+_GRID_LUT = np.zeros((256, 3), dtype=np.uint8)
+_GRID_LUT[FREE] = (255, 255, 255)
+_GRID_LUT[UNKNOWN] = (200, 200, 200)
+_GRID_LUT[OCCUPIED] = (20, 20, 20)
+_GRID_LUT.setflags(write=False)
+
+
 @dataclass(frozen=True)
 class RenderSnapshot:
     """Everything one frame shows, copied out of the env."""
@@ -84,28 +91,26 @@ class Renderer:
         v = self.size_px[1] - (xy[:, 1] - g.origin_y_m) / g.resolution_m * self.px_per_cell
         return np.stack([u, v], axis=1)
 
-    def _base_image(self, grid: np.ndarray, area_types: np.ndarray | None) -> np.ndarray:
-        rgb = np.empty(grid.shape + (3,), dtype=np.uint8)
-        rgb[grid == FREE] = (255, 255, 255)
-        rgb[grid == UNKNOWN] = (200, 200, 200)
-        rgb[grid == OCCUPIED] = (20, 20, 20)
+    def _base_image(self, grid: np.ndarray, area_types: np.ndarray | None) -> Any:
+        """The map as a PIL image at frame size (colour lookup at grid size, then a NEAREST resize)."""
+        from PIL import Image
+
+        rgb = _GRID_LUT[grid]
         if area_types is not None and area_types.shape == grid.shape:
             for code, colour in AREA_COLOURS.items():
                 m = area_types == code
                 if m.any():
                     rgb[m] = (0.45 * rgb[m] + 0.55 * np.array(colour)).astype(np.uint8)
-        rgb = rgb[::-1]  # row 0 is the lowest y: flip so that y points up
-        h, w = grid.shape
-        rows = np.minimum((np.arange(self.size_px[1]) / self.px_per_cell).astype(np.int64), h - 1)
-        cols = np.minimum((np.arange(self.size_px[0]) / self.px_per_cell).astype(np.int64), w - 1)
-        return rgb[rows][:, cols]
+        # Row 0 is the lowest y: flip so that y points up.
+        small = Image.fromarray(np.ascontiguousarray(rgb[::-1]))
+        return small.resize(self.size_px, Image.Resampling.NEAREST)
 
     def draw(self, snap: RenderSnapshot) -> np.ndarray:
         """Return an (H_px, W_px, 3) uint8 frame."""
-        from PIL import Image, ImageDraw
+        from PIL import ImageDraw
 
         ov = snap.overlay or {}
-        img = Image.fromarray(self._base_image(snap.map, ov.get("area_types")))
+        img = self._base_image(snap.map, ov.get("area_types"))
         draw = ImageDraw.Draw(img, "RGBA")
         lw = max(1, int(round(self.px_per_cell * 0.4)))
         if len(snap.segments_m):
@@ -113,22 +118,21 @@ class Renderer:
             b = self.world_to_px(snap.segments_m[:, 2:4])
             for (u0, v0), (u1, v1) in zip(a, b, strict=True):
                 draw.line([(u0, v0), (u1, v1)], fill=(60, 90, 220, 90), width=lw)
+        hits_px = None
         if (
             snap.scan is not None
             and snap.beam_angles_rad is not None
             and snap.sensor_pose is not None
         ):
             sx, sy, syaw = snap.sensor_pose
-            r = np.where(snap.scan > 0, snap.scan, np.nan)
-            ang = syaw + snap.beam_angles_rad
-            ends = np.stack([sx + r * np.cos(ang), sy + r * np.sin(ang)], axis=1)
-            ok = np.isfinite(ends).all(axis=1)
-            origin = self.world_to_px(np.array([[sx, sy]]))[0]
-            hit = ok & (snap.scan < snap.max_range_m)
-            for (u, v), is_hit in zip(self.world_to_px(ends[ok]), hit[ok], strict=True):
-                draw.line([tuple(origin), (u, v)], fill=(255, 140, 0, 40), width=1)
-                if is_hit:
-                    draw.point((u, v), fill=(230, 60, 0, 255))
+            ok = snap.scan > 0
+            r = snap.scan[ok].astype(np.float64)
+            ang = syaw + snap.beam_angles_rad[ok]
+            ends = self.world_to_px(np.stack([sx + r * np.cos(ang), sy + r * np.sin(ang)], axis=1))
+            if len(ends) >= 3:
+                # The scanned area as one translucent polygon: one draw call, not a line per beam.
+                draw.polygon([tuple(q) for q in ends], fill=(255, 140, 0, 45))
+            hits_px = ends[r < snap.max_range_m]
         for path in ov.get("paths_m", []) or []:
             p = np.asarray(path, dtype=np.float64)
             if p.ndim == 2 and len(p) >= 2:
@@ -160,6 +164,8 @@ class Renderer:
                 fill=(0, 120, 255, 200),
                 width=max(1, lw),
             )
+        if hits_px is not None and len(hits_px):
+            draw.point([tuple(q) for q in hits_px], fill=(230, 60, 0, 255))
         x, y, yaw = snap.pose
         ((u, v),) = self.world_to_px(np.array([[x, y]]))
         rpx = snap.radius_m / self.geometry.resolution_m * self.px_per_cell
