@@ -23,6 +23,7 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
         "2",
         "--max-time-s",
         "40",
+        "--random-start",
         "--out",
         str(out),
         "--no-progress",
@@ -52,6 +53,16 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
         "trajectories.png",
     ):
         assert (out / name).exists()
+    # Paired: every policy starts a seed from the same pose; different seeds start elsewhere.
+    import numpy as np
+
+    def start(policy: str, seed: int) -> np.ndarray:
+        return np.load(out / "trajectories" / f"maze1__{policy}__{seed}.npy")[0]
+
+    for seed in (0, 1):
+        assert np.allclose(start("semantic", seed), start("frontier", seed))
+        assert np.allclose(start("semantic", seed), start("nearest", seed))
+    assert not np.allclose(start("semantic", 0), start("semantic", 1))
     # Same command again: everything is skipped.
     assert main(argv) == 0
     assert json.loads(capsys.readouterr().out.splitlines()[0])["skipped"] == 12
