@@ -58,7 +58,8 @@ def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy
             data[key] = {**data[key], **value}
         else:
             data[key] = value
-    return policy_cls(build_params(cls, data))
+    params: Any = build_params(cls, data)
+    return policy_cls(params)
 
 
 def _frontier(arg: str, overrides: dict[str, Any]) -> Policy:

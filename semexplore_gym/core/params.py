@@ -117,7 +117,7 @@ def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -
     if not isinstance(data, Mapping):
         raise ConfigError(f"{_prefix or cls.__name__}: expected a mapping, got {data!r}")
     hints = _field_types(cls)
-    names = [f.name for f in dataclasses.fields(cls) if f.init]
+    names = [f.name for f in dataclasses.fields(cls) if f.init]  # type: ignore[arg-type]
     kwargs: dict[str, Any] = {}
     for key, value in data.items():
         path = f"{_prefix}.{key}" if _prefix else str(key)
