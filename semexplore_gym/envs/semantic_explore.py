@@ -234,7 +234,8 @@ class SemanticExploreEnv(gym.Env):
         self.path_length_m = 0.0
         self._trajectory: list[tuple[float, float]] = [(pose[0], pose[1])]
         self._overlay = {}
-        self._scan = self._sense_and_map()
+        self._true_pose = self.sim.pose
+        self._scan = self._sense_and_map(self._true_pose)
         info = self._info({"new_area": 0.0, "time": 0.0, "collision": 0.0})
         if self.render_mode == "human":
             self.render()
@@ -245,9 +246,9 @@ class SemanticExploreEnv(gym.Env):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         v_mps, w_radps = self._scale_action(action)
         cfg = self.config
-        before = self.sim.pose
+        before = self._true_pose
         new_collision = self.sim.step(v_mps, w_radps, cfg.episode.dt_s)
-        after = self.sim.pose
+        after = self._true_pose = self.sim.pose
         self._n_steps += 1
         # From the step count, not a running sum, so 600 steps of 0.2 s are exactly 120 s.
         self.sim_time_s = round(self._n_steps * cfg.episode.dt_s, 9)
@@ -257,7 +258,7 @@ class SemanticExploreEnv(gym.Env):
             self.odometry.update(before, after, self.np_random) if self._odometry_noisy else after
         )
         n_free_before = self.grid.n_free_cells
-        self._scan = self._sense_and_map()
+        self._scan = self._sense_and_map(after)
         new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
         rw = cfg.reward
         terms = {
@@ -296,8 +297,8 @@ class SemanticExploreEnv(gym.Env):
             v = max(v, 0.0)
         return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
-    def _sense_and_map(self) -> np.ndarray:
-        x, y, yaw = self.sim.pose
+    def _sense_and_map(self, true_pose: tuple[float, float, float]) -> np.ndarray:
+        x, y, yaw = true_pose
         scan = self.lidar.scan(x, y, yaw, self.np_random)
         ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
         self.grid.integrate_scan(
