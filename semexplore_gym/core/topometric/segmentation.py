@@ -64,6 +64,7 @@ import gc
 import heapq
 import math
 import time
+from itertools import combinations
 from typing import Any
 
 import numpy as np
@@ -534,9 +535,13 @@ class _Segmenter:
     def _xy(self, rows, cols) -> np.ndarray:
         """Fractional work-grid (row, col) (cell centres at +0.5) to world (x, y) metres, (n, 2)."""
         g = self.g
-        x = g.origin_x_m + (np.asarray(cols, dtype=np.float64) + self.c0) * g.resolution_m
-        y = g.origin_y_m + (np.asarray(rows, dtype=np.float64) + self.r0) * g.resolution_m
-        return np.column_stack([np.atleast_1d(x), np.atleast_1d(y)])
+        cols = np.asarray(cols, dtype=np.float64).ravel()
+        rows = np.asarray(rows, dtype=np.float64).ravel()
+        # filled in place: column_stack's generic concatenation costs more than the arithmetic
+        out = np.empty((max(cols.size, rows.size), 2))
+        out[:, 0] = g.origin_x_m + (cols + self.c0) * g.resolution_m
+        out[:, 1] = g.origin_y_m + (rows + self.r0) * g.resolution_m
+        return out
 
     def _cells_xy(self, cells) -> np.ndarray:
         r, c = np.divmod(np.asarray(cells, dtype=np.int64), self.W)
@@ -706,12 +711,13 @@ class _Segmenter:
             vxy = np.zeros((0, 2))
         vlen_l = vlen.tolist()
         voff_l = voff.tolist()
-        pieces = [vxy[voff_l[j] : voff_l[j + 1]] for j in range(n_req)]
+        pieces = list(map(vxy.__getitem__, map(slice, voff_l[:n_req], voff_l[1 : n_req + 1])))
         area_paths: list[dict[int, np.ndarray]] = [{} for _ in range(n_prov)]
-        path_len: dict[tuple[int, int], float] = {}
-        for j in range(n_req):
-            area_paths[req_area[j]][req_op[j]] = pieces[j]
-            path_len[(req_area[j], req_op[j])] = vlen_l[j]
+        for a, k, piece in zip(req_area, req_op, pieces, strict=True):
+            area_paths[a][k] = piece
+        path_len: dict[tuple[int, int], float] = dict(
+            zip(zip(req_area, req_op, strict=True), vlen_l[:n_req], strict=True)
+        )
         # --- coordinates ------------------------------------------------------------------------
         anchor_xy = self._cells_xy(np.array(op_anchor, np.int64)) if n_all else np.zeros((0, 2))
         for zi, (_g, twin, fo) in enumerate(zero_fp):
@@ -750,36 +756,38 @@ class _Segmenter:
         anchors_l = anchor_xy.tolist()
         widths_l = widths_m.tolist()
         ends_list = list(ends_xy)
-        openings: list[Opening] = []
-        for k in range(n_all):
-            a0, a1 = op_areas[k]
-            openings.append(
-                _opening(
-                    k,
-                    ends_list[k],
-                    tuple(mids_l[k]),
-                    widths_l[k],
-                    (ids_l[a0], ids_l[a1] if a1 >= 0 else -1),
-                    op_is_front[k],
-                    tuple(anchors_l[k]),
-                )
+        sides = [(ids_l[a0], ids_l[a1] if a1 >= 0 else -1) for a0, a1 in op_areas]
+        openings: list[Opening] = list(
+            map(
+                _opening,
+                range(n_all),
+                ends_list,
+                map(tuple, mids_l),
+                widths_l,
+                sides,
+                op_is_front,
+                map(tuple, anchors_l),
             )
+        )
         area_ops: list[list[int]] = [region_ops[g] + region_fronts[g] for g in range(n_reg)]
         area_ops += [[twin, fo] for (_g, twin, fo) in zero_fp]
         counts_l = counts.tolist()
         centre_l = centre_xy.tolist()
         type_of = {t: AreaType(t) for t in (INTER, PATH, DEAD, FRONT)}
         ptype = prov_type.tolist()
-        areas: dict[int, Area] = {}
-        for a in range(n_prov):
-            areas[ids_l[a]] = _area(
-                ids_l[a],
-                type_of[ptype[a]],
-                tuple(centre_l[a]),
-                tuple(area_ops[a]),
-                area_paths[a],
-                counts_l[a] if a < n_reg else 0,
+        n_cells = counts_l[:n_reg] + [0] * (n_prov - n_reg)
+        areas: dict[int, Area] = {
+            i: _area(i, type_of[t], tuple(c), tuple(o), pa, nc)
+            for i, t, c, o, pa, nc in zip(
+                ids_l[:n_prov],
+                ptype,
+                centre_l,
+                area_ops,
+                area_paths,
+                n_cells,
+                strict=True,
             )
+        }
 
         # graph edges; intersection edges join every pair of legs at the centre, in one batch
         req_index = {key: j for j, key in enumerate(zip(req_area, req_op, strict=True))}
@@ -791,12 +799,12 @@ class _Segmenter:
             ops = area_ops[a]
             aid = ids_l[a]
             if ptype[a] == INTER:
-                legs = [req_index[(a, k)] for k in ops]
-                for i in range(len(ops)):
-                    for j in range(i + 1, len(ops)):
-                        pair_a.append(legs[i])
-                        pair_b.append(legs[j])
-                        pair_meta.append((ops[i], ops[j], aid, vlen_l[legs[i]] + vlen_l[legs[j]]))
+                legs = [(req_index[(a, k)], k) for k in ops]
+                # combinations() yields the pairs (i < j) in the order of the nested loops
+                for (li, oi), (lj, oj) in combinations(legs, 2):
+                    pair_a.append(li)
+                    pair_b.append(lj)
+                    pair_meta.append((oi, oj, aid, vlen_l[li] + vlen_l[lj]))
             elif len(ops) == 2 and ops[0] in area_paths[a]:
                 edges.append(
                     _edge(ops[0], ops[1], aid, path_len[(a, ops[0])], area_paths[a][ops[0]])
@@ -806,9 +814,12 @@ class _Segmenter:
                 vxy, voff, np.array(pair_a, np.int64), np.array(pair_b, np.int64)
             )
             joff_l = joff.tolist()
-            jpieces = [jxy[joff_l[k] : joff_l[k + 1]] for k in range(len(pair_a))]
-            for k, (oa, ob, aid, ln) in enumerate(pair_meta):
-                edges.append(_edge(oa, ob, aid, ln, jpieces[k]))
+            n_pair = len(pair_a)
+            jpieces = map(jxy.__getitem__, map(slice, joff_l[:n_pair], joff_l[1 : n_pair + 1]))
+            edges.extend(
+                _edge(oa, ob, aid, ln, piece)
+                for (oa, ob, aid, ln), piece in zip(pair_meta, jpieces, strict=True)
+            )
 
         frontiers = self._frontier_objects(
             ids_l, path_len, region_fronts, zero_fp, n_reg, edges, openings, op_areas, ptype
