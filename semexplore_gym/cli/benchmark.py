@@ -28,6 +28,24 @@ def _split_worlds(text: str) -> list[str]:
     return out
 
 
+def _check_worlds(worlds: list[str], seed: int) -> None:
+    """Build each world once before any mission starts, so a typo fails at once, not per mission.
+
+    Raises:
+        ValueError: an unknown or malformed world spelling (the message names it).
+        FileNotFoundError: a map file that does not exist.
+    """
+    from semexplore_gym.core.worlds import make_world
+
+    for world in worlds:
+        try:
+            make_world(world.replace("seed=*", f"seed={seed}"))
+        except FileNotFoundError as e:
+            raise FileNotFoundError(f"--worlds {world!r}: {e}") from None
+        except ValueError as e:
+            raise ValueError(f"--worlds {world!r}: {e}") from None
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "benchmark",
@@ -99,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
     worlds = _split_worlds(args.worlds)
     policies = _split(args.policies)
     seeds = parse_seeds(args.runs, args.seed0)
+    _check_worlds(worlds, seeds[0])
     from policies.registry import policy_factories, strip_label
 
     known = policy_factories()

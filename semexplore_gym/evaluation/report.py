@@ -181,7 +181,7 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
                 grid, ys.mean(axis=0), color=colours[policy], label=f"{policy} (n={len(traces)})"
             )
             ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
-        ax.set_title(world)
+        ax.set_title(world_label(world))
         ax.set_xlabel("time (s)")
         ax.set_ylabel("explored free area (m²)")
         ax.grid(alpha=0.3)
@@ -216,7 +216,7 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
                     color=colours[names[i]],
                     zorder=3,
                 )
-            ax.set_title(world)
+            ax.set_title(world_label(world))
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3, axis="y")
         fig.tight_layout()
@@ -243,7 +243,7 @@ def _trajectory_figure(
             ax.set_yticks([])
             rs = groups[world].get(policy, [])
             if not rs:
-                ax.set_title(f"{world} / {policy}: no run", fontsize=8)
+                ax.set_title(f"{world_label(world)} / {policy}: no run", fontsize=8)
                 continue
             rs = sorted(rs, key=lambda r: r["mission_time_s"])
             r = rs[(len(rs) - 1) // 2]
@@ -260,11 +260,23 @@ def _trajectory_figure(
                 ax.plot(traj[0, 0], traj[0, 1], "o", color="green", ms=5)
                 ax.plot(traj[-1, 0], traj[-1, 1], "s", color="red", ms=5)
             ax.set_title(
-                f"{world} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}",
+                f"{world_label(world)} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}",
                 fontsize=8,
             )
     fig.tight_layout()
     return _save(fig, out / "trajectories.png")
+
+
+def world_label(world: str, max_parts: int = 3) -> str:
+    """A short figure title for a world spelling: map files keep only their last path parts.
+
+    ``/data/maps/turtlebot3/world/map.yaml`` becomes ``turtlebot3/world/map.yaml``; names and
+    procedural spellings (``maze:seed=*,size_m=5``) are returned unchanged.
+    """
+    if "/" not in world and "\\" not in world:
+        return world
+    parts = Path(world).parts
+    return "/".join(parts[-max_parts:])
 
 
 def _save(fig: Any, path: Path) -> Path:

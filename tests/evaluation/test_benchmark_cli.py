@@ -94,3 +94,25 @@ def test_ray_backend_runs_two_missions(tmp_path, capsys) -> None:
     assert main(argv) == 0
     rows = read_runs(out / "runs.csv")
     assert sorted(r["seed"] for r in rows) == [0, 1]
+
+
+@pytest.mark.parametrize(
+    ("worlds", "fragment"),
+    [("maze1,no/such/map.yaml", "world file not found"), ("maze1,mazee", "unknown world 'mazee'")],
+)
+def test_bad_world_fails_before_any_mission(tmp_path, capsys, worlds, fragment) -> None:
+    out = tmp_path / "bench"
+    argv = ["benchmark", "--worlds", worlds, "--runs", "1", "--out", str(out), "--no-progress"]
+    assert main(argv) != 0
+    err = capsys.readouterr().err
+    assert fragment in err and "--worlds" in err
+    assert not (out / "runs.csv").exists()  # nothing ran
+
+
+def test_world_label_shortens_map_paths_only() -> None:
+    from semexplore_gym.evaluation.report import world_label
+
+    assert world_label("/data/maps/turtlebot3/world/map.yaml") == "turtlebot3/world/map.yaml"
+    assert world_label("maps/map.yaml") == "maps/map.yaml"
+    assert world_label("maze:seed=*,size_m=5") == "maze:seed=*,size_m=5"
+    assert world_label("maze1") == "maze1"
