@@ -216,7 +216,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
     p.add_argument("--config", default=None, help="env config: preset name or YAML path")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
-    p.add_argument("--workers", type=int, default=1, help="test missions in parallel processes (default: %(default)s)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="test missions in parallel processes (default: %(default)s)",
+    )
     return p
 
 
@@ -300,9 +305,7 @@ def run(args: argparse.Namespace) -> int:
             env_config=args.config,
             policy_overrides=ws,
         )
-    res = run_benchmark(
-        tasks, out / "test", workers=args.workers, progress=not args.no_progress
-    )
+    res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
     rows = read_runs(out / "test" / "runs.csv")
     labels = list(sets)
     table = summarise(rows, labels, args.target_coverage, args.penalty_s)

@@ -77,3 +77,35 @@ def test_segment_ros_map(tmp_path, capsys):
     d = json.loads(capsys.readouterr().out)
     assert d["intersections"] >= 1  # the arena around the pillars
     assert (tmp_path / "tb3.png").stat().st_size > 1000
+
+
+def test_time_ms_excludes_kernel_loading(capsys, monkeypatch):
+    # The CLI segments a tiny grid first, so the reported time is the map's own segmentation.
+    from semexplore_gym.core import topometric
+
+    calls = []
+    real = topometric.segment_map
+
+    def spy(grid, *a, **k):
+        calls.append(getattr(grid, "shape", None))
+        return real(grid, *a, **k)
+
+    monkeypatch.setattr(topometric, "segment_map", spy)
+    assert seg_cli.run(parse(["segment", "maze1", "--json"])) == 0
+    assert calls[0] == (8, 8) and len(calls) == 2 and calls[1][0] > 100
+    assert json.loads(capsys.readouterr().out)["time_ms"] > 0
+
+
+def test_closed_pipe_ends_quietly(monkeypatch):
+    # `semexplore segment ... --json | head`: the reader goes away; exit 0, no traceback.
+    import semexplore_gym.cli as cli
+
+    redirected = []
+
+    def broken(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(seg_cli, "run", broken)
+    monkeypatch.setattr(cli.os, "dup2", lambda a, b: redirected.append(b))
+    assert cli.main(["segment", "maze1", "--json"]) == 0
+    assert len(redirected) == 1
