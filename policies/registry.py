@@ -2,8 +2,9 @@
 
 Specs: ``"semantic"`` (the scripted expert), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a trained
-agent). A spec may carry an argument after a colon. Keyword overrides set fields of the policy's
-parameter dataclass, nested (``cost={"w_v": 2}``) or dotted (``**{"cost.w_v": 2}``); ``params=``
+agent), ``"py:<module or file.py>:<Name>"`` (your own :class:`~policies.base.Policy` subclass
+or factory, so ``semexplore benchmark`` can compare it with the built-in ones). A spec may carry
+an argument after a colon. Keyword overrides set fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted (``**{"cost.w_v": 2}``); ``params=``
 gives a whole parameter object or mapping to start from.
 """
 
@@ -89,6 +90,64 @@ def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
     return SB3Policy(arg, **overrides)
 
 
+def _python(arg: str, overrides: dict[str, Any]) -> Policy:
+    """``py:MODULE:NAME`` or ``py:path/to/file.py:NAME``: a user's own policy.
+
+    ``NAME`` is a :class:`~policies.base.Policy` subclass or a factory function returning a
+    policy; the overrides are passed to it as keyword arguments.
+    """
+    import hashlib
+    import importlib
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    source, sep, attr = arg.rpartition(":")
+    if not sep or not source or not attr:
+        raise ValueError(
+            f"policy 'py:{arg}' must name a module or .py file and an object: "
+            "'py:my_package.planner:MyPolicy' or 'py:path/to/planner.py:MyPolicy'"
+        )
+    if source.endswith(".py"):
+        path = Path(source).resolve()
+        if not path.is_file():
+            raise FileNotFoundError(f"policy 'py:{arg}': no such file {path}")
+        digest = hashlib.sha1(str(path).encode()).hexdigest()[:12]
+        mod_name = f"_semexplore_user_policy_{path.stem}_{digest}"
+        module = sys.modules.get(mod_name)
+        if module is None:
+            spec = importlib.util.spec_from_file_location(mod_name, path)
+            assert spec is not None and spec.loader is not None
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[mod_name] = module
+            try:
+                spec.loader.exec_module(module)
+            except BaseException:
+                del sys.modules[mod_name]
+                raise
+    else:
+        try:
+            module = importlib.import_module(source)
+        except ModuleNotFoundError as e:
+            raise ValueError(
+                f"policy 'py:{arg}': cannot import module {source!r} ({e}); is it on PYTHONPATH?"
+            ) from None
+    if not hasattr(module, attr):
+        raise ValueError(f"policy 'py:{arg}': module {source!r} has no attribute {attr!r}")
+    target = getattr(module, attr)
+    if not callable(target):
+        raise ValueError(
+            f"policy 'py:{arg}': {attr!r} is a {type(target).__name__}, not a class or function"
+        )
+    policy = target(**overrides)
+    if not isinstance(policy, Policy):
+        raise ValueError(
+            f"policy 'py:{arg}': {attr}() returned a {type(policy).__name__}, "
+            "not a policies.base.Policy"
+        )
+    return policy
+
+
 def policy_factories() -> dict[str, Factory]:
     """The known policy names and their factories ``(argument, overrides) -> Policy``."""
     return {
@@ -97,6 +156,7 @@ def policy_factories() -> dict[str, Factory]:
         "nearest": _nearest,
         "random": _random,
         "sb3": _sb3,
+        "py": _python,
     }
 
 
@@ -125,6 +185,7 @@ def make_policy(spec: str, **overrides: Any) -> Policy:
     factories = policy_factories()
     if name not in factories:
         raise ValueError(
-            f"unknown policy {spec!r}; known: {', '.join(sorted(factories))} (sb3 as 'sb3:path.zip')"
+            f"unknown policy {spec!r}; known: {', '.join(sorted(factories))} "
+            "(sb3 as 'sb3:path.zip', your own as 'py:module:Class' or 'py:file.py:Class')"
         )
     return factories[name](arg, dict(overrides))

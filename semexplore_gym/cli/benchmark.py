@@ -124,6 +124,14 @@ def run(args: argparse.Namespace) -> int:
     for p in policies:
         if strip_label(p).partition(":")[0] not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
+        if strip_label(p).partition(":")[0] in ("py", "sb3"):
+            # user code and model files: load them once now, so a typo fails before any mission
+            from policies.registry import make_policy
+
+            try:
+                make_policy(p)
+            except (ValueError, FileNotFoundError) as e:
+                raise ValueError(f"--policies {p!r}: {e}") from None
     from semexplore_gym.core.params import to_dict
     from semexplore_gym.envs.config import load_env_config
 
