@@ -1,11 +1,13 @@
 """Build any policy from a short spec string: ``make_policy("semantic", **overrides)``.
 
 Specs: ``"semantic"`` (the scripted expert), ``"frontier"`` (ROS frontier_exploration
-baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a trained
-agent), ``"py:<module or file.py>:<Name>"`` (your own :class:`~policies.base.Policy` subclass
-or factory, so ``semexplore benchmark`` can compare it with the built-in ones). A spec may carry
-an argument after a colon. Keyword overrides set fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted (``**{"cost.w_v": 2}``); ``params=``
-gives a whole parameter object or mapping to start from.
+baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
+trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
+agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
+:class:`~policies.base.Policy` subclass or factory, so ``semexplore benchmark`` can compare it
+with the built-in ones). A spec may carry an argument after a colon. Keyword overrides set
+fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted
+(``**{"cost.w_v": 2}``); ``params=`` gives a whole parameter object or mapping to start from.
 """
 
 from __future__ import annotations
@@ -82,11 +84,17 @@ def _random(arg: str, overrides: dict[str, Any]) -> Policy:
 
 
 def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.sb3_policy import SB3Policy
-
     if not arg:
         raise ValueError("policy 'sb3' needs a model path: 'sb3:path/to/model.zip'")
     overrides.pop("params", None)
+    from policies.macro_agent import MacroAgentPolicy, read_macro_run
+
+    # A model trained on a macro-action env id decides frontiers or weights; the expert drives.
+    run = read_macro_run(arg)
+    if run is not None:
+        return MacroAgentPolicy(arg, run=run, **overrides)
+    from policies.sb3_policy import SB3Policy
+
     return SB3Policy(arg, **overrides)
 
 

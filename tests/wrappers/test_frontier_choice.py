@@ -228,3 +228,20 @@ def test_registered_macro_envs_pass_check_env(env_id: str) -> None:
         mask = env.get_wrapper_attr("action_masks")()
         assert mask.dtype == bool and mask[0]
     env.close()
+
+
+def test_observation_vector_shows_the_first_k_and_counts_all() -> None:
+    from semexplore_gym.core.grid import FREE, UNKNOWN
+    from semexplore_gym.core.macro_features import observation_size, observation_vector
+
+    params = MacroParams(n_candidates=2, time_scale_s=100.0)
+    cands = [_cand((float(i), 0.0), 1.0 + i, float(i)) for i in range(5)]
+    grid = np.full((4, 5), UNKNOWN, np.uint8)
+    grid[:2] = FREE  # 10 of 20 cells known
+    vec, shown = observation_vector(cands, grid, 25.0, params)
+    assert vec.shape == (observation_size(params),) == (2 * N_CANDIDATE_FEATURES + 4,)
+    assert shown == cands[:2]
+    np.testing.assert_allclose(vec[-4:], [0.5, 0.25, 1.0, 5 / 8], atol=1e-6)
+    vec0, shown0 = observation_vector([], grid, 500.0, params)
+    assert shown0 == [] and not vec0[:-4].any()
+    np.testing.assert_allclose(vec0[-4:], [0.5, 1.0, 0.0, 0.0], atol=1e-6)
