@@ -8,6 +8,9 @@
    (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` and the ablations
    of the paper weights ``semantic[paper,w_p=0]``, ``semantic[paper,w_I=0]``,
    ``semantic[paper,w_p=w_I=0]``.
+   ``--agents`` adds learned agents (any policy spec, e.g. a ``SemanticExploreWeights-v0`` PPO
+   model that chooses the weights at every decision: ``sb3:runs/pw/model.zip[learned]``) on the
+   same test worlds and seeds.
 3. Write ``OUT/compare.md`` and ``OUT/compare.csv`` (median mission time, coverage, score,
    Mann-Whitney U p-value of each set's mission times against the paper's) and
    ``OUT/mission_times.png`` (box plot per weight set). ``OUT/weights.json`` has every set.
@@ -110,9 +113,12 @@ def summarise(
 
 
 def write_table(
-    out: Path, table: list[dict[str, Any]], sets: dict[str, dict[str, float]]
+    out: Path,
+    table: list[dict[str, Any]],
+    sets: dict[str, dict[str, float]],
+    agents: list[str] | None = None,
 ) -> tuple[Path, Path]:
-    """``compare.csv`` and ``compare.md`` from :func:`summarise` rows."""
+    """``compare.csv`` and ``compare.md`` from :func:`summarise` rows (``agents``: their specs)."""
     cols = list(table[0])
     csv_path = out / "compare.csv"
     with csv_path.open("w", newline="") as f:
@@ -136,6 +142,7 @@ def write_table(
             f"- `{lab}`: " + ", ".join(f"{k}={v:.4g}" for k, v in ws.items())
             for lab, ws in sets.items()
         ),
+        *(f"- `{spec}`: learned agent (policy spec)" for spec in agents or []),
         "",
     ]
     md_path = out / "compare.md"
@@ -213,6 +220,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--tune-field", action="store_true", help="also tune the potential field's f_g, f_o, f_l"
     )
+    p.add_argument(
+        "--agents",
+        default="",
+        help="comma-separated policy specs compared on the test worlds too, e.g. "
+        "'sb3:runs/pw/model.zip[learned weights]'",
+    )
     p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
     p.add_argument("--config", default=None, help="env config: preset name or YAML path")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
@@ -254,6 +267,20 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.trials < 1:
         raise ValueError(f"--trials must be >= 1, got {args.trials}")
+    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
+    if agents:
+        from policies.registry import make_policy, strip_label
+
+        for spec in agents:
+            if strip_label(spec).partition(":")[0] == "semantic":
+                raise ValueError(
+                    f"--agents {spec!r}: weight sets of the expert are built in; give learned "
+                    "or other agents here"
+                )
+            try:
+                make_policy(spec)  # a bad path or spec fails now, not after the tuning
+            except (ValueError, FileNotFoundError) as e:
+                raise ValueError(f"--agents {spec!r}: {e}") from None
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_manifest(
@@ -305,11 +332,15 @@ def run(args: argparse.Namespace) -> int:
             env_config=args.config,
             policy_overrides=ws,
         )
+    if agents:
+        tasks += expand_tasks(
+            test_worlds, agents, test_seeds, max_time_s=args.max_time_s, env_config=args.config
+        )
     res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
     rows = read_runs(out / "test" / "runs.csv")
-    labels = list(sets)
+    labels = [*sets, *agents]
     table = summarise(rows, labels, args.target_coverage, args.penalty_s)
-    csv_path, md_path = write_table(out, table, sets)
+    csv_path, md_path = write_table(out, table, sets, agents)
     plot = write_boxplot(out, rows, labels)
     print(
         json.dumps(

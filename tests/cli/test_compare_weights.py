@@ -86,3 +86,26 @@ def test_compare_weights_writes_table_and_plot(tmp_path: Path) -> None:
         runs = list(csv.DictReader(f))
     assert sorted(r["policy"] for r in runs) == sorted(weight_sets({}))
     assert {r["seed"] for r in runs} == {"1000"}
+
+
+def test_agents_join_the_test_table_and_bad_agents_fail_early(tmp_path: Path) -> None:
+    out = tmp_path / "cw"
+    argv = [
+        "compare-weights",
+        "--train-worlds", "maze:seed=*,size_m=4",
+        "--test-worlds", "maze:seed=*,size_m=4",
+        "--trials", "1", "--train-runs", "1", "--runs", "1",
+        "--max-time-s", "10", "--no-progress",
+    ]  # fmt: skip
+    assert main([*argv, "--agents", "random[rnd]", "--out", str(out)]) == 0
+    with (out / "compare.csv").open() as f:
+        table = {r["weights"]: r for r in csv.DictReader(f)}
+    assert list(table) == [*weight_sets({}), "random[rnd]"]
+    assert int(table["random[rnd]"]["n"]) == 1
+    assert float(table["random[rnd]"]["median_mission_time_s"]) == pytest.approx(10.0)
+    assert "`random[rnd]`: learned agent" in (out / "compare.md").read_text()
+
+    bad = tmp_path / "bad"
+    assert main([*argv, "--agents", "sb3:no/such/model.zip", "--out", str(bad)]) == 2
+    assert not (bad / "tuning").exists()  # rejected before any tuning trial
+    assert main([*argv, "--agents", "semantic[x]", "--out", str(bad)]) == 2
