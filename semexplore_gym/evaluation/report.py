@@ -178,7 +178,10 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
             # After a mission ends its area stays at its final value.
             ys = np.stack([np.interp(grid, t[:, 0], t[:, 2]) for t in traces])
             ax.plot(
-                grid, ys.mean(axis=0), color=colours[policy], label=f"{policy} (n={len(traces)})"
+                grid,
+                ys.mean(axis=0),
+                color=colours[policy],
+                label=f"{policy_label(policy)} (n={len(traces)})",
             )
             ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
         ax.set_title(world_label(world))
@@ -207,7 +210,10 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
         for ax, world in zip(axes[0], worlds, strict=True):
             names = list(groups[world])
             data = [_values(groups[world][p], key) for p in names]
-            ax.boxplot([d if d.size else np.array([np.nan]) for d in data], tick_labels=names)
+            ax.boxplot(
+                [d if d.size else np.array([np.nan]) for d in data],
+                tick_labels=[policy_label(n) for n in names],
+            )
             for i, d in enumerate(data):
                 ax.scatter(
                     np.full(d.size, i + 1) + np.linspace(-0.08, 0.08, max(d.size, 1))[: d.size],
@@ -243,7 +249,7 @@ def _trajectory_figure(
             ax.set_yticks([])
             rs = groups[world].get(policy, [])
             if not rs:
-                ax.set_title(f"{world_label(world)} / {policy}: no run", fontsize=8)
+                ax.set_title(f"{world_label(world)} / {policy_label(policy)}: no run", fontsize=8)
                 continue
             rs = sorted(rs, key=lambda r: r["mission_time_s"])
             r = rs[(len(rs) - 1) // 2]
@@ -260,11 +266,26 @@ def _trajectory_figure(
                 ax.plot(traj[0, 0], traj[0, 1], "o", color="green", ms=5)
                 ax.plot(traj[-1, 0], traj[-1, 1], "s", color="red", ms=5)
             ax.set_title(
-                f"{world_label(world)} / {policy}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}",
+                f"{world_label(world)} / {policy_label(policy)}\nseed {r['seed']}: {r['mission_time_s']:.0f} s, cov {r['coverage']:.2f}",
                 fontsize=8,
             )
     fig.tight_layout()
     return _save(fig, out / "trajectories.png")
+
+
+def policy_label(spec: str) -> str:
+    """A short figure label for a policy spec: a model or file spec shows its ``[label]``.
+
+    ``sb3:runs/fc/model.zip[frontier PPO]`` becomes ``frontier PPO`` and
+    ``sb3:runs/fc/model.zip`` becomes ``sb3:model.zip``; built-in specs such as
+    ``semantic[paper]`` are returned unchanged (tables always keep the full spec).
+    """
+    name, _, rest = spec.partition(":")
+    if name not in ("sb3", "py") or not rest:
+        return spec
+    if spec.endswith("]") and "[" in spec:
+        return spec[spec.rindex("[") + 1 : -1].strip() or spec
+    return f"{name}:{Path(rest).name}"
 
 
 def world_label(world: str, max_parts: int = 3) -> str:

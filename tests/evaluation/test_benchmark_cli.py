@@ -116,3 +116,13 @@ def test_world_label_shortens_map_paths_only() -> None:
     assert world_label("maps/map.yaml") == "maps/map.yaml"
     assert world_label("maze:seed=*,size_m=5") == "maze:seed=*,size_m=5"
     assert world_label("maze1") == "maze1"
+
+
+def test_policy_label_shortens_model_and_file_specs_only() -> None:
+    from semexplore_gym.evaluation.report import policy_label
+
+    assert policy_label("sb3:runs/fc/model.zip[frontier PPO]") == "frontier PPO"
+    assert policy_label("sb3:runs/fc/model.zip") == "sb3:model.zip"
+    assert policy_label("py:/home/me/planner.py:Mine") == "py:planner.py:Mine"
+    assert policy_label("semantic[paper]") == "semantic[paper]"
+    assert policy_label("nearest") == "nearest"
