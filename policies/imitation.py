@@ -6,6 +6,11 @@ behaviour-cloned model can be fine-tuned with PPO. The expert is any :class:`pol
 (normally the scripted semantic expert); it sees the raw observation, the learner the
 egocentric features computed from that same observation (:class:`EgocentricEncoder`).
 
+Recording can inject DART noise into the executed expert actions (labels stay clean), and
+:func:`train_bc` can mirror samples left-right, keep the best epoch by held-out action error
+and decay the learning rate; ``scripts/bench_imitation.py`` compares a trained model with the
+expert at the expert's own mission time on held-out worlds.
+
 Datasets are ``.npz`` files holding the egocentric observations (``obs__<key>``), the expert's
 actions, an episode id per sample and a JSON ``meta`` record; :class:`DatasetWriter` rewrites
 the file atomically after every episode, so an interrupted recording keeps its finished
@@ -30,7 +35,11 @@ from typing import Any
 import numpy as np
 
 from policies.base import Policy
-from semexplore_gym.core.egocentric import EgocentricEncoder, EgocentricParams
+from semexplore_gym.core.egocentric import (
+    EgocentricEncoder,
+    EgocentricParams,
+    mirror_observations,
+)
 
 #: Name of the JSON record stored inside model zips: policy class and feature parameters.
 MODEL_META_NAME = "semexplore.json"
@@ -90,6 +99,32 @@ class ImitationDataset:
             np.concatenate([self.actions, other.actions]),
             np.concatenate([self.episode_ids, other.episode_ids + shift]),
             dict(self.meta),
+        )
+
+    @staticmethod
+    def concatenate_all(parts: Sequence[ImitationDataset]) -> ImitationDataset:
+        """Like chained :meth:`concatenate` calls (ids shifted part by part), in one copy."""
+        meta: dict[str, Any] = {}
+        for p in reversed(parts):  # earlier parts' facts win, as in concatenate
+            meta.update(p.meta)
+        parts = [p for p in parts if len(p)]
+        if not parts:
+            return ImitationDataset.empty(meta)
+        if len(parts) == 1:
+            return ImitationDataset(parts[0].obs, parts[0].actions, parts[0].episode_ids, meta)
+        keys = set(parts[0].obs)
+        for p in parts[1:]:
+            if set(p.obs) != keys:
+                raise ValueError(f"observation keys differ: {sorted(keys)} vs {sorted(p.obs)}")
+        ids, next_id = [], int(parts[0].episode_ids.min())
+        for p in parts:
+            ids.append(p.episode_ids - int(p.episode_ids.min()) + next_id)
+            next_id = int(ids[-1].max()) + 1
+        return ImitationDataset(
+            {k: np.concatenate([p.obs[k] for p in parts]) for k in parts[0].obs},
+            np.concatenate([p.actions for p in parts]),
+            np.concatenate(ids),
+            meta,
         )
 
     def subset(self, mask: np.ndarray) -> ImitationDataset:
@@ -158,23 +193,61 @@ class DatasetWriter:
         path: Output ``.npz`` path; an existing file is extended when ``append`` is True.
         meta: JSON-safe facts stored with the data.
         append: Start from the samples already in ``path``.
+        min_interval_s: Skip the rewrite when the last one was less than this long ago (call
+            :meth:`flush` at the end); 0 rewrites after every episode. Rewriting a large
+            compressed file after every short episode would cost more than recording it.
     """
 
     def __init__(
-        self, path: str | os.PathLike, meta: dict[str, Any] | None = None, append: bool = False
+        self,
+        path: str | os.PathLike,
+        meta: dict[str, Any] | None = None,
+        append: bool = False,
+        min_interval_s: float = 0.0,
     ) -> None:
         self.path = Path(path)
-        self.data = (
+        self.min_interval_s = float(min_interval_s)
+        self._last_save = -math.inf
+        self._dirty = False
+        self._data = (
             ImitationDataset.load(self.path)
             if append and self.path.is_file()
             else ImitationDataset.empty(meta)
         )
         if meta:
-            self.data.meta.update(meta)
+            self._data.meta.update(meta)
+        # Episodes not yet merged into _data: merging all at once is linear, per episode quadratic.
+        self._pending: list[ImitationDataset] = []
+
+    @property
+    def data(self) -> ImitationDataset:
+        """All samples so far (the file's content after the next :meth:`flush`)."""
+        if self._pending:
+            self._data = ImitationDataset.concatenate_all([self._data, *self._pending])
+            self._pending = []
+        return self._data
 
     def add(self, episode: ImitationDataset) -> None:
-        self.data = self.data.concatenate(episode)
-        self.data.save(self.path)
+        """Append an episode; write the file unless the last write was too recent."""
+        self._pending.append(episode)
+        self._mark_dirty()
+
+    def replace(self, data: ImitationDataset) -> None:
+        """Make ``data`` the file's content; write it unless the last write was too recent."""
+        self._data, self._pending = data, []
+        self._mark_dirty()
+
+    def _mark_dirty(self) -> None:
+        self._dirty = True
+        if time.perf_counter() - self._last_save >= self.min_interval_s:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the file now if episodes were added since the last write."""
+        if self._dirty:
+            self.data.save(self.path)
+            self._last_save = time.perf_counter()
+            self._dirty = False
 
 
 # ---------------------------------------------------------------------- roll-outs
@@ -225,12 +298,18 @@ def rollout_episode(
     seed: int | None = None,
     max_steps: int = 1000,
     episode_id: int = 0,
+    noise_std: float = 0.0,
 ) -> EpisodeRecord:
     """Run one episode, labelling every visited state with the expert's action.
 
     Each step executes the expert's action with probability ``beta`` and the learner's
     otherwise (``learner`` may be None only when ``beta == 1``). The expert is asked every step,
     also when the learner drives, so its internal plan follows the visited states.
+
+    With ``noise_std > 0`` the executed expert action gets zero-mean Gaussian noise of that
+    standard deviation per component (drawn from ``rng``, then clipped to [-1, 1]) while the
+    label stays the clean action (DART, Laskey et al. 2017): the data then shows how the expert
+    recovers from the small drifts a learner makes.
 
     Args:
         env: The raw ``SemanticExplore-v0`` env (not wrapped).
@@ -242,7 +321,10 @@ def rollout_episode(
         seed: Seed for ``env.reset`` and ``expert.reset``.
         max_steps: Step cap of the episode.
         episode_id: Episode id stored with the samples.
+        noise_std: DART noise on the executed expert actions (0: none).
     """
+    if not (0.0 <= noise_std and math.isfinite(noise_std)):
+        raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
     if not 0.0 <= beta <= 1.0:
         raise ValueError(f"beta must be in [0, 1], got {beta!r}")
     if learner is None and beta < 1.0:
@@ -272,7 +354,13 @@ def rollout_episode(
             break
         use_expert = beta >= 1.0 or rng.random() < beta
         n_expert += int(use_expert)
-        action = a_expert if use_expert else learner_action(learner, f)
+        if not use_expert:
+            action = learner_action(learner, f)
+        elif noise_std > 0.0:
+            noise = rng.normal(0.0, noise_std, a_expert.shape).astype(np.float32)
+            action = np.clip(a_expert + noise, -1.0, 1.0)
+        else:
+            action = a_expert
         obs, reward, terminated, truncated, info = env.step(action)
         ret += float(reward)
         if terminated or truncated:
@@ -306,31 +394,58 @@ def record_expert_dataset(
     meta: dict[str, Any] | None = None,
     progress: bool = False,
     log_fn: Callable[[str, float, int], None] | None = None,
+    noise_std: float = 0.0,
+    noise_fraction: float = 1.0,
+    save_interval_s: float = 0.0,
 ) -> ImitationDataset:
     """Roll out the expert for ``n_episodes`` (seeds ``seed``, ``seed+1``, ...) and record them.
 
-    When ``path`` is given the ``.npz`` is rewritten after every episode. ``log_fn(tag, value,
-    step)`` receives per-episode coverage and length.
+    When ``path`` is given the ``.npz`` is rewritten after an episode when ``save_interval_s``
+    passed since the last write (0: after every episode), and at the end. ``log_fn(tag, value,
+    step)`` receives per-episode coverage and length. The first ``round(noise_fraction *
+    n_episodes)`` episodes execute the expert's actions with DART noise ``noise_std`` (see
+    :func:`rollout_episode`), drawn from a generator seeded with ``seed``; the rest are clean.
     """
     if n_episodes < 1:
         raise ValueError(f"n_episodes must be >= 1, got {n_episodes!r}")
+    if not 0.0 <= noise_fraction <= 1.0:
+        raise ValueError(f"noise_fraction must be in [0, 1], got {noise_fraction!r}")
     full_meta = {
         "egocentric": params.to_dict(),
         "expert": getattr(expert, "name", type(expert).__name__),
         **(meta or {}),
     }
-    writer = DatasetWriter(path, full_meta) if path is not None else None
-    data = ImitationDataset.empty(full_meta)
+    if noise_std > 0:
+        full_meta["dart_noise_std"] = float(noise_std)
+        full_meta["dart_noise_fraction"] = float(noise_fraction)
+    writer = (
+        DatasetWriter(path, full_meta, min_interval_s=save_interval_s) if path is not None else None
+    )
+    rng = np.random.default_rng(seed)
+    n_noisy = round(noise_fraction * n_episodes) if noise_std > 0 else 0
+    parts: list[ImitationDataset] = []
     for ep in _progress(range(n_episodes), progress, "expert episodes"):
         rec = rollout_episode(
-            env, expert, params, seed=seed + ep, max_steps=max_steps, episode_id=ep
+            env,
+            expert,
+            params,
+            rng=rng,
+            seed=seed + ep,
+            max_steps=max_steps,
+            episode_id=ep,
+            noise_std=noise_std if ep < n_noisy else 0.0,
         )
-        data = data.concatenate(rec.data)
+        parts.append(rec.data)
         if writer is not None:
             writer.add(rec.data)
         if log_fn is not None:
             log_fn("expert/coverage", rec.coverage, ep)
             log_fn("expert/steps", rec.steps, ep)
+    if writer is not None:
+        writer.flush()
+    # One concatenation at the end: growing the arrays per episode is quadratic.
+    data = ImitationDataset.concatenate_all(parts)
+    data.meta = full_meta
     return data
 
 
@@ -388,6 +503,9 @@ def train_bc(
     log_fn: Callable[[str, float, int], None] | None = None,
     step_offset: int = 0,
     eval_data: ImitationDataset | None = None,
+    mirror_params: EgocentricParams | None = None,
+    select_best: bool = False,
+    lr_final_fraction: float = 1.0,
 ) -> dict[str, list[float]]:
     """Behaviour cloning: minimise ``-log pi(a_expert | o) - ent_weight * entropy`` with Adam.
 
@@ -404,15 +522,27 @@ def train_bc(
         log_fn: ``log_fn(tag, value, step)`` for per-epoch scalars.
         step_offset: Added to the epoch index passed to ``log_fn`` (DAgger rounds).
         eval_data: Held-out samples; their :func:`action_error` is recorded after each epoch.
+        mirror_params: When given, each minibatch sample is replaced by its left-right mirror
+            image (:func:`~semexplore_gym.core.egocentric.mirror_observations`) with
+            probability 1/2, doubling the data for free; these are the data's parameters.
+        select_best: With ``eval_data``, restore the weights of the epoch with the lowest
+            held-out action error at the end (early stopping without stopping).
+        lr_final_fraction: The learning rate decays along a cosine from ``lr`` to
+            ``lr * lr_final_fraction`` over the epochs (1: constant).
 
     Returns:
         ``{"loss": [...], "neglogp": [...], "entropy": [...]}`` one value per epoch, plus
-        ``"eval_action_error"`` when ``eval_data`` is given.
+        ``"eval_action_error"`` when ``eval_data`` is given (and ``"best_epoch"``, a
+        one-element list, when ``select_best`` restored a checkpoint).
     """
+    import copy
+
     import torch as th
 
     if len(dataset) == 0:
         raise ValueError("train_bc needs a non-empty dataset")
+    if not 0.0 < lr_final_fraction <= 1.0:
+        raise ValueError(f"lr_final_fraction must be in (0, 1], got {lr_final_fraction!r}")
     if epochs < 1 or batch_size < 1 or not lr > 0:
         raise ValueError(
             f"epochs, batch_size and lr must be positive, got {epochs}, {batch_size}, {lr}"
@@ -420,16 +550,31 @@ def train_bc(
     th.manual_seed(seed)
     rng = np.random.default_rng(seed)
     optimizer = th.optim.Adam(policy.parameters(), lr=lr, weight_decay=l2_weight)
-    actions = th.as_tensor(dataset.actions, device=policy.device)
     history: dict[str, list[float]] = {"loss": [], "neglogp": [], "entropy": []}
+    best_err, best_state, best_epoch = math.inf, None, -1
     for epoch in _progress(range(epochs), progress, "BC epochs"):
+        frac = 0.5 * (1.0 + math.cos(math.pi * epoch / max(1, epochs - 1))) if epochs > 1 else 1.0
+        for group in optimizer.param_groups:
+            group["lr"] = lr * (lr_final_fraction + (1.0 - lr_final_fraction) * frac)
         policy.set_training_mode(True)
         order = rng.permutation(len(dataset))
         sums = np.zeros(3)
         for start in range(0, len(order), batch_size):
-            idx = order[start : start + batch_size]
+            idx = np.sort(order[start : start + batch_size])  # sorted: faster gathers
+            obs_b = {k: v[idx] for k, v in dataset.obs.items()}
+            act_b = dataset.actions[idx]
+            if mirror_params is not None:
+                flip = rng.random(len(idx)) < 0.5
+                if flip.any():
+                    m_obs, m_act = mirror_observations(
+                        {k: v[flip] for k, v in obs_b.items()}, act_b[flip], mirror_params
+                    )
+                    for k in obs_b:
+                        obs_b[k][flip] = m_obs[k]
+                    act_b[flip] = m_act
             _values, log_prob, entropy = policy.evaluate_actions(
-                _to_tensors(dataset.obs, idx, policy.device), actions[idx]
+                {k: th.as_tensor(v, device=policy.device) for k, v in obs_b.items()},
+                th.as_tensor(act_b, device=policy.device),
             )
             neglogp = -log_prob.mean()
             ent = entropy.mean() if entropy is not None else th.zeros(())
@@ -448,6 +593,12 @@ def train_bc(
             history.setdefault("eval_action_error", []).append(err)
             if log_fn is not None:
                 log_fn("bc/eval_action_error", err, step_offset + epoch)
+            if select_best and err < best_err:
+                best_err, best_epoch = err, epoch
+                best_state = copy.deepcopy(policy.state_dict())
+    if best_state is not None:
+        policy.load_state_dict(best_state)
+        history["best_epoch"] = [float(best_epoch)]
     policy.set_training_mode(False)
     return history
 
@@ -495,6 +646,7 @@ def run_dagger(
     max_steps: int = 1000,
     progress: bool = False,
     log_fn: Callable[[str, float, int], None] | None = None,
+    save_interval_s: float = 0.0,
 ) -> DaggerResult:
     """DAgger: roll out the learner with beta-mixing, label with the expert, aggregate, refit.
 
@@ -513,6 +665,8 @@ def run_dagger(
         max_steps: Step cap per episode.
         progress: tqdm bars.
         log_fn: ``log_fn(tag, value, step)`` for per-round scalars.
+        save_interval_s: Minimum time between rewrites of ``dataset_path`` (it is always
+            written at the end of every round).
     """
     if rounds < 1 or episodes_per_round < 1:
         raise ValueError(
@@ -523,10 +677,14 @@ def run_dagger(
     data = (
         dataset if dataset is not None else ImitationDataset.empty({"egocentric": params.to_dict()})
     )
-    writer = DatasetWriter(dataset_path, data.meta) if dataset_path is not None else None
+    writer = (
+        DatasetWriter(dataset_path, data.meta, min_interval_s=save_interval_s)
+        if dataset_path is not None
+        else None
+    )
     if writer is not None and len(data):
-        writer.data = data
-        data.save(writer.path)
+        writer.replace(data)
+        writer.flush()
     bc_kwargs = dict(bc_kwargs or {})
     epochs = int(bc_kwargs.get("epochs", 10))
     history: list[dict[str, float]] = []
@@ -551,11 +709,12 @@ def run_dagger(
             episode_seed += 1
             data = data.concatenate(rec.data)
             if writer is not None:
-                writer.data = data
-                data.save(writer.path)
+                writer.replace(data)
             covs.append(rec.coverage)
             fracs.append(rec.expert_fraction)
             n_new += len(rec.data)
+        if writer is not None:
+            writer.flush()
         fit = train_bc(
             data, learner, seed=seed + r, log_fn=log_fn, step_offset=r * epochs, **bc_kwargs
         )

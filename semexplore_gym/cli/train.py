@@ -52,19 +52,33 @@ class EnvSection:
 
 @dataclass(frozen=True)
 class EgocentricSection:
+    """``EgocentricParams`` fields (defaults: the original one-channel encoding)."""
+
     crop_cells: int = 64
     crop_resolution_m: float | None = 0.1
     n_scan_bins: int = 60
+    channels: tuple[str, ...] = ("occupancy",)
+    frontier_clearance_m: float = 0.1
+    distance_scale_per_m: float = 20.0
+    trail_radius_m: float = 0.1
+    scan_bins_centred: bool = False
 
 
 @dataclass(frozen=True)
 class ExpertSection:
-    """The labelling expert (a ``policies.registry`` spec) and how much to record."""
+    """The labelling expert (a ``policies.registry`` spec) and how much to record.
+
+    ``noise_std`` > 0 records the first ``noise_fraction`` of the episodes with DART noise on
+    the executed actions (labels stay clean); ``save_interval_s`` throttles dataset rewrites.
+    """
 
     spec: str = "semantic"
     episodes: int = 8
     max_steps: int = 600
     holdout_fraction: float = 0.125
+    noise_std: float = 0.0
+    noise_fraction: float = 1.0
+    save_interval_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -78,21 +92,32 @@ class PolicySection:
 
 @dataclass(frozen=True)
 class BCSection:
+    """``train_bc`` settings; ``mirror`` needs ``egocentric.scan_bins_centred`` and odd beams per bin."""
+
     epochs: int = 15
     batch_size: int = 64
     lr: float = 3e-4
     ent_weight: float = 1e-3
     l2_weight: float = 0.0
+    mirror: bool = False
+    select_best: bool = False
+    lr_final_fraction: float = 1.0
 
 
 @dataclass(frozen=True)
 class DaggerSection:
-    """DAgger rounds; ``beta`` is the per-round probability of executing the expert's action."""
+    """DAgger rounds; ``beta`` is the per-round probability of executing the expert's action.
+
+    Each round refits on the aggregate with the ``bc`` settings for ``epochs_per_round`` epochs,
+    except that ``select_best`` replaces ``bc.select_best``: the held-out error is measured on
+    expert states only, which the aggregate holds fewer of with every round.
+    """
 
     rounds: int = 3
     episodes_per_round: int = 2
     beta: tuple[float, ...] = (0.5, 0.25, 0.0)
     epochs_per_round: int = 5
+    select_best: bool = False
 
 
 @dataclass(frozen=True)
@@ -181,10 +206,7 @@ def _make_raw_env(cfg: TrainConfig) -> Any:
 def _egocentric_params(cfg: TrainConfig) -> Any:
     from semexplore_gym.wrappers.egocentric import EgocentricParams
 
-    e = cfg.egocentric
-    return EgocentricParams(
-        crop_cells=e.crop_cells, crop_resolution_m=e.crop_resolution_m, n_scan_bins=e.n_scan_bins
-    )
+    return EgocentricParams(**to_dict(cfg.egocentric))
 
 
 def _is_macro(cfg: TrainConfig) -> bool:
@@ -296,6 +318,15 @@ def _train_imitation(
 
     params = _egocentric_params(cfg)
     raw_env = _make_raw_env(cfg)
+    if cfg.bc.mirror:
+        n_beams = raw_env.unwrapped.config.lidar.n_beams
+        per_bin = n_beams // params.n_scan_bins
+        if not params.scan_bins_centred or per_bin % 2 == 0:
+            raise ValueError(
+                "bc.mirror needs egocentric.scan_bins_centred=true and an odd number of beams per "
+                f"scan bin; got scan_bins_centred={params.scan_bins_centred}, "
+                f"{n_beams} beams / {params.n_scan_bins} bins = {per_bin}"
+            )
     expert = _make_expert(cfg)
     progress = not args.no_progress
     t0 = time.perf_counter()
@@ -310,6 +341,9 @@ def _train_imitation(
         meta={"world": cfg.env.world, "expert_spec": cfg.expert.spec},
         progress=progress,
         log_fn=log,
+        noise_std=cfg.expert.noise_std,
+        noise_fraction=cfg.expert.noise_fraction,
+        save_interval_s=cfg.expert.save_interval_s,
     )
     record_s = time.perf_counter() - t0
     train, held = data.split_by_episode(
@@ -337,6 +371,9 @@ def _train_imitation(
         "ent_weight": bc.ent_weight,
         "l2_weight": bc.l2_weight,
         "progress": progress,
+        "mirror_params": params if bc.mirror else None,
+        "select_best": bc.select_best,
+        "lr_final_fraction": bc.lr_final_fraction,
     }
     t0 = time.perf_counter()
     eval_data = held if len(held) else None
@@ -345,6 +382,8 @@ def _train_imitation(
     )
     metrics["bc_s"] = time.perf_counter() - t0
     metrics["bc_final_loss"] = hist["loss"][-1]
+    if "best_epoch" in hist:
+        metrics["bc_best_epoch"] = int(hist["best_epoch"][0])
     if len(held):
         metrics["heldout_action_error_after_bc"] = action_error(policy, held)
         log("bc/heldout_action_error", metrics["heldout_action_error_after_bc"], bc.epochs)
@@ -366,11 +405,13 @@ def _train_imitation(
                 "epochs": d.epochs_per_round,
                 "progress": False,
                 "eval_data": eval_data,
+                "select_best": d.select_best,
             },
             seed=cfg.seed,
             max_steps=cfg.expert.max_steps,
             progress=progress,
             log_fn=log,
+            save_interval_s=cfg.expert.save_interval_s,
         )
         metrics["dagger_s"] = time.perf_counter() - t0
         metrics["dagger_rounds"] = result.rounds

@@ -13,6 +13,7 @@ from semexplore_gym.core.egocentric import (  # noqa: F401  (re-exported)
     EgocentricEncoder,
     EgocentricParams,
     egocentric_features,
+    mirror_observations,
 )
 
 
@@ -21,7 +22,7 @@ def egocentric_observation_space(params: EgocentricParams) -> spaces.Dict:
     c = params.crop_cells
     return spaces.Dict(
         {
-            "image": spaces.Box(0, 255, shape=(1, c, c), dtype=np.uint8),
+            "image": spaces.Box(0, 255, shape=(params.n_channels, c, c), dtype=np.uint8),
             "scan": spaces.Box(0.0, 1.0, shape=(params.n_scan_bins,), dtype=np.float32),
             "features": spaces.Box(0.0, 1.0, shape=(N_FEATURES,), dtype=np.float32),
         }
@@ -71,6 +72,8 @@ class EgocentricObservation(gym.ObservationWrapper):
     ) -> tuple[Any, dict[str, Any]]:
         obs, info = self.env.reset(seed=seed, options=options)
         self._sync(info)
+        if self._encoder is not None:
+            self._encoder.reset()  # a new episode: forget the previous trail
         return self.observation(obs), info
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:

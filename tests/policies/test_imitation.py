@@ -349,3 +349,112 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
             ]
         )
         assert rc == 0
+
+
+# ------------------------------------------------- DART noise, best epoch, mirroring
+class ConstantExpert(Policy):
+    """Always drives straight at half speed."""
+
+    name = "constant"
+
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        return np.array([0.5, 0.0], np.float32)
+
+
+def test_dart_noise_perturbs_execution_not_labels() -> None:
+    from policies.imitation import rollout_episode
+
+    env = _env()
+
+    def run(noise_std: float, rng_seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """(scans seen, labels) of a 12-step episode from the same start."""
+        rec = rollout_episode(
+            env,
+            ConstantExpert(),
+            PARAMS,
+            rng=np.random.default_rng(rng_seed),
+            seed=4,
+            max_steps=12,
+            noise_std=noise_std,
+        )
+        return rec.data.obs["scan"], rec.data.actions
+
+    clean_end, clean_labels = run(0.0, 0)
+    noisy_end, noisy_labels = run(0.3, 0)
+    again_end, _ = run(0.3, 0)
+    other_end, _ = run(0.3, 1)
+    # Labels are the clean expert action whatever was executed.
+    np.testing.assert_array_equal(noisy_labels, np.tile([0.5, 0.0], (12, 1)))
+    np.testing.assert_array_equal(clean_labels, noisy_labels)
+    # The noise changes what happens, and comes only from the given generator.
+    assert not np.array_equal(clean_end, noisy_end)
+    np.testing.assert_array_equal(noisy_end, again_end)
+    assert not np.array_equal(noisy_end, other_end)
+    with pytest.raises(ValueError, match="noise_std"):
+        rollout_episode(env, ConstantExpert(), PARAMS, seed=4, max_steps=2, noise_std=-0.1)
+    env.close()
+
+
+def test_select_best_restores_the_best_epoch_and_mirroring_trains() -> None:
+    from policies.imitation import action_error, record_expert_dataset, train_bc
+
+    env = _env()
+    params = EgocentricParams(
+        crop_cells=36, crop_resolution_m=0.15, n_scan_bins=72, scan_bins_centred=True
+    )
+    data = record_expert_dataset(env, ReactiveExpert(), None, 3, params, seed=0, max_steps=40)
+    train, held = data.split_by_episode(0.34, np.random.default_rng(0))
+    from gymnasium import spaces
+
+    from policies.imitation import make_policy
+    from semexplore_gym.wrappers.egocentric import egocentric_observation_space
+
+    policy = make_policy(
+        egocentric_observation_space(params),
+        spaces.Box(-1.0, 1.0, (2,), np.float32),
+        net_arch=[32],
+        features_extractor_kwargs={"cnn_output_dim": 16},
+    )
+    # A learning rate this large makes the held-out error jump around between epochs.
+    hist = train_bc(
+        train,
+        policy,
+        epochs=5,
+        batch_size=16,
+        lr=3e-3,
+        eval_data=held,
+        select_best=True,
+        mirror_params=params,
+        lr_final_fraction=0.1,
+    )
+    errs = hist["eval_action_error"]
+    assert len(errs) == 5 and hist["best_epoch"] == [float(int(np.argmin(errs)))]
+    assert action_error(policy, held) == pytest.approx(min(errs), rel=1e-6)
+    with pytest.raises(ValueError, match="scan_bins_centred"):
+        train_bc(train, policy, epochs=1, mirror_params=PARAMS)
+    env.close()
+
+
+def test_concatenate_all_matches_chained_concatenate() -> None:
+    rng = np.random.default_rng(2)
+    parts = [_fake_episode(n, e, rng) for n, e in [(3, 4), (2, 0), (4, 9)]]
+    parts[0].meta["a"] = 1
+    chained = parts[0].concatenate(parts[1]).concatenate(parts[2])
+    once = ImitationDataset.concatenate_all([ImitationDataset.empty({"w": 2}), *parts])
+    np.testing.assert_array_equal(once.episode_ids, chained.episode_ids)
+    np.testing.assert_array_equal(once.actions, chained.actions)
+    np.testing.assert_array_equal(once.obs["image"], chained.obs["image"])
+    assert once.meta == {"w": 2, "a": 1}
+
+
+def test_dataset_writer_throttles_rewrites_and_flushes(tmp_path: Path) -> None:
+    rng = np.random.default_rng(3)
+    path = tmp_path / "d.npz"
+    writer = DatasetWriter(path, meta={"k": 1}, min_interval_s=3600.0)
+    writer.add(_fake_episode(4, 0, rng))  # the first episode is written at once
+    writer.add(_fake_episode(2, 0, rng))  # within the interval: kept in memory only
+    assert len(ImitationDataset.load(path)) == 4 and len(writer.data) == 6
+    writer.flush()
+    back = ImitationDataset.load(path)
+    assert len(back) == 6 and back.episode_ids.tolist() == [0] * 4 + [1] * 2
+    assert back.meta == {"k": 1}

@@ -186,3 +186,27 @@ def test_wrapped_env_passes_the_sb3_env_checker() -> None:
     env = EgocentricObservation(_make_env(), crop_cells=36, crop_resolution_m=0.15)
     env_checker.check_env(env, warn=False)
     env.close()
+
+
+def test_wrapper_with_extra_channels_resets_the_trail() -> None:
+    from semexplore_gym.wrappers.egocentric import EgocentricObservation
+
+    params = EgocentricParams(
+        crop_cells=36,
+        crop_resolution_m=0.1,
+        channels=("occupancy", "frontier_distance", "trail"),
+        trail_radius_m=0.0,
+    )
+    env = EgocentricObservation(_make_env(), params=params)
+    assert env.observation_space["image"].shape == (3, 36, 36)
+    obs, _ = env.reset(seed=3)
+    assert env.observation_space.contains(obs)
+    assert np.count_nonzero(obs["image"][2] == 0) == 1  # only the start cell is on the trail
+    # At the start most of the maze is unknown: some cells lie downhill towards a frontier.
+    assert (obs["image"][1] < 128).any()
+    for _ in range(5):
+        obs, *_ = env.step(np.array([1.0, 0.0], np.float32))
+    assert np.count_nonzero(obs["image"][2] == 0) >= 3  # driving ahead leaves a trail behind
+    obs, _ = env.reset(seed=3)
+    assert np.count_nonzero(obs["image"][2] == 0) == 1
+    env.close()
