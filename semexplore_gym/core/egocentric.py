@@ -198,16 +198,11 @@ def frontier_distance_m(grid: np.ndarray, resolution_m: float, clearance_m: floa
     """
     from scipy import ndimage
 
+    from semexplore_gym.core.frontiers import frontier_cell_mask
     from semexplore_gym.core.grid_search import distance_field
 
     free = grid == FREE
-    unknown = grid == UNKNOWN
-    nbr = np.zeros_like(unknown)
-    nbr[1:, :] |= unknown[:-1, :]
-    nbr[:-1, :] |= unknown[1:, :]
-    nbr[:, 1:] |= unknown[:, :-1]
-    nbr[:, :-1] |= unknown[:, 1:]
-    frontier = free & nbr
+    frontier = frontier_cell_mask(grid, cell_convention="free")
     if not frontier.any():
         return np.full(grid.shape, np.inf)
     occupied = grid == OCCUPIED

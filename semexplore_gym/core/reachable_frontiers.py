@@ -26,6 +26,7 @@ import numpy.typing as npt
 from numba import njit
 from scipy import ndimage
 
+from semexplore_gym.core.frontiers import frontier_cell_mask
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
 
 
@@ -69,14 +70,8 @@ def frontier_groups(
     ever fill: the inside of thick walls seen through gaps in their mapped faces, pockets along
     walls. Returns ``(labels, n)``; label 0 is "not a kept frontier".
     """
-    free = grid == FREE
     unknown = grid == UNKNOWN
-    near_unknown = np.zeros_like(free)
-    near_unknown[1:, :] |= unknown[:-1, :]
-    near_unknown[:-1, :] |= unknown[1:, :]
-    near_unknown[:, 1:] |= unknown[:, :-1]
-    near_unknown[:, :-1] |= unknown[:, 1:]
-    cells = free & near_unknown
+    cells = frontier_cell_mask(grid, cell_convention="free")
     labels, n = ndimage.label(cells, structure=np.ones((3, 3), dtype=bool))
     if n == 0:
         return labels, 0
