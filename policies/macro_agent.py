@@ -36,6 +36,7 @@ from policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.core.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.macro_features import (
     MacroParams,
+    action_mask,
     action_to_weights,
     observation_size,
     observation_vector,
@@ -216,8 +217,7 @@ class MacroAgentPolicy(Policy):
         cands = self.driver.frontier_candidates(obs, scoring)
         vec, shown = observation_vector(cands, obs["map"], now_s, self.macro_params)
         if self.kind == "frontier":
-            mask = np.zeros(self.macro_params.n_candidates, dtype=bool)
-            mask[: max(1, len(shown))] = True
+            mask = action_mask(len(shown), self.macro_params)
             raw, _ = self.model.predict(vec, deterministic=self.deterministic, action_masks=mask)
             k = int(np.asarray(raw).reshape(-1)[0])
             chosen: FrontierCandidate | None = (

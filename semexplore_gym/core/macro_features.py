@@ -142,6 +142,16 @@ def observation_vector(
     return np.concatenate([feats.ravel(), glob]).astype(np.float32), shown
 
 
+def action_mask(n_shown: int, params: MacroParams) -> np.ndarray:
+    """``(K,)`` bool mask of a frontier-choice agent's valid actions: the candidates shown.
+
+    Action 0 is always valid: with no candidate it means "the driver's own choice".
+    """
+    mask = np.zeros(params.n_candidates, dtype=bool)
+    mask[: max(1, n_shown)] = True
+    return mask
+
+
 def observation_size(params: MacroParams) -> int:
     """Length of the observation vector for ``params``."""
     return params.n_candidates * N_CANDIDATE_FEATURES + N_GLOBAL_FEATURES

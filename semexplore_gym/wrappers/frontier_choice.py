@@ -40,6 +40,7 @@ from semexplore_gym.core.macro_features import (  # noqa: F401  (re-exported)
     N_GLOBAL_FEATURES,
     WEIGHT_RANGES,
     MacroParams,
+    action_mask,
     action_to_weights,
     candidate_features,
     observation_size,
@@ -182,9 +183,7 @@ class FrontierChoice(_MacroWrapper):
 
     def action_masks(self) -> np.ndarray:
         """``(K,)`` bool: True for the actions that name a real candidate (at least action 0)."""
-        mask = np.zeros(self.params.n_candidates, dtype=bool)
-        mask[: max(1, len(self.candidates))] = True
-        return mask
+        return action_mask(len(self.candidates), self.params)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         k = int(np.asarray(action).reshape(-1)[0]) if np.ndim(action) else int(action)

@@ -10,17 +10,6 @@ import pytest
 from semexplore_gym.cli import main
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "agents"
-TINY = [
-    "--set", "env.world=maze:seed=0,size_m=4",
-    "--set", "env.overrides=[episode.max_time_s=30]",
-    "--set", "ppo.total_timesteps=8",
-    "--set", "ppo.n_steps=4",
-    "--set", "ppo.batch_size=4",
-    "--set", "ppo.n_epochs=1",
-    "--set", "env.macro.max_macro_time_s=2",
-    "--set", "env.macro.decision_period_s=2",
-    "--no-progress",
-]  # fmt: skip
 
 
 @pytest.fixture(autouse=True)
@@ -38,11 +27,22 @@ def _one_thread() -> None:
     ],
 )
 def test_macro_training_runs_a_few_steps(
-    tmp_path: Path, algo: str, config: str, cls_name: str
+    tmp_path: Path, algo: str, config: str, cls_name: str, tiny_macro_train_args
 ) -> None:
     out = tmp_path / algo
     assert (
-        main(["train", "--algo", algo, "--config", str(CONFIGS / config), "--out", str(out), *TINY])
+        main(
+            [
+                "train",
+                "--algo",
+                algo,
+                "--config",
+                str(CONFIGS / config),
+                "--out",
+                str(out),
+                *tiny_macro_train_args(2),
+            ]
+        )
         == 0
     )
     metrics = json.loads((out / "metrics.json").read_text())

@@ -13,17 +13,6 @@ import semexplore_gym  # noqa: F401  (registers the env ids)
 from semexplore_gym.cli import main
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "agents"
-TINY = [
-    "--set", "env.world=maze:seed=0,size_m=4",
-    "--set", "env.overrides=[episode.max_time_s=30]",
-    "--set", "ppo.total_timesteps=8",
-    "--set", "ppo.n_steps=4",
-    "--set", "ppo.batch_size=4",
-    "--set", "ppo.n_epochs=1",
-    "--set", "env.macro.max_macro_time_s=3",
-    "--set", "env.macro.decision_period_s=3",
-    "--no-progress",
-]  # fmt: skip
 KINDS = {
     "frontier": ("maskable_ppo", "frontier_choice_maze.yml", "SemanticExploreFrontier-v0"),
     "weights": ("ppo", "planner_weights_maze.yml", "SemanticExploreWeights-v0"),
@@ -40,7 +29,7 @@ def _one_thread() -> None:
 
 
 @pytest.fixture(scope="module")
-def trained(tmp_path_factory) -> dict[str, Path]:
+def trained(tmp_path_factory, tiny_macro_train_args) -> dict[str, Path]:
     import torch
 
     torch.set_num_threads(1)
@@ -48,7 +37,7 @@ def trained(tmp_path_factory) -> dict[str, Path]:
     for kind, (algo, config, _) in KINDS.items():
         run = tmp_path_factory.mktemp(kind)
         argv = ["train", "--algo", algo, "--config", str(CONFIGS / config), "--out", str(run)]
-        assert main([*argv, *TINY]) == 0
+        assert main([*argv, *tiny_macro_train_args(3)]) == 0
         out[kind] = run / "model.zip"
     return out
 

@@ -1,0 +1,31 @@
+"""Shared test helpers."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def tiny_macro_train_args() -> Callable[[float], list[str]]:
+    """``semexplore train`` overrides for a few-step macro-env training on a 4 m maze.
+
+    Call it with the decision length in simulated seconds (``max_macro_time_s`` and
+    ``decision_period_s``).
+    """
+
+    def args(decision_s: float) -> list[str]:
+        return [
+            "--set", "env.world=maze:seed=0,size_m=4",
+            "--set", "env.overrides=[episode.max_time_s=30]",
+            "--set", "ppo.total_timesteps=8",
+            "--set", "ppo.n_steps=4",
+            "--set", "ppo.batch_size=4",
+            "--set", "ppo.n_epochs=1",
+            "--set", f"env.macro.max_macro_time_s={decision_s:g}",
+            "--set", f"env.macro.decision_period_s={decision_s:g}",
+            "--no-progress",
+        ]  # fmt: skip
+
+    return args
