@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import json
 import shlex
 import sys
@@ -69,7 +70,8 @@ class ExpertSection:
     """The labelling expert (a ``policies.registry`` spec) and how much to record.
 
     ``noise_std`` > 0 records the first ``noise_fraction`` of the episodes with DART noise on
-    the executed actions (labels stay clean); ``save_interval_s`` throttles dataset rewrites.
+    the executed actions (labels stay clean); ``save_interval_s`` throttles dataset rewrites;
+    ``workers`` > 1 records episodes in that many processes (same data as one).
     """
 
     spec: str = "semantic"
@@ -79,6 +81,7 @@ class ExpertSection:
     noise_std: float = 0.0
     noise_fraction: float = 1.0
     save_interval_s: float = 0.0
+    workers: int = 1
 
 
 @dataclass(frozen=True)
@@ -110,7 +113,8 @@ class DaggerSection:
 
     Each round refits on the aggregate with the ``bc`` settings for ``epochs_per_round`` epochs,
     except that ``select_best`` replaces ``bc.select_best``: the held-out error is measured on
-    expert states only, which the aggregate holds fewer of with every round.
+    expert states only, which the aggregate holds fewer of with every round. ``workers`` > 1
+    runs the episodes of a round in that many processes (same data as one).
     """
 
     rounds: int = 3
@@ -118,6 +122,7 @@ class DaggerSection:
     beta: tuple[float, ...] = (0.5, 0.25, 0.0)
     epochs_per_round: int = 5
     select_best: bool = False
+    workers: int = 1
 
 
 @dataclass(frozen=True)
@@ -138,7 +143,8 @@ class PPOSection:
 class TrainConfig:
     """Everything ``semexplore train`` needs; loaded from YAML with strict keys.
 
-    ``torch_threads`` sets ``torch.set_num_threads`` for the run.
+    ``torch_threads`` sets ``torch.set_num_threads`` for the run (BC and the DAgger refits;
+    roll-outs drive the learner with one thread).
     """
 
     seed: int = 0
@@ -344,6 +350,9 @@ def _train_imitation(
         noise_std=cfg.expert.noise_std,
         noise_fraction=cfg.expert.noise_fraction,
         save_interval_s=cfg.expert.save_interval_s,
+        workers=cfg.expert.workers,
+        make_env=functools.partial(_make_raw_env, cfg),
+        make_expert=functools.partial(_make_expert, cfg),
     )
     record_s = time.perf_counter() - t0
     train, held = data.split_by_episode(
@@ -412,6 +421,9 @@ def _train_imitation(
             progress=progress,
             log_fn=log,
             save_interval_s=cfg.expert.save_interval_s,
+            workers=d.workers,
+            make_env=functools.partial(_make_raw_env, cfg),
+            make_expert=functools.partial(_make_expert, cfg),
         )
         metrics["dagger_s"] = time.perf_counter() - t0
         metrics["dagger_rounds"] = result.rounds
@@ -506,8 +518,13 @@ def run(args: argparse.Namespace) -> int:
         cfg = load_train_config(args.config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
-    if cfg.torch_threads < 1:
-        raise ValueError(f"torch_threads must be >= 1, got {cfg.torch_threads!r}")
+    for key, value in (
+        ("torch_threads", cfg.torch_threads),
+        ("expert.workers", cfg.expert.workers),
+        ("dagger.workers", cfg.dagger.workers),
+    ):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
     if args.algo == "maskable_ppo" and not _is_macro(cfg):
         raise ValueError(
             f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
@@ -531,7 +548,6 @@ def run(args: argparse.Namespace) -> int:
     )
     import torch
 
-    # Small CNN/MLP nets train faster single-threaded than with threads fighting over 2 cores.
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
     t0 = time.perf_counter()

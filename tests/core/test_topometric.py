@@ -443,3 +443,84 @@ def test_records_match_their_dataclass_constructors():
                 assert a == b
         with pytest.raises(dataclasses.FrozenInstanceError):
             obj.id = 99  # type: ignore[misc]  (frozen, as built by the constructor)
+
+
+def _corridor_grid(size: int, seed: int) -> np.ndarray:
+    """Crossing 10-cell corridors every 50 cells, some segments walled off, open at the edges."""
+    rng = np.random.default_rng(seed)
+    g = np.full((size, size), OCCUPIED, dtype=np.uint8)
+    starts = np.arange(20, size - 9, 50)
+    for s in starts:
+        g[s : s + 10, :] = FREE
+        g[:, s : s + 10] = FREE
+    for s in starts:
+        for m in rng.integers(0, size - 4, size=2):
+            if rng.random() < 0.5:
+                g[s : s + 10, m : m + 4] = OCCUPIED
+            else:
+                g[m : m + 4, s : s + 10] = OCCUPIED
+    return g
+
+
+def _reference_graph_quantities(m: TopometricMap):
+    """p_l per frontier and L_path straight from their definitions (Dijkstra over the edges)."""
+    import heapq
+
+    inter = {a.id for a in m.areas.values() if a.type == INTER}
+    adj: dict[int, list[tuple[int, float]]] = {}
+    for e in m.edges:
+        if e.area_id not in inter:
+            adj.setdefault(e.opening_a, []).append((e.opening_b, e.length_m))
+            adj.setdefault(e.opening_b, []).append((e.opening_a, e.length_m))
+    out = []
+    for f in m.frontiers:
+        dist, heap, hit = {f.opening_id: 0.0}, [(0.0, f.opening_id)], None
+        while heap:
+            d, u = heapq.heappop(heap)
+            if d > dist[u]:
+                continue
+            on = [a for a in m.openings[u].area_ids if a in inter]
+            if on:
+                hit = (on[0], d)
+                break
+            for v, w in adj.get(u, ()):
+                if d + w < dist.get(v, math.inf):
+                    dist[v] = d + w
+                    heapq.heappush(heap, (d + w, v))
+        out.append(hit)
+    leg = {}  # (area, opening) -> length of the area's path from that opening
+    for e in m.edges:
+        if e.area_id not in inter:
+            leg.setdefault((e.area_id, e.opening_a), e.length_m)
+    for a in m.areas.values():
+        for oid, p in a.paths_m.items():
+            if a.id in inter:
+                leg[(a.id, oid)] = float(np.sum(np.hypot(*np.diff(p, axis=0).T)))
+    lengths = []
+    for a in m.areas.values():
+        if a.type == PATH:
+            o1, o2 = a.opening_ids
+            ends = [
+                [b for b in m.openings[o].area_ids if b in inter and b != a.id] for o in (o1, o2)
+            ]
+            if ends[0] and ends[1]:
+                lengths.append(leg[(ends[0][0], o1)] + leg[(a.id, o1)] + leg[(ends[1][0], o2)])
+    for o in m.openings:
+        a0, a1 = o.area_ids
+        if a0 != a1 and a0 in inter and a1 in inter:
+            lengths.append(leg[(a0, o.id)] + leg[(a1, o.id)])
+    return out, (float(np.mean(lengths)) if lengths and len(inter) >= 2 else math.nan)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_frontier_distances_and_l_path_match_their_definitions(seed):
+    m = segment_map(_corridor_grid(170, seed), RES_M, CLEARANCE_M)
+    assert m.frontiers and m.counts()["intersections"] >= 2
+    expected, l_path = _reference_graph_quantities(m)
+    for f, hit in zip(m.frontiers, expected, strict=True):
+        if hit is None:
+            assert f.intersection_id is None
+        else:
+            assert f.intersection_id == hit[0]
+            assert f.path_length_m == pytest.approx(hit[1], abs=1e-9)
+    assert m.mean_intersection_path_m == pytest.approx(l_path, rel=1e-6)

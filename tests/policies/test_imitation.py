@@ -274,6 +274,7 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
 
     repo = Path(__file__).resolve().parents[2]
     common = ["--no-progress", "--set", f"env.world={WORLD}", "--set", "egocentric.crop_cells=36"]
+    common += ["--set", "torch_threads=1"]  # one core: keep the shared machine's other one free
     bc_out = tmp_path / "bc"
     rc = main(
         [
@@ -295,6 +296,8 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
             "expert.max_steps=20",
             "--set",
             "bc.epochs=2",
+            "--set",
+            "expert.workers=1",
         ]
     )
     assert rc == 0

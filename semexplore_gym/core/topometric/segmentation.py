@@ -61,10 +61,8 @@ them on its first call.
 from __future__ import annotations
 
 import gc
-import heapq
 import math
 import time
-from itertools import combinations
 from typing import Any
 
 import numpy as np
@@ -78,6 +76,7 @@ from semexplore_gym.core.grid import (
     from_ros_values,
     validate_encoded_grid,
 )
+from semexplore_gym.core.topometric import _graph_kernels as GK
 from semexplore_gym.core.topometric import _kernels as K
 from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.topometric.types import (
@@ -555,149 +554,41 @@ class _Segmenter:
         W = self.W
         lab = self.lab
         n_op = int(op_px.size)
-        INTER, PATH, DEAD, FRONT = (
-            int(AreaType.INTERSECTION),
-            int(AreaType.PATHWAY),
-            int(AreaType.DEAD_END),
-            int(AreaType.FRONTIER_PATHWAY),
-        )
+        front = int(AreaType.FRONTIER_PATHWAY)
 
-        # --- types: frontiers count as openings -------------------------------------------------
-        f_reg = fr["region"]
-        n_regular = np.bincount(op_core, minlength=n_reg) + np.bincount(op_far, minlength=n_reg)
-        n_front = np.bincount(f_reg, minlength=n_reg)
-        total = n_regular + n_front
-        rtype = np.full(n_reg, DEAD, dtype=np.int64)
-        rtype[total >= 3] = INTER
-        rtype[(total == 2) & (n_front >= 1)] = FRONT
-        rtype[(total == 2) & (n_front == 0)] = PATH
-        rtype[(total == 1) & (n_front == 1)] = FRONT
-        rtype_l = rtype.tolist()
-
-        # --- openings: chords 0..n_op-1, then per frontier a frontier opening, preceded by a twin
-        # (the mouth of a zero-area frontier pathway) when the frontier lies on an intersection
-        op_areas: list[tuple[int, int]] = list(zip(op_core.tolist(), op_far.tolist(), strict=True))
-        op_front_idx: list[int] = [-1] * n_op  # frontier index of the opening (-1 for chords)
-        op_is_front: list[bool] = [False] * n_op
-        region_ops: list[list[int]] = [[] for _ in range(n_reg)]
-        for k, (a0, a1) in enumerate(op_areas):
-            region_ops[a0].append(k)
-            region_ops[a1].append(k)
-        region_fronts: list[list[int]] = [[] for _ in range(n_reg)]
-        zero_fp: list[tuple[int, int, int]] = []  # (host region, twin opening, frontier opening)
-        for fi, g in enumerate(f_reg.tolist()):
-            if rtype_l[g] == INTER:
-                z = n_reg + len(zero_fp)
-                twin, fo = len(op_areas), len(op_areas) + 1
-                op_areas += [(g, z), (z, -1)]
-                op_is_front += [False, True]
-                op_front_idx += [fi, fi]
-                region_ops[g].append(twin)
-                zero_fp.append((g, twin, fo))
-            else:
-                fo = len(op_areas)
-                op_areas.append((g, -1))
-                op_is_front.append(True)
-                op_front_idx.append(fi)
-                region_fronts[g].append(fo)
-        n_prov = n_reg + len(zero_fp)
-        n_all = len(op_areas)
-        f_anchor = fr["anchor"].tolist()
-        op_anchor = op_px.tolist() + [f_anchor[fi] for fi in op_front_idx[n_op:]]
-
-        # --- path requests: (area, opening, start, end, pre, post) --------------------------------
-        req_area: list[int] = []
-        req_op: list[int] = []
-        req_s: list[int] = []
-        req_e: list[int] = []
-        req_pre: list[int] = []
-        req_post: list[int] = []
-        sc = side_core.tolist()
-        sf = side_far.tolist()
-        opx = op_px.tolist()
-        core = op_core.tolist()
-        far_req: list[
-            tuple[int, int, int]
-        ] = []  # (region, opening, start): far end found in a batch
-        for g in range(n_reg):
-            t = rtype_l[g]
-            ops = region_ops[g]
-            if t == INTER:
-                root = int(centres[g])
-                for k in ops:
-                    req_area.append(g)
-                    req_op.append(k)
-                    req_e.append(root)
-                    req_post.append(-1)
-                    if k < n_op:
-                        req_s.append(sc[k] if core[k] == g else sf[k])
-                        req_pre.append(opx[k])
-                    else:
-                        req_s.append(op_anchor[k])
-                        req_pre.append(-1)
-            elif t == PATH:
-                k1, k2 = ops
-                s1 = sc[k1] if core[k1] == g else sf[k1]
-                s2 = sc[k2] if core[k2] == g else sf[k2]
-                req_area += [g, g]
-                req_op += [k1, k2]
-                req_s += [s1, s2]
-                req_e += [s2, s1]
-                req_pre += [opx[k1], opx[k2]]
-                req_post += [opx[k2], opx[k1]]
-            elif t == FRONT:
-                frs = region_fronts[g]
-                if ops:
-                    k, fo = ops[0], frs[0]
-                    s1 = sc[k] if core[k] == g else sf[k]
-                    req_area += [g, g]
-                    req_op += [k, fo]
-                    req_s += [s1, op_anchor[fo]]
-                    req_e += [op_anchor[fo], s1]
-                    req_pre += [opx[k], -1]
-                    req_post += [-1, opx[k]]
-                elif len(frs) == 2:
-                    fo1, fo2 = frs
-                    req_area += [g, g]
-                    req_op += [fo1, fo2]
-                    req_s += [op_anchor[fo1], op_anchor[fo2]]
-                    req_e += [op_anchor[fo2], op_anchor[fo1]]
-                    req_pre += [-1, -1]
-                    req_post += [-1, -1]
-                else:
-                    far_req.append((g, frs[0], op_anchor[frs[0]]))
-            elif ops:
-                k = ops[0]
-                far_req.append((g, k, sc[k] if core[k] == g else sf[k]))
-        if far_req:
-            far = K.far_skeleton_pixels(
-                W, self.sk, self.px, self.st, lab, np.array([q[2] for q in far_req], np.int64)
-            )
-            for (g, k, s), e in zip(far_req, far.tolist(), strict=True):
-                req_area.append(g)
-                req_op.append(k)
-                req_s.append(s)
-                req_e.append(e)
-                req_pre.append(opx[k] if k < n_op else -1)
-                req_post.append(-1)
-        n_req = len(req_area)
-        if n_req:
-            cells, off = K.tree_paths(
+        # --- types, openings and path requests (provisional indices, see _graph_kernels) -------
+        rtype = GK.area_types(n_reg, op_core, op_far, fr["region"])
+        op_a0, op_a1, op_front, op_anchor, aoff, aops, _zf_host, zf_twin, zf_fo, req = (
+            GK.plan_paths(
+                rtype,
+                op_core,
+                op_far,
+                fr["region"],
+                centres,
+                side_core,
+                side_far,
+                op_px,
+                fr["anchor"],
+                W,
                 self.sk,
                 self.px,
                 self.st,
-                self.sk_par,
-                self.sk_dep,
-                np.array(req_s, np.int64),
-                np.array(req_e, np.int64),
-                np.array(req_pre, np.int64),
-                np.array(req_post, np.int64),
+                lab,
+            )
+        )
+        n_zf = int(zf_fo.size)
+        n_prov = n_reg + n_zf
+        n_all = int(op_a0.size)
+        n_req = int(req.shape[1])
+        if n_req:
+            cells, off = K.tree_paths(
+                self.sk, self.px, self.st, self.sk_par, self.sk_dep, req[2], req[3], req[4], req[5]
             )
             vcells, voff, vlen = K.smooth_paths(
                 W,
                 cells,
                 off,
-                np.array(req_area, np.int64),
+                req[0],
                 self.dcell,
                 self.min_clear,
                 lab,
@@ -709,26 +600,18 @@ class _Segmenter:
             voff = np.zeros(1, np.int64)
             vlen = np.zeros(0)
             vxy = np.zeros((0, 2))
-        vlen_l = vlen.tolist()
         voff_l = voff.tolist()
         pieces = list(map(vxy.__getitem__, map(slice, voff_l[:n_req], voff_l[1 : n_req + 1])))
         area_paths: list[dict[int, np.ndarray]] = [{} for _ in range(n_prov)]
-        for a, k, piece in zip(req_area, req_op, pieces, strict=True):
+        for a, k, piece in zip(req[0].tolist(), req[1].tolist(), pieces, strict=True):
             area_paths[a][k] = piece
-        path_len: dict[tuple[int, int], float] = dict(
-            zip(zip(req_area, req_op, strict=True), vlen_l[:n_req], strict=True)
-        )
+
         # --- coordinates ------------------------------------------------------------------------
-        anchor_xy = self._cells_xy(np.array(op_anchor, np.int64)) if n_all else np.zeros((0, 2))
-        for zi, (_g, twin, fo) in enumerate(zero_fp):
+        anchor_xy = self._cells_xy(op_anchor) if n_all else np.zeros((0, 2))
+        for z, (twin, fo) in enumerate(zip(zf_twin.tolist(), zf_fo.tolist(), strict=True)):
             pt = np.repeat(anchor_xy[fo : fo + 1], 2, axis=0)
-            area_paths[n_reg + zi] = {twin: pt, fo: pt}
-            path_len[(n_reg + zi, twin)] = 0.0
-            path_len[(n_reg + zi, fo)] = 0.0
-        centre_cells = np.concatenate(
-            [centres, np.array([f_anchor[op_front_idx[fo]] for (_g, _t, fo) in zero_fp], np.int64)]
-        )
-        centre_xy = self._cells_xy(centre_cells)
+            area_paths[n_reg + z] = {twin: pt, fo: pt}
+        centre_xy = self._cells_xy(np.concatenate([centres, op_anchor[zf_fo]]))
         ends_xy = np.zeros((n_all, 2, 2))
         mids = np.zeros((n_all, 2))
         widths_m = np.zeros(n_all)
@@ -738,7 +621,7 @@ class _Segmenter:
             mids[:n_op] = ends_xy[:n_op].mean(axis=1)
             widths_m[:n_op] = widths * res
         if n_all > n_op:
-            fidx = np.array(op_front_idx[n_op:], np.int64)
+            fidx = op_front[n_op:]
             fe = fr["ends"][fidx]
             ends_xy[n_op:, 0] = self._xy(fe[:, 0] + 0.5, fe[:, 1] + 0.5)
             ends_xy[n_op:, 1] = self._xy(fe[:, 2] + 0.5, fe[:, 3] + 0.5)
@@ -746,85 +629,83 @@ class _Segmenter:
             widths_m[n_op:] = fr["width"][fidx] * res
 
         # --- identities -------------------------------------------------------------------------
-        prov_type = np.concatenate([rtype, np.full(len(zero_fp), FRONT, np.int64)])
+        prov_type = np.concatenate([rtype, np.full(n_zf, front, np.int64)])
         ids, next_id = self._match_ids(n_reg, n_prov, centre_xy, prov_type)
         ids_l = ids.tolist()
+        _lens, _req_of, edges2, pairs, plen, fronts, fronts_len, lpath = GK.graph_summary(
+            prov_type, aoff, aops, op_a0, op_a1, op_front, req, vlen, zf_twin, zf_fo, n_reg
+        )
         self._lap("paths")
 
         # --- records ----------------------------------------------------------------------------
-        mids_l = mids.tolist()
-        anchors_l = anchor_xy.tolist()
-        widths_l = widths_m.tolist()
-        ends_list = list(ends_xy)
-        sides = [(ids_l[a0], ids_l[a1] if a1 >= 0 else -1) for a0, a1 in op_areas]
+        side_b = np.where(op_a1 >= 0, ids[op_a1], -1) if n_all else op_a1
         openings: list[Opening] = list(
             map(
                 _opening,
                 range(n_all),
-                ends_list,
-                map(tuple, mids_l),
-                widths_l,
-                sides,
-                op_is_front,
-                map(tuple, anchors_l),
+                list(ends_xy),
+                map(tuple, mids.tolist()),
+                widths_m.tolist(),
+                zip(ids[op_a0].tolist(), side_b.tolist(), strict=True),
+                (op_a1 < 0).tolist(),
+                map(tuple, anchor_xy.tolist()),
             )
         )
-        area_ops: list[list[int]] = [region_ops[g] + region_fronts[g] for g in range(n_reg)]
-        area_ops += [[twin, fo] for (_g, twin, fo) in zero_fp]
-        counts_l = counts.tolist()
-        centre_l = centre_xy.tolist()
-        type_of = {t: AreaType(t) for t in (INTER, PATH, DEAD, FRONT)}
-        ptype = prov_type.tolist()
-        n_cells = counts_l[:n_reg] + [0] * (n_prov - n_reg)
+        aops_l = aops.tolist()
+        aoff_l = aoff.tolist()
+        type_of = {int(t): t for t in AreaType}
+        n_cells = counts.tolist()[:n_reg] + [0] * n_zf
         areas: dict[int, Area] = {
-            i: _area(i, type_of[t], tuple(c), tuple(o), pa, nc)
-            for i, t, c, o, pa, nc in zip(
+            i: _area(i, type_of[t], tuple(c), tuple(aops_l[lo:hi]), pa, nc)
+            for i, t, c, lo, hi, pa, nc in zip(
                 ids_l[:n_prov],
-                ptype,
-                centre_l,
-                area_ops,
+                prov_type.tolist(),
+                centre_xy.tolist(),
+                aoff_l[:n_prov],
+                aoff_l[1:],
                 area_paths,
                 n_cells,
                 strict=True,
             )
         }
 
-        # graph edges; intersection edges join every pair of legs at the centre, in one batch
-        req_index = {key: j for j, key in enumerate(zip(req_area, req_op, strict=True))}
-        pair_a: list[int] = []
-        pair_b: list[int] = []
-        pair_meta: list[tuple[int, int, int, float]] = []
-        edges: list[GraphEdge] = []
-        for a in range(n_prov):
-            ops = area_ops[a]
-            aid = ids_l[a]
-            if ptype[a] == INTER:
-                legs = [(req_index[(a, k)], k) for k in ops]
-                # combinations() yields the pairs (i < j) in the order of the nested loops
-                for (li, oi), (lj, oj) in combinations(legs, 2):
-                    pair_a.append(li)
-                    pair_b.append(lj)
-                    pair_meta.append((oi, oj, aid, vlen_l[li] + vlen_l[lj]))
-            elif len(ops) == 2 and ops[0] in area_paths[a]:
-                edges.append(
-                    _edge(ops[0], ops[1], aid, path_len[(a, ops[0])], area_paths[a][ops[0]])
-                )
-        if pair_a:
-            jxy, joff = K.join_legs(
-                vxy, voff, np.array(pair_a, np.int64), np.array(pair_b, np.int64)
-            )
+        # graph edges: areas with two openings, then every pair of an intersection's legs
+        vlen_l = vlen.tolist()
+        edges: list[GraphEdge] = [
+            _edge(o1, o2, ids_l[a], vlen_l[j], pieces[j])
+            if j >= 0
+            else _edge(o1, o2, ids_l[a], 0.0, area_paths[a][o1])
+            for o1, o2, a, j in edges2.tolist()
+        ]
+        if pairs.shape[1]:
+            jxy, joff = K.join_legs(vxy, voff, pairs[0], pairs[1])
             joff_l = joff.tolist()
-            n_pair = len(pair_a)
+            n_pair = int(pairs.shape[1])
             jpieces = map(jxy.__getitem__, map(slice, joff_l[:n_pair], joff_l[1 : n_pair + 1]))
             edges.extend(
-                _edge(oa, ob, aid, ln, piece)
-                for (oa, ob, aid, ln), piece in zip(pair_meta, jpieces, strict=True)
+                map(
+                    _edge,
+                    pairs[2].tolist(),
+                    pairs[3].tolist(),
+                    [ids_l[a] for a in pairs[4].tolist()],
+                    plen.tolist(),
+                    jpieces,
+                )
             )
 
-        frontiers = self._frontier_objects(
-            ids_l, path_len, region_fronts, zero_fp, n_reg, edges, openings, op_areas, ptype
-        )
-        l_path = _mean_intersection_path(path_len, n_prov, area_ops, op_areas, ptype)
+        frontiers = [
+            Frontier(
+                ids_l[a],
+                fo,
+                openings[fo].anchor_m,
+                openings[fo].width_m,
+                ids_l[hit] if hit >= 0 else None,
+                p_l,
+            )
+            for (a, fo, hit), p_l in zip(fronts.tolist(), fronts_len.tolist(), strict=True)
+        ]
+        n_inter = int(np.count_nonzero(prov_type == int(AreaType.INTERSECTION)))
+        l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
 
         # --- raster -----------------------------------------------------------------------------
         area_raster = np.full(self.g.shape, -1, dtype=np.int32)
@@ -848,61 +729,6 @@ class _Segmenter:
             time_ms=(time.perf_counter() - self.t_start) * 1000.0,
             extras=extras,
         )
-
-    # ------------------------------------------------------------------------------------------
-    def _frontier_objects(
-        self, ids_l, path_len, region_fronts, zero_fp, n_reg, edges, openings, op_areas, ptype
-    ) -> list[Frontier]:
-        """Frontier records with the nearest intersection and ``p_l`` (graph distance to it).
-
-        Works on provisional area indices (``op_areas``, ``ptype``); ids are mapped at the end.
-        """
-        items: list[tuple[int, int]] = [(g, fo) for g in range(n_reg) for fo in region_fronts[g]]
-        items += [(n_reg + zi, fo) for zi, (_g, _twin, fo) in enumerate(zero_fp)]
-        if not items:
-            return []
-        inter = int(AreaType.INTERSECTION)
-        prov_of = {aid: a for a, aid in enumerate(ids_l)}
-        adj: dict[int, list[tuple[int, float]]] = {}
-        for e in edges:
-            if ptype[prov_of[e.area_id]] == inter:
-                continue
-            adj.setdefault(e.opening_a, []).append((e.opening_b, e.length_m))
-            adj.setdefault(e.opening_b, []).append((e.opening_a, e.length_m))
-
-        def intersection_of(oid: int) -> int | None:
-            for a in op_areas[oid]:
-                if a >= 0 and ptype[a] == inter:
-                    return a
-            return None
-
-        out: list[Frontier] = []
-        for a, fo in items:
-            # Dijkstra from the frontier until an opening of an intersection is reached
-            dist = {fo: 0.0}
-            heap = [(0.0, fo)]
-            found: tuple[int, float] | None = None
-            while heap:
-                d, u = heapq.heappop(heap)
-                if d > dist.get(u, math.inf):
-                    continue
-                ia = intersection_of(u)
-                if ia is not None:
-                    found = (ids_l[ia], d)
-                    break
-                for v, w in adj.get(u, ()):
-                    nd = d + w
-                    if nd < dist.get(v, math.inf):
-                        dist[v] = nd
-                        heapq.heappush(heap, (nd, v))
-            if found is not None:
-                iid, p_l = found
-            else:
-                iid = None
-                p_l = path_len.get((a, fo), 0.0)
-            o = openings[fo]
-            out.append(Frontier(ids_l[a], fo, o.anchor_m, o.width_m, iid, float(p_l)))
-        return out
 
     # ------------------------------------------------------------------------------------------
     def _match_ids(self, n_reg: int, n_prov: int, centre_xy, prov_type) -> tuple[np.ndarray, int]:
@@ -956,36 +782,3 @@ class _Segmenter:
                 ids[a] = next_id
                 next_id += 1
         return ids, next_id
-
-
-# ----------------------------------------------------------------------------------------------
-# Helpers
-# ----------------------------------------------------------------------------------------------
-
-
-def _mean_intersection_path(path_len, n_prov, area_ops, op_areas, ptype) -> float:
-    """``L_path``: mean centre-to-centre path length between adjacent intersections (nan if none).
-
-    Pairs are intersections joined by one pathway, or sharing an opening. Provisional indices.
-    """
-    inter = int(AreaType.INTERSECTION)
-    path = int(AreaType.PATHWAY)
-    if ptype.count(inter) < 2:
-        return float("nan")
-
-    def other(oid: int, a: int) -> int:
-        a0, a1 = op_areas[oid]
-        b = a1 if a0 == a else a0
-        return b if b >= 0 and b != a and ptype[b] == inter else -1
-
-    lengths: list[float] = []
-    for a in range(n_prov):
-        if ptype[a] == path and len(area_ops[a]) == 2:
-            o1, o2 = area_ops[a]
-            i1, i2 = other(o1, a), other(o2, a)
-            if i1 >= 0 and i2 >= 0:
-                lengths.append(path_len[(i1, o1)] + path_len[(a, o1)] + path_len[(i2, o2)])
-    for oid, (a0, a1) in enumerate(op_areas):
-        if a0 >= 0 and a1 >= 0 and a0 != a1 and ptype[a0] == inter and ptype[a1] == inter:
-            lengths.append(path_len[(a0, oid)] + path_len[(a1, oid)])
-    return float(np.mean(lengths)) if lengths else float("nan")
