@@ -420,7 +420,7 @@ class _Segmenter:
 
         centres = K.region_centres(px, lab, dcell, n_reg, W)
         cover_m = p.cover_depth_m if p.cover_depth_m is not None else 2.0 * self.clear_m + 2.0 * res
-        sk_par, sk_dep, cells, counts = K.grow_regions(
+        sk_par, sk_dep, counts = K.grow_regions(
             W,
             sk,
             px,
@@ -436,7 +436,7 @@ class _Segmenter:
             n_reg,
             n_free,
         )
-        self.lab, self.st, self.sk_par, self.sk_dep, self.cells = lab, st, sk_par, sk_dep, cells
+        self.lab, self.st, self.sk_par, self.sk_dep = lab, st, sk_par, sk_dep
         self._lap("regions")
 
         self.n_reg = n_reg
