@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import pytest
 
@@ -29,3 +29,18 @@ def tiny_macro_train_args() -> Callable[[float], list[str]]:
         ]  # fmt: skip
 
     return args
+
+
+@pytest.fixture(scope="module")
+def one_torch_thread() -> Iterator[None]:
+    """Torch on one thread for the module: small nets on a shared 2-core machine train several
+    times faster than with threads competing (restored afterwards; no-op without torch)."""
+    try:
+        import torch
+    except ImportError:
+        yield
+        return
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)

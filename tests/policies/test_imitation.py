@@ -24,18 +24,7 @@ WORLD = "maze:size_m=5,seed=1"
 PARAMS = EgocentricParams(crop_cells=36, crop_resolution_m=0.15, n_scan_bins=60)
 
 
-@pytest.fixture(autouse=True, scope="module")
-def _one_torch_thread() -> Any:
-    """Small nets on a shared 2-core machine train several times faster on one thread."""
-    try:
-        import torch
-    except ImportError:
-        yield
-        return
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 # --------------------------------------------------------------- dataset (no torch)
