@@ -89,6 +89,7 @@ from semexplore_gym.core.graph_search import (
 )
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.line_of_sight import segment_is_clear
+from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.potential_field import (
     PotentialFieldCommand,
     PotentialFieldParams,
@@ -194,10 +195,7 @@ class SemanticExpertParams:
             "progress_timeout_s",
             "local_min_timeout_s",
         )
-        for name in positive:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        require_finite(self, positive, positive=True)
         nonneg = (
             "clearance_margin_m",
             "commitment_radius_m",
@@ -212,10 +210,7 @@ class SemanticExpertParams:
             "backoff_duration_s",
             "blacklist_radius_m",
         )
-        for name in nonneg:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        require_finite(self, nonneg, positive=False)
         if not 0.0 <= self.backoff_speed_fraction <= 1.0:
             raise ValueError(
                 f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"

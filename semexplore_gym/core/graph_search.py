@@ -45,6 +45,7 @@ from typing import Literal
 
 import numpy as np
 
+from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
 
 
@@ -69,10 +70,7 @@ class FrontierCostWeights:
     heading_lookahead_m: float = 0.5
 
     def __post_init__(self) -> None:
-        for name in ("w_v", "w_p", "w_i", "heading_lookahead_m"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        require_finite(self, ("w_v", "w_p", "w_i", "heading_lookahead_m"), positive=False)
         if not (math.isfinite(self.fallback_path_length_m) and self.fallback_path_length_m > 0.0):
             raise ValueError(
                 f"fallback_path_length_m must be a positive finite number, got {self.fallback_path_length_m!r}"

@@ -37,6 +37,7 @@ import numpy as np
 
 from semexplore_gym.core.graph_search import FrontierCandidate
 from semexplore_gym.core.grid import UNKNOWN
+from semexplore_gym.core.params import require_finite
 
 N_CANDIDATE_FEATURES = 8
 N_GLOBAL_FEATURES = 4
@@ -73,22 +74,20 @@ class MacroParams:
     def __post_init__(self) -> None:
         if int(self.n_candidates) < 1:
             raise ValueError(f"n_candidates must be >= 1, got {self.n_candidates!r}")
-        for name in (
-            "max_macro_time_s",
-            "decision_period_s",
-            "dist_scale_m",
-            "count_scale",
-            "cost_scale",
-            "width_scale_m",
-            "time_scale_s",
-        ):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0.0):
-                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
-        for name in ("area_reward_per_m2", "time_penalty_per_s"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0.0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {v!r}")
+        require_finite(
+            self,
+            (
+                "max_macro_time_s",
+                "decision_period_s",
+                "dist_scale_m",
+                "count_scale",
+                "cost_scale",
+                "width_scale_m",
+                "time_scale_s",
+            ),
+            positive=True,
+        )
+        require_finite(self, ("area_reward_per_m2", "time_penalty_per_s"), positive=False)
 
 
 def candidate_features(

@@ -9,6 +9,7 @@ strings from a command line. YAML is parsed with ``yaml.safe_load`` only (never 
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import types
 import typing
@@ -23,6 +24,16 @@ T = TypeVar("T")
 
 class ConfigError(ValueError):
     """A configuration value or key is invalid; the message names its dotted path."""
+
+
+def require_finite(obj: Any, names: Iterable[str], *, positive: bool, prefix: str = "") -> None:
+    """Raise a ValueError naming the first of ``obj``'s fields ``names`` that is not a finite
+    number ``> 0`` (``positive``) or ``>= 0``: the ``__post_init__`` check of parameter sets."""
+    for name in names:
+        v = getattr(obj, name)
+        if not (math.isfinite(v) and (v > 0.0 if positive else v >= 0.0)):
+            what = "a positive finite number" if positive else "a finite number >= 0"
+            raise ValueError(f"{prefix}{name} must be {what}, got {v!r}")
 
 
 def _field_types(cls: type) -> dict[str, Any]:

@@ -36,6 +36,7 @@ from numba import njit
 
 from semexplore_gym.core.grid import OCCUPIED, GridGeometry
 from semexplore_gym.core.line_of_sight import farthest_visible_index
+from semexplore_gym.core.params import require_finite
 
 
 @dataclass(frozen=True)
@@ -91,31 +92,33 @@ class PotentialFieldParams:
     braking_time_s: float = 0.6
 
     def __post_init__(self) -> None:
-        for name in (
-            "f_g",
-            "f_o",
-            "f_l",
-            "lookahead_clearance_m",
-            "safety_margin_m",
-            "contact_margin_m",
-            "map_guard_radius_m",
-            "guard_steer_max_rad",
-            "guard_steer_min_free_m",
-        ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-        for name in (
-            "min_lookahead_m",
-            "max_lookahead_m",
-            "heading_gain_per_s",
-            "turn_in_place_rad",
-            "braking_time_s",
-            "guard_steer_step_rad",
-        ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        require_finite(
+            self,
+            (
+                "f_g",
+                "f_o",
+                "f_l",
+                "lookahead_clearance_m",
+                "safety_margin_m",
+                "contact_margin_m",
+                "map_guard_radius_m",
+                "guard_steer_max_rad",
+                "guard_steer_min_free_m",
+            ),
+            positive=False,
+        )
+        require_finite(
+            self,
+            (
+                "min_lookahead_m",
+                "max_lookahead_m",
+                "heading_gain_per_s",
+                "turn_in_place_rad",
+                "braking_time_s",
+                "guard_steer_step_rad",
+            ),
+            positive=True,
+        )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise ValueError(
                 f"max_lookahead_m ({self.max_lookahead_m}) < min_lookahead_m ({self.min_lookahead_m})"
@@ -134,10 +137,11 @@ class RobotLimits:
     max_range_m: float
 
     def __post_init__(self) -> None:
-        for name in ("radius_m", "max_linear_speed_mps", "max_angular_speed_radps", "max_range_m"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        require_finite(
+            self,
+            ("radius_m", "max_linear_speed_mps", "max_angular_speed_radps", "max_range_m"),
+            positive=True,
+        )
 
 
 @dataclass(frozen=True)

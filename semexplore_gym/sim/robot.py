@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
+from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.worlds.world import World
 
 WALL_COLLISION_TYPE = 1
@@ -45,17 +46,19 @@ class RobotParams:
     max_turn_torque_nm: float = 20.0
 
     def __post_init__(self) -> None:
-        for name in (
-            "radius_m",
-            "mass_kg",
-            "max_linear_speed_mps",
-            "max_angular_speed_radps",
-            "max_drive_force_n",
-            "max_turn_torque_nm",
-        ):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"robot.{name} must be a positive finite number, got {v!r}")
+        require_finite(
+            self,
+            (
+                "radius_m",
+                "mass_kg",
+                "max_linear_speed_mps",
+                "max_angular_speed_radps",
+                "max_drive_force_n",
+                "max_turn_torque_nm",
+            ),
+            positive=True,
+            prefix="robot.",
+        )
         if self.max_linear_speed_mps > 5.0:
             raise ValueError(
                 f"robot.max_linear_speed_mps={self.max_linear_speed_mps} is beyond what the physics is tuned for (<= 5 m/s)"

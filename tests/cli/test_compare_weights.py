@@ -18,6 +18,17 @@ def _rows(label: str, times: list[float], cov: float = 0.99) -> list[dict]:
     return [{"policy": label, "mission_time_s": t, "coverage": cov} for t in times]
 
 
+def _tiny_run(max_time_s: float) -> list[str]:
+    """A one-trial, one-run compare-weights on 4 m mazes (add ``--out``)."""
+    return [
+        "compare-weights",
+        "--train-worlds", "maze:seed=*,size_m=4",
+        "--test-worlds", "maze:seed=*,size_m=4",
+        "--trials", "1", "--train-runs", "1", "--runs", "1",
+        "--max-time-s", f"{max_time_s:g}", "--no-progress",
+    ]  # fmt: skip
+
+
 def test_summarise_medians_completion_and_p_values() -> None:
     rows = _rows(PAPER, [100.0, 110.0, 120.0, 130.0]) + _rows(TUNED, [50.0, 60.0, 70.0, 80.0])
     rows += _rows("semantic[paper,w_p=0]", [100.0, 110.0, 120.0, 130.0], cov=0.87)
@@ -63,13 +74,7 @@ def test_overlapping_train_and_test_seeds_are_rejected(tmp_path: Path) -> None:
 
 def test_compare_weights_writes_table_and_plot(tmp_path: Path) -> None:
     out = tmp_path / "cw"
-    argv = [
-        "compare-weights",
-        "--train-worlds", "maze:seed=*,size_m=4",
-        "--test-worlds", "maze:seed=*,size_m=4",
-        "--trials", "1", "--train-runs", "1", "--runs", "1",
-        "--max-time-s", "20", "--out", str(out), "--no-progress",
-    ]  # fmt: skip
+    argv = [*_tiny_run(max_time_s=20), "--out", str(out)]
     assert main(argv) == 0
     with (out / "compare.csv").open() as f:
         table = list(csv.DictReader(f))
@@ -90,13 +95,7 @@ def test_compare_weights_writes_table_and_plot(tmp_path: Path) -> None:
 
 def test_agents_join_the_test_table_and_bad_agents_fail_early(tmp_path: Path) -> None:
     out = tmp_path / "cw"
-    argv = [
-        "compare-weights",
-        "--train-worlds", "maze:seed=*,size_m=4",
-        "--test-worlds", "maze:seed=*,size_m=4",
-        "--trials", "1", "--train-runs", "1", "--runs", "1",
-        "--max-time-s", "10", "--no-progress",
-    ]  # fmt: skip
+    argv = _tiny_run(max_time_s=10)
     assert main([*argv, "--agents", "random[rnd]", "--out", str(out)]) == 0
     with (out / "compare.csv").open() as f:
         table = {r["weights"]: r for r in csv.DictReader(f)}
