@@ -70,10 +70,11 @@ def plan_paths(
     farthest from it. A request runs from ``s`` to ``e`` with ``pre`` / ``post`` cells (>= 0)
     added before / after.
 
-    Returns ``(op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_host, zf_twin, zf_fo, req)``:
+    Returns ``(op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_twin, zf_fo, req)``:
     per opening its areas (``op_a1 == -1`` for frontier openings), its frontier index (-1 for
     chords) and anchor cell; the openings of area ``a`` are ``aops[aoff[a]:aoff[a + 1]]`` (its
-    chords and twins in id order, then its frontier openings); the zero-area frontier pathways;
+    chords and twins in id order, then its frontier openings); the twin and frontier openings of
+    the zero-area frontier pathways;
     and ``req`` (6, n): rows area, opening, s, e, pre, post.
     """
     n_reg = rtype.size
@@ -214,19 +215,17 @@ def plan_paths(
             k = far_op[q]
             _request(req, n, far_area[q], k, far_start[q], far[q], op_px[k] if k < n_op else -1, -1)
             n += 1
-    return op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_host, zf_twin, zf_fo, req[:, :n].copy()
+    return op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_twin, zf_fo, req[:, :n].copy()
 
 
 @njit(cache=True, error_model="numpy")
-def graph_summary(ptype, aoff, aops, op_a0, op_a1, op_front, req, vlen, zf_twin, zf_fo, n_reg):
+def graph_summary(ptype, aoff, aops, op_a0, op_a1, req, vlen, zf_twin, zf_fo, n_reg):
     """Edges, the frontiers' nearest intersections and the intersection-to-intersection lengths.
 
     Returns:
-        ``(area_lens, req_of, edges2, pairs, plen, fronts, fronts_len, lpath)``:
-        ``area_lens[k, s]`` / ``req_of[k, s]``: path length and (last) request of the area on
-        side ``s`` of opening ``k`` (nan / -1 if none; zero-area pathways have length 0 and
-        no request). ``edges2`` (n, 4): opening a, opening b, area, request (-1 for zero-area
-        pathways) of every non-intersection area with two openings, in area order; ``pairs``
+        ``(edges2, pairs, plen, fronts, fronts_len, lpath)``. ``edges2`` (n, 4): opening a,
+        opening b, area, request (-1 for zero-area pathways) of every non-intersection area
+        with two openings, in area order; ``pairs``
         (5, n): request a, request b, opening a, opening b, area for every pair of an
         intersection's legs (areas in order, pairs as ``itertools.combinations``) and ``plen``
         their lengths; ``fronts`` (n, 3) area, frontier opening, nearest intersection (-1 if
@@ -371,8 +370,6 @@ def graph_summary(ptype, aoff, aops, op_a0, op_a1, op_front, req, vlen, zf_twin,
             lpath[nl] = area_lens[k, 0] + area_lens[k, 1]
             nl += 1
     return (
-        area_lens,
-        req_of,
         edges2[:ne].copy(),
         pairs,
         plen,

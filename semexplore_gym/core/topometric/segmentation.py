@@ -558,23 +558,21 @@ class _Segmenter:
 
         # --- types, openings and path requests (provisional indices, see _graph_kernels) -------
         rtype = GK.area_types(n_reg, op_core, op_far, fr["region"])
-        op_a0, op_a1, op_front, op_anchor, aoff, aops, _zf_host, zf_twin, zf_fo, req = (
-            GK.plan_paths(
-                rtype,
-                op_core,
-                op_far,
-                fr["region"],
-                centres,
-                side_core,
-                side_far,
-                op_px,
-                fr["anchor"],
-                W,
-                self.sk,
-                self.px,
-                self.st,
-                lab,
-            )
+        op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_twin, zf_fo, req = GK.plan_paths(
+            rtype,
+            op_core,
+            op_far,
+            fr["region"],
+            centres,
+            side_core,
+            side_far,
+            op_px,
+            fr["anchor"],
+            W,
+            self.sk,
+            self.px,
+            self.st,
+            lab,
         )
         n_zf = int(zf_fo.size)
         n_prov = n_reg + n_zf
@@ -632,8 +630,8 @@ class _Segmenter:
         prov_type = np.concatenate([rtype, np.full(n_zf, front, np.int64)])
         ids, next_id = self._match_ids(n_reg, n_prov, centre_xy, prov_type)
         ids_l = ids.tolist()
-        _lens, _req_of, edges2, pairs, plen, fronts, fronts_len, lpath = GK.graph_summary(
-            prov_type, aoff, aops, op_a0, op_a1, op_front, req, vlen, zf_twin, zf_fo, n_reg
+        edges2, pairs, plen, fronts, fronts_len, lpath = GK.graph_summary(
+            prov_type, aoff, aops, op_a0, op_a1, req, vlen, zf_twin, zf_fo, n_reg
         )
         self._lap("paths")
 
