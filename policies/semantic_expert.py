@@ -244,8 +244,8 @@ class SemanticExpertPolicy(Policy):
     Args:
         params: Parameters (default: the paper's weights and our robustness settings).
         segmenter: ``segment_map``-compatible callable ``(grid, geometry, clearance_m,
-            params=..., previous=...) -> TopometricMap``; default
-            :func:`semexplore_gym.core.topometric.segment_map`.
+            params=..., previous=...) -> TopometricMap``; default a
+            :class:`semexplore_gym.core.topometric.TopometricSegmenter` of its own.
 
     Attributes (after ``reset``): ``tmap`` the last topometric map, ``candidates`` the scored
     frontiers of the last replan, ``mode`` (``"semantic"``, ``"fallback"``, ``"escape"``,
@@ -287,9 +287,10 @@ class SemanticExpertPolicy(Policy):
                 f"info lacks {e.args[0]!r}: reset needs the env's map_geometry, robot, lidar and dt_s"
             ) from e
         if self._segmenter is None:
-            from semexplore_gym.core.topometric import segment_map
+            # one segmenter per policy: it keeps its scratch memory between replans
+            from semexplore_gym.core.topometric import TopometricSegmenter
 
-            self._segmenter = segment_map
+            self._segmenter = TopometricSegmenter()
         self.clearance_m = self.limits.radius_m + self.params.clearance_margin_m
         self.tmap = None
         self.candidates = []

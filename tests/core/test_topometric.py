@@ -21,7 +21,13 @@ from _topometric_maps import (
 from scipy import ndimage
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, parse_ascii_grid
-from semexplore_gym.core.topometric import AreaType, SegmentationParams, TopometricMap, segment_map
+from semexplore_gym.core.topometric import (
+    AreaType,
+    SegmentationParams,
+    TopometricMap,
+    TopometricSegmenter,
+    segment_map,
+)
 
 INTER, PATH, DEAD, FRONT = (
     AreaType.INTERSECTION,
@@ -428,21 +434,52 @@ def test_debug_extras():
     assert m.time_ms > 0
 
 
-def test_records_match_their_dataclass_constructors():
-    import dataclasses
-
+def test_records_match_their_constructors():
     _, m = seg(T_OPEN)
     for obj in [m.openings[0], next(iter(m.areas.values())), m.edges[0], m.frontiers[0]]:
-        again = dataclasses.replace(obj)  # goes through the generated __init__
-        for f in dataclasses.fields(obj):
-            a, b = getattr(obj, f.name), getattr(again, f.name)
+        again = type(obj)(*obj)  # the generated constructor, field by field
+        assert type(obj)._fields == again._fields
+        for name in obj._fields:
+            a, b = getattr(obj, name), getattr(again, name)
             assert type(a) is type(b)
             if isinstance(a, np.ndarray):
                 assert np.array_equal(a, b)
-            elif f.name != "paths_m":
+            elif name != "paths_m":
                 assert a == b
-        with pytest.raises(dataclasses.FrozenInstanceError):
-            obj.id = 99  # type: ignore[misc]  (frozen, as built by the constructor)
+        with pytest.raises(AttributeError):
+            obj.id = 99  # type: ignore[misc]  (records are immutable)
+    o = m.openings[0]
+    assert type(o.area_ids) is tuple and type(o.midpoint_m) is tuple and type(o.width_m) is float
+    a = next(iter(m.areas.values()))
+    assert isinstance(a.type, AreaType) and type(a.opening_ids) is tuple and type(a.n_cells) is int
+
+
+def test_segmenter_reuses_scratch_without_changing_results():
+    """A TopometricSegmenter gives segment_map's results on maps that grow, shrink and grow,
+    and a later call never alters an earlier result (no output aliases the scratch arrays)."""
+    import pickle
+
+    segmenter = TopometricSegmenter()
+    grids = [_corridor_grid(s, seed) for s, seed in ((150, 0), (90, 1), (200, 2), (60, 3))]
+    maps = [segmenter(g, RES_M, CLEARANCE_M) for g in grids]
+    first_raster = maps[0].area_ids.copy()
+    first_paths = [e.path_m.copy() for e in maps[0].edges]
+    for g, m in zip(grids, maps, strict=True):
+        ref = segment_map(g, RES_M, CLEARANCE_M)
+        assert np.array_equal(m.area_ids, ref.area_ids)
+        assert m.counts() == ref.counts() and len(m.edges) == len(ref.edges)
+        assert [o.width_m for o in m.openings] == [o.width_m for o in ref.openings]
+        assert [f.midpoint_m for f in m.frontiers] == [f.midpoint_m for f in ref.frontiers]
+        for e, r in zip(m.edges, ref.edges, strict=True):
+            assert e.length_m == r.length_m and np.array_equal(e.path_m, r.path_m)
+    assert np.array_equal(maps[0].area_ids, first_raster)
+    assert all(np.array_equal(e.path_m, p) for e, p in zip(maps[0].edges, first_paths, strict=True))
+    # the scratch stays behind when the segmenter is pickled (policies travel to workers)
+    assert len(pickle.dumps(segmenter)) < 1000
+    again = pickle.loads(pickle.dumps(segmenter))
+    assert np.array_equal(again(grids[2], RES_M, CLEARANCE_M).area_ids, maps[2].area_ids)
+    with pytest.raises(TypeError, match="SegmentationParams"):
+        TopometricSegmenter(params={"spur_ratio": 1.0})  # type: ignore[arg-type]
 
 
 def _corridor_grid(size: int, seed: int) -> np.ndarray:

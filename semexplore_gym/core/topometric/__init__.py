@@ -1,7 +1,8 @@
-"""Semantic topometric segmentation of occupancy grids (see :func:`segment_map`)."""
+"""Semantic topometric segmentation of occupancy grids (see :func:`segment_map` and
+:class:`TopometricSegmenter`)."""
 
 from semexplore_gym.core.topometric.params import SegmentationParams
-from semexplore_gym.core.topometric.segmentation import segment_map
+from semexplore_gym.core.topometric.segmentation import TopometricSegmenter, segment_map
 from semexplore_gym.core.topometric.types import (
     Area,
     AreaType,
@@ -19,5 +20,6 @@ __all__ = [
     "Opening",
     "SegmentationParams",
     "TopometricMap",
+    "TopometricSegmenter",
     "segment_map",
 ]

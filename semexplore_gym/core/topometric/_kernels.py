@@ -139,7 +139,7 @@ def _try_blob(work, state, stack, blob, j, max_speck_cells, max_hole_cells) -> i
 
 @njit(cache=True, error_model="numpy")
 def filter_small_blobs(
-    work: np.ndarray, max_speck_cells: int, max_hole_cells: int
+    work: np.ndarray, max_speck_cells: int, max_hole_cells: int, state: np.ndarray
 ) -> tuple[int, np.ndarray]:
     """Erase occupied specks and close unknown holes next to free cells, in place.
 
@@ -148,11 +148,13 @@ def filter_small_blobs(
     touching the edge becomes FREE when its neighbours are all FREE, OCCUPIED otherwise. Blobs
     are found from their cells that are 4-adjacent to a free cell.
 
+    ``state`` is uint8 scratch of ``H * W`` zeros.
+
     Returns the number of cells changed and the free cells that had an UNKNOWN 4-neighbour
     before filtering (frontier candidates, to be re-checked).
     """
     H, W = work.shape
-    state = np.zeros(H * W, np.uint8)  # 1 = big/edge blob or handled, 2 = current blob
+    # state: 1 = big/edge blob or handled, 2 = current blob
     mx = max(max_speck_cells, max_hole_cells, 1)
     stack = np.empty(8 * (mx + 2), np.int64)
     blob = np.empty(mx + 1, np.int64)
@@ -271,10 +273,12 @@ def _fh_run(grow, a, b, f, v, z, crow, min_clear_cells, base, clist, n_c):
 
 
 @njit(cache=True, error_model="numpy")
-def _column_distances(work: np.ndarray) -> np.ndarray:
-    """Per column, cells to the nearest non-free cell (outside the array counts as non-free)."""
+def _column_distances(work: np.ndarray, g: np.ndarray) -> None:
+    """Per column, cells to the nearest non-free cell (outside the array counts as non-free).
+
+    Written into ``g`` (float32, the shape of ``work``).
+    """
     H, W = work.shape
-    g = np.empty((H, W), np.float32)
     for c in range(W):
         g[0, c] = 1.0 if work[0, c] == FREE_V else 0.0
     for r in range(1, H):
@@ -288,20 +292,17 @@ def _column_distances(work: np.ndarray) -> np.ndarray:
             up = g[r + 1, c] + 1.0
             if up < g[r, c]:
                 g[r, c] = up
-    return g
 
 
 @njit(cache=True, error_model="numpy")
 def _row_envelopes(
-    work: np.ndarray, g: np.ndarray, min_clear_cells: float
-) -> tuple[np.ndarray, np.ndarray, int]:
+    work: np.ndarray, g: np.ndarray, min_clear_cells: float, cspace: np.ndarray, clist: np.ndarray
+) -> tuple[np.ndarray, int]:
     H, W = work.shape
     n_free = 0
     wf = work.ravel()
     for i in range(H * W):
         n_free += wf[i] == FREE_V
-    cspace = np.zeros((H, W), np.uint8)
-    clist = np.empty(n_free + 1, np.int32)
     n_c = 0
     f = np.empty(W + 2, np.float64)
     v = np.empty(W + 2, np.int64)
@@ -321,12 +322,16 @@ def _row_envelopes(
             while c < W and row[c] == FREE_V:
                 c += 1
             n_c = _fh_run(grow, a, c, f, v, z, cspace[r], min_clear_cells, r * W, clist, n_c)
-    return cspace, clist[:n_c], n_free
+    return clist[:n_c], n_free
 
 
 def clearance_field(
-    work: np.ndarray, min_clear_cells: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    work: np.ndarray,
+    min_clear_cells: float,
+    dcell: np.ndarray,
+    cspace: np.ndarray,
+    clist: np.ndarray,
+) -> tuple[np.ndarray, int]:
     """Exact Euclidean clearance of the free cells of an encoded grid and the configuration space.
 
     ``dcell`` (float32) is the distance from a cell centre to the nearest non-free cell centre
@@ -336,10 +341,13 @@ def clearance_field(
     of Felzenszwalb and Huttenlocher's transform runs over free runs only: the blocked cell
     ending a run is closer than any column beyond it. (Two kernels: one kernel holding both
     passes compiles to a much slower column pass.)
+
+    ``dcell`` (float32) and ``cspace`` (uint8, all zeros on entry), both of the shape of
+    ``work``, are written in place; ``clist`` is int32 scratch of at least ``work.size + 1`` cells. Returns the C-space
+    cell list (a view of ``clist``) and the number of free cells.
     """
-    g = _column_distances(work)
-    cspace, clist, n_free = _row_envelopes(work, g, float(min_clear_cells))
-    return g, cspace, clist, n_free
+    _column_distances(work, dcell)
+    return _row_envelopes(work, dcell, float(min_clear_cells), cspace, clist)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -387,20 +395,21 @@ def _zs_ok(img: np.ndarray, r: int, c: int, sub: int) -> bool:
 
 
 @njit(cache=True, error_model="numpy")
-def _mdeg(img: np.ndarray, r: int, c: int) -> int:
-    """Degree of a pixel under m-adjacency (diagonals count only without a shared 4-neighbour)."""
-    up = img[r + 1, c] != 0
-    dn = img[r - 1, c] != 0
-    rt = img[r, c + 1] != 0
-    lf = img[r, c - 1] != 0
+def _mdeg(f: np.ndarray, W: int, i: int) -> int:
+    """Degree of flat pixel ``i`` under m-adjacency (diagonals count only without a shared
+    4-neighbour). Flat indexing: no division per pixel."""
+    up = f[i + W] != 0
+    dn = f[i - W] != 0
+    rt = f[i + 1] != 0
+    lf = f[i - 1] != 0
     n = int(up) + int(dn) + int(rt) + int(lf)
-    if img[r + 1, c + 1] != 0 and not up and not rt:
+    if f[i + W + 1] != 0 and not up and not rt:
         n += 1
-    if img[r + 1, c - 1] != 0 and not up and not lf:
+    if f[i + W - 1] != 0 and not up and not lf:
         n += 1
-    if img[r - 1, c + 1] != 0 and not dn and not rt:
+    if f[i - W + 1] != 0 and not dn and not rt:
         n += 1
-    if img[r - 1, c - 1] != 0 and not dn and not lf:
+    if f[i - W - 1] != 0 and not dn and not lf:
         n += 1
     return n
 
@@ -409,17 +418,16 @@ def _mdeg(img: np.ndarray, r: int, c: int) -> int:
 def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
     """Remove simple pixels of m-degree >= 3 (junction blobs) in place; returns the kept pixels."""
     H, W = img.shape
+    f = img.ravel()
+    simple = _zs_tables()[2]
     changed = True
     while changed:
         changed = False
         for k in range(px.size):
             i = px[k]
-            r = i // W
-            c = i - r * W
-            if img[r, c] and _mdeg(img, r, c) >= 3 and _zs_ok(img, r, c, 2):
-                img[r, c] = 0
+            if f[i] and _mdeg(f, W, i) >= 3 and simple[_code(f, i, W)]:
+                f[i] = 0
                 changed = True
-    f = img.ravel()
     n = 0
     for k in range(px.size):
         if f[px[k]]:
@@ -467,20 +475,21 @@ def _code(f: np.ndarray, i: int, W: int) -> int:
 
 
 @njit(cache=True, error_model="numpy")
-def thin(img: np.ndarray, allfg: np.ndarray) -> np.ndarray:
+def thin(img: np.ndarray, allfg: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     """Zhang-Suen thinning in place, with a work list and a sequential re-check.
 
     ``img`` is uint8 0/1 with an empty border; it becomes the skeleton. The re-check keeps 2x2
     blocks connected. ``allfg`` lists its foreground pixels (sorted). Junction blobs are reduced
-    afterwards (:func:`reduce_blobs`). Returns the sorted flat indices of the skeleton pixels.
+    afterwards (:func:`reduce_blobs`). ``scratch`` is int32 of at least ``3 * (allfg.size + 1)``
+    cells. Returns the sorted flat indices of the skeleton pixels.
     """
     H, W = img.shape
     f = img.ravel()
     tab = _zs_tables()
     n_fg = allfg.size
-    cand = np.empty(n_fg + 1, np.int32)
-    nxt = np.empty(n_fg + 1, np.int32)
-    marked = np.empty(n_fg + 1, np.int32)
+    cand = scratch[: n_fg + 1]
+    nxt = scratch[n_fg + 1 : 2 * n_fg + 2]
+    marked = scratch[2 * n_fg + 2 : 3 * n_fg + 3]
     n = 0
     for k in range(n_fg):
         i = allfg[k]
@@ -535,14 +544,13 @@ def thin(img: np.ndarray, allfg: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def _mnbrs(sk: np.ndarray, W: int, i: int, out: np.ndarray) -> int:
-    r = i // W
-    c = i - r * W
+def _mnbrs(f: np.ndarray, W: int, i: int, out: np.ndarray) -> int:
+    """m-adjacent neighbours of flat pixel ``i`` of the flat skeleton ``f`` into ``out``."""
     n = 0
-    up = sk[r + 1, c] != 0
-    dn = sk[r - 1, c] != 0
-    rt = sk[r, c + 1] != 0
-    lf = sk[r, c - 1] != 0
+    up = f[i + W] != 0
+    dn = f[i - W] != 0
+    rt = f[i + 1] != 0
+    lf = f[i - 1] != 0
     if up:
         out[n] = i + W
         n += 1
@@ -555,16 +563,16 @@ def _mnbrs(sk: np.ndarray, W: int, i: int, out: np.ndarray) -> int:
     if lf:
         out[n] = i - 1
         n += 1
-    if sk[r + 1, c + 1] != 0 and not up and not rt:
+    if f[i + W + 1] != 0 and not up and not rt:
         out[n] = i + W + 1
         n += 1
-    if sk[r + 1, c - 1] != 0 and not up and not lf:
+    if f[i + W - 1] != 0 and not up and not lf:
         out[n] = i + W - 1
         n += 1
-    if sk[r - 1, c + 1] != 0 and not dn and not rt:
+    if f[i - W + 1] != 0 and not dn and not rt:
         out[n] = i - W + 1
         n += 1
-    if sk[r - 1, c - 1] != 0 and not dn and not lf:
+    if f[i - W - 1] != 0 and not dn and not lf:
         out[n] = i - W - 1
         n += 1
     return n
@@ -579,14 +587,12 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
     ordered from a to b). Pure cycles get one of their pixels as a node with a self-loop.
     """
     H, W = sk.shape
+    skf = sk.ravel()
     n = px.size
     nb = np.empty(8, np.int64)
     nb2 = np.empty(8, np.int64)
     for k in range(n):
-        i = px[k]
-        r = i // W
-        c = i - r * W
-        st[i] = -2 if _mdeg(sk, r, c) == 2 else -4
+        st[px[k]] = -2 if _mdeg(skf, W, px[k]) == 2 else -4
     # cluster node pixels
     node_of = np.full(n, -1, np.int64)  # node id per px entry (only node pixels)
     stack = np.empty(n + 1, np.int64)
@@ -602,7 +608,7 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
         while top > 0:
             top -= 1
             j = stack[top]
-            cnt = _mnbrs(sk, W, j, nb)
+            cnt = _mnbrs(skf, W, j, nb)
             for t in range(cnt):
                 q = nb[t]
                 if st[q] == -4:
@@ -629,7 +635,7 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
             if st[u] < 0:
                 continue
             a = st[u]
-            cnt = _mnbrs(sk, W, u, nb)
+            cnt = _mnbrs(skf, W, u, nb)
             for t in range(cnt):
                 v = nb[t]
                 if st[v] != -2:
@@ -641,7 +647,7 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
                     st[cur] = -3
                     edge_px[ep] = cur
                     ep += 1
-                    c2 = _mnbrs(sk, W, cur, nb2)
+                    c2 = _mnbrs(skf, W, cur, nb2)
                     w = -1
                     for s in range(c2):
                         if nb2[s] != prev:
@@ -1479,6 +1485,7 @@ def grow_regions(
     op_core,
     n_reg,
     n_free,
+    q,
 ):
     """Label every reachable free cell with a region and build one shortest-path tree per region.
 
@@ -1492,6 +1499,8 @@ def grow_regions(
     cell. On return ``st`` holds, for skeleton pixels, their skeleton index and, for other
     labelled cells, the parent cell towards the skeleton (-1 for chord cells).
 
+    ``q`` is int32 scratch of at least ``n_free + 1`` cells.
+
     Returns ``(sk_par, sk_dep, counts)``: the skeleton tree and the cells per region.
     """
     H = sk.shape[0]
@@ -1499,8 +1508,12 @@ def grow_regions(
     sk_flat = sk.ravel()
     d_flat = dcell.ravel()
     w_flat = work.ravel()
+    # skeleton pixels are exactly the cells with st >= 0 here; their labels are copied into a
+    # compact array so the tree search touches one grid-sized array (st), not three
+    lab_sk = np.empty(n_px, np.int32)
     for k in range(n_px):
         st[px[k]] = k
+        lab_sk[k] = lab[px[k]]
     sk_par = np.full(n_px, -1, np.int32)
     sk_dep = np.full(n_px, -1, np.int32)
     qs = np.empty(n_px + 1, np.int32)
@@ -1519,12 +1532,11 @@ def grow_regions(
             k = qs[head]
             head += 1
             i = px[k]
-            g = lab[i]
+            g = lab_sk[k]
             for dr in range(-1, 2):
                 for dc in range(-1, 2):
-                    j = i + dr * W + dc
-                    if sk_flat[j] and lab[j] == g:
-                        kj = st[j]
+                    kj = st[i + dr * W + dc]
+                    if kj >= 0 and lab_sk[kj] == g:
                         if sk_dep[kj] < 0:
                             sk_dep[kj] = sk_dep[k] + 1
                             sk_par[kj] = k
@@ -1543,7 +1555,6 @@ def grow_regions(
                 break
         if not extra:
             break
-    q = np.empty(n_free + 1, np.int32)
     counts = np.zeros(n_reg, np.int64)
     tail = 0
     for k in range(n_px):
@@ -1712,20 +1723,26 @@ def frontier_cells(W, work, lab, cand):
 
 @njit(cache=True, error_model="numpy")
 def scatter_labels(out, lab, lut, W, r0, c0):
-    """``out[r + r0, c + c0] = lut[lab[r * W + c]]`` for labelled work-grid cells inside ``out``."""
+    """Fill ``out`` (contents undefined on entry): ``out[r + r0, c + c0] = lut[lab[r * W + c]]``
+    for labelled work-grid cells, -1 everywhere else (one pass over ``out``)."""
     H0, W0 = out.shape
     Hw = lab.size // W
     ra = max(0, -r0)
     rb = min(Hw, H0 - r0)
     ca = max(0, -c0)
     cb = min(W, W0 - c0)
-    for r in range(ra, rb):
-        base = r * W
-        orow = out[r + r0]
-        for c in range(ca, cb):
-            g = lab[base + c]
-            if g >= 0:
-                orow[c + c0] = lut[g]
+    for ro in range(H0):
+        orow = out[ro]
+        r = ro - r0
+        if r < ra or r >= rb:
+            orow[:] = -1
+            continue
+        orow[: ca + c0] = -1
+        orow[cb + c0 :] = -1
+        base = r * W - c0
+        for co in range(ca + c0, cb + c0):
+            g = lab[base + co]
+            orow[co] = lut[g] if g >= 0 else -1
 
 
 @njit(cache=True, error_model="numpy")

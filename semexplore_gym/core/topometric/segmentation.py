@@ -63,6 +63,9 @@ from __future__ import annotations
 import gc
 import math
 import time
+from collections import deque
+from itertools import repeat
+from operator import setitem
 from typing import Any
 
 import numpy as np
@@ -89,57 +92,10 @@ from semexplore_gym.core.topometric.types import (
 )
 
 _MARGIN = 2
-_new = object.__new__
-_set = object.__setattr__
-
-
-# The generated ``__init__`` of a frozen dataclass assigns each field through
-# ``object.__setattr__``; for the thousands of records of a large map that is most of the
-# assembly time. These builders fill the instance dict directly. The records have no
-# ``__post_init__``, so the result is the same object (tests compare it with the constructor).
-def _opening(i, endpoints, mid, width, area_ids, frontier, anchor) -> Opening:
-    o = _new(Opening)
-    _set(
-        o,
-        "__dict__",
-        {
-            "id": i,
-            "endpoints_m": endpoints,
-            "midpoint_m": mid,
-            "width_m": width,
-            "area_ids": area_ids,
-            "is_frontier": frontier,
-            "anchor_m": anchor,
-        },
-    )
-    return o
-
-
-def _area(i, t, centre, opening_ids, paths, n_cells) -> Area:
-    o = _new(Area)
-    _set(
-        o,
-        "__dict__",
-        {
-            "id": i,
-            "type": t,
-            "centre_m": centre,
-            "opening_ids": opening_ids,
-            "paths_m": paths,
-            "n_cells": n_cells,
-        },
-    )
-    return o
-
-
-def _edge(a, b, area_id, length, path) -> GraphEdge:
-    o = _new(GraphEdge)
-    _set(
-        o,
-        "__dict__",
-        {"opening_a": a, "opening_b": b, "area_id": area_id, "length_m": length, "path_m": path},
-    )
-    return o
+_TYPE_OF = {int(t): t for t in AreaType}
+# Records are named tuples, built straight from their field tuples: tuple.__new__ over zipped
+# columns runs without a Python frame per record (thousands of records on a large map).
+_tnew = tuple.__new__
 
 
 # ----------------------------------------------------------------------------------------------
@@ -200,6 +156,90 @@ def _check_clearance(clearance_m: float) -> float:
 # ----------------------------------------------------------------------------------------------
 
 
+class _Scratch:
+    """Grid-sized scratch arrays, kept by a :class:`TopometricSegmenter` between calls.
+
+    Fresh arrays of a few MB cost more in page faults than the pass that fills them (a 1600^2
+    map needs about 50 MB of scratch: 10-15 % of its segmentation time when freshly mapped).
+    """
+
+    def __init__(self, keep: bool) -> None:
+        self.keep = keep
+        self._bufs: dict[str, np.ndarray] = {}
+
+    def take(self, name: str, n: int, dtype: type, fill: int | None = None) -> np.ndarray:
+        """A 1-D array of ``n`` elements, all ``fill`` (or undefined), reused while large enough."""
+        b = self._bufs.get(name)
+        if b is not None and b.size >= n:
+            b = b[:n]
+            if fill is not None:
+                b.fill(fill)
+            return b
+        # headroom when kept: an explored map grows a little between successive calls
+        size = n + n // 4 + 1024 if self.keep else n
+        # zeros come from calloc: pages nobody touches are never faulted in
+        b = np.zeros(size, dtype) if fill == 0 else np.empty(size, dtype)
+        if self.keep:
+            self._bufs[name] = b
+        b = b[:n]
+        if fill:
+            b.fill(fill)
+        return b
+
+
+class TopometricSegmenter:
+    """:func:`segment_map` as an object that keeps its scratch memory between calls.
+
+    An exploration loop segments a growing map at every update; reusing the grid-sized
+    scratch arrays saves their page faults (about 10-15 % of the time on maps of 400^2 cells
+    and more). The results are identical to :func:`segment_map`'s. The scratch arrays (about
+    20 bytes per cell of the largest map seen) are not pickled.
+
+    Not thread-safe: use one segmenter per thread (or per policy).
+
+    Args:
+        params: Default :class:`SegmentationParams` for calls that pass none.
+
+    Example::
+
+        segmenter = TopometricSegmenter()
+        tmap = None
+        for grid in growing_maps:
+            tmap = segmenter(grid, geometry, clearance_m=0.155, previous=tmap)
+    """
+
+    def __init__(self, params: SegmentationParams | None = None) -> None:
+        if params is not None and not isinstance(params, SegmentationParams):
+            raise TypeError(f"params must be a SegmentationParams, got {type(params).__name__}")
+        self.params = params if params is not None else SegmentationParams()
+        self._scratch = _Scratch(keep=True)
+
+    def __call__(
+        self,
+        grid: npt.ArrayLike,
+        geometry_or_resolution: GridGeometry | float,
+        clearance_m: float,
+        params: SegmentationParams | None = None,
+        previous: TopometricMap | None = None,
+    ) -> TopometricMap:
+        """Segment ``grid``; the arguments are those of :func:`segment_map`."""
+        return _segment(
+            grid,
+            geometry_or_resolution,
+            clearance_m,
+            params if params is not None else self.params,
+            previous,
+            self._scratch,
+        )
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"params": self.params}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.params = state["params"]
+        self._scratch = _Scratch(keep=True)
+
+
 def segment_map(
     grid: npt.ArrayLike,
     geometry_or_resolution: GridGeometry | float,
@@ -228,7 +268,16 @@ def segment_map(
         TypeError: wrong dtype or argument types.
         ValueError: wrong shape, values outside the encoding, non-positive resolution, negative
             clearance, or a geometry that does not match the grid.
+
+    To segment many maps (an exploration loop), :class:`TopometricSegmenter` gives the same
+    results faster by reusing its scratch memory.
     """
+    return _segment(
+        grid, geometry_or_resolution, clearance_m, params, previous, _Scratch(keep=False)
+    )
+
+
+def _segment(grid, geometry_or_resolution, clearance_m, params, previous, scratch) -> TopometricMap:
     t_start = time.perf_counter()
     enc = _as_encoded_grid(grid)
     geometry = _as_geometry(geometry_or_resolution, enc.shape)
@@ -244,7 +293,7 @@ def segment_map(
     was_enabled = gc.isenabled()
     gc.disable()
     try:
-        return _Segmenter(enc, geometry, clearance, params, previous, t_start).run()
+        return _Segmenter(enc, geometry, clearance, params, previous, t_start, scratch).run()
     finally:
         if was_enabled:
             gc.enable()
@@ -283,8 +332,9 @@ def _next_id_of(previous: TopometricMap | None) -> int:
 class _Segmenter:
     """One segmentation run (internal; holds the intermediate arrays of the crop)."""
 
-    def __init__(self, enc, geometry, clearance, params, previous, t_start) -> None:
+    def __init__(self, enc, geometry, clearance, params, previous, t_start, scratch) -> None:
         self.enc = enc
+        self.scratch = scratch
         self.g = geometry
         self.res = geometry.resolution_m
         self.clear_m = clearance
@@ -313,33 +363,41 @@ class _Segmenter:
             return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
         r0, r1 = rmin - _MARGIN, rmax + _MARGIN + 1
         c0, c1 = cmin - _MARGIN, cmax + _MARGIN + 1
-        work = np.full((r1 - r0, c1 - c0), UNKNOWN, dtype=np.uint8)
+        H, W = r1 - r0, c1 - c0
+        take = self.scratch.take
+        work = take("work", H * W, np.uint8, UNKNOWN).reshape(H, W)
         sr0, sr1, sc0, sc1 = max(r0, 0), min(r1, H0), max(c0, 0), min(c1, W0)
         work[sr0 - r0 : sr1 - r0, sc0 - c0 : sc1 - c0] = enc[sr0:sr1, sc0:sc1]
         self.r0, self.c0 = r0, c0
         self.work = work
-        H, W = work.shape
         self.H, self.W = H, W
         cell_area = res * res
         _, self.fcand = K.filter_small_blobs(
             work,
             int(p.max_speckle_area_m2 / cell_area + 1e-9),
             int(p.max_hole_area_m2 / cell_area + 1e-9),
+            take("state", H * W, np.uint8, 0),
         )
         self._lap("filter")
 
         self.min_clear = self.clear_m / res - 1e-6
-        dcell, sk, c_list, n_free = K.clearance_field(work, self.min_clear)
+        dcell = take("dcell", H * W, np.float32).reshape(H, W)
+        sk = take("sk", H * W, np.uint8, 0).reshape(H, W)
+        c_list, n_free = K.clearance_field(
+            work, self.min_clear, dcell, sk, take("ilist", H * W + 1, np.int32)
+        )
         self.dcell = dcell
         self._lap("distance")
         if p.keep_debug:
             self.cspace_debug = sk.astype(bool)
-        px = K.thin(sk, c_list)  # sk: C-space mask, thinned in place to the skeleton
+        px = K.thin(
+            sk, c_list, take("thin", 3 * (c_list.size + 1), np.int32)
+        )  # sk: C-space mask, thinned in place to the skeleton
         self._lap("skeleton")
         if px.size == 0:
             return _empty_map(self.g, self.clear_m, self.previous, self.t_start, self.stage_ms)
 
-        st = np.full(H * W, -1, dtype=np.int32)
+        st = take("st", H * W, np.int32, -1)
         min_depth_cells = p.min_dead_end_depth_m / res
         for _ in range(max(1, int(p.max_prune_iterations))):
             graph = self._extract(sk, px, dcell, st)
@@ -388,7 +446,7 @@ class _Segmenter:
             max(2, int(round(p.min_pathway_length_m / res))),
             math.radians(p.chord_search_deg),
         )
-        lab = np.full(H * W, -1, dtype=np.int32)
+        lab = take("lab", H * W, np.int32, -1)
         n_reg, _node_reg, _mid_reg, op_px, op_edge, op_idx, op_core, op_far = K.build_regions(
             graph["n"],
             graph["alive"],
@@ -435,6 +493,7 @@ class _Segmenter:
             op_core,
             n_reg,
             n_free,
+            take("ilist", n_free + 1, np.int32),
         )
         self.lab, self.st, self.sk_par, self.sk_dep = lab, st, sk_par, sk_dep
         self._lap("regions")
@@ -593,38 +652,50 @@ class _Segmenter:
                 max(p.path_tolerance_m / res, 0.0),
                 res,
             )
-            vxy = self._cells_xy(vcells)
         else:
+            vcells = np.zeros(0, np.int64)
             voff = np.zeros(1, np.int64)
             vlen = np.zeros(0)
-            vxy = np.zeros((0, 2))
+
+        # --- coordinates: one conversion for all cells, one for all fractional points ---------
+        fidx = op_front[n_op:]
+        fe = fr["ends"][fidx]
+        parts = [vcells, op_anchor, centres, op_anchor[zf_fo], fr["mid"][fidx]]
+        b = np.cumsum([0] + [len(x) for x in parts]).tolist()
+        cxy = self._cells_xy(np.concatenate(parts))
+        vxy, anchor_xy, centre_xy, fmid_xy = (
+            cxy[: b[1]],
+            cxy[b[1] : b[2]],
+            cxy[b[2] : b[4]],
+            cxy[b[4] :],
+        )
+        n_fe = n_all - n_op
+        exy = self._xy(
+            np.concatenate([ends[:, 0], ends[:, 2], fe[:, 0] + 0.5, fe[:, 2] + 0.5]),
+            np.concatenate([ends[:, 1], ends[:, 3], fe[:, 1] + 0.5, fe[:, 3] + 0.5]),
+        )
+        ends_xy = np.empty((n_all, 2, 2))
+        ends_xy[:n_op, 0] = exy[:n_op]
+        ends_xy[:n_op, 1] = exy[n_op : 2 * n_op]
+        ends_xy[n_op:, 0] = exy[2 * n_op : 2 * n_op + n_fe]
+        ends_xy[n_op:, 1] = exy[2 * n_op + n_fe :]
+        mids = np.empty((n_all, 2))
+        mids[:n_op] = (ends_xy[:n_op, 0] + ends_xy[:n_op, 1]) * 0.5
+        mids[n_op:] = fmid_xy
+        widths_m = np.concatenate([widths * res, fr["width"][fidx] * res])
+
         voff_l = voff.tolist()
         pieces = list(map(vxy.__getitem__, map(slice, voff_l[:n_req], voff_l[1 : n_req + 1])))
         area_paths: list[dict[int, np.ndarray]] = [{} for _ in range(n_prov)]
-        for a, k, piece in zip(req[0].tolist(), req[1].tolist(), pieces, strict=True):
-            area_paths[a][k] = piece
+        # area_paths[a][k] = piece for every request, in request order, without a Python loop
+        deque(
+            map(setitem, map(area_paths.__getitem__, req[0].tolist()), req[1].tolist(), pieces),
+            maxlen=0,
+        )
 
-        # --- coordinates ------------------------------------------------------------------------
-        anchor_xy = self._cells_xy(op_anchor) if n_all else np.zeros((0, 2))
         for z, (twin, fo) in enumerate(zip(zf_twin.tolist(), zf_fo.tolist(), strict=True)):
             pt = np.repeat(anchor_xy[fo : fo + 1], 2, axis=0)
             area_paths[n_reg + z] = {twin: pt, fo: pt}
-        centre_xy = self._cells_xy(np.concatenate([centres, op_anchor[zf_fo]]))
-        ends_xy = np.zeros((n_all, 2, 2))
-        mids = np.zeros((n_all, 2))
-        widths_m = np.zeros(n_all)
-        if n_op:
-            ends_xy[:n_op, 0] = self._xy(ends[:, 0], ends[:, 1])
-            ends_xy[:n_op, 1] = self._xy(ends[:, 2], ends[:, 3])
-            mids[:n_op] = ends_xy[:n_op].mean(axis=1)
-            widths_m[:n_op] = widths * res
-        if n_all > n_op:
-            fidx = op_front[n_op:]
-            fe = fr["ends"][fidx]
-            ends_xy[n_op:, 0] = self._xy(fe[:, 0] + 0.5, fe[:, 1] + 0.5)
-            ends_xy[n_op:, 1] = self._xy(fe[:, 2] + 0.5, fe[:, 3] + 0.5)
-            mids[n_op:] = self._cells_xy(fr["mid"][fidx])
-            widths_m[n_op:] = fr["width"][fidx] * res
 
         # --- identities -------------------------------------------------------------------------
         prov_type = np.concatenate([rtype, np.full(n_zf, front, np.int64)])
@@ -639,40 +710,44 @@ class _Segmenter:
         side_b = np.where(op_a1 >= 0, ids[op_a1], -1) if n_all else op_a1
         openings: list[Opening] = list(
             map(
-                _opening,
-                range(n_all),
-                list(ends_xy),
-                map(tuple, mids.tolist()),
-                widths_m.tolist(),
-                zip(ids[op_a0].tolist(), side_b.tolist(), strict=True),
-                (op_a1 < 0).tolist(),
-                map(tuple, anchor_xy.tolist()),
+                _tnew,
+                repeat(Opening),
+                zip(
+                    range(n_all),
+                    list(ends_xy),
+                    map(tuple, mids.tolist()),
+                    widths_m.tolist(),
+                    zip(ids[op_a0].tolist(), side_b.tolist(), strict=True),
+                    (op_a1 < 0).tolist(),
+                    map(tuple, anchor_xy.tolist()),
+                    strict=True,
+                ),
             )
         )
         aops_l = aops.tolist()
         aoff_l = aoff.tolist()
-        type_of = {int(t): t for t in AreaType}
-        n_cells = counts.tolist()[:n_reg] + [0] * n_zf
-        areas: dict[int, Area] = {
-            i: _area(i, type_of[t], tuple(c), tuple(aops_l[lo:hi]), pa, nc)
-            for i, t, c, lo, hi, pa, nc in zip(
-                ids_l[:n_prov],
-                prov_type.tolist(),
-                centre_xy.tolist(),
-                aoff_l[:n_prov],
-                aoff_l[1:],
+        area_ids = ids_l[:n_prov]
+        area_recs = map(
+            _tnew,
+            repeat(Area),
+            zip(
+                area_ids,
+                map(_TYPE_OF.__getitem__, prov_type.tolist()),
+                map(tuple, centre_xy.tolist()),
+                map(tuple, map(aops_l.__getitem__, map(slice, aoff_l[:n_prov], aoff_l[1:]))),
                 area_paths,
-                n_cells,
+                counts.tolist()[:n_reg] + [0] * n_zf,
                 strict=True,
-            )
-        }
+            ),
+        )
+        areas: dict[int, Area] = dict(zip(area_ids, area_recs, strict=True))
 
         # graph edges: areas with two openings, then every pair of an intersection's legs
         vlen_l = vlen.tolist()
         edges: list[GraphEdge] = [
-            _edge(o1, o2, ids_l[a], vlen_l[j], pieces[j])
+            _tnew(GraphEdge, (o1, o2, ids_l[a], vlen_l[j], pieces[j]))
             if j >= 0
-            else _edge(o1, o2, ids_l[a], 0.0, area_paths[a][o1])
+            else _tnew(GraphEdge, (o1, o2, ids_l[a], 0.0, area_paths[a][o1]))
             for o1, o2, a, j in edges2.tolist()
         ]
         if pairs.shape[1]:
@@ -682,12 +757,16 @@ class _Segmenter:
             jpieces = map(jxy.__getitem__, map(slice, joff_l[:n_pair], joff_l[1 : n_pair + 1]))
             edges.extend(
                 map(
-                    _edge,
-                    pairs[2].tolist(),
-                    pairs[3].tolist(),
-                    [ids_l[a] for a in pairs[4].tolist()],
-                    plen.tolist(),
-                    jpieces,
+                    _tnew,
+                    repeat(GraphEdge),
+                    zip(
+                        pairs[2].tolist(),
+                        pairs[3].tolist(),
+                        map(ids_l.__getitem__, pairs[4].tolist()),
+                        plen.tolist(),
+                        jpieces,
+                        strict=True,
+                    ),
                 )
             )
 
@@ -706,7 +785,7 @@ class _Segmenter:
         l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
 
         # --- raster -----------------------------------------------------------------------------
-        area_raster = np.full(self.g.shape, -1, dtype=np.int32)
+        area_raster = np.empty(self.g.shape, dtype=np.int32)
         K.scatter_labels(area_raster, lab, ids[:n_reg].astype(np.int32), W, self.r0, self.c0)
         self._lap("assemble")
         extras: dict[str, Any] = {"next_area_id": next_id, "stage_ms": self.stage_ms}
@@ -775,8 +854,6 @@ class _Segmenter:
                 if best is not None:
                     ids[a] = best
                     used.add(best)
-        for a in range(n_prov):
-            if ids[a] < 0:
-                ids[a] = next_id
-                next_id += 1
-        return ids, next_id
+        fresh = np.flatnonzero(ids < 0)
+        ids[fresh] = next_id + np.arange(fresh.size)
+        return ids, next_id + int(fresh.size)
