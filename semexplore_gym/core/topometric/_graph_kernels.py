@@ -48,6 +48,106 @@ def area_types(n_reg, op_core, op_far, f_reg):
     return rtype
 
 
+@njit(cache=True, error_model="numpy")
+def opening_sides(op_edge, op_idx, open_a, eoff, epx, ea, eb, rep):
+    """Skeleton pixels on either side of each opening pixel: ``(side_core, side_far)``.
+
+    The core side is the previous pixel of the edge when the opening is at its ``a`` end (the
+    end node's representative when the opening is the edge's first pixel), the next one at its
+    ``b`` end; the far side is the other neighbour along the edge.
+    """
+    n = op_edge.size
+    side_core = np.empty(n, np.int64)
+    side_far = np.empty(n, np.int64)
+    last = epx.size - 1
+    for k in range(n):
+        e = op_edge[k]
+        idx = op_idx[k]
+        pos = eoff[e] + idx
+        prev_px = epx[max(pos - 1, 0)]
+        next_px = epx[min(pos + 1, last)]
+        if open_a[e] == idx:
+            side_core[k] = prev_px if idx >= 1 else rep[ea[e]]
+            side_far[k] = next_px
+        else:
+            side_core[k] = next_px if pos + 1 < eoff[e + 1] else rep[eb[e]]
+            side_far[k] = prev_px
+    return side_core, side_far
+
+
+@njit(cache=True, error_model="numpy")
+def world_coordinates(
+    vcells,
+    op_anchor,
+    centres,
+    zf_fo,
+    f_mid,
+    fidx,
+    ends,
+    f_ends,
+    widths,
+    f_width,
+    W,
+    r0,
+    c0,
+    origin_x,
+    origin_y,
+    res,
+):
+    """World coordinates (metres) of everything the records need, in one pass.
+
+    Cells are converted at their centres, fractional (row, col) points as they are:
+    ``x = origin_x + (col + c0) * res``, ``y = origin_y + (row + r0) * res``.
+
+    Returns ``(vxy, anchor_xy, centre_xy, ends_xy, mids, widths_m)``: the path vertices, the
+    openings' anchors, the provisional areas' centres (regions, then zero-area frontier
+    pathways at their frontier's anchor), the openings' endpoints ``(n, 2, 2)``, midpoints and
+    widths (chords, then frontier openings).
+    """
+    n_op = ends.shape[0]
+    n_fe = fidx.size
+    n_all = n_op + n_fe
+    vxy = np.empty((vcells.size, 2))
+    for k in range(vcells.size):
+        _cell_xy(vxy, k, vcells[k], W, r0, c0, origin_x, origin_y, res)
+    anchor_xy = np.empty((op_anchor.size, 2))
+    for k in range(op_anchor.size):
+        _cell_xy(anchor_xy, k, op_anchor[k], W, r0, c0, origin_x, origin_y, res)
+    n_reg = centres.size
+    centre_xy = np.empty((n_reg + zf_fo.size, 2))
+    for k in range(n_reg):
+        _cell_xy(centre_xy, k, centres[k], W, r0, c0, origin_x, origin_y, res)
+    for k in range(zf_fo.size):
+        _cell_xy(centre_xy, n_reg + k, op_anchor[zf_fo[k]], W, r0, c0, origin_x, origin_y, res)
+    ends_xy = np.empty((n_all, 2, 2))
+    mids = np.empty((n_all, 2))
+    widths_m = np.empty(n_all)
+    for k in range(n_op):
+        for s in range(2):
+            ends_xy[k, s, 0] = origin_x + (ends[k, 2 * s + 1] + c0) * res
+            ends_xy[k, s, 1] = origin_y + (ends[k, 2 * s] + r0) * res
+        mids[k, 0] = (ends_xy[k, 0, 0] + ends_xy[k, 1, 0]) * 0.5
+        mids[k, 1] = (ends_xy[k, 0, 1] + ends_xy[k, 1, 1]) * 0.5
+        widths_m[k] = widths[k] * res
+    for t in range(n_fe):
+        k = n_op + t
+        f = fidx[t]
+        for s in range(2):
+            ends_xy[k, s, 0] = origin_x + ((f_ends[f, 2 * s + 1] + 0.5) + c0) * res
+            ends_xy[k, s, 1] = origin_y + ((f_ends[f, 2 * s] + 0.5) + r0) * res
+        _cell_xy(mids, k, f_mid[f], W, r0, c0, origin_x, origin_y, res)
+        widths_m[k] = f_width[f] * res
+    return vxy, anchor_xy, centre_xy, ends_xy, mids, widths_m
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _cell_xy(out, k, cell, W, r0, c0, origin_x, origin_y, res):
+    r = cell // W
+    c = cell - r * W
+    out[k, 0] = origin_x + ((c + 0.5) + c0) * res
+    out[k, 1] = origin_y + ((r + 0.5) + r0) * res
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _request(req, n, area, op, s, e, pre, post):
     req[0, n] = area

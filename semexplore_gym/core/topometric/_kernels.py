@@ -871,6 +871,49 @@ def _has_plateau(edge_px, first, n, step, dflat, W, lim, min_len):
 
 
 @njit(cache=True, error_model="numpy")
+def skeleton_graph(sk, px, dcell, st):
+    """:func:`extract_graph`, then :func:`splice_pass_nodes` when a node has degree 2.
+
+    Returns ``(n, rep, r, deg, noff, npx, ne, ea, eb, eoff, epx, alive)``; ``deg`` counts the
+    spliced edges.
+    """
+    (n, rep, r, deg, noff, npx, ne, ea, eb, eoff, epx) = extract_graph(sk, px, dcell, st)
+    alive = np.ones(n, np.bool_)
+    has_pass = False
+    for v in range(n):
+        if deg[v] == 2:
+            has_pass = True
+            break
+    if ne > 0 and has_pass:
+        alive, ne, ea, eb, eoff, epx = splice_pass_nodes(n, deg, noff, npx, ne, ea, eb, eoff, epx)
+        deg = np.zeros(n, np.int64)
+        for e in range(ea.size):
+            deg[ea[e]] += 1
+            deg[eb[e]] += 1
+    return n, rep, r, deg, noff, npx, ne, ea, eb, eoff, epx, alive
+
+
+@njit(cache=True, error_model="numpy")
+def remove_pixels(sk, px, gone):
+    """Clear the pixels ``gone`` of the skeleton ``sk`` and reduce junction blobs again;
+    returns the remaining skeleton pixels (sorted, as ``px``)."""
+    f = sk.ravel()
+    for k in range(gone.size):
+        f[gone[k]] = 0
+    n = 0
+    for k in range(px.size):
+        if f[px[k]]:
+            n += 1
+    kept = np.empty(n, np.int64)
+    n = 0
+    for k in range(px.size):
+        if f[px[k]]:
+            kept[n] = px[k]
+            n += 1
+    return reduce_blobs(sk, kept)
+
+
+@njit(cache=True, error_model="numpy")
 def spur_pixels(
     W,
     node_rep,

@@ -420,9 +420,7 @@ class _Segmenter:
             )
             if spur.size == 0:
                 break
-            sk.ravel()[spur] = 0
-            px = px[sk.ravel()[px] != 0]
-            px = K.reduce_blobs(sk, px)
+            px = K.remove_pixels(sk, px, spur)
         else:
             graph = self._extract(sk, px, dcell, st)
         self.sk, self.px = sk, px
@@ -502,7 +500,16 @@ class _Segmenter:
         fronts = self._frontiers()
         self._lap("frontiers")
 
-        side_core, side_far = self._opening_sides(graph, op_edge, op_idx, open_a)
+        side_core, side_far = GK.opening_sides(
+            op_edge,
+            op_idx,
+            open_a,
+            graph["eoff"],
+            graph["epx"],
+            graph["ea"],
+            graph["eb"],
+            graph["rep"],
+        )
         return self._assemble(
             n_reg,
             centres,
@@ -519,44 +526,8 @@ class _Segmenter:
 
     # ------------------------------------------------------------------------------------------
     def _extract(self, sk, px, dcell, st) -> dict[str, Any]:
-        (n, rep, r, deg, noff, npx, ne, ea, eb, eoff, epx) = K.extract_graph(sk, px, dcell, st)
-        alive = np.ones(n, dtype=np.bool_)
-        if ne and np.any(deg == 2):
-            alive, ne, ea, eb, eoff, epx = K.splice_pass_nodes(
-                n, deg, noff, npx, ne, ea, eb, eoff, epx
-            )
-            deg = np.bincount(ea, minlength=n) + np.bincount(eb, minlength=n)
-        return {
-            "n": n,
-            "rep": rep,
-            "r": r,
-            "deg": deg,
-            "noff": noff,
-            "npx": npx,
-            "ne": ne,
-            "ea": ea,
-            "eb": eb,
-            "eoff": eoff,
-            "epx": epx,
-            "alive": alive,
-        }
-
-    def _opening_sides(self, graph, op_edge, op_idx, open_a):
-        """Skeleton pixels on either side of each opening pixel (core side, far side)."""
-        eoff, epx, ea, eb, rep = graph["eoff"], graph["epx"], graph["ea"], graph["eb"], graph["rep"]
-        lo = eoff[op_edge]
-        hi = eoff[op_edge + 1]
-        at_a = open_a[op_edge] == op_idx
-        pos = lo + op_idx
-        prev_px = epx[np.maximum(pos - 1, 0)]
-        next_px = epx[np.minimum(pos + 1, epx.size - 1)]
-        side_core = np.where(
-            at_a,
-            np.where(op_idx >= 1, prev_px, rep[ea[op_edge]]),
-            np.where(pos + 1 < hi, next_px, rep[eb[op_edge]]),
-        )
-        side_far = np.where(at_a, next_px, prev_px)
-        return side_core.astype(np.int64), side_far.astype(np.int64)
+        names = ("n", "rep", "r", "deg", "noff", "npx", "ne", "ea", "eb", "eoff", "epx", "alive")
+        return dict(zip(names, K.skeleton_graph(sk, px, dcell, st), strict=True))
 
     # ------------------------------------------------------------------------------------------
     def _frontiers(self) -> dict[str, np.ndarray]:
@@ -657,33 +628,25 @@ class _Segmenter:
             voff = np.zeros(1, np.int64)
             vlen = np.zeros(0)
 
-        # --- coordinates: one conversion for all cells, one for all fractional points ---------
-        fidx = op_front[n_op:]
-        fe = fr["ends"][fidx]
-        parts = [vcells, op_anchor, centres, op_anchor[zf_fo], fr["mid"][fidx]]
-        b = np.cumsum([0] + [len(x) for x in parts]).tolist()
-        cxy = self._cells_xy(np.concatenate(parts))
-        vxy, anchor_xy, centre_xy, fmid_xy = (
-            cxy[: b[1]],
-            cxy[b[1] : b[2]],
-            cxy[b[2] : b[4]],
-            cxy[b[4] :],
+        g = self.g
+        vxy, anchor_xy, centre_xy, ends_xy, mids, widths_m = GK.world_coordinates(
+            vcells,
+            op_anchor,
+            centres,
+            zf_fo,
+            fr["mid"],
+            op_front[n_op:],
+            ends,
+            fr["ends"],
+            widths,
+            fr["width"],
+            W,
+            self.r0,
+            self.c0,
+            g.origin_x_m,
+            g.origin_y_m,
+            g.resolution_m,
         )
-        n_fe = n_all - n_op
-        exy = self._xy(
-            np.concatenate([ends[:, 0], ends[:, 2], fe[:, 0] + 0.5, fe[:, 2] + 0.5]),
-            np.concatenate([ends[:, 1], ends[:, 3], fe[:, 1] + 0.5, fe[:, 3] + 0.5]),
-        )
-        ends_xy = np.empty((n_all, 2, 2))
-        ends_xy[:n_op, 0] = exy[:n_op]
-        ends_xy[:n_op, 1] = exy[n_op : 2 * n_op]
-        ends_xy[n_op:, 0] = exy[2 * n_op : 2 * n_op + n_fe]
-        ends_xy[n_op:, 1] = exy[2 * n_op + n_fe :]
-        mids = np.empty((n_all, 2))
-        mids[:n_op] = (ends_xy[:n_op, 0] + ends_xy[:n_op, 1]) * 0.5
-        mids[n_op:] = fmid_xy
-        widths_m = np.concatenate([widths * res, fr["width"][fidx] * res])
-
         voff_l = voff.tolist()
         pieces = list(map(vxy.__getitem__, map(slice, voff_l[:n_req], voff_l[1 : n_req + 1])))
         area_paths: list[dict[int, np.ndarray]] = [{} for _ in range(n_prov)]
@@ -812,6 +775,8 @@ class _Segmenter:
         """Final area ids: carried over from ``previous`` by skeleton overlap, else fresh."""
         prev = self.previous
         next_id = _next_id_of(prev)
+        if prev is None:
+            return np.arange(next_id, next_id + n_prov, dtype=np.int64), next_id + n_prov
         ids = np.full(n_prov, -1, dtype=np.int64)
         if prev is not None and prev.areas:
             used: set[int] = set()
