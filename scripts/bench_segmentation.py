@@ -5,7 +5,7 @@ Grids of ``size x size`` cells, occupied except for ``corridor_cells``-wide corr
 blocked with probability ``block_prob`` (seeded). Corridors run to the map edge, where the
 outside counts as unknown, so the grids also have frontiers.
 
-Each size is segmented ``--repeats`` times by one :class:`TopometricSegmenter`, as in an
+Each size is segmented ``--repeats`` times by its own :class:`TopometricSegmenter`, as in an
 exploration loop (it reuses its scratch memory; ``--one-shot`` calls :func:`segment_map`, which
 starts from fresh memory every time). Prints a markdown table of the median and fastest time by
 size with the area counts, next to the GRID-FAST C++ reference (g++ -O2, one thread, measured
@@ -67,7 +67,10 @@ def main(argv: list[str] | None = None) -> int:
         "--sizes", type=int, nargs="+", default=[200, 400, 800, 1600], help="grid sizes in cells"
     )
     ap.add_argument(
-        "--repeats", type=int, default=7, help="timed runs per size (the median is reported)"
+        "--repeats",
+        type=int,
+        default=15,
+        help="rounds of one timed call per size (the median and fastest are reported)",
     )
     ap.add_argument("--seed", type=int, default=0, help="seed of the random blockages")
     ap.add_argument("--resolution", type=float, default=0.05, help="cell size in metres")
@@ -103,31 +106,36 @@ def main(argv: list[str] | None = None) -> int:
         "| median ms | fastest ms | GRID-FAST C++ ms |"
     )
     print("|---|---|---|---|---|---|---|---|---|")
-    stage_rows = []
-    for size in args.sizes:
-        grid = corridor_grid(size, rng, block_prob=args.block_prob)
-        times = []
-        stages: dict[str, list[float]] = {}
-        tmap = None
-        segment = segment_map if args.one_shot else TopometricSegmenter(params)
-        if not args.one_shot:
-            segment(grid, args.resolution, args.clearance)  # sizes its scratch memory
-        for _ in range(args.repeats):
+    # Round-robin over the sizes: this VM's speed drifts over seconds (other tenants), so each
+    # round times one call per size and every size samples the same mix of fast and slow spells.
+    grids = [corridor_grid(size, rng, block_prob=args.block_prob) for size in args.sizes]
+    segmenters = [segment_map if args.one_shot else TopometricSegmenter(params) for _ in grids]
+    for segment, grid in zip(segmenters, grids, strict=True):
+        segment(grid, args.resolution, args.clearance, params)  # sizes a segmenter's scratch
+    times: list[list[float]] = [[] for _ in grids]
+    stages: list[dict[str, list[float]]] = [{} for _ in grids]
+    tmaps = [None] * len(grids)
+    for _ in range(args.repeats):
+        for k, (segment, grid) in enumerate(zip(segmenters, grids, strict=True)):
             t0 = time.perf_counter()
             tmap = segment(grid, args.resolution, args.clearance, params)
-            times.append((time.perf_counter() - t0) * 1000.0)
-            for k, v in tmap.extras.get("stage_ms", {}).items():
-                stages.setdefault(k, []).append(v)
+            times[k].append((time.perf_counter() - t0) * 1000.0)
+            for name, v in tmap.extras.get("stage_ms", {}).items():
+                stages[k].setdefault(name, []).append(v)
+            tmaps[k] = tmap
+    stage_rows = []
+    for size, tmap, t_ms, st in zip(args.sizes, tmaps, times, stages, strict=True):
         assert tmap is not None
         c = tmap.counts()
         ref = GRIDFAST_REFERENCE_MS.get(size)
         ref_s = f"{ref:g}" if ref is not None else "-"
         print(
-            f"| {size}x{size} | {c['intersections']} | {c['pathways']} | {c['dead_ends']} | {c['frontier_pathways']} "
-            f"| {len(tmap.openings)} | {np.median(times):.1f} | {np.min(times):.1f} | {ref_s} |"
+            f"| {size}x{size} | {c['intersections']} | {c['pathways']} | {c['dead_ends']} "
+            f"| {c['frontier_pathways']} | {len(tmap.openings)} | {np.median(t_ms):.1f} "
+            f"| {np.min(t_ms):.1f} | {ref_s} |"
         )
-        stage_rows.append((size, {k: float(np.median(v)) for k, v in stages.items()}))
-        sys.stdout.flush()
+        stage_rows.append((size, {k: float(np.median(v)) for k, v in st.items()}))
+    sys.stdout.flush()
     if args.stages:
         print()
         names = list(stage_rows[0][1]) if stage_rows else []
