@@ -1093,10 +1093,13 @@ def _chord(work, r, c, base, n_angles, max_angle, max_t, step):
         ang = base + max_angle * a / max(n_angles, 1)
         ur = np.sin(ang)
         uc = np.cos(ang)
-        t1 = _march(work, pr, pc, ur, uc, max_t, step)
+        # Each march stops as soon as its chord can no longer beat the best one: a sample
+        # sequence cut at ``cap`` returns the same hit when there is one before ``cap`` and
+        # ``cap + 1`` (a sure reject) otherwise, so the chosen chord is unchanged.
+        t1 = _march(work, pr, pc, ur, uc, min(max_t, best), step)
         if t1 >= best:
             continue
-        t2 = _march(work, pr, pc, -ur, -uc, max_t, step)
+        t2 = _march(work, pr, pc, -ur, -uc, min(max_t, best - 1e-9 - t1), step)
         tot = t1 + t2
         if tot < best - 1e-9:
             best = tot
