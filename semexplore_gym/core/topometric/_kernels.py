@@ -415,11 +415,13 @@ def _mdeg(f: np.ndarray, W: int, i: int) -> int:
 
 
 @njit(cache=True, error_model="numpy")
-def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
-    """Remove simple pixels of m-degree >= 3 (junction blobs) in place; returns the kept pixels."""
+def reduce_blobs(img: np.ndarray, px: np.ndarray, simple: np.ndarray) -> np.ndarray:
+    """Remove simple pixels of m-degree >= 3 (junction blobs) in place; returns the kept pixels.
+
+    ``simple`` is row 2 of :func:`_zs_tables` (simple point by neighbour code).
+    """
     H, W = img.shape
     f = img.ravel()
-    simple = _zs_tables()[2]
     changed = True
     while changed:
         changed = False
@@ -428,6 +430,12 @@ def reduce_blobs(img: np.ndarray, px: np.ndarray) -> np.ndarray:
             if f[i] and _mdeg(f, W, i) >= 3 and simple[_code(f, i, W)]:
                 f[i] = 0
                 changed = True
+    return _still_set(f, px)
+
+
+@njit(cache=True, error_model="numpy")
+def _still_set(f: np.ndarray, px: np.ndarray) -> np.ndarray:
+    """The entries of ``px`` whose pixel in the flat image ``f`` is still set (order kept)."""
     n = 0
     for k in range(px.size):
         if f[px[k]]:
@@ -526,16 +534,7 @@ def thin(img: np.ndarray, allfg: np.ndarray, scratch: np.ndarray) -> np.ndarray:
             f[nxt[k]] &= 1
             cand[k] = nxt[k]
         n = nn
-    cnt = 0
-    for k in range(n_fg):
-        cnt += f[allfg[k]]
-    px = np.empty(cnt, np.int64)
-    cnt = 0
-    for k in range(n_fg):
-        if f[allfg[k]]:
-            px[cnt] = allfg[k]
-            cnt += 1
-    return reduce_blobs(img, px)
+    return reduce_blobs(img, _still_set(f, allfg), tab[2])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -900,17 +899,7 @@ def remove_pixels(sk, px, gone):
     f = sk.ravel()
     for k in range(gone.size):
         f[gone[k]] = 0
-    n = 0
-    for k in range(px.size):
-        if f[px[k]]:
-            n += 1
-    kept = np.empty(n, np.int64)
-    n = 0
-    for k in range(px.size):
-        if f[px[k]]:
-            kept[n] = px[k]
-            n += 1
-    return reduce_blobs(sk, kept)
+    return reduce_blobs(sk, px, _zs_tables()[2])  # skips and drops the cleared pixels
 
 
 @njit(cache=True, error_model="numpy")

@@ -491,7 +491,7 @@ class _Segmenter:
             op_core,
             n_reg,
             n_free,
-            take("ilist", n_free + 1, np.int32),
+            take("ilist", n_free + 1, np.int32),  # the C-space list is no longer needed
         )
         self.lab, self.st, self.sk_par, self.sk_dep = lab, st, sk_par, sk_dep
         self._lap("regions")
