@@ -1,8 +1,8 @@
 """Frontier-exploration baselines: ROS ``frontier_exploration`` (FE) and Yamauchi's nearest frontier.
 
 Both drive with the same move_base-like navigator (:class:`MoveBaseParams`): a Navfn-like
-global planner on an inflated costmap (:mod:`semexplore_gym.core.grid_search`) and a DWA local
-planner (:mod:`semexplore_gym.core.dwa`), with move_base's failure handling:
+global planner on an inflated costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local
+planner (:mod:`semexplore_gym.core.planning.dwa`), with move_base's failure handling:
 
 * a new goal is planned once (``planner_frequency_hz = 0``, the TurtleBot3 setting); the path is
   replanned when the local planner fails (no admissible trajectory, or it can only stand still);
@@ -65,10 +65,10 @@ from typing import Any, Literal
 import numpy as np
 
 from policies.base import Policy, StepStats
-from semexplore_gym.core.dwa import DWAParams, DWAPlanner, scan_points_m
-from semexplore_gym.core.frontiers import GridFrontier, detect_frontiers
+from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner, scan_points_m
+from semexplore_gym.core.frontiers.detection import GridFrontier, detect_frontiers
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from semexplore_gym.core.grid_search import (
+from semexplore_gym.core.planning.grid_search import (
     INSCRIBED_COST,
     NO_INFORMATION,
     CostmapParams,

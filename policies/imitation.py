@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from policies.base import Policy
-from semexplore_gym.core.egocentric import (
+from semexplore_gym.core.features.egocentric import (
     EgocentricEncoder,
     EgocentricParams,
     mirror_observations,

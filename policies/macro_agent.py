@@ -12,7 +12,7 @@ accepted (``semexplore explore``, ``benchmark``, ``compare-weights --agents``) a
 with the expert on the same worlds and seeds. It decides when the macro env would: at the
 first step, and afterwards once the commanded frontier is finished (reached, mapped, given up
 or gone) or the decision's time budget (``max_macro_time_s`` / ``decision_period_s``) is used
-up. The observation vector comes from :mod:`semexplore_gym.core.macro_features`, the same
+up. The observation vector comes from :mod:`semexplore_gym.core.features.macro`, the same
 code the env wrappers use.
 
 The model's settings are read from the ``config.yaml`` that ``semexplore train`` writes beside
@@ -33,8 +33,8 @@ from policies.base import Policy
 from policies.config import build_params, nest_dotted
 from policies.macro_driver import ExpertDriver
 from policies.semantic_expert import SemanticExpertParams
-from semexplore_gym.core.graph_search import FrontierCandidate, FrontierCostWeights
-from semexplore_gym.core.macro_features import (
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
+from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
     action_to_weights,

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from policies.semantic_expert import Segmenter, SemanticExpertParams, SemanticExpertPolicy
-from semexplore_gym.core.graph_search import (
+from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
     FrontierCostWeights,
     search_frontier_paths,

@@ -11,7 +11,7 @@ import numpy as np
 
 from policies.base import Policy, StepStats
 from policies.imitation import learner_action
-from semexplore_gym.core.egocentric import EgocentricEncoder
+from semexplore_gym.core.features.egocentric import EgocentricEncoder
 
 
 class SB3Policy(Policy):

@@ -4,11 +4,11 @@ Each replanning step (section II of Fredriksson et al.):
 
 1. **Pose identification.** Segment the observed occupancy grid into the semantic topometric
    map (``segment_map``); the frontiers ``F_i`` are those of its frontier pathways.
-2. **Goal selection.** Algorithm 1 (:mod:`semexplore_gym.core.graph_search`) finds the path
+2. **Goal selection.** Algorithm 1 (:mod:`semexplore_gym.core.planning.graph_search`) finds the path
    along the map to every frontier and scores it with
    ``C = d / L_path + w_v v - (w_p p_l + w_I (O(I) + P_u(I)))``; ``F* = argmin C``.
 3. **Navigation.** Every step, the modified potential field
-   (:mod:`semexplore_gym.core.potential_field`) follows the path to ``F*``.
+   (:mod:`semexplore_gym.core.planning.potential_field`) follows the path to ``F*``.
 4. **Stop.** The mission ends when no frontier remains.
 
 The policy is honest: it reads only the observation (``map``, ``pose``, ``scan``) and the
@@ -40,7 +40,7 @@ What the paper leaves open, and how this policy handles it (parameters in
   frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
   space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
   frontier a grid search with its clearance can reach
-  (:mod:`semexplore_gym.core.reachable_frontiers`), and keeps that goal while it lasts. Tiny
+  (:mod:`semexplore_gym.core.frontiers.reachable`), and keeps that goal while it lasts. Tiny
   frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
   inside of walls, pockets along them) are ignored.
 * **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
@@ -82,15 +82,15 @@ from typing import Any, Literal
 import numpy as np
 
 from policies.base import Policy, StepStats
-from semexplore_gym.core.graph_search import (
+from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
     FrontierCostWeights,
     search_frontier_paths,
 )
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
-from semexplore_gym.core.line_of_sight import segment_is_clear
+from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.params import require_finite
-from semexplore_gym.core.potential_field import (
+from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
     PotentialFieldParams,
     RobotLimits,
@@ -100,7 +100,7 @@ from semexplore_gym.core.potential_field import (
     potential_field_command,
     resample_polyline,
 )
-from semexplore_gym.core.reachable_frontiers import (
+from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,

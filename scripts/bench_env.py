@@ -73,7 +73,7 @@ def bench_steps(world: str, n_steps: int) -> dict[str, float]:
 def bench_lidar_vs_pymunk(world: str, n_scans: int = 300) -> dict[str, float]:
     import pymunk
 
-    from semexplore_gym.core.raycast import SegmentIndex, cast_scan
+    from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
     from semexplore_gym.core.worlds import make_world
     from semexplore_gym.core.worlds.start import sample_start_pose
 

@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-from semexplore_gym.core.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 
 
 def maze_segments(
@@ -139,7 +139,7 @@ def first_call_s(cold: bool) -> float:
     code = (
         "import time; t = time.perf_counter();"
         "import numpy as np;"
-        "from semexplore_gym.core.raycast import SegmentIndex, cast_scan;"
+        "from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan;"
         "i = SegmentIndex(np.array([[0.,0.,1.,0.]]*30) + np.arange(30)[:, None]);"
         "cast_scan(i, 0.5, 0.5, 0.0, np.linspace(0, 6.28, 360), 3.5);"
         "print(time.perf_counter() - t)"

@@ -19,8 +19,8 @@ import numpy as np
 from bench_lidar import corridor_poses, maze_segments
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
-from semexplore_gym.core.occupancy_grid import MappingParams, OccupancyGrid
-from semexplore_gym.core.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from semexplore_gym.core.occupancy_grid import MappingParams
-from semexplore_gym.core.odometry import OdometryNoiseParams
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams
+from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
 from semexplore_gym.core.params import ConfigError, from_dict, load_yaml, merge_overrides
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams

@@ -11,9 +11,9 @@ import numpy as np
 from gymnasium import spaces
 
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.occupancy_grid import OccupancyGrid
-from semexplore_gym.core.odometry import OdometryDrift
-from semexplore_gym.core.raycast import SegmentIndex
+from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
+from semexplore_gym.core.mapping.odometry import OdometryDrift
+from semexplore_gym.core.mapping.raycast import SegmentIndex
 from semexplore_gym.core.worlds import make_world
 from semexplore_gym.core.worlds.start import (
     reachable_free_mask,

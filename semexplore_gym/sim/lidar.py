@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semexplore_gym.core.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The :class:`EgocentricObservation` wrapper (features computed in :mod:`semexplore_gym.core.egocentric`)."""
+"""The :class:`EgocentricObservation` wrapper (features computed in :mod:`semexplore_gym.core.features.egocentric`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from semexplore_gym.core.egocentric import (  # noqa: F401  (re-exported)
+from semexplore_gym.core.features.egocentric import (  # noqa: F401  (re-exported)
     N_FEATURES,
     EgocentricEncoder,
     EgocentricParams,

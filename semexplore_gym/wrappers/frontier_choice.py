@@ -21,7 +21,7 @@ Reward of a decision: ``area_reward_per_m2 * (new mapped free area, m^2) - time_
 (simulated seconds it took)``. Episode end: terminated when the base env terminates (coverage
 goal) or the driver finds no frontier left; truncated when the base env truncates.
 
-Observation (``Box(-1, 1, (K * 8 + 4,), float32)``): see :mod:`semexplore_gym.core.macro_features`,
+Observation (``Box(-1, 1, (K * 8 + 4,), float32)``): see :mod:`semexplore_gym.core.features.macro`,
 where the features, :class:`MacroParams` and :func:`action_to_weights` live (re-exported here).
 """
 
@@ -33,9 +33,9 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from semexplore_gym.core.graph_search import FrontierCandidate, FrontierCostWeights
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.grid import UNKNOWN
-from semexplore_gym.core.macro_features import (  # noqa: F401  (re-exported)
+from semexplore_gym.core.features.macro import (  # noqa: F401  (re-exported)
     N_CANDIDATE_FEATURES,
     N_GLOBAL_FEATURES,
     WEIGHT_RANGES,

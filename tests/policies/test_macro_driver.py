@@ -10,7 +10,7 @@ import pytest
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from policies.macro_driver import ExpertDriver
-from semexplore_gym.core.graph_search import FrontierCostWeights
+from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 
 
 def _env_with_two_candidates() -> tuple[gym.Env, ExpertDriver, dict, dict, list]:

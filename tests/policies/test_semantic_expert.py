@@ -176,7 +176,7 @@ def test_stuck_robot_backs_off_and_blacklists_its_goal():
 
 
 def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
-    from semexplore_gym.core.graph_search import FrontierCandidate
+    from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
     def cand(x: float, cost: float, area: int) -> FrontierCandidate:
         f = Frontier(area, area, (x, 1.0), 1.0, None, 1.0)

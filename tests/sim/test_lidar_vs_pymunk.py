@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from semexplore_gym.core.raycast import SegmentIndex, cast_rays
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_rays
 
 pymunk = pytest.importorskip("pymunk")
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
-from semexplore_gym.core.reachable_frontiers import (
+from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     frontier_groups,
     nearest_reachable_frontier,

@@ -17,7 +17,7 @@ from semexplore_gym.core.worlds import (
 )
 from semexplore_gym.core.worlds.geometry import crossed_links
 
-MAPS = Path(__file__).resolve().parents[2] / ".." / "shared" / "maps"
+MAPS = Path(__file__).resolve().parents[3] / ".." / "shared" / "maps"
 
 pytestmark = [
     pytest.mark.shared_maps,

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from semexplore_gym.core.frontier_distance import frontier_distance_m, relative_distance_image
+from semexplore_gym.core.frontiers.distance import frontier_distance_m, relative_distance_image
 from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
 
 #: Number of scalar features in the ``features`` entry.

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from semexplore_gym.core.egocentric import EgocentricEncoder, EgocentricParams
-from semexplore_gym.core.frontier_distance import frontier_distance_m, relative_distance_image
-from semexplore_gym.core.frontiers import frontier_cell_mask
+from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
+from semexplore_gym.core.frontiers.distance import frontier_distance_m, relative_distance_image
+from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, parse_ascii_grid
-from semexplore_gym.core.grid_search import distance_field
+from semexplore_gym.core.planning.grid_search import distance_field
 from semexplore_gym.core.worlds.grid_maze import carve_maze
 
 VALUES = np.array([OCCUPIED, UNKNOWN, FREE], np.uint8)

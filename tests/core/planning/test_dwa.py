@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from semexplore_gym.core.dwa import DWAParams, DWAPlanner, scan_points_m
+from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner, scan_points_m
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
 
 DT_S = 0.2

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
-from semexplore_gym.core.line_of_sight import segment_is_clear
-from semexplore_gym.core.potential_field import (
+from semexplore_gym.core.planning.line_of_sight import segment_is_clear
+from semexplore_gym.core.planning.potential_field import (
     PotentialFieldParams,
     RobotLimits,
     beam_angles_rad,

@@ -1,6 +1,6 @@
 """Path length from every cell to the nearest frontier cell, as one numba kernel.
 
-The ``frontier_distance`` channel of :mod:`semexplore_gym.core.egocentric` needs this field at
+The ``frontier_distance`` channel of :mod:`semexplore_gym.core.features.egocentric` needs this field at
 every step. Composed from general tools (a scipy dilation for the wall clearance, then the
 heap-based Dijkstra of :func:`semexplore_gym.core.grid_search.distance_field`) it cost most of
 an encode. The kernel here fuses the frontier test, the clearance mask and the search, and

@@ -8,7 +8,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from semexplore_gym.core.graph_search import (
+from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     find_frontier_paths,
     project_onto_polyline,
@@ -126,7 +126,7 @@ def brute_force_costs(
     Uses the same first legs (robot to each opening of its area), so only the graph part is
     recomputed here.
     """
-    from semexplore_gym.core.graph_search import (
+    from semexplore_gym.core.planning.graph_search import (
         _first_legs,
         _heading_angle,
         _polyline_length,

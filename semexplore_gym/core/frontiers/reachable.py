@@ -26,7 +26,7 @@ import numpy.typing as npt
 from numba import njit
 from scipy import ndimage
 
-from semexplore_gym.core.frontiers import frontier_cell_mask
+from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, parse_ascii_grid
-from semexplore_gym.core.occupancy_grid import MappingParams, OccupancyGrid
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
 
 P = MappingParams()
 L_FREE = np.float32(P.log_odds_free)

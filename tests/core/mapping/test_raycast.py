@@ -8,7 +8,7 @@ import pickle
 import numpy as np
 import pytest
 
-from semexplore_gym.core.raycast import SegmentIndex, cast_rays, cast_scan
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_rays, cast_scan
 
 SQRT2 = math.sqrt(2.0)
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semexplore_gym.core.graph_search import FrontierCandidate
+from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.params import require_finite
 

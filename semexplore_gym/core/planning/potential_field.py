@@ -35,7 +35,7 @@ import numpy.typing as npt
 from numba import njit
 
 from semexplore_gym.core.grid import OCCUPIED, GridGeometry
-from semexplore_gym.core.line_of_sight import farthest_visible_index
+from semexplore_gym.core.planning.line_of_sight import farthest_visible_index
 from semexplore_gym.core.params import require_finite
 
 

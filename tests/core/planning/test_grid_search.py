@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, parse_ascii_grid
-from semexplore_gym.core.grid_search import (
+from semexplore_gym.core.planning.grid_search import (
     INSCRIBED_COST,
     LETHAL_COST,
     NO_INFORMATION,

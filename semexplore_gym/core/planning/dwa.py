@@ -43,7 +43,7 @@ from numba import njit
 from scipy import ndimage
 
 from semexplore_gym.core.grid import OCCUPIED, GridGeometry
-from semexplore_gym.core.grid_search import distance_field
+from semexplore_gym.core.planning.grid_search import distance_field
 
 __all__ = ["DWACommand", "DWAParams", "DWAPlanner", "scan_points_m"]
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from semexplore_gym.core.egocentric import (
+from semexplore_gym.core.features.egocentric import (
     EgocentricEncoder,
     EgocentricParams,
     frontier_distance_m,

@@ -10,7 +10,7 @@ import pytest
 from semexplore_gym.core.grid import FREE
 from semexplore_gym.core.topometric import AreaType, SegmentationParams, segment_map
 
-MAPS = Path(__file__).resolve().parents[2] / ".." / "shared" / "maps"
+MAPS = Path(__file__).resolve().parents[3] / ".." / "shared" / "maps"
 FILES = sorted(MAPS.rglob("*.yaml")) if MAPS.is_dir() else []
 CLEARANCE_M = 0.155
 SMALL_CELLS = 1_000_000  # maps above this run in the slow test

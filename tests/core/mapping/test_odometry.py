@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from semexplore_gym.core.odometry import (
+from semexplore_gym.core.mapping.odometry import (
     OdometryDrift,
     OdometryNoiseParams,
     compose_motion,

@@ -1,0 +1,1 @@
+"""Features for learning agents: egocentric map crops and macro-action observations."""

@@ -1,0 +1,2 @@
+"""Frontiers: wavefront detection (WFD), the nearest reachable frontier for a disc robot, and
+path distance to the nearest frontier."""

@@ -1,0 +1,1 @@
+"""Mapping: LiDAR ray casting, log-odds occupancy grids and the odometry drift model."""
