@@ -8,7 +8,7 @@ went. The acceptance target is a maze1 mission at >= 100x simulated time.
 
 Usage::
 
-    python scripts/bench_expert.py [--world maze1] [--seeds 0 1 2] [--set KEY=VALUE] [--json]
+    python scripts/bench_expert.py [--world maze1] [--seeds 0 1 2] [--policy-set KEY=VALUE] [--json]
 """
 
 from __future__ import annotations
@@ -27,10 +27,10 @@ def main(argv: list[str] | None = None) -> int:
         "--seeds", type=int, nargs="+", default=[0], help="seeds of the timed missions (default: 0)"
     )
     ap.add_argument(
-        "--config", default=None, help="policy config YAML (sections env / policy / params)"
+        "--policy-config", default=None, help="policy config YAML (sections env / policy / params)"
     )
     ap.add_argument(
-        "--set",
+        "--policy-set",
         dest="overrides",
         action="append",
         default=[],
@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     from policies.rollout import STAGES, run_mission
     from semexplore_gym.core.params import parse_override
 
-    cfg = load_policy_config(args.config)
+    cfg = load_policy_config(args.policy_config)
     kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}
     if cfg.params:
         kwargs["params"] = cfg.params

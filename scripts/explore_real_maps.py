@@ -9,7 +9,7 @@ as an error row and the script goes on; the exit code is 1 if any map failed.
 Usage::
 
     python scripts/explore_real_maps.py [--maps-dir ../shared/maps] [--max-time-s 1200]
-        [--only intel_map] [--policy semantic] [--config FILE] [--set KEY=VALUE] [--jsonl out.jsonl]
+        [--only intel_map] [--policy semantic] [--policy-config FILE] [--policy-set KEY=VALUE] [--jsonl out.jsonl]
 """
 
 from __future__ import annotations
@@ -62,10 +62,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--policy", default="semantic", help="policy spec (default: semantic)")
     ap.add_argument(
-        "--config", default=None, help="policy config YAML (sections env / policy / params)"
+        "--policy-config", default=None, help="policy config YAML (sections env / policy / params)"
     )
     ap.add_argument(
-        "--set",
+        "--policy-set",
         dest="overrides",
         action="append",
         default=[],
@@ -106,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
         if n not in names:
             print(f"unknown map {n!r}; known: {', '.join(sorted(names))}", file=sys.stderr)
             return 2
-    cfg = load_policy_config(args.config)
+    cfg = load_policy_config(args.policy_config)
     kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}
     if cfg.params:
         kwargs["params"] = cfg.params

@@ -17,14 +17,14 @@ def tiny_macro_train_args() -> Callable[[float], list[str]]:
 
     def args(decision_s: float) -> list[str]:
         return [
-            "--set", "env.world=maze:seed=0,size_m=4",
-            "--set", "env.overrides=[episode.max_time_s=30]",
-            "--set", "ppo.total_timesteps=8",
-            "--set", "ppo.n_steps=4",
-            "--set", "ppo.batch_size=4",
-            "--set", "ppo.n_epochs=1",
-            "--set", f"env.macro.max_macro_time_s={decision_s:g}",
-            "--set", f"env.macro.decision_period_s={decision_s:g}",
+            "--train-set", "env.world=maze:seed=0,size_m=4",
+            "--train-set", "env.overrides=[episode.max_time_s=30]",
+            "--train-set", "ppo.total_timesteps=8",
+            "--train-set", "ppo.n_steps=4",
+            "--train-set", "ppo.batch_size=4",
+            "--train-set", "ppo.n_epochs=1",
+            "--train-set", f"env.macro.max_macro_time_s={decision_s:g}",
+            "--train-set", f"env.macro.decision_period_s={decision_s:g}",
             "--no-progress",
         ]  # fmt: skip
 

@@ -12,6 +12,8 @@ import json
 import shlex
 import sys
 
+from semexplore_gym.cli._flags import add_renamed_flag
+
 
 def _split(text: str) -> list[str]:
     return [t.strip() for t in text.split(",") if t.strip()] if text else []
@@ -73,9 +75,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--max-time-s", type=float, default=None, help="stop each mission after this simulated time"
     )
-    p.add_argument("--config", default=None, help="env config: preset name or YAML path")
+    p.add_argument("--env-config", default=None, help="env config: preset name or YAML path")
     p.add_argument(
-        "--set",
+        "--env-set",
+        dest="env_overrides",
         action="append",
         default=[],
         metavar="KEY=VALUE",
@@ -102,6 +105,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
+    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
+    add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
     return p
 
 
@@ -135,8 +140,12 @@ def run(args: argparse.Namespace) -> int:
     from semexplore_gym.core.params import to_dict
     from semexplore_gym.envs.config import load_env_config
 
-    overrides = list(args.set) + (["episode.random_start=true"] if args.random_start else [])
-    env_config = load_env_config(args.config, overrides) if (args.config or overrides) else None
+    overrides = list(args.env_overrides) + (
+        ["episode.random_start=true"] if args.random_start else []
+    )
+    env_config = (
+        load_env_config(args.env_config, overrides) if (args.env_config or overrides) else None
+    )
     tasks = expand_tasks(worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config)
     from pathlib import Path
 
@@ -149,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
             "policies": policies,
             "seeds": seeds,
             "max_time_s": args.max_time_s,
-            "config": args.config,
+            "config": args.env_config,
             "env_config": to_dict(env_config) if env_config is not None else None,
             "workers": args.workers,
             "backend": args.backend,

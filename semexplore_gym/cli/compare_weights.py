@@ -33,6 +33,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from semexplore_gym.cli._flags import add_renamed_flag
+
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
 
@@ -227,8 +229,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "'sb3:runs/pw/model.zip[learned weights]'",
     )
     p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
-    p.add_argument("--config", default=None, help="env config: preset name or YAML path")
+    p.add_argument("--env-config", default=None, help="env config: preset name or YAML path")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
     p.add_argument(
         "--workers",
         type=int,
@@ -299,7 +302,7 @@ def run(args: argparse.Namespace) -> int:
         args.max_time_s,
         args.target_coverage,
         args.penalty_s,
-        env_config=args.config,
+        env_config=args.env_config,
     )
 
     def show(number: int, weights: dict[str, float], value: float) -> None:
@@ -329,12 +332,12 @@ def run(args: argparse.Namespace) -> int:
             [label],
             test_seeds,
             max_time_s=args.max_time_s,
-            env_config=args.config,
+            env_config=args.env_config,
             policy_overrides=ws,
         )
     if agents:
         tasks += expand_tasks(
-            test_worlds, agents, test_seeds, max_time_s=args.max_time_s, env_config=args.config
+            test_worlds, agents, test_seeds, max_time_s=args.max_time_s, env_config=args.env_config
         )
     res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
     rows = read_runs(out / "test" / "runs.csv")

@@ -4,7 +4,7 @@ Example::
 
     semexplore explore --world maze1 --policy semantic --seed 0 --gif maze1.gif
     semexplore explore --world ../shared/maps/turtlebot3/world/map.yaml --json
-    semexplore explore --world maze2 --config configs/expert/paper.yaml --set cost.w_v=2
+    semexplore explore --world maze2 --policy-config configs/expert/paper.yaml --policy-set cost.w_v=2
 """
 
 from __future__ import annotations
@@ -13,6 +13,8 @@ import argparse
 import json
 import sys
 from typing import Any
+
+from semexplore_gym.cli._flags import add_renamed_flag
 
 #: Keys of the ``--json`` object, in order.
 JSON_KEYS: tuple[str, ...] = (
@@ -44,7 +46,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--seed", type=int, default=0, help="seed for env.reset and the policy (default: 0)"
     )
     p.add_argument(
-        "--config",
+        "--policy-config",
         default=None,
         help="policy config YAML with sections env / policy / params (e.g. configs/expert/paper.yaml)",
     )
@@ -54,7 +56,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="env config: preset name (default, paper) or YAML path; replaces the config file's env section",
     )
     p.add_argument(
-        "--set",
+        "--policy-set",
         dest="overrides",
         action="append",
         default=[],
@@ -93,6 +95,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="print the result as one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_renamed_flag(
+        p, "--config", "use --policy-config FILE (policy config) or --env-config (env config)"
+    )
+    add_renamed_flag(
+        p, "--set", "use --policy-set KEY=VALUE (policy parameter) or --env-set (env config)"
+    )
     return p
 
 
@@ -107,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
 
     if not (args.max_time_s > 0):
         raise ValueError(f"--max-time-s must be positive, got {args.max_time_s!r}")
-    cfg = load_policy_config(args.config)
+    cfg = load_policy_config(args.policy_config)
     spec = args.policy or cfg.policy or "semantic"
     overrides: dict[str, Any] = {}
     for text in args.overrides:

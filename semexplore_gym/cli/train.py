@@ -1,4 +1,4 @@
-"""``semexplore train --algo bc|dagger|ppo --config FILE --out DIR``: train a learning agent.
+"""``semexplore train --algo bc|dagger|ppo --train-config FILE --out DIR``: train a learning agent.
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.params import ConfigError, from_dict, load_yaml, merge_overrides, to_dict
 
 ALGOS = ("bc", "dagger", "ppo", "maskable_ppo")
@@ -478,10 +479,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         choices=ALGOS,
         help="bc, dagger, ppo or maskable_ppo (macro-action envs)",
     )
-    p.add_argument("--config", default=None, help="agent config YAML (configs/agents/*.yml)")
+    p.add_argument("--train-config", default=None, help="agent config YAML (configs/agents/*.yml)")
     p.add_argument("--out", required=True, help="run directory (created)")
     p.add_argument(
-        "--set",
+        "--train-set",
         dest="overrides",
         action="append",
         default=[],
@@ -489,16 +490,18 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="override a config key, e.g. bc.epochs=5 (repeatable)",
     )
     p.add_argument("--no-progress", action="store_true", help="no tqdm progress bars")
+    add_renamed_flag(p, "--config", "use --train-config FILE (agent training config YAML)")
+    add_renamed_flag(p, "--set", "use --train-set KEY=VALUE (training config override)")
     return p
 
 
 def _command_line(args: argparse.Namespace) -> str:
     """The ``semexplore train`` command that reproduces this run (also when called via ``main``)."""
     parts = ["semexplore", "train", "--algo", args.algo, "--out", str(args.out)]
-    if args.config:
-        parts += ["--config", str(args.config)]
+    if args.train_config:
+        parts += ["--train-config", str(args.train_config)]
     for text in args.overrides:
-        parts += ["--set", text]
+        parts += ["--train-set", text]
     if args.no_progress:
         parts.append("--no-progress")
     return shlex.join(parts)
@@ -515,7 +518,7 @@ def run(args: argparse.Namespace) -> int:
         )
         return 2
     try:
-        cfg = load_train_config(args.config, args.overrides)
+        cfg = load_train_config(args.train_config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
     for key, value in (

@@ -43,9 +43,9 @@ def test_explore_text_output_with_paper_config(capsys):
             "explore",
             "--world",
             "maze1",
-            "--config",
+            "--policy-config",
             str(cfg),
-            "--set",
+            "--policy-set",
             "cost.w_v=2",
             "--max-time-s",
             "2",
@@ -61,14 +61,14 @@ def test_explore_rejects_bad_keys_and_files(tmp_path, capsys):
     def explore(*extra: str) -> int:
         return main(["explore", "--world", "maze1", *extra, "--no-progress"])
 
-    assert explore("--set", "cost.w_x=2", "--max-time-s", "1") == 2
+    assert explore("--policy-set", "cost.w_x=2", "--max-time-s", "1") == 2
     assert "cost.w_x" in capsys.readouterr().err
     bad = tmp_path / "bad.yaml"
     bad.write_text("params:\n  potential_field:\n    f_q: 1\n")
-    assert explore("--config", str(bad), "--max-time-s", "1") == 2
+    assert explore("--policy-config", str(bad), "--max-time-s", "1") == 2
     assert "potential_field.f_q" in capsys.readouterr().err
     top = tmp_path / "top.yaml"
     top.write_text("robot:\n  radius_m: 0.1\n")
-    assert explore("--config", str(top), "--max-time-s", "1") == 2
+    assert explore("--policy-config", str(top), "--max-time-s", "1") == 2
     assert "robot" in capsys.readouterr().err
-    assert explore("--config", str(tmp_path / "missing.yaml")) == 2
+    assert explore("--policy-config", str(tmp_path / "missing.yaml")) == 2

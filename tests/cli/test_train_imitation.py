@@ -33,7 +33,7 @@ def test_bad_workers_are_rejected_before_any_work(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], override: str, message: str
 ) -> None:
     out = tmp_path / "run"
-    rc = main(["train", "--algo", "dagger", "--out", str(out), "--no-progress", "--set", override])
+    rc = main(["train", "--algo", "dagger", "--out", str(out), "--no-progress", "--train-set", override])
     assert rc == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
@@ -44,25 +44,25 @@ def test_dagger_with_two_workers_records_the_same_data(tmp_path: Path) -> None:
     """The CLI's env and expert factories feed the workers; the data equals one process's."""
     tiny = [
         "--no-progress",
-        "--set", "torch_threads=1",
-        "--set", "env.world=maze:size_m=4,seed=3",
-        "--set", "egocentric.crop_cells=36",
-        "--set", "expert.spec=semantic",
-        "--set", "expert.episodes=3",
-        "--set", "expert.max_steps=12",
-        "--set", "expert.holdout_fraction=0.34",
-        "--set", "bc.epochs=1",
-        "--set", "dagger.rounds=1",
-        "--set", "dagger.episodes_per_round=2",
-        "--set", "dagger.epochs_per_round=1",
+        "--train-set", "torch_threads=1",
+        "--train-set", "env.world=maze:size_m=4,seed=3",
+        "--train-set", "egocentric.crop_cells=36",
+        "--train-set", "expert.spec=semantic",
+        "--train-set", "expert.episodes=3",
+        "--train-set", "expert.max_steps=12",
+        "--train-set", "expert.holdout_fraction=0.34",
+        "--train-set", "bc.epochs=1",
+        "--train-set", "dagger.rounds=1",
+        "--train-set", "dagger.episodes_per_round=2",
+        "--train-set", "dagger.epochs_per_round=1",
     ]  # fmt: skip
     datasets = {}
     for workers in (1, 2):
         out = tmp_path / f"w{workers}"
         rc = main(
-            ["train", "--algo", "dagger", "--config", str(CONFIGS / "dagger_maze.yml")]
+            ["train", "--algo", "dagger", "--train-config", str(CONFIGS / "dagger_maze.yml")]
             + ["--out", str(out), *tiny]
-            + ["--set", f"expert.workers={workers}", "--set", f"dagger.workers={workers}"]
+            + ["--train-set", f"expert.workers={workers}", "--train-set", f"dagger.workers={workers}"]
         )
         assert rc == 0
         metrics = json.loads((out / "metrics.json").read_text())

@@ -36,7 +36,7 @@ def test_macro_training_runs_a_few_steps(
                 "train",
                 "--algo",
                 algo,
-                "--config",
+                "--train-config",
                 str(CONFIGS / config),
                 "--out",
                 str(out),
@@ -57,9 +57,9 @@ def test_macro_training_runs_a_few_steps(
 
 def test_macro_env_id_rejects_imitation_and_mask_needs_macro(tmp_path: Path) -> None:
     cfg = str(CONFIGS / "planner_weights_maze.yml")
-    assert main(["train", "--algo", "bc", "--config", cfg, "--out", str(tmp_path / "a")]) == 2
+    assert main(["train", "--algo", "bc", "--train-config", cfg, "--out", str(tmp_path / "a")]) == 2
     cfg = str(CONFIGS / "ppo_maze.yml")
     assert (
-        main(["train", "--algo", "maskable_ppo", "--config", cfg, "--out", str(tmp_path / "b")])
+        main(["train", "--algo", "maskable_ppo", "--train-config", cfg, "--out", str(tmp_path / "b")])
         == 2
     )

@@ -262,30 +262,30 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
     from semexplore_gym.cli import main
 
     repo = Path(__file__).resolve().parents[2]
-    common = ["--no-progress", "--set", f"env.world={WORLD}", "--set", "egocentric.crop_cells=36"]
-    common += ["--set", "torch_threads=1"]  # one core: keep the shared machine's other one free
+    common = ["--no-progress", "--train-set", f"env.world={WORLD}", "--train-set", "egocentric.crop_cells=36"]
+    common += ["--train-set", "torch_threads=1"]  # one core: keep the shared machine's other one free
     bc_out = tmp_path / "bc"
     rc = main(
         [
             "train",
             "--algo",
             "bc",
-            "--config",
+            "--train-config",
             str(repo / "configs/agents/bc_maze.yml"),
             "--out",
             str(bc_out),
             *common,
         ]
         + [
-            "--set",
+            "--train-set",
             f"expert.spec={expert}",
-            "--set",
+            "--train-set",
             "expert.episodes=2",
-            "--set",
+            "--train-set",
             "expert.max_steps=20",
-            "--set",
+            "--train-set",
             "bc.epochs=2",
-            "--set",
+            "--train-set",
             "expert.workers=1",
         ]
     )
@@ -300,20 +300,20 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
             "train",
             "--algo",
             "ppo",
-            "--config",
+            "--train-config",
             str(repo / "configs/agents/ppo_maze.yml"),
             "--out",
             str(ppo_out),
             *common,
         ]
         + [
-            "--set",
+            "--train-set",
             "ppo.total_timesteps=64",
-            "--set",
+            "--train-set",
             "ppo.n_steps=32",
-            "--set",
+            "--train-set",
             "ppo.batch_size=16",
-            "--set",
+            "--train-set",
             f"ppo.init_from={bc_out / 'model.zip'}",
         ]
     )

@@ -36,7 +36,7 @@ def trained(tmp_path_factory, tiny_macro_train_args) -> dict[str, Path]:
     out = {}
     for kind, (algo, config, _) in KINDS.items():
         run = tmp_path_factory.mktemp(kind)
-        argv = ["train", "--algo", algo, "--config", str(CONFIGS / config), "--out", str(run)]
+        argv = ["train", "--algo", algo, "--train-config", str(CONFIGS / config), "--out", str(run)]
         assert main([*argv, *tiny_macro_train_args(3)]) == 0
         out[kind] = run / "model.zip"
     return out
