@@ -1,4 +1,5 @@
-"""World specs: ``make_world("maze1")``, ``make_world("office:seed=3,size_m=20")``, ``make_world("map.yaml")``."""
+"""World specs: ``make_world("maze1")``, ``make_world("office:seed=3,size_m=20")``,
+``make_world("map.yaml")``, ``make_world("map:tb3-world")``."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from semexplore_gym.core.worlds.catalogue import resolve_map_file
 from semexplore_gym.core.worlds.cave import CaveParams, generate_cave
 from semexplore_gym.core.worlds.fixed_mazes import make_maze1, make_maze2
 from semexplore_gym.core.worlds.grid_maze import MazeParams, generate_maze
@@ -25,6 +27,7 @@ _FAMILIES: dict[str, tuple[type, Callable[..., World]]] = {
 }
 _ROS_SUFFIXES = (".yaml", ".yml")
 _JSON_SUFFIXES = (".json",)
+_CATALOGUE_PREFIX = "map:"
 
 
 def list_world_names() -> list[str]:
@@ -106,6 +109,9 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
       ``rng``, so an env's RNG makes the world reproducible; with neither, seed 0 is used.
       ``World.metadata["spec"]`` is the fully resolved spec (seed included).
     - a path ending ``.yaml`` / ``.yml`` (ROS map_server map) or ``.json`` (HouseExpo plan).
+    - ``"map:NAME"``: a catalogue map (``semexplore maps list``), read from the directories in
+      ``$SEMEXPLORE_MAPS_DIR`` or else the map cache, where ``semexplore maps get NAME`` puts it
+      (:mod:`.catalogue`).
 
     Args:
         spec: The spec string or a path.
@@ -114,16 +120,21 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
     Raises:
         ValueError: unknown world name or family, unknown or ill-typed or out-of-range
             parameter (the message names it and lists the valid ones), malformed file.
-        FileNotFoundError: a map file that does not exist.
+        FileNotFoundError: a map file that does not exist, or a catalogue map not downloaded.
     """
+    if isinstance(spec, str) and spec.strip().startswith(_CATALOGUE_PREFIX):
+        map_name = spec.strip()[len(_CATALOGUE_PREFIX) :].strip()
+        spec, label = resolve_map_file(map_name), f"{_CATALOGUE_PREFIX}{map_name}"
+    else:
+        label = str(spec)
     if _is_file_spec(spec):
         path = Path(spec)
         if not path.is_file():
             raise FileNotFoundError(f"world file not found: {path}")
         if path.suffix.lower() in _ROS_SUFFIXES:
-            return load_ros_map_world(path, name=str(spec))
+            return load_ros_map_world(path, name=label)
         if path.suffix.lower() in _JSON_SUFFIXES:
-            return load_houseexpo_world(path, name=str(spec))
+            return load_houseexpo_world(path, name=label)
         raise ValueError(
             f"world file {path} has an unsupported extension; use .yaml/.yml (ROS map) or .json (HouseExpo)"
         )
@@ -138,7 +149,8 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
     if name not in _FAMILIES:
         raise ValueError(
             f"unknown world {name!r}; available worlds: {', '.join(list_world_names())} "
-            "(or a path to a .yaml ROS map or a .json HouseExpo plan)"
+            "(or a path to a .yaml ROS map or a .json HouseExpo plan, or map:NAME from "
+            "'semexplore maps list')"
         )
     params_cls, generate = _FAMILIES[name]
     fields = {f.name: f for f in dataclasses.fields(params_cls)}
