@@ -20,6 +20,7 @@ SUBCOMMANDS: dict[str, str] = {
     "benchmark": "benchmark",
     "train": "train",
     "compare-weights": "compare_weights",
+    "maps": "maps",
 }
 
 

@@ -1,0 +1,125 @@
+"""``semexplore maps``: the catalogue of public real-world maps, and fetching them.
+
+Example::
+
+    semexplore maps list
+    semexplore maps get tb3-world                       # into the cache, sha256-checked
+    semexplore maps get tb3-world --from ../shared/maps # offline: copy from a local directory
+    semexplore maps path tb3-world                      # where map:tb3-world is read from
+    semexplore explore --world map:tb3-world
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+MIRROR_ENV = "SEMEXPLORE_MAPS_MIRROR"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        "maps",
+        help="list, download and locate public real-world maps (world=map:NAME)",
+        description="The map catalogue: public ROS maps pinned to a commit, with licence and "
+        "sha256. Downloaded maps are used with --world map:NAME.",
+    )
+    actions = p.add_subparsers(dest="maps_action", metavar="ACTION")
+    actions.add_parser("list", help="one line per map: name, size, licence, source")
+    get = actions.add_parser(
+        "get", help="download maps into the cache (or --dir), verifying each file's sha256"
+    )
+    get.add_argument("names", nargs="+", metavar="NAME", help="catalogue map name(s)")
+    get.add_argument(
+        "--dir",
+        default=None,
+        help="maps directory to put NAME/ in (default: the cache; see 'semexplore maps path')",
+    )
+    get.add_argument(
+        "--from",
+        dest="from_dir",
+        default=None,
+        metavar="DIR",
+        help="copy from a local directory (e.g. ../shared/maps) instead of downloading",
+    )
+    get.add_argument(
+        "--mirror",
+        default=os.environ.get(MIRROR_ENV) or None,
+        metavar="URL",
+        help=f"download from URL/OWNER/REPO/COMMIT/PATH instead of raw.githubusercontent.com "
+        f"(default: ${MIRROR_ENV})",
+    )
+    get.add_argument(
+        "--timeout-s", type=float, default=30.0, help="network timeout (default: %(default)s)"
+    )
+    path = actions.add_parser(
+        "path", help="the file map:NAME loads, or without NAME the cache directory"
+    )
+    path.add_argument("name", nargs="?", default=None, metavar="NAME")
+    p.set_defaults(_maps_parser=p)
+    return p
+
+
+def _size(n_bytes: int) -> str:
+    return f"{n_bytes / 1024:.0f} KB" if n_bytes < 1024 * 1024 else f"{n_bytes / 2**20:.1f} MB"
+
+
+def _list() -> int:
+    from semexplore_gym.core.worlds.catalogue import CATALOGUE
+
+    rows = [(m.name, _size(m.size_bytes), m.licence, m.source) for m in CATALOGUE.values()]
+    widths = [max(len(r[i]) for r in rows) for i in range(3)]
+    for name, size, licence, source in rows:
+        print(f"{name:<{widths[0]}}  {size:>{widths[1]}}  {licence:<{widths[2]}}  {source}")
+    return 0
+
+
+def _get(args: argparse.Namespace) -> int:
+    from semexplore_gym.core.worlds.catalogue import (
+        RAW_GITHUB_BASE,
+        get_catalogue_map,
+        maps_cache_dir,
+    )
+    from semexplore_gym.maps import MapFetchError, copy_map, download_map
+
+    if not (args.timeout_s > 0):
+        raise ValueError(f"--timeout-s must be positive, got {args.timeout_s!r}")
+    for name in args.names:
+        get_catalogue_map(name)  # unknown names fail before anything is fetched
+    root = Path(args.dir).expanduser() if args.dir else maps_cache_dir()
+    for name in args.names:
+        try:
+            if args.from_dir:
+                world = copy_map(name, Path(args.from_dir).expanduser(), root / name)
+            else:
+                world = download_map(
+                    name,
+                    root / name,
+                    base_url=args.mirror or RAW_GITHUB_BASE,
+                    timeout_s=args.timeout_s,
+                )
+        except MapFetchError as e:
+            print(f"semexplore maps get: error: {e}", file=sys.stderr)
+            return 1
+        print(f"{name}: {world}")
+    return 0
+
+
+def _path(args: argparse.Namespace) -> int:
+    from semexplore_gym.core.worlds.catalogue import maps_cache_dir, resolve_map_file
+
+    print(resolve_map_file(args.name) if args.name else maps_cache_dir())
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.maps_action == "list":
+        return _list()
+    if args.maps_action == "get":
+        return _get(args)
+    if args.maps_action == "path":
+        return _path(args)
+    args._maps_parser.print_help()
+    return 2
