@@ -20,6 +20,7 @@ FORBIDDEN = {
         "semexplore_gym.rendering",
         "semexplore_gym.cli",
         "semexplore_gym.evaluation", "semexplore_gym.macro_envs",
+        "semexplore_gym.maps",
         "policies",
         "torch",
         "stable_baselines3",
@@ -35,6 +36,16 @@ FORBIDDEN = {
         "policies",
     ],
     "semexplore_gym/envs": [
+        "semexplore_gym.wrappers",
+        "semexplore_gym.cli",
+        "semexplore_gym.evaluation", "semexplore_gym.macro_envs",
+        "policies",
+    ],
+    # Map fetching (network I/O) sits beside envs: it uses the catalogue in core, nothing above.
+    "semexplore_gym/maps": [
+        "gymnasium",
+        "semexplore_gym.sim",
+        "semexplore_gym.envs",
         "semexplore_gym.wrappers",
         "semexplore_gym.cli",
         "semexplore_gym.evaluation", "semexplore_gym.macro_envs",
