@@ -32,7 +32,6 @@ import numpy as np
 from policies.base import Policy
 from policies.macro_driver import ExpertDriver
 from policies.semantic_expert import SemanticExpertParams
-from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
@@ -41,6 +40,7 @@ from semexplore_gym.core.features.macro import (
     observation_vector,
 )
 from semexplore_gym.core.params import build_params
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 #: Macro env ids and the kind of decision their agents make.
 MACRO_ENV_KINDS = {

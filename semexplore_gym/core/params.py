@@ -245,7 +245,7 @@ def _layer_data(layer: Any, presets: Mapping[str, Any] | None) -> Mapping[str, A
         if text.endswith((".yaml", ".yml")) or os.sep in text or Path(text).exists():
             return load_yaml(text)
         raise ConfigError(
-            f"unknown config {text!r}: not a preset ({', '.join(presets or ())}) nor a .yaml file"
+            f"unknown config {text!r}: not a preset ({', '.join(presets or ()) or 'none'}) nor a .yaml file"
         )
     if dataclasses.is_dataclass(layer) and not isinstance(layer, type):
         return to_dict(layer)
