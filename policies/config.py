@@ -1,4 +1,8 @@
-"""Policy configuration files: YAML -> frozen parameter dataclasses, plus ``key=value`` overrides.
+"""Policy configuration files: the sections of ``configs/expert/*.yaml``.
+
+A policy's parameters are built like every other parameter set, by
+:func:`semexplore_gym.core.params.build_params` (re-exported here): layers (a mapping with
+nested or dotted keys, a YAML file, a parameter object) then ``key=value`` overrides.
 
 An explore/benchmark config file (e.g. ``configs/expert/paper.yaml``) has up to three sections::
 
@@ -13,15 +17,13 @@ Unknown keys, in the file or in an override, raise :class:`ConfigError` naming t
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import Any
 
-from semexplore_gym.core.params import ConfigError, from_dict, load_yaml, merge_overrides
+from semexplore_gym.core.params import ConfigError, build_params, load_yaml
 
-T = TypeVar("T")
-
-__all__ = ["ConfigError", "PolicyRunConfig", "build_params", "load_policy_config", "nest_dotted"]
+__all__ = ["ConfigError", "PolicyRunConfig", "build_params", "load_policy_config"]
 
 
 @dataclass(frozen=True)
@@ -58,36 +60,3 @@ def load_policy_config(source: str | os.PathLike | Mapping[str, Any] | None) -> 
     if policy is not None and not isinstance(policy, str):
         raise ConfigError(f"policy{where}: expected a string, got {policy!r}")
     return PolicyRunConfig(env=data.get("env"), policy=policy, params=dict(params))
-
-
-def nest_dotted(values: Mapping[str, Any]) -> dict[str, Any]:
-    """``{"a.b": 1, "c": {...}}`` -> ``{"a": {"b": 1}, "c": {...}}`` (nested mappings merge)."""
-    out: dict[str, Any] = {}
-    for key, value in values.items():
-        parts = str(key).split(".")
-        node = out
-        for p in parts[:-1]:
-            nxt = node.get(p)
-            if not isinstance(nxt, dict):
-                nxt = {}
-                node[p] = nxt
-            node = nxt
-        leaf = parts[-1]
-        if isinstance(value, Mapping) and isinstance(node.get(leaf), dict):
-            node[leaf] = {**node[leaf], **nest_dotted(value)}
-        elif isinstance(value, Mapping):
-            node[leaf] = nest_dotted(value)
-        else:
-            node[leaf] = value
-    return out
-
-
-def build_params(
-    cls: type[T], data: Mapping[str, Any] | None = None, overrides: Iterable[str] = ()
-) -> T:
-    """Build parameter dataclass ``cls`` from a nested mapping plus ``"a.b=value"`` overrides.
-
-    Raises:
-        ConfigError: unknown key (named by its dotted path) or a value of the wrong type/range.
-    """
-    return from_dict(cls, merge_overrides(nest_dotted(data or {}), overrides))

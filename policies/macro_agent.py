@@ -30,10 +30,8 @@ from typing import Any
 import numpy as np
 
 from policies.base import Policy
-from policies.config import build_params, nest_dotted
 from policies.macro_driver import ExpertDriver
 from policies.semantic_expert import SemanticExpertParams
-from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
@@ -41,7 +39,8 @@ from semexplore_gym.core.features.macro import (
     observation_size,
     observation_vector,
 )
-from semexplore_gym.core.params import from_dict
+from semexplore_gym.core.params import build_params
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 #: Macro env ids and the kind of decision their agents make.
 MACRO_ENV_KINDS = {
@@ -146,7 +145,7 @@ class MacroAgentPolicy(Policy):
 
             algo_cls = PPO
         self.kind: str = run["kind"]
-        self.macro_params: MacroParams = from_dict(MacroParams, dict(run["macro"]))
+        self.macro_params: MacroParams = build_params(MacroParams, run["macro"])
         self.model = algo_cls.load(str(path), device="cpu")
         n_obs = observation_size(self.macro_params)
         if tuple(self.model.observation_space.shape or ()) != (n_obs,):
@@ -154,9 +153,7 @@ class MacroAgentPolicy(Policy):
                 f"{path}: the model observes {self.model.observation_space.shape} values but "
                 f"MacroParams(n_candidates={self.macro_params.n_candidates}) gives ({n_obs},)"
             )
-        self.driver = ExpertDriver(
-            build_params(SemanticExpertParams, nest_dotted(dict(run["expert"])))
-        )
+        self.driver = ExpertDriver(build_params(SemanticExpertParams, run["expert"]))
         self.deterministic = bool(deterministic)
         self.name = f"macro-{self.kind}:{path.name}"
         self._paper = FrontierCostWeights()

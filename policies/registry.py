@@ -7,7 +7,8 @@ agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
 :class:`~policies.base.Policy` subclass or factory, so ``semexplore benchmark`` can compare it
 with the built-in ones). A spec may carry an argument after a colon. Keyword overrides set
 fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted
-(``**{"cost.w_v": 2}``); ``params=`` gives a whole parameter object or mapping to start from.
+(``**{"cost.w_v": 2}``); ``params=`` gives the layer to start from (a parameter object, a
+mapping or a YAML file), all merged by :func:`semexplore_gym.core.params.build_params`.
 """
 
 from __future__ import annotations
@@ -16,26 +17,20 @@ from collections.abc import Callable
 from typing import Any
 
 from policies.base import Policy
-from policies.config import build_params, nest_dotted
+from semexplore_gym.core.params import build_params
 
 Factory = Callable[[str, dict[str, Any]], Policy]
 
 
 def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-    from semexplore_gym.core.params import to_dict
 
     segmenter = overrides.pop("segmenter", None)
     base = overrides.pop("params", None)
     if arg:
         raise ValueError(f"policy 'semantic' takes no argument, got 'semantic:{arg}'")
-    data = to_dict(base) if isinstance(base, SemanticExpertParams) else nest_dotted(base or {})
-    for key, value in nest_dotted(overrides).items():
-        if isinstance(value, dict) and isinstance(data.get(key), dict):
-            data[key] = {**data[key], **value}
-        else:
-            data[key] = value
-    return SemanticExpertPolicy(build_params(SemanticExpertParams, data), segmenter=segmenter)
+    params = build_params(SemanticExpertParams, base, overrides)
+    return SemanticExpertPolicy(params, segmenter=segmenter)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
@@ -45,7 +40,6 @@ def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy
         NearestFrontierParams,
         NearestFrontierPolicy,
     )
-    from semexplore_gym.core.params import to_dict
 
     cls, policy_cls = (
         (FrontierExplorationParams, FrontierExplorationPolicy)
@@ -54,14 +48,7 @@ def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy
     )
     if arg:
         raise ValueError(f"policy {kind!r} takes no argument, got '{kind}:{arg}'")
-    base = overrides.pop("params", None)
-    data = to_dict(base) if isinstance(base, cls) else nest_dotted(base or {})
-    for key, value in nest_dotted(overrides).items():
-        if isinstance(value, dict) and isinstance(data.get(key), dict):
-            data[key] = {**data[key], **value}
-        else:
-            data[key] = value
-    params: Any = build_params(cls, data)
+    params: Any = build_params(cls, overrides.pop("params", None), overrides)
     return policy_cls(params)
 
 

@@ -52,10 +52,10 @@ def main(argv: list[str] | None = None) -> int:
     from policies.config import load_policy_config
     from policies.registry import make_policy
     from policies.rollout import STAGES, run_mission
-    from semexplore_gym.core.params import parse_override
+    from semexplore_gym.core.params import merge_overrides
 
     cfg = load_policy_config(args.policy_config)
-    kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}
+    kwargs = merge_overrides(None, args.overrides)
     if cfg.params:
         kwargs["params"] = cfg.params
     env = gym.make(

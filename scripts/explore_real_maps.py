@@ -96,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
     from policies.config import load_policy_config
     from policies.registry import make_policy
     from policies.rollout import run_mission
-    from semexplore_gym.core.params import parse_override
+    from semexplore_gym.core.params import merge_overrides
 
     if not args.maps_dir.is_dir():
         print(f"maps directory not found: {args.maps_dir}", file=sys.stderr)
@@ -107,7 +107,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"unknown map {n!r}; known: {', '.join(sorted(names))}", file=sys.stderr)
             return 2
     cfg = load_policy_config(args.policy_config)
-    kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}
+    kwargs = merge_overrides(None, args.overrides)
     if cfg.params:
         kwargs["params"] = cfg.params
 

@@ -21,10 +21,9 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from policies.config import build_params, nest_dotted
 from policies.macro_driver import ExpertDriver
 from policies.semantic_expert import SemanticExpertParams
-from semexplore_gym.core.params import from_dict
+from semexplore_gym.core.params import build_params
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 from semexplore_gym.wrappers.frontier_choice import FrontierChoice, MacroParams, PlannerWeights
 
@@ -40,9 +39,8 @@ def _parts(
     env = SemanticExploreEnv(
         world=world, config=config, overrides=overrides, render_mode=render_mode
     )
-    params = macro if isinstance(macro, MacroParams) else from_dict(MacroParams, dict(macro or {}))
-    driver = ExpertDriver(build_params(SemanticExpertParams, nest_dotted(dict(expert or {}))))
-    return env, driver, params
+    driver = ExpertDriver(build_params(SemanticExpertParams, expert))
+    return env, driver, build_params(MacroParams, macro)
 
 
 def make_frontier_choice_env(

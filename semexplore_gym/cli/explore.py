@@ -111,17 +111,13 @@ def run(args: argparse.Namespace) -> int:
     from policies.config import load_policy_config
     from policies.registry import make_policy
     from policies.rollout import run_mission
-    from semexplore_gym.core.params import parse_override
+    from semexplore_gym.core.params import merge_overrides
 
     if not (args.max_time_s > 0):
         raise ValueError(f"--max-time-s must be positive, got {args.max_time_s!r}")
     cfg = load_policy_config(args.policy_config)
     spec = args.policy or cfg.policy or "semantic"
-    overrides: dict[str, Any] = {}
-    for text in args.overrides:
-        keys, value = parse_override(text)
-        overrides[".".join(keys)] = value
-    policy_kwargs: dict[str, Any] = dict(overrides)
+    policy_kwargs: dict[str, Any] = merge_overrides(None, args.overrides)  # nested by key path
     if cfg.params:
         policy_kwargs["params"] = cfg.params
     policy = make_policy(spec, **policy_kwargs)

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
-from semexplore_gym.core.params import ConfigError, from_dict, load_yaml, merge_overrides
+from semexplore_gym.core.params import build_params
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 
@@ -77,18 +77,22 @@ class EnvConfig:
     episode: EpisodeParams = field(default_factory=EpisodeParams)
 
 
-#: Named configurations; ``configs/<name>.yaml`` in the repository holds the same values.
-PRESETS: dict[str, dict[str, Any]] = {
-    "default": {},
+#: Named configurations, the layers ``config="<name>"`` stands for. ``configs/<name>.yaml`` in
+#: the repository holds the same values (tests/envs/test_env_config.py compares them).
+PRESETS: dict[str, EnvConfig] = {
+    "default": EnvConfig(),
     # The paper's TurtleBot3 limits (section IV): 0.15 m/s and 2 rad/s.
-    "paper": {"robot": {"max_linear_speed_mps": 0.15, "max_angular_speed_radps": 2.0}},
+    "paper": EnvConfig(robot=RobotParams(max_linear_speed_mps=0.15, max_angular_speed_radps=2.0)),
 }
 
 
 def load_env_config(
-    config: EnvConfig | str | os.PathLike | dict | None = None, overrides: list[str] | None = None
+    config: EnvConfig | str | os.PathLike | Mapping[str, Any] | None = None,
+    overrides: Iterable[str] | None = None,
 ) -> EnvConfig:
-    """Resolve ``config`` (None, a preset name, a YAML path, a dict or an EnvConfig) plus overrides.
+    """Resolve ``config`` (None, a preset name, a YAML path, a mapping or an EnvConfig) plus overrides.
+
+    :func:`~semexplore_gym.core.params.build_params` with the env's :data:`PRESETS`.
 
     Args:
         config: What to start from; a string that is not a preset name is read as a YAML file.
@@ -98,29 +102,4 @@ def load_env_config(
         ConfigError: unknown preset, unknown key (named with its dotted path) or a bad value.
         FileNotFoundError: a config path that does not exist.
     """
-    if isinstance(config, EnvConfig) and not overrides:
-        return config
-    if isinstance(config, EnvConfig):
-        from semexplore_gym.core.params import to_dict
-
-        data: dict[str, Any] = to_dict(config)
-    elif config is None:
-        data = {}
-    elif isinstance(config, dict):
-        data = config
-    elif isinstance(config, (str, os.PathLike)):
-        text = str(config)
-        if text in PRESETS:
-            data = PRESETS[text]
-        elif text.endswith((".yaml", ".yml")) or os.sep in text or Path(text).exists():
-            data = load_yaml(text)
-        else:
-            raise ConfigError(
-                f"unknown config {text!r}: not a preset ({', '.join(PRESETS)}) nor a .yaml file"
-            )
-    else:
-        raise ConfigError(
-            f"config must be None, a preset name, a YAML path, a dict or an EnvConfig; got {type(config).__name__}"
-        )
-    data = merge_overrides(data, overrides or [])
-    return from_dict(EnvConfig, data)
+    return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)

@@ -6,8 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from policies.config import ConfigError, build_params, load_policy_config, nest_dotted
+from policies.config import ConfigError, build_params, load_policy_config
+from policies.registry import make_policy
 from policies.semantic_expert import SemanticExpertParams
+from semexplore_gym.core.features.macro import WEIGHT_RANGES
+from semexplore_gym.core.planning.graph_search import FrontierCostWeights
+from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -34,11 +38,13 @@ def test_paper_config_holds_the_paper_values():
 
 def test_overrides_and_unknown_keys_name_the_dotted_path(tmp_path):
     p = build_params(
-        SemanticExpertParams, {"cost": {"w_v": 1.0}}, ["cost.w_p=0.5", "replan_period_s=4"]
+        SemanticExpertParams,
+        {"cost": {"w_v": 1.0}},
+        overrides=["cost.w_p=0.5", "replan_period_s=4"],
     )
     assert (p.cost.w_v, p.cost.w_p, p.replan_period_s) == (1.0, 0.5, 4.0)
     with pytest.raises(ConfigError, match="potential_field.f_q"):
-        build_params(SemanticExpertParams, {}, ["potential_field.f_q=1"])
+        build_params(SemanticExpertParams, {}, overrides=["potential_field.f_q=1"])
     with pytest.raises(ConfigError, match="cost.w_v"):
         build_params(SemanticExpertParams, {"cost": {"w_v": "fast"}})
     with pytest.raises(ConfigError, match="replan_period_s"):
@@ -51,5 +57,27 @@ def test_overrides_and_unknown_keys_name_the_dotted_path(tmp_path):
         load_policy_config(tmp_path / "missing.yaml")
 
 
-def test_nest_dotted_merges_levels():
-    assert nest_dotted({"a.b": 1, "a": {"c": 2}, "d": 3}) == {"a": {"b": 1, "c": 2}, "d": 3}
+def test_paper_yaml_is_the_paper_preset():
+    """configs/expert/paper.yaml restates the defaults, which are the paper's values."""
+    cfg = load_policy_config(REPO / "configs" / "expert" / "paper.yaml")
+    paper = SemanticExpertParams()
+    assert build_params(SemanticExpertParams, cfg.params) == paper
+    assert paper.cost == FrontierCostWeights() and paper.potential_field == PotentialFieldParams()
+    # Every value the file sets is the default's, so it cannot drift from the code silently.
+    for section, values in cfg.params.items():
+        for key, value in values.items():
+            assert getattr(getattr(paper, section), key) == value, f"{section}.{key}"
+    # The weights action's centre (action 0) is the paper's cost weights.
+    w = paper.cost
+    assert tuple(mid for _, mid, _ in WEIGHT_RANGES) == (w.w_v, w.w_p, w.w_i)
+
+
+def test_make_policy_layers_params_then_keyword_overrides():
+    base = SemanticExpertParams(cost=FrontierCostWeights(w_v=1.0), replan_period_s=3.0)
+    p = make_policy("semantic", params=base, **{"cost.w_p": 0.5}, cost={"w_i": 0.3}).params
+    assert (p.cost.w_v, p.cost.w_p, p.cost.w_i, p.replan_period_s) == (1.0, 0.5, 0.3, 3.0)
+    q = make_policy("semantic", params={"cost.w_v": 2.0}, cost=FrontierCostWeights(w_p=0.4))
+    assert q.params.cost == FrontierCostWeights(w_p=0.4)
+    assert make_policy("semantic", params=base).params == base
+    with pytest.raises(ConfigError, match="cost.w_q"):
+        make_policy("semantic", **{"cost.w_q": 1.0})
