@@ -52,6 +52,31 @@ Algorithm (a clearance-aware skeleton segmentation, in the spirit of GRID-FAST's
     overlaps most (one-to-one, by position in the world frame), so ids are stable while the map
     grows; zero-area frontier pathways are matched by frontier position.
 
+Where each stage lives
+----------------------
+``_stages._Segmenter.run`` calls one method per stage, in order. The numba kernels are in the
+package :mod:`.kernels`, one module per stage (paths relative to ``core/topometric/``):
+
+=============================  ===========================================  =========================
+Stage                          Module                                       ``_Segmenter`` method
+=============================  ===========================================  =========================
+1. Crop and clean              ``kernels/clean.py``                         ``_crop``, ``_clean``
+2. Configuration space         ``kernels/cspace.py``                        ``_configuration_space``
+3. Skeleton                    ``kernels/skeleton.py`` (thinning),          ``_skeleton``
+                               ``kernels/skeleton_graph.py`` (graph)
+4. Pruning                     ``kernels/prune.py``                         ``_prune``
+5. Intersections and openings  ``kernels/openings.py``                      ``_openings``
+6. Regions                     ``kernels/regions.py`` (the cut at the       ``_regions``
+                               openings runs in ``_openings``)
+7. Frontiers                   ``kernels/frontiers.py``                     ``_frontiers``
+8. Types                       ``kernels/graph.py`` (``area_types``)        ``_assemble``
+9. Paths and graph             ``kernels/paths.py``, ``kernels/graph.py``,  ``_paths``, ``_assemble``
+                               records: ``_records.py``
+10. Identity                   ``_identity.py``                             ``_identities``
+=============================  ===========================================  =========================
+
+This module holds the entry points and the input checks.
+
 Cost is linear in the number of cells (no pairwise loops over openings): numba kernels for the
 grid work, Python only to build the output records. See ``scripts/bench_segmentation.py`` for
 measured times. The kernels are compiled once per machine (numba cache); a new process loads

@@ -1,4 +1,4 @@
-"""Stage 1 of the segmentation, crop and clean: the bounding box of the free cells and the noise filter.
+"""Stage 1 of the segmentation, crop and clean: the free cells' bounding box, the noise filter.
 
 :func:`scan_grid` checks the encoding and finds the free cells' bounding box (the crop);
 :func:`filter_small_blobs` erases occupied specks in free space and closes small unknown holes,
