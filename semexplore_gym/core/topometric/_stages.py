@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -46,6 +46,9 @@ from semexplore_gym.core.topometric.kernels.skeleton import thin
 from semexplore_gym.core.topometric.kernels.skeleton_graph import skeleton_graph
 from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.topometric.types import AreaType, TopometricMap
+
+if TYPE_CHECKING:
+    from semexplore_gym.core.topometric.segmentation import _Scratch
 
 _MARGIN = 2
 _GRAPH_FIELDS = ("n", "rep", "r", "deg", "noff", "npx", "ne", "ea", "eb", "eoff", "epx", "alive")
@@ -91,7 +94,7 @@ class _Segmenter:
         params: SegmentationParams,
         previous: TopometricMap | None,
         t_start: float,
-        scratch: Any,
+        scratch: _Scratch,
     ) -> None:
         self.enc = enc
         self.scratch = scratch
