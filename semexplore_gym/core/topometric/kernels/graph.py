@@ -1,8 +1,10 @@
-"""Numba kernels that turn the segmentation's regions and openings into the topometric graph.
+"""Stages 8 and 9 of the segmentation: area types and the topometric graph.
 
-They run after the grid kernels of :mod:`._kernels` and work on small per-region and
-per-opening arrays: area types to openings, path requests, graph edges, the frontiers' nearest
-intersections and the lengths behind ``L_path``. Python then only builds the output records.
+These kernels run after the grid kernels and work on small per-region and per-opening arrays:
+area types from the opening counts (:func:`area_types`, stage 8), path requests
+(:func:`plan_paths`), graph edges, the frontiers' nearest intersections and the lengths behind
+``L_path`` (:func:`graph_summary`), and world coordinates (:func:`world_coordinates`). Python
+then only builds the output records.
 
 Indices are *provisional*: regions ``0..n_reg-1``, then one zero-area frontier pathway per
 frontier that lies on an intersection's wall (``n_reg..n_prov-1``). Openings are the chords
@@ -15,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from semexplore_gym.core.topometric._kernels import far_skeleton_pixels
+from semexplore_gym.core.topometric.kernels.paths import far_skeleton_pixels
 from semexplore_gym.core.topometric.types import AreaType
 
 # compile-time constants for the kernels
