@@ -203,9 +203,9 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
     pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)
     other = cand(-2.0, 0.8, 8)
     moved = cand(3.4, 1.1, 7)  # the same frontier pathway, its frontier receded
-    assert pol._commit([other, moved]) is moved
+    assert pol.choose_goal([other, moved]) is moved
     much_cheaper = cand(-2.0, 0.2, 8)
-    assert pol._commit([much_cheaper, moved]) is much_cheaper
+    assert pol.choose_goal([much_cheaper, moved]) is much_cheaper
 
 
 def test_reset_needs_the_env_facts_and_params_validate():
