@@ -33,7 +33,6 @@ from policies.base import Policy
 from policies.config import build_params, nest_dotted
 from policies.macro_driver import ExpertDriver
 from policies.semantic_expert import SemanticExpertParams
-from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
@@ -42,6 +41,7 @@ from semexplore_gym.core.features.macro import (
     observation_vector,
 )
 from semexplore_gym.core.params import from_dict
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 #: Macro env ids and the kind of decision their agents make.
 MACRO_ENV_KINDS = {

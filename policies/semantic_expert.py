@@ -14,61 +14,17 @@ Each replanning step (section II of Fredriksson et al.):
 The policy is honest: it reads only the observation (``map``, ``pose``, ``scan``) and the
 static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), never ground truth.
 
-What the paper leaves open, and how this policy handles it (parameters in
-:class:`SemanticExpertParams`, all times in simulated seconds):
+What the paper leaves open (replanning events, goal commitment, narrow frontiers, the
+grid-frontier fallback, stop confirmation, local minima, stuck recovery, blacklisting) and the
+parameters for it are described in :mod:`policies.semantic_expert_params`. Goals are
+blacklisted, progress is watched and stuck recoveries are driven by the navigation stack the
+frontier baselines share (:mod:`policies.navigation`).
 
-* **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
-  ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
-  segmentation and search run only every ``replan_period_s``, and at once when the goal is
-  reached, when it vanishes (no UNKNOWN cell is left within ``goal_check_radius_m`` of it: its
-  frontier has been mapped), when the path is used up, or when a recovery ends. A scheduled
-  replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
-  became known since the last one, e.g. while the robot crosses explored space.
-* **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
-  pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
-  old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
-  cheaper by more than ``switch_margin`` (cost units of ``C``). This stops the robot from
-  oscillating between near-equal frontiers.
-* **Narrow frontiers** (``min_frontier_width_m``, ``clearance_margin_m``): frontier openings
-  narrower than ``min_frontier_width_m`` are ignored; the segmentation's clearance
-  ``radius + clearance_margin_m`` already closes passages the robot cannot follow.
-* **Path entry check**: when the straight first leg from the robot to the map's path crosses
-  an occupied cell (the robot stands outside every area), a grid path with the robot's
-  clearance leads to the path instead.
-* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_m``,
-  ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
-  frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
-  space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
-  frontier a grid search with its clearance can reach
-  (:mod:`semexplore_gym.core.frontiers.reachable`), and keeps that goal while it lasts. Tiny
-  frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
-  inside of walls, pockets along them) are ignored.
-* **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
-  replans found no frontier from either source.
-* **Potential-field local minima** (in :class:`PotentialFieldParams`): the lookahead point
-  ``G`` needs a sight line with the robot's clearance (``lookahead_clearance_m``), so the field
-  does not pull the robot onto wall ends at corners and doorways; a collision guard
-  (``safety_margin_m``, ``contact_margin_m``, ``braking_time_s``, ``map_guard_radius_m``) caps
-  the speed before any obstacle; guard steering (``guard_steer_max_rad``) turns the robot
-  towards the nearest open heading when the guard blocks the field's direction.
-* **Local-minimum escape** (``local_min_timeout_s``, ``escape_duration_s``,
-  ``escape_repulsion_scale``): when the field has held the robot almost still (forward command
-  below 10 % of the maximum) for ``local_min_timeout_s`` (a dead end or doorway where repulsion
-  cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the collision
-  guard still keeps the robot off the walls.
-* **Stuck recovery** (``stuck_timeout_s``, ``stuck_radius_m``, ``progress_timeout_s``,
-  ``progress_min_new_cells``, ``backoff_duration_s``, ``backoff_speed_fraction``): the robot is
-  stuck when it stayed within ``stuck_radius_m`` for ``stuck_timeout_s`` while the map grew by
-  fewer than ``progress_min_new_cells`` known cells, or when for ``progress_timeout_s`` neither
-  the remaining path to its goal shrank (by 0.1 m) nor the map grew. It then backs off for
-  ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
-  space when the way back is blocked), blacklists the goal and replans.
-* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
-  blacklisted by a recovery, or reached ``max_goal_reaches`` times without their frontier
-  disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
-  the mission.
-
-``counters`` and ``events`` record how often each behaviour fired.
+Subclasses steer the expert through its public hooks: :meth:`SemanticExpertPolicy.choose_goal`
+(which scored frontier to pursue), :meth:`~SemanticExpertPolicy.on_replan_due` and
+:meth:`~SemanticExpertPolicy.on_replanned` (notifications around each replan), and
+:meth:`~SemanticExpertPolicy.request_replan`; :meth:`~SemanticExpertPolicy.frontier_candidates`
+scores the frontiers of any observation without changing the plan.
 """
 
 from __future__ import annotations
@@ -82,14 +38,14 @@ from typing import Any, Literal
 import numpy as np
 
 from policies.base import Policy, StepStats
-from policies.navigation import GoalBlacklist, ProgressWatch
+from policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
+from policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
 )
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
-from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
     FrontierCostWeights,
@@ -98,16 +54,20 @@ from semexplore_gym.core.planning.graph_search import (
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
-    PotentialFieldParams,
     RobotLimits,
     beam_angles_rad,
-    front_free_distance,
-    nearby_obstacle_points,
     potential_field_command,
     resample_polyline,
 )
-from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.topometric.types import TopometricMap
+
+__all__ = [
+    "REPLAN_REASONS",
+    "Segmenter",
+    "SemanticExpertParams",
+    "SemanticExpertPolicy",
+    "area_type_raster",
+]
 
 Segmenter = Callable[..., TopometricMap]
 
@@ -116,119 +76,6 @@ REPLAN_REASONS = ("no_plan", "period", "goal_reached", "path_done", "goal_vanish
 
 #: The rest of the path must shrink by more than this to count as progress.
 _PATH_PROGRESS_MARGIN_M = 0.1
-
-
-@dataclass(frozen=True)
-class SemanticExpertParams:
-    """All parameters of the semantic expert (defaults: the paper's weights, then ours).
-
-    Attributes:
-        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (paper: 4, 0.2, 0.1).
-        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (paper: 30, 0.065, 1.5) and
-            the command mapping.
-        segmentation: Parameters of ``segment_map`` (the robot clearance is not one of them).
-        prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
-        clearance_margin_m: Segmentation clearance is the robot radius plus this.
-        replan_period_s: Period of the scheduled replans (segmentation + Algorithm 1).
-        resegment_min_new_m2: A scheduled replan re-segments the map only if at least this much
-            area became known since the last segmentation; otherwise it reruns Algorithm 1 on
-            the previous topometric map from the new pose.
-        goal_reached_radius_m: The goal counts as reached within this distance.
-        goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
-            left within this distance of it.
-        commitment_radius_m: A frontier this close to the current goal is the same goal.
-        switch_margin: Another frontier replaces the current one only if cheaper by this much.
-        min_frontier_width_m: Narrower frontier openings are ignored.
-        grid_fallback: Use the grid BFS frontier while the topometric map offers none.
-        fallback_min_frontier_m: Smallest frontier group the fallback considers (its cell count
-            times the resolution, metres). Smaller groups are mostly leaks through gaps in
-            rasterised walls, which no robot can clear.
-        fallback_min_unknown_depth_m: The fallback ignores frontiers without unknown space at
-            least this far from every known cell next to them (the inside of thick walls seen
-            through gaps in their mapped faces, thin pockets along walls: no scan fills them).
-        fallback_reach_m: The fallback's goal lies within this distance of the frontier.
-        stop_confirmations: Consecutive replans without any frontier before stopping.
-        local_min_timeout_s: Time almost still (forward command < 10 % of max) before escaping.
-        escape_duration_s: Duration of a local-minimum escape.
-        escape_repulsion_scale: Factor on ``f_o`` during an escape.
-        stuck_timeout_s: Time within ``stuck_radius_m`` (and no map growth) that means stuck.
-        stuck_radius_m: See ``stuck_timeout_s``.
-        progress_timeout_s: Time without path progress nor map growth that means stuck.
-        progress_min_new_cells: Known cells the map must gain to count as growth.
-        backoff_duration_s: Length of the back-off manoeuvre of a stuck recovery.
-        backoff_speed_fraction: Back-off speed as a fraction of the top speed.
-        blacklist_radius_m: Frontiers this close to a blacklisted goal are ignored.
-        max_goal_reaches: A goal reached this many times without clearing is blacklisted.
-    """
-
-    cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
-    potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
-    segmentation: SegmentationParams = field(default_factory=SegmentationParams)
-    prune_by: Literal["opening", "area"] = "opening"
-    clearance_margin_m: float = 0.05
-    replan_period_s: float = 2.0
-    resegment_min_new_m2: float = 0.1
-    goal_reached_radius_m: float = 0.35
-    goal_check_radius_m: float = 0.5
-    commitment_radius_m: float = 1.0
-    switch_margin: float = 0.5
-    min_frontier_width_m: float = 0.25
-    grid_fallback: bool = True
-    fallback_min_frontier_m: float = 0.35
-    fallback_min_unknown_depth_m: float = 0.2
-    fallback_reach_m: float = 0.1
-    stop_confirmations: int = 2
-    local_min_timeout_s: float = 3.0
-    escape_duration_s: float = 4.0
-    escape_repulsion_scale: float = 0.3
-    stuck_timeout_s: float = 8.0
-    stuck_radius_m: float = 0.25
-    progress_timeout_s: float = 30.0
-    progress_min_new_cells: int = 20
-    backoff_duration_s: float = 1.5
-    backoff_speed_fraction: float = 0.5
-    blacklist_radius_m: float = 0.5
-    max_goal_reaches: int = 2
-
-    def __post_init__(self) -> None:
-        if self.prune_by not in ("opening", "area"):
-            raise ValueError(f"prune_by must be 'opening' or 'area', got {self.prune_by!r}")
-        positive = (
-            "replan_period_s",
-            "goal_reached_radius_m",
-            "goal_check_radius_m",
-            "stuck_timeout_s",
-            "stuck_radius_m",
-            "progress_timeout_s",
-            "local_min_timeout_s",
-        )
-        require_finite(self, positive, positive=True)
-        nonneg = (
-            "clearance_margin_m",
-            "commitment_radius_m",
-            "switch_margin",
-            "min_frontier_width_m",
-            "fallback_min_frontier_m",
-            "fallback_min_unknown_depth_m",
-            "resegment_min_new_m2",
-            "fallback_reach_m",
-            "escape_duration_s",
-            "escape_repulsion_scale",
-            "backoff_duration_s",
-            "blacklist_radius_m",
-        )
-        require_finite(self, nonneg, positive=False)
-        if not 0.0 <= self.backoff_speed_fraction <= 1.0:
-            raise ValueError(
-                f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
-            )
-        for name in (
-            "stop_confirmations",
-            "max_goal_reaches",
-            "progress_min_new_cells",
-        ):
-            if int(getattr(self, name)) < 1:
-                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
 
 
 @dataclass
@@ -327,10 +174,9 @@ class SemanticExpertPolicy(Policy):
         self._last_cmd: PotentialFieldCommand | None = None
         self._still_s = 0.0
         self._escape_until_s = -1.0
-        self._recovery_until_s = -1.0
-        self._recovery_turn = 0.0
         self._known_cells = int(np.count_nonzero(np.asarray(obs["map"]) != UNKNOWN))
         prm = self.params
+        self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
         # Stuck: the robot stayed near one point while the map hardly grew ...
         self._motion_watch = ProgressWatch(
             prm.stuck_timeout_s,
@@ -363,13 +209,12 @@ class SemanticExpertPolicy(Policy):
             self._angles = beam_angles_rad(len(scan))
         self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
 
-        if self._time_s < self._recovery_until_s:
+        if self._backoff.active(self._time_s):
             v, w = self._recovery_command(grid, pose, scan)
             self.mode = "recovery"
         else:
-            if self._recovery_until_s > 0.0:
+            if self._backoff.finish():
                 # Recovery just ended: give up the goal that got us stuck, replan at once.
-                self._recovery_until_s = -1.0
                 self._blacklist_goal()
             if self._needs_replan(grid, pose):
                 self._replan(grid, pose, stats)
@@ -381,7 +226,7 @@ class SemanticExpertPolicy(Policy):
             else:
                 v, w = self._follow(grid, pose, scan)
                 self._watch_progress(pose)
-                if self._time_s < self._recovery_until_s:
+                if self._backoff.active(self._time_s):
                     v, w = self._recovery_command(grid, pose, scan)
         self._time_s += self.dt_s
         action = np.array(
@@ -769,8 +614,7 @@ class SemanticExpertPolicy(Policy):
         self.counters["recoveries"] += 1
         goal = self._plan.goal_xy_m if self._plan is not None else None
         self._log("recovery", f"goal={goal}")
-        self._recovery_until_s = self._time_s + self.params.backoff_duration_s
-        self._recovery_turn = 1.0 if self.rng.random() < 0.5 else -1.0
+        self._backoff.start(self._time_s, self.rng)
         self.mode = "recovery"
         self._reset_watchdogs()
 
@@ -784,32 +628,8 @@ class SemanticExpertPolicy(Policy):
         self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
     ) -> tuple[float, float]:
         assert self._angles is not None
-        lim = self.limits
-        pf = self.params.potential_field
-        near = nearby_obstacle_points(grid, self.geometry, pose, pf.map_guard_radius_m)
-        back = front_free_distance(
-            scan,
-            self._angles,
-            lim.max_range_m,
-            lim.radius_m + pf.safety_margin_m,
-            backwards=True,
-            contact_half_width_m=lim.radius_m + pf.contact_margin_m,
-            extra_points_xy=near,
-        )
-        if back > 0.05:
-            v = -self.params.backoff_speed_fraction * lim.max_linear_speed_mps
-            v = max(v, -back / pf.braking_time_s)
-            return v, 0.0
-        # The way back is blocked too: turn towards the most open direction.
-        ok = (scan > 0) & np.isfinite(scan)
-        if not ok.any():
-            return 0.0, self._recovery_turn * 0.5 * lim.max_angular_speed_radps
-        k = int(np.argmax(np.where(ok, scan, -1.0)))
-        # In (-pi, pi]: the beam straight behind turns the robot left. wrap_angle_rad's
-        # [-pi, pi) would turn it right, and differs from this in the last bit elsewhere.
-        ang = math.atan2(math.sin(self._angles[k]), math.cos(self._angles[k]))
-        return 0.0, float(
-            np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps)
+        return self._backoff.command(
+            grid, self.geometry, pose, scan, self._angles, self.limits, self.params.potential_field
         )
 
     def _blacklist_goal(self) -> None:

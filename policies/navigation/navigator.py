@@ -31,6 +31,7 @@ import numpy as np
 
 from policies.base import StepStats
 from policies.navigation.bookkeeping import ProgressWatch
+from policies.navigation.recovery import RotateRecovery
 from semexplore_gym.core.frontiers.detection import detect_frontiers
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner
@@ -204,6 +205,9 @@ class Navigator:
             radius_m=params.oscillation_distance_m,
             radius_inclusive=True,
         )
+        self._rotation = RotateRecovery(
+            params.recovery_rotation_rad, params.recovery_angular_speed_radps
+        )
         self._reset_goal_state(0.0)
 
     def _reset_goal_state(self, now_s: float) -> None:
@@ -213,7 +217,7 @@ class Navigator:
         self._last_plan_s = -math.inf
         self._oscillation.reset(now_s)
         self._recoveries = 0
-        self._recovery_left_rad = 0.0
+        self._rotation.stop()
 
     def set_goal(self, goal_xy_m: tuple[float, float], now_s: float) -> None:
         """Start navigating to a new goal (move_base ``sendGoal``)."""
@@ -252,10 +256,8 @@ class Navigator:
         prm = self.params
         self.last_plan_failed = False
         if self.status == NavStatus.RECOVERING:
-            if self._recovery_left_rad > 0.0:
-                w = min(prm.recovery_angular_speed_radps, self.limits[1])
-                self._recovery_left_rad -= w * self.dt_s
-                return self._command(0.0, w)
+            if self._rotation.active:
+                return self._command(0.0, self._rotation.turn(self.limits[1], self.dt_s))
             # Recovery over: plan again (move_base goes back to PLANNING).
             self.status = NavStatus.ACTIVE
             self._need_plan = True
@@ -342,21 +344,16 @@ class Navigator:
 
     def _recover(self, now_s: float) -> tuple[float, float]:
         if self._recoveries >= self.params.max_recoveries:
-            self.status = NavStatus.ABORTED
-            self.counters["aborts"] += 1
-            self.path = None
-            self.dwa.clear()
+            self.abort()
             return self._command(0.0, 0.0)
         self._recoveries += 1
         self.counters["recoveries"] += 1
         self.status = NavStatus.RECOVERING
-        self._recovery_left_rad = self.params.recovery_rotation_rad
+        self._rotation.start()
         self._oscillation.reset(now_s)
-        if self._recovery_left_rad <= 0.0:
+        if not self._rotation.active:
             return self._command(0.0, 0.0)
-        w = min(self.params.recovery_angular_speed_radps, self.limits[1])
-        self._recovery_left_rad -= w * self.dt_s
-        return self._command(0.0, w)
+        return self._command(0.0, self._rotation.turn(self.limits[1], self.dt_s))
 
     def _command(self, v: float, w: float) -> tuple[float, float]:
         self.velocity = (float(v), float(w))
