@@ -46,6 +46,7 @@ costmap it runs on), ``global_planning_ms`` the goal selection and Navfn, and
 
 from __future__ import annotations
 
+import abc
 import dataclasses
 import math
 import time
@@ -87,15 +88,36 @@ __all__ = [
 
 
 class _FrontierBaseline(Policy):
-    """Shared plumbing: reading obs/info, the navigator, actions, stats and overlay."""
+    """Shared plumbing: reading obs/info, the navigator, the step, actions, stats and overlay.
 
-    def __init__(self, navigation: MoveBaseParams, blacklist: GoalBlacklist) -> None:
+    A step reads the observation, lets the subclass choose or keep the navigator's goal
+    (:meth:`_update_goal`), then drives (:meth:`_drive`, one navigator step by default).
+
+    Args:
+        params: The subclass's parameters (``None``: its ``params_type()`` defaults).
+        overrides: Keyword overrides applied on top.
+    """
+
+    params_type: type[Any]
+
+    def __init__(self, params: Any = None, **overrides: Any) -> None:
         super().__init__()
-        self._nav_params = navigation
+        p = params if params is not None else self.params_type()
+        if overrides:
+            p = dataclasses.replace(p, **overrides)
+        self.params = p
         self.nav: Navigator | None = None
         self.frontiers: list[GridFrontier] = []
-        self.blacklist = blacklist
+        self.blacklist = self._new_blacklist()
         self.counters: dict[str, int] = {}
+
+    @abc.abstractmethod
+    def _new_blacklist(self) -> GoalBlacklist:
+        """The (empty) blacklist of aborted goals, as the subclass's rule has it."""
+
+    @abc.abstractmethod
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        """Choose or keep the navigator's goal for this step; may end the mission (``_finish``)."""
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -119,7 +141,9 @@ class _FrontierBaseline(Policy):
             raise ValueError(
                 f"robot limits and dt_s must be positive, got {self.max_v}, {self.max_w}, {self.dt_s}"
             )
-        self.nav = Navigator(self._nav_params, self.radius_m, (self.max_v, self.max_w), self.dt_s)
+        self.nav = Navigator(
+            self.params.navigation, self.radius_m, (self.max_v, self.max_w), self.dt_s
+        )
         warm_up_navigation_kernels()
         self.now_s = 0.0
         self.frontiers = []
@@ -137,16 +161,44 @@ class _FrontierBaseline(Policy):
         scan = scan_points_m(pose, obs["scan"], self.max_range_m, self.min_range_m)
         return grid, pose, scan
 
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        if self.nav is None:
+            raise RuntimeError("call reset() before act()")
+        stats = StepStats()
+        self.last_stats = stats
+        if self.done:
+            return self._action(0.0, 0.0)
+        grid, pose, scan = self._read(obs)
+        self._update_goal(grid, pose, stats)
+        if self.done:
+            return self._action(0.0, 0.0)
+        v, w = self._drive(grid, pose, scan, stats)
+        stats.extra = {"nav_status": self.nav.status, "n_frontiers": len(self.frontiers)}
+        self.now_s += self.dt_s
+        return self._action(v, w)
+
+    def _drive(
+        self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats
+    ) -> tuple[float, float]:
+        assert self.nav is not None
+        return self.nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
+
+    def _blacklist_aborted_goal(self) -> None:
+        assert self.nav is not None
+        if self.nav.goal_xy_m is not None:
+            self.blacklist.add(self.nav.goal_xy_m)
+            self.counters["blacklisted"] += 1
+
     def _action(self, v: float, w: float) -> np.ndarray:
         a = np.array([v / self.max_v, w / self.max_w], dtype=np.float32)
         return np.clip(a, -1.0, 1.0)
 
-    def _finish(self, reason: str) -> np.ndarray:
+    def _finish(self, reason: str) -> None:
+        """End the mission: the robot stops, ``stop_reason`` says why."""
         self.done = True
         self.stop_reason = reason
         if self.nav is not None:
             self.nav.cancel()
-        return self._action(0.0, 0.0)
 
     def overlay(self) -> dict[str, Any]:
         if self.nav is None:
@@ -202,9 +254,7 @@ class FrontierExplorationParams:
     min_frontier_cells: int = 2
     search_on_costmap: bool = True
     explore_costmap: CostmapParams = field(
-        default_factory=lambda: CostmapParams(
-            inscribed_radius_m=0.105, inflation_radius_m=0.15, cost_scaling_factor=10.0
-        )
+        default_factory=lambda: CostmapParams(inflation_radius_m=0.15)
     )
     check_reachability: bool = False
     blacklist_box_m: float = 0.5
@@ -236,13 +286,14 @@ class FrontierExplorationPolicy(_FrontierBaseline):
     """
 
     name = "frontier"
+    params_type = FrontierExplorationParams
+    params: FrontierExplorationParams
 
     def __init__(self, params: FrontierExplorationParams | None = None, **overrides: Any) -> None:
-        p = params if params is not None else FrontierExplorationParams()
-        if overrides:
-            p = dataclasses.replace(p, **overrides)
-        self.params = p
-        super().__init__(p.navigation, GoalBlacklist(p.blacklist_box_m, shape="box"))
+        super().__init__(params, **overrides)
+
+    def _new_blacklist(self) -> GoalBlacklist:
+        return GoalBlacklist(self.params.blacklist_box_m, shape="box")
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -259,24 +310,15 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         assert self.nav is not None
         self.nav.check_blocked = self.params.check_reachability
 
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        if self.nav is None:
-            raise RuntimeError("call reset() before act()")
-        stats = StepStats()
-        self.last_stats = stats
-        if self.done:
-            return self._action(0.0, 0.0)
-        grid, pose, scan = self._read(obs)
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        assert self.nav is not None
         nav = self.nav
         prm = self.params
-
         if nav.status == NavStatus.SUCCEEDED:
             self.blacklist.clear()  # melodic FrontierPlugin clears the blacklist on success
             self._moving = False
         elif nav.status == NavStatus.ABORTED:
-            if nav.goal_xy_m is not None:
-                self.blacklist.add(nav.goal_xy_m)
-                self.counters["blacklisted"] += 1
+            self._blacklist_aborted_goal()
             nav.cancel()
             self._moving = False
 
@@ -290,7 +332,7 @@ class FrontierExplorationPolicy(_FrontierBaseline):
             if goal is None:
                 self._no_frontier_count += 1
                 if self._no_frontier_count > prm.no_frontier_retries:
-                    return self._finish(
+                    self._finish(
                         "no frontiers left"
                         if not self.frontiers
                         else "all frontiers blacklisted or unreachable"
@@ -306,21 +348,21 @@ class FrontierExplorationPolicy(_FrontierBaseline):
                     self._moving = True
                     self.counters["goals_sent"] += 1
 
-        if (
-            prm.check_reachability
-            and nav.goal_xy_m is not None
-            and self._goal_blocked(grid, nav.goal_xy_m)
-        ):
+    def _drive(
+        self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats
+    ) -> tuple[float, float]:
+        assert self.nav is not None
+        nav = self.nav
+        check = self.params.check_reachability
+        if check and nav.goal_xy_m is not None and self._goal_blocked(grid, nav.goal_xy_m):
             # The committed goal is now (next to) a wall: drop it before driving on.
             nav.abort()
-        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
-        if prm.check_reachability and nav.last_plan_failed:
+        v, w = super()._drive(grid, pose, scan, stats)
+        if check and nav.last_plan_failed:
             # The committed goal became unreachable on the updated map: drop it at once
             # instead of waiting out planner patience and recoveries.
             nav.abort()
-        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
-        self.now_s += self.dt_s
-        return self._action(v, w)
+        return v, w
 
     def _next_goal(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
@@ -431,13 +473,14 @@ class NearestFrontierPolicy(_FrontierBaseline):
     """
 
     name = "nearest"
+    params_type = NearestFrontierParams
+    params: NearestFrontierParams
 
     def __init__(self, params: NearestFrontierParams | None = None, **overrides: Any) -> None:
-        p = params if params is not None else NearestFrontierParams()
-        if overrides:
-            p = dataclasses.replace(p, **overrides)
-        self.params = p
-        super().__init__(p.navigation, GoalBlacklist(p.blacklist_radius_m))
+        super().__init__(params, **overrides)
+
+    def _new_blacklist(self) -> GoalBlacklist:
+        return GoalBlacklist(self.params.blacklist_radius_m)
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -448,20 +491,12 @@ class NearestFrontierPolicy(_FrontierBaseline):
         self._target_cell: tuple[int, int] | None = None
         self.path_length_m = math.inf
 
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        if self.nav is None:
-            raise RuntimeError("call reset() before act()")
-        stats = StepStats()
-        self.last_stats = stats
-        if self.done:
-            return self._action(0.0, 0.0)
-        grid, pose, scan = self._read(obs)
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        assert self.nav is not None
         nav = self.nav
         prm = self.params
-
-        if nav.status == NavStatus.ABORTED and nav.goal_xy_m is not None:
-            self.blacklist.add(nav.goal_xy_m)
-            self.counters["blacklisted"] += 1
+        if nav.status == NavStatus.ABORTED:
+            self._blacklist_aborted_goal()
         need_target = nav.status in (
             NavStatus.IDLE,
             NavStatus.SUCCEEDED,
@@ -481,7 +516,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
                         reason = "no reachable frontier left"
                     else:
                         reason = "no frontiers left"
-                    return self._finish(reason)
+                    self._finish(reason)
             else:
                 self._no_frontier_count = 0
                 nav.set_goal(goal, self.now_s)
@@ -493,11 +528,6 @@ class NearestFrontierPolicy(_FrontierBaseline):
             t0 = time.perf_counter()
             self.frontiers = self._detect(grid, pose)
             stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
-
-        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
-        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
-        self.now_s += self.dt_s
-        return self._action(v, w)
 
     def _detect(self, grid: np.ndarray, pose: np.ndarray) -> list[GridFrontier]:
         prm = self.params

@@ -21,21 +21,28 @@ from policies.config import build_params, nest_dotted
 Factory = Callable[[str, dict[str, Any]], Policy]
 
 
-def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+def _build_params(cls: type, overrides: dict[str, Any]) -> Any:
+    """``cls`` from ``overrides``: ``params=`` (an instance or mapping) as the base, the other
+    keys (nested or dotted) merged into it one level deep."""
     from semexplore_gym.core.params import to_dict
 
-    segmenter = overrides.pop("segmenter", None)
     base = overrides.pop("params", None)
-    if arg:
-        raise ValueError(f"policy 'semantic' takes no argument, got 'semantic:{arg}'")
-    data = to_dict(base) if isinstance(base, SemanticExpertParams) else nest_dotted(base or {})
+    data = to_dict(base) if isinstance(base, cls) else nest_dotted(base or {})
     for key, value in nest_dotted(overrides).items():
         if isinstance(value, dict) and isinstance(data.get(key), dict):
             data[key] = {**data[key], **value}
         else:
             data[key] = value
-    return SemanticExpertPolicy(build_params(SemanticExpertParams, data), segmenter=segmenter)
+    return build_params(cls, data)
+
+
+def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
+    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+
+    segmenter = overrides.pop("segmenter", None)
+    if arg:
+        raise ValueError(f"policy 'semantic' takes no argument, got 'semantic:{arg}'")
+    return SemanticExpertPolicy(_build_params(SemanticExpertParams, overrides), segmenter=segmenter)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
@@ -45,7 +52,6 @@ def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy
         NearestFrontierParams,
         NearestFrontierPolicy,
     )
-    from semexplore_gym.core.params import to_dict
 
     cls, policy_cls = (
         (FrontierExplorationParams, FrontierExplorationPolicy)
@@ -54,15 +60,7 @@ def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy
     )
     if arg:
         raise ValueError(f"policy {kind!r} takes no argument, got '{kind}:{arg}'")
-    base = overrides.pop("params", None)
-    data = to_dict(base) if isinstance(base, cls) else nest_dotted(base or {})
-    for key, value in nest_dotted(overrides).items():
-        if isinstance(value, dict) and isinstance(data.get(key), dict):
-            data[key] = {**data[key], **value}
-        else:
-            data[key] = value
-    params: Any = build_params(cls, data)
-    return policy_cls(params)
+    return policy_cls(_build_params(cls, overrides))
 
 
 def _frontier(arg: str, overrides: dict[str, Any]) -> Policy:

@@ -75,9 +75,10 @@ class SemanticExpertParams:
     """All parameters of the semantic expert (defaults: the paper's weights, then ours).
 
     Attributes:
-        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (paper: 4, 0.2, 0.1).
-        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (paper: 30, 0.065, 1.5) and
-            the command mapping.
+        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (defaults: the paper's, defined
+            once in :class:`FrontierCostWeights`).
+        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (defaults: the paper's, in
+            :class:`PotentialFieldParams`) and the command mapping.
         segmentation: Parameters of ``segment_map`` (the robot clearance is not one of them).
         prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
         clearance_margin_m: Segmentation clearance is the robot radius plus this.

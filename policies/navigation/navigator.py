@@ -104,11 +104,7 @@ class MoveBaseParams:
             oscillation timeout and a recovery).
     """
 
-    costmap: CostmapParams = field(
-        default_factory=lambda: CostmapParams(
-            inscribed_radius_m=0.105, inflation_radius_m=0.2, cost_scaling_factor=10.0
-        )
-    )
+    costmap: CostmapParams = field(default_factory=CostmapParams)
     navfn: NavfnParams = field(default_factory=lambda: NavfnParams(escape_radius_m=0.15))
     dwa: DWAParams = field(default_factory=DWAParams)
     planner_frequency_hz: float = 0.0
