@@ -55,7 +55,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from policies.base import Policy, StepStats
+from policies.base import Policy, StepStats, read_env_facts
 from policies.navigation import (
     GoalBlacklist,
     MoveBaseParams,
@@ -66,7 +66,7 @@ from policies.navigation import (
     warm_up_navigation_kernels,
 )
 from semexplore_gym.core.frontiers.detection import GridFrontier, detect_frontiers
-from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 from semexplore_gym.core.planning.dwa import scan_points_m
 from semexplore_gym.core.planning.grid_search import (
     INSCRIBED_COST,
@@ -123,20 +123,14 @@ class _FrontierBaseline(Policy):
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
     ) -> None:
         super().reset(obs, info, seed=seed)
-        try:
-            self.geometry = GridGeometry.from_dict(info["map_geometry"])
-            robot = info["robot"]
-            self.radius_m = float(robot["radius_m"])
-            self.max_v = float(robot["max_linear_speed_mps"])
-            self.max_w = float(robot["max_angular_speed_radps"])
-            lidar = info["lidar"]
-            self.max_range_m = float(lidar["max_range_m"])
-            self.min_range_m = float(lidar.get("min_range_m", 0.0))
-            self.dt_s = float(info["dt_s"])
-        except (KeyError, TypeError) as e:
-            raise ValueError(
-                f"{type(self).__name__}.reset needs info with map_geometry, robot, lidar and dt_s: {e!r}"
-            ) from None
+        facts = read_env_facts(info, type(self).__name__)
+        self.geometry = facts.geometry
+        self.radius_m = facts.radius_m
+        self.max_v = facts.max_linear_speed_mps
+        self.max_w = facts.max_angular_speed_radps
+        self.max_range_m = facts.max_range_m
+        self.min_range_m = facts.min_range_m
+        self.dt_s = facts.dt_s
         if not (self.max_v > 0 and self.max_w > 0 and self.dt_s > 0):
             raise ValueError(
                 f"robot limits and dt_s must be positive, got {self.max_v}, {self.max_w}, {self.dt_s}"

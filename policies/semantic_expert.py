@@ -37,7 +37,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from policies.base import Policy, StepStats
+from policies.base import Policy, StepStats, read_env_facts
 from policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
 from policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.core.frontiers.reachable import (
@@ -45,7 +45,7 @@ from semexplore_gym.core.frontiers.reachable import (
     grid_path_to,
     nearest_reachable_frontier,
 )
-from semexplore_gym.core.grid import UNKNOWN, GridGeometry
+from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
     FrontierCostWeights,
@@ -125,21 +125,15 @@ class SemanticExpertPolicy(Policy):
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
     ) -> None:
         super().reset(obs, info, seed=seed)
-        try:
-            self.geometry = GridGeometry.from_dict(info["map_geometry"])
-            robot = info["robot"]
-            lidar = info["lidar"]
-            self.dt_s = float(info["dt_s"])
-            self.limits = RobotLimits(
-                radius_m=float(robot["radius_m"]),
-                max_linear_speed_mps=float(robot["max_linear_speed_mps"]),
-                max_angular_speed_radps=float(robot["max_angular_speed_radps"]),
-                max_range_m=float(lidar["max_range_m"]),
-            )
-        except KeyError as e:
-            raise ValueError(
-                f"info lacks {e.args[0]!r}: reset needs the env's map_geometry, robot, lidar and dt_s"
-            ) from e
+        facts = read_env_facts(info, type(self).__name__)
+        self.geometry = facts.geometry
+        self.dt_s = facts.dt_s
+        self.limits = RobotLimits(
+            radius_m=facts.radius_m,
+            max_linear_speed_mps=facts.max_linear_speed_mps,
+            max_angular_speed_radps=facts.max_angular_speed_radps,
+            max_range_m=facts.max_range_m,
+        )
         if self._segmenter is None:
             # one segmenter per policy: it keeps its scratch memory between replans
             from semexplore_gym.core.topometric import TopometricSegmenter
