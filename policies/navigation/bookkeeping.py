@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from typing import Literal
+from typing import Literal, cast
 
 __all__ = ["GoalBlacklist", "ProgressWatch"]
 
@@ -60,7 +60,7 @@ class GoalBlacklist:
 
     def __contains__(self, xy_m: object) -> bool:
         """Whether ``xy_m`` lies within the disc or box of a blacklisted goal."""
-        x, y = xy_m  # type: ignore[misc]
+        x, y = cast("tuple[float, float]", xy_m)
         size = self.size_m
         if self.shape == "box":
             return any(abs(x - bx) <= size and abs(y - by) <= size for bx, by in self.points_m)
