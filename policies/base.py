@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from semexplore_gym.core.grid import GridGeometry
+
 
 @dataclass
 class StepStats:
@@ -24,6 +26,57 @@ class StepStats:
     local_planning_ms: float = 0.0
     replanned: bool = False
     extra: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class EnvFacts:
+    """The static facts of the env's ``info`` a policy may read (see :func:`read_env_facts`).
+
+    Attributes:
+        geometry: The map observation's frame (``info["map_geometry"]``).
+        radius_m: Robot radius.
+        max_linear_speed_mps: Top forward speed (action ``v = 1``).
+        max_angular_speed_radps: Top turn rate (action ``omega = 1``).
+        max_range_m: LiDAR maximum range.
+        min_range_m: LiDAR minimum range (0 when ``info`` does not say).
+        dt_s: Control period.
+    """
+
+    geometry: GridGeometry
+    radius_m: float
+    max_linear_speed_mps: float
+    max_angular_speed_radps: float
+    max_range_m: float
+    min_range_m: float
+    dt_s: float
+
+
+def read_env_facts(info: dict[str, Any], policy_name: str) -> EnvFacts:
+    """Read ``map_geometry``, ``robot``, ``lidar`` and ``dt_s`` from the env's ``info``.
+
+    Args:
+        info: The ``info`` dict of ``env.reset``.
+        policy_name: Who reads (for the error message).
+
+    Raises:
+        ValueError: an entry is missing or malformed.
+    """
+    try:
+        robot = info["robot"]
+        lidar = info["lidar"]
+        return EnvFacts(
+            geometry=GridGeometry.from_dict(info["map_geometry"]),
+            radius_m=float(robot["radius_m"]),
+            max_linear_speed_mps=float(robot["max_linear_speed_mps"]),
+            max_angular_speed_radps=float(robot["max_angular_speed_radps"]),
+            max_range_m=float(lidar["max_range_m"]),
+            min_range_m=float(lidar.get("min_range_m", 0.0)),
+            dt_s=float(info["dt_s"]),
+        )
+    except (KeyError, TypeError) as e:
+        raise ValueError(
+            f"{policy_name}.reset needs info with map_geometry, robot, lidar and dt_s: {e!r}"
+        ) from None
 
 
 class Policy(abc.ABC):

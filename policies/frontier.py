@@ -1,18 +1,8 @@
 """Frontier-exploration baselines: ROS ``frontier_exploration`` (FE) and Yamauchi's nearest frontier.
 
-Both drive with the same move_base-like navigator (:class:`MoveBaseParams`): a Navfn-like
-global planner on an inflated costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local
-planner (:mod:`semexplore_gym.core.planning.dwa`), with move_base's failure handling:
-
-* a new goal is planned once (``planner_frequency_hz = 0``, the TurtleBot3 setting); the path is
-  replanned when the local planner fails (no admissible trajectory, or it can only stand still);
-* while planning fails the robot stands still; after ``planner_patience_s`` (5 s), or when
-  the local planner has failed for ``controller_patience_s`` (15 s), or the robot has not
-  moved ``oscillation_distance_m`` (0.2 m) for ``oscillation_timeout_s`` (10 s), a recovery
-  runs: rotate in place once round (``recovery_rotation_rad`` at
-  ``recovery_angular_speed_radps``; move_base's ``rotate_recovery``), then plan again;
-* after ``max_recoveries`` (2, the two rotations of move_base's default recovery list) the
-  goal is **aborted**.
+Both drive with the same move_base-like :class:`~policies.navigation.Navigator` (Navfn global
+plan, DWA local control, planner and controller patience, rotate recoveries, abort), and skip
+goals near aborted ones with a :class:`~policies.navigation.GoalBlacklist`.
 
 :class:`FrontierExplorationPolicy` (``"frontier"``) follows ``frontier_exploration``
 (``explore_server`` + ``BoundedExploreLayer``, indigo; blacklist of the melodic plugin):
@@ -56,6 +46,7 @@ costmap it runs on), ``global_planning_ms`` the goal selection and Navfn, and
 
 from __future__ import annotations
 
+import abc
 import dataclasses
 import math
 import time
@@ -64,403 +55,93 @@ from typing import Any, Literal
 
 import numpy as np
 
-from policies.base import Policy, StepStats
-from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner, scan_points_m
+from policies.base import Policy, StepStats, read_env_facts
+from policies.navigation import (
+    GoalBlacklist,
+    MoveBaseParams,
+    Navigator,
+    NavStatus,
+    check_int_at_least,
+    check_positive,
+    warm_up_navigation_kernels,
+)
 from semexplore_gym.core.frontiers.detection import GridFrontier, detect_frontiers
-from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
+from semexplore_gym.core.planning.dwa import scan_points_m
 from semexplore_gym.core.planning.grid_search import (
     INSCRIBED_COST,
     NO_INFORMATION,
     CostmapParams,
-    GridPath,
-    NavfnParams,
     cells_near_occupied,
     distance_field,
     geodesic_distance_m,
     inflate_costmap,
     navfn_cell_costs,
-    plan_path,
 )
 
 __all__ = [
     "FrontierExplorationParams",
     "FrontierExplorationPolicy",
-    "MoveBaseParams",
-    "NavStatus",
-    "Navigator",
     "NearestFrontierParams",
     "NearestFrontierPolicy",
 ]
 
 
-def _check_positive(obj: Any, names: tuple[str, ...], allow_zero: bool = False) -> None:
-    for name in names:
-        v = getattr(obj, name)
-        ok = isinstance(v, (int, float)) and math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
-        if not ok:
-            bound = ">= 0" if allow_zero else "> 0"
-            raise ValueError(
-                f"{type(obj).__name__}.{name} must be a finite number {bound}, got {v!r}"
-            )
+class _FrontierBaseline(Policy):
+    """Shared plumbing: reading obs/info, the navigator, the step, actions, stats and overlay.
 
+    A step reads the observation, lets the subclass choose or keep the navigator's goal
+    (:meth:`_update_goal`), then drives (:meth:`_drive`, one navigator step by default).
 
-def _check_int_at_least(obj: Any, name: str, minimum: int) -> None:
-    v = getattr(obj, name)
-    if not (isinstance(v, int) and not isinstance(v, bool) and v >= minimum):
-        raise ValueError(f"{type(obj).__name__}.{name} must be an integer >= {minimum}, got {v!r}")
-
-
-@dataclass(frozen=True)
-class MoveBaseParams:
-    """The move_base-like navigator shared by both baselines.
-
-    Attributes:
-        costmap: Global costmap (TurtleBot3 burger: inflation 0.2 m; ``track_unknown_space``).
-            Its ``inscribed_radius_m`` is replaced by the robot radius from ``info``.
-        navfn: Global planner cost model. ``escape_radius_m`` lets a robot that touched the
-            inscribed band plan out of it (ROS relies on recoveries for that).
-        dwa: Local planner (TurtleBot3 DWA settings). Speed limits are capped by the env's,
-            ``control_period_s`` and ``robot_radius_m`` are taken from ``info``.
-        planner_frequency_hz: Periodic global replanning; 0 = only for a new goal or after a
-            local-planner failure (TurtleBot3 ``planner_frequency: 0.0``).
-        planner_patience_s: How long planning may fail before a recovery.
-        controller_patience_s: How long the local planner may fail before a recovery.
-        oscillation_timeout_s: Time without moving ``oscillation_distance_m`` before a recovery.
-        oscillation_distance_m: See ``oscillation_timeout_s``.
-        recovery_rotation_rad: Angle of one in-place rotation recovery.
-        recovery_angular_speed_radps: Its angular speed (``rotate_recovery`` default 1.0).
-        max_recoveries: Recoveries per goal before the goal is aborted.
-        stand_still_speed_mps: A local-planner command slower than this in both v and
-            ``stand_still_speed_mps / radius`` in omega counts as a failure (ROS DWA never
-            samples such commands: TurtleBot3 ``min_trans_vel`` 0.11, ``min_rot_vel`` 1.37).
-        replan_on_blocked_path: Replan as soon as the rest of the path passes within the robot
-            radius of a newly mapped obstacle (move_base only replans when the local planner
-            fails, with ``planner_frequency`` 0, so a stale path through a wall first costs an
-            oscillation timeout and a recovery).
+    Args:
+        params: The subclass's parameters (``None``: its ``params_type()`` defaults).
+        overrides: Keyword overrides applied on top.
     """
 
-    costmap: CostmapParams = field(
-        default_factory=lambda: CostmapParams(
-            inscribed_radius_m=0.105, inflation_radius_m=0.2, cost_scaling_factor=10.0
-        )
-    )
-    navfn: NavfnParams = field(default_factory=lambda: NavfnParams(escape_radius_m=0.15))
-    dwa: DWAParams = field(default_factory=DWAParams)
-    planner_frequency_hz: float = 0.0
-    planner_patience_s: float = 5.0
-    controller_patience_s: float = 15.0
-    oscillation_timeout_s: float = 10.0
-    oscillation_distance_m: float = 0.2
-    recovery_rotation_rad: float = 2.0 * math.pi
-    recovery_angular_speed_radps: float = 1.0
-    max_recoveries: int = 2
-    stand_still_speed_mps: float = 0.005
-    replan_on_blocked_path: bool = False
+    params_type: type[Any]
 
-    def __post_init__(self) -> None:
-        _check_positive(
-            self,
-            (
-                "planner_patience_s",
-                "controller_patience_s",
-                "oscillation_timeout_s",
-                "recovery_angular_speed_radps",
-            ),
-        )
-        _check_positive(
-            self,
-            (
-                "planner_frequency_hz",
-                "oscillation_distance_m",
-                "recovery_rotation_rad",
-                "stand_still_speed_mps",
-            ),
-            allow_zero=True,
-        )
-        if not (isinstance(self.max_recoveries, int) and self.max_recoveries >= 0):
-            raise ValueError(
-                f"MoveBaseParams.max_recoveries must be an integer >= 0, got {self.max_recoveries!r}"
-            )
-
-
-class NavStatus:
-    """Navigator states (strings, so they show up readably in stats)."""
-
-    IDLE = "idle"
-    ACTIVE = "active"
-    RECOVERING = "recovering"
-    SUCCEEDED = "succeeded"
-    ABORTED = "aborted"
-
-
-class Navigator:
-    """move_base emulation: Navfn global plan, DWA local control, patience and recoveries."""
-
-    def __init__(
-        self,
-        params: MoveBaseParams,
-        robot_radius_m: float,
-        limits: tuple[float, float],
-        dt_s: float,
-    ) -> None:
-        radius = float(robot_radius_m)
-        cm = params.costmap
-        self.costmap_params = dataclasses.replace(
-            cm, inscribed_radius_m=radius, inflation_radius_m=max(cm.inflation_radius_m, radius)
-        )
-        dwa = dataclasses.replace(
-            params.dwa,
-            robot_radius_m=radius,
-            control_period_s=dt_s,
-            inflation_radius_m=max(params.dwa.inflation_radius_m, radius),
-        )
-        self.params = params
-        self.dwa = DWAPlanner(dwa)
-        self.limits = (float(limits[0]), float(limits[1]))
-        self.dt_s = float(dt_s)
-        self.radius_m = radius
-        self.status = NavStatus.IDLE
-        self.goal_xy_m: tuple[float, float] | None = None
-        self.path: GridPath | None = None
-        self.velocity = (0.0, 0.0)
-        self.trajectory_m = np.zeros((0, 2))
-        self.counters = {
-            "plans": 0,
-            "plan_failures": 0,
-            "recoveries": 0,
-            "aborts": 0,
-            "successes": 0,
-        }
-        self.last_plan_failed = False
-        # Set by a policy to force replan_on_blocked_path (FE's check_reachability).
-        self.check_blocked = False
-        self._reset_goal_state(0.0)
-
-    def _reset_goal_state(self, now_s: float) -> None:
-        self._need_plan = True
-        self._plan_fail_since: float | None = None
-        self._ctrl_fail_since: float | None = None
-        self._last_plan_s = -math.inf
-        self._osc_anchor: tuple[float, float] | None = None
-        self._osc_since = now_s
-        self._recoveries = 0
-        self._recovery_left_rad = 0.0
-
-    def set_goal(self, goal_xy_m: tuple[float, float], now_s: float) -> None:
-        """Start navigating to a new goal (move_base ``sendGoal``)."""
-        self.goal_xy_m = (float(goal_xy_m[0]), float(goal_xy_m[1]))
-        self.status = NavStatus.ACTIVE
-        self.path = None
-        self.dwa.clear()
-        self._reset_goal_state(now_s)
-
-    def abort(self) -> None:
-        """Give up the current goal now (status ABORTED), without patience or recoveries."""
-        if self.goal_xy_m is not None:
-            self.status = NavStatus.ABORTED
-            self.counters["aborts"] += 1
-            self.path = None
-            self.dwa.clear()
-
-    def cancel(self) -> None:
-        self.goal_xy_m = None
-        self.path = None
-        self.dwa.clear()
-        self.status = NavStatus.IDLE
-
-    def step(
-        self,
-        now_s: float,
-        pose: np.ndarray,
-        grid: np.ndarray,
-        geometry: GridGeometry,
-        scan_pts: np.ndarray | None,
-        stats: StepStats,
-    ) -> tuple[float, float]:
-        """One control period; returns ``(v_mps, omega_radps)`` and updates ``status``."""
-        if self.status not in (NavStatus.ACTIVE, NavStatus.RECOVERING) or self.goal_xy_m is None:
-            return self._command(0.0, 0.0)
-        prm = self.params
-        self.last_plan_failed = False
-        if self.status == NavStatus.RECOVERING:
-            if self._recovery_left_rad > 0.0:
-                w = min(prm.recovery_angular_speed_radps, self.limits[1])
-                self._recovery_left_rad -= w * self.dt_s
-                return self._command(0.0, w)
-            # Recovery over: plan again (move_base goes back to PLANNING).
-            self.status = NavStatus.ACTIVE
-            self._need_plan = True
-            self._plan_fail_since = None
-            self._ctrl_fail_since = None
-            self._osc_anchor = None
-            self._osc_since = now_s
-
-        if (
-            prm.planner_frequency_hz > 0
-            and now_s - self._last_plan_s >= 1.0 / prm.planner_frequency_hz
-        ):
-            self._need_plan = True
-        blocked = (prm.replan_on_blocked_path or self.check_blocked) and self._path_blocked(
-            pose, grid, geometry
-        )
-        if self._need_plan or blocked:
-            t0 = time.perf_counter()
-            path = self._plan(pose, grid, geometry)
-            stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
-            stats.replanned = True
-            self._last_plan_s = now_s
-            self.counters["plans"] += 1
-            if path is None:
-                self.last_plan_failed = True
-                self.counters["plan_failures"] += 1
-                self._need_plan = True
-                if self._plan_fail_since is None:
-                    self._plan_fail_since = now_s
-                if now_s - self._plan_fail_since >= prm.planner_patience_s:
-                    return self._recover(now_s)
-                return self._command(0.0, 0.0)
-            self.path = path
-            self.dwa.set_path(path.points_m)
-            self._need_plan = False
-            self._plan_fail_since = None
-
-        if self._oscillating(now_s, pose):
-            return self._recover(now_s)
-
-        t0 = time.perf_counter()
-        cmd = self.dwa.compute(
-            pose, self.velocity, grid, geometry, obstacle_points_m=scan_pts, limits=self.limits
-        )
-        stats.local_planning_ms += (time.perf_counter() - t0) * 1e3
-        self.trajectory_m = cmd.trajectory_m
-        if cmd.goal_reached:
-            self.status = NavStatus.SUCCEEDED
-            self.counters["successes"] += 1
-            return self._command(0.0, 0.0)
-        still = (
-            abs(cmd.v_mps) < prm.stand_still_speed_mps
-            and abs(cmd.omega_radps) * self.radius_m < prm.stand_still_speed_mps
-        )
-        if not cmd.valid or still:
-            # Local planner failure: replan next step; recover after controller patience.
-            if self._ctrl_fail_since is None:
-                self._ctrl_fail_since = now_s
-            self._need_plan = True
-            if now_s - self._ctrl_fail_since >= prm.controller_patience_s:
-                return self._recover(now_s)
-            return self._command(0.0, 0.0)
-        self._ctrl_fail_since = None
-        return self._command(cmd.v_mps, cmd.omega_radps)
-
-    def _path_blocked(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> bool:
-        if self.path is None:
-            return False
-        rest = self.path.cells[self.dwa.progress_index + 1 :]
-        if len(rest) == 0:
-            return False
-        # Cells round the robot may be in the inscribed band on purpose (the planner's escape
-        # radius); only the path ahead of them counts.
-        x, y = geometry.grid_to_world(rest[:, 0], rest[:, 1])
-        skip = max(self.params.navfn.escape_radius_m, self.radius_m)
-        ahead = rest[np.hypot(x - pose[0], y - pose[1]) > skip]
-        if len(ahead) == 0:
-            return False
-        return bool(cells_near_occupied(grid, ahead, self.radius_m, geometry.resolution_m).any())
-
-    def _plan(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> GridPath | None:
-        costmap = inflate_costmap(grid, geometry.resolution_m, self.costmap_params)
-        assert self.goal_xy_m is not None
-        return plan_path(costmap, geometry, pose[:2], self.goal_xy_m, self.params.navfn)
-
-    def _oscillating(self, now_s: float, pose: np.ndarray) -> bool:
-        p = (float(pose[0]), float(pose[1]))
-        if (
-            self._osc_anchor is None
-            or math.dist(p, self._osc_anchor) >= self.params.oscillation_distance_m
-        ):
-            self._osc_anchor = p
-            self._osc_since = now_s
-            return False
-        return now_s - self._osc_since >= self.params.oscillation_timeout_s
-
-    def _recover(self, now_s: float) -> tuple[float, float]:
-        if self._recoveries >= self.params.max_recoveries:
-            self.status = NavStatus.ABORTED
-            self.counters["aborts"] += 1
-            self.path = None
-            self.dwa.clear()
-            return self._command(0.0, 0.0)
-        self._recoveries += 1
-        self.counters["recoveries"] += 1
-        self.status = NavStatus.RECOVERING
-        self._recovery_left_rad = self.params.recovery_rotation_rad
-        self._osc_anchor = None
-        self._osc_since = now_s
-        if self._recovery_left_rad <= 0.0:
-            return self._command(0.0, 0.0)
-        w = min(self.params.recovery_angular_speed_radps, self.limits[1])
-        self._recovery_left_rad -= w * self.dt_s
-        return self._command(0.0, w)
-
-    def _command(self, v: float, w: float) -> tuple[float, float]:
-        self.velocity = (float(v), float(w))
-        return self.velocity
-
-
-def _warm_up_kernels() -> None:
-    """Run every numba kernel once on a tiny map, so that loading or compiling them lands in
-    ``reset`` and not in the timing statistics of the first steps."""
-    grid = np.full((12, 12), FREE, dtype=np.uint8)
-    grid[:, 8:] = UNKNOWN
-    grid[0, :8] = OCCUPIED
-    geo = GridGeometry(0.05, 0.0, 0.0, 12, 12)
-    detect_frontiers(grid, geo, (0.1, 0.2))
-    costmap = inflate_costmap(grid, 0.05, CostmapParams())
-    plan_path(costmap, geo, (0.1, 0.3), (0.35, 0.35))
-    geodesic_distance_m(grid == FREE, geo, (0.1, 0.3))
-    dwa = DWAPlanner(DWAParams())
-    dwa.set_path(np.array([[0.1, 0.3], [0.35, 0.35]]))
-    dwa.compute((0.1, 0.3, 0.0), (0.0, 0.0), grid, geo, obstacle_points_m=np.array([[0.3, 0.5]]))
-
-
-class _FrontierBaseline(Policy):
-    """Shared plumbing: reading obs/info, the navigator, actions, stats and overlay."""
-
-    def __init__(self, navigation: MoveBaseParams) -> None:
+    def __init__(self, params: Any = None, **overrides: Any) -> None:
         super().__init__()
-        self._nav_params = navigation
+        p = params if params is not None else self.params_type()
+        if overrides:
+            p = dataclasses.replace(p, **overrides)
+        self.params = p
         self.nav: Navigator | None = None
         self.frontiers: list[GridFrontier] = []
-        self.blacklist: list[tuple[float, float]] = []
+        self.blacklist = self._new_blacklist()
         self.counters: dict[str, int] = {}
+
+    @abc.abstractmethod
+    def _new_blacklist(self) -> GoalBlacklist:
+        """The (empty) blacklist of aborted goals, as the subclass's rule has it."""
+
+    @abc.abstractmethod
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        """Choose or keep the navigator's goal for this step; may end the mission (``_finish``)."""
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
     ) -> None:
         super().reset(obs, info, seed=seed)
-        try:
-            self.geometry = GridGeometry.from_dict(info["map_geometry"])
-            robot = info["robot"]
-            self.radius_m = float(robot["radius_m"])
-            self.max_v = float(robot["max_linear_speed_mps"])
-            self.max_w = float(robot["max_angular_speed_radps"])
-            lidar = info["lidar"]
-            self.max_range_m = float(lidar["max_range_m"])
-            self.min_range_m = float(lidar.get("min_range_m", 0.0))
-            self.dt_s = float(info["dt_s"])
-        except (KeyError, TypeError) as e:
-            raise ValueError(
-                f"{type(self).__name__}.reset needs info with map_geometry, robot, lidar and dt_s: {e!r}"
-            ) from None
+        facts = read_env_facts(info, type(self).__name__)
+        self.geometry = facts.geometry
+        self.radius_m = facts.radius_m
+        self.max_v = facts.max_linear_speed_mps
+        self.max_w = facts.max_angular_speed_radps
+        self.max_range_m = facts.max_range_m
+        self.min_range_m = facts.min_range_m
+        self.dt_s = facts.dt_s
         if not (self.max_v > 0 and self.max_w > 0 and self.dt_s > 0):
             raise ValueError(
                 f"robot limits and dt_s must be positive, got {self.max_v}, {self.max_w}, {self.dt_s}"
             )
-        self.nav = Navigator(self._nav_params, self.radius_m, (self.max_v, self.max_w), self.dt_s)
-        _warm_up_kernels()
+        self.nav = Navigator(
+            self.params.navigation, self.radius_m, (self.max_v, self.max_w), self.dt_s
+        )
+        warm_up_navigation_kernels()
         self.now_s = 0.0
         self.frontiers = []
-        self.blacklist = []
+        self.blacklist.clear()
         self.counters = {"selections": 0, "goals_sent": 0, "blacklisted": 0}
         self._no_frontier_count = 0
 
@@ -474,22 +155,44 @@ class _FrontierBaseline(Policy):
         scan = scan_points_m(pose, obs["scan"], self.max_range_m, self.min_range_m)
         return grid, pose, scan
 
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        if self.nav is None:
+            raise RuntimeError("call reset() before act()")
+        stats = StepStats()
+        self.last_stats = stats
+        if self.done:
+            return self._action(0.0, 0.0)
+        grid, pose, scan = self._read(obs)
+        self._update_goal(grid, pose, stats)
+        if self.done:
+            return self._action(0.0, 0.0)
+        v, w = self._drive(grid, pose, scan, stats)
+        stats.extra = {"nav_status": self.nav.status, "n_frontiers": len(self.frontiers)}
+        self.now_s += self.dt_s
+        return self._action(v, w)
+
+    def _drive(
+        self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats
+    ) -> tuple[float, float]:
+        assert self.nav is not None
+        return self.nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
+
+    def _blacklist_aborted_goal(self) -> None:
+        assert self.nav is not None
+        if self.nav.goal_xy_m is not None:
+            self.blacklist.add(self.nav.goal_xy_m)
+            self.counters["blacklisted"] += 1
+
     def _action(self, v: float, w: float) -> np.ndarray:
         a = np.array([v / self.max_v, w / self.max_w], dtype=np.float32)
         return np.clip(a, -1.0, 1.0)
 
-    def _blacklisted(self, xy: tuple[float, float], half_box_m: float) -> bool:
-        return any(
-            abs(xy[0] - bx) <= half_box_m and abs(xy[1] - by) <= half_box_m
-            for bx, by in self.blacklist
-        )
-
-    def _finish(self, reason: str) -> np.ndarray:
+    def _finish(self, reason: str) -> None:
+        """End the mission: the robot stops, ``stop_reason`` says why."""
         self.done = True
         self.stop_reason = reason
         if self.nav is not None:
             self.nav.cancel()
-        return self._action(0.0, 0.0)
 
     def overlay(self) -> dict[str, Any]:
         if self.nav is None:
@@ -545,9 +248,7 @@ class FrontierExplorationParams:
     min_frontier_cells: int = 2
     search_on_costmap: bool = True
     explore_costmap: CostmapParams = field(
-        default_factory=lambda: CostmapParams(
-            inscribed_radius_m=0.105, inflation_radius_m=0.15, cost_scaling_factor=10.0
-        )
+        default_factory=lambda: CostmapParams(inflation_radius_m=0.15)
     )
     check_reachability: bool = False
     blacklist_box_m: float = 0.5
@@ -555,7 +256,7 @@ class FrontierExplorationParams:
     navigation: MoveBaseParams = field(default_factory=MoveBaseParams)
 
     def __post_init__(self) -> None:
-        _check_positive(
+        check_positive(
             self, ("frequency_hz", "goal_aliasing_m", "blacklist_box_m"), allow_zero=True
         )
         if self.travel_point not in ("closest", "middle", "centroid"):
@@ -566,8 +267,8 @@ class FrontierExplorationParams:
             raise ValueError(
                 f"selection must be 'euclidean' or 'bfs_order', got {self.selection!r}"
             )
-        _check_int_at_least(self, "min_frontier_cells", 1)
-        _check_int_at_least(self, "no_frontier_retries", 0)
+        check_int_at_least(self, "min_frontier_cells", 1)
+        check_int_at_least(self, "no_frontier_retries", 0)
 
 
 class FrontierExplorationPolicy(_FrontierBaseline):
@@ -579,13 +280,14 @@ class FrontierExplorationPolicy(_FrontierBaseline):
     """
 
     name = "frontier"
+    params_type = FrontierExplorationParams
+    params: FrontierExplorationParams
 
     def __init__(self, params: FrontierExplorationParams | None = None, **overrides: Any) -> None:
-        p = params if params is not None else FrontierExplorationParams()
-        if overrides:
-            p = dataclasses.replace(p, **overrides)
-        self.params = p
-        super().__init__(p.navigation)
+        super().__init__(params, **overrides)
+
+    def _new_blacklist(self) -> GoalBlacklist:
+        return GoalBlacklist(self.params.blacklist_box_m, shape="box")
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -602,24 +304,15 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         assert self.nav is not None
         self.nav.check_blocked = self.params.check_reachability
 
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        if self.nav is None:
-            raise RuntimeError("call reset() before act()")
-        stats = StepStats()
-        self.last_stats = stats
-        if self.done:
-            return self._action(0.0, 0.0)
-        grid, pose, scan = self._read(obs)
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        assert self.nav is not None
         nav = self.nav
         prm = self.params
-
         if nav.status == NavStatus.SUCCEEDED:
             self.blacklist.clear()  # melodic FrontierPlugin clears the blacklist on success
             self._moving = False
         elif nav.status == NavStatus.ABORTED:
-            if nav.goal_xy_m is not None:
-                self.blacklist.append(nav.goal_xy_m)
-                self.counters["blacklisted"] += 1
+            self._blacklist_aborted_goal()
             nav.cancel()
             self._moving = False
 
@@ -633,7 +326,7 @@ class FrontierExplorationPolicy(_FrontierBaseline):
             if goal is None:
                 self._no_frontier_count += 1
                 if self._no_frontier_count > prm.no_frontier_retries:
-                    return self._finish(
+                    self._finish(
                         "no frontiers left"
                         if not self.frontiers
                         else "all frontiers blacklisted or unreachable"
@@ -649,21 +342,21 @@ class FrontierExplorationPolicy(_FrontierBaseline):
                     self._moving = True
                     self.counters["goals_sent"] += 1
 
-        if (
-            prm.check_reachability
-            and nav.goal_xy_m is not None
-            and self._goal_blocked(grid, nav.goal_xy_m)
-        ):
+    def _drive(
+        self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats
+    ) -> tuple[float, float]:
+        assert self.nav is not None
+        nav = self.nav
+        check = self.params.check_reachability
+        if check and nav.goal_xy_m is not None and self._goal_blocked(grid, nav.goal_xy_m):
             # The committed goal is now (next to) a wall: drop it before driving on.
             nav.abort()
-        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
-        if prm.check_reachability and nav.last_plan_failed:
+        v, w = super()._drive(grid, pose, scan, stats)
+        if check and nav.last_plan_failed:
             # The committed goal became unreachable on the updated map: drop it at once
             # instead of waiting out planner patience and recoveries.
             nav.abort()
-        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
-        self.now_s += self.dt_s
-        return self._action(v, w)
+        return v, w
 
     def _next_goal(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
@@ -684,9 +377,7 @@ class FrontierExplorationPolicy(_FrontierBaseline):
         t0 = time.perf_counter()
         self.counters["selections"] += 1
         candidates = [(f, self._travel_point(f)) for f in self.frontiers]
-        candidates = [
-            (f, p) for f, p in candidates if not self._blacklisted(p, prm.blacklist_box_m)
-        ]
+        candidates = [(f, p) for f, p in candidates if p not in self.blacklist]
         if prm.selection == "euclidean":
             candidates.sort(key=lambda fp: fp[0].min_distance_m)
         if prm.check_reachability and candidates:
@@ -758,14 +449,14 @@ class NearestFrontierParams:
     navigation: MoveBaseParams = field(default_factory=MoveBaseParams)
 
     def __post_init__(self) -> None:
-        _check_positive(self, ("replan_period_s",))
-        _check_positive(self, ("blacklist_radius_m",), allow_zero=True)
+        check_positive(self, ("replan_period_s",))
+        check_positive(self, ("blacklist_radius_m",), allow_zero=True)
         if self.cell_convention not in ("free", "unknown"):
             raise ValueError(
                 f"cell_convention must be 'free' or 'unknown', got {self.cell_convention!r}"
             )
-        _check_int_at_least(self, "min_frontier_cells", 1)
-        _check_int_at_least(self, "no_frontier_retries", 0)
+        check_int_at_least(self, "min_frontier_cells", 1)
+        check_int_at_least(self, "no_frontier_retries", 0)
 
 
 class NearestFrontierPolicy(_FrontierBaseline):
@@ -776,13 +467,14 @@ class NearestFrontierPolicy(_FrontierBaseline):
     """
 
     name = "nearest"
+    params_type = NearestFrontierParams
+    params: NearestFrontierParams
 
     def __init__(self, params: NearestFrontierParams | None = None, **overrides: Any) -> None:
-        p = params if params is not None else NearestFrontierParams()
-        if overrides:
-            p = dataclasses.replace(p, **overrides)
-        self.params = p
-        super().__init__(p.navigation)
+        super().__init__(params, **overrides)
+
+    def _new_blacklist(self) -> GoalBlacklist:
+        return GoalBlacklist(self.params.blacklist_radius_m)
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -793,20 +485,12 @@ class NearestFrontierPolicy(_FrontierBaseline):
         self._target_cell: tuple[int, int] | None = None
         self.path_length_m = math.inf
 
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        if self.nav is None:
-            raise RuntimeError("call reset() before act()")
-        stats = StepStats()
-        self.last_stats = stats
-        if self.done:
-            return self._action(0.0, 0.0)
-        grid, pose, scan = self._read(obs)
+    def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
+        assert self.nav is not None
         nav = self.nav
         prm = self.params
-
-        if nav.status == NavStatus.ABORTED and nav.goal_xy_m is not None:
-            self.blacklist.append(nav.goal_xy_m)
-            self.counters["blacklisted"] += 1
+        if nav.status == NavStatus.ABORTED:
+            self._blacklist_aborted_goal()
         need_target = nav.status in (
             NavStatus.IDLE,
             NavStatus.SUCCEEDED,
@@ -826,7 +510,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
                         reason = "no reachable frontier left"
                     else:
                         reason = "no frontiers left"
-                    return self._finish(reason)
+                    self._finish(reason)
             else:
                 self._no_frontier_count = 0
                 nav.set_goal(goal, self.now_s)
@@ -838,11 +522,6 @@ class NearestFrontierPolicy(_FrontierBaseline):
             t0 = time.perf_counter()
             self.frontiers = self._detect(grid, pose)
             stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
-
-        v, w = nav.step(self.now_s, pose, grid, self.geometry, scan, stats)
-        stats.extra = {"nav_status": nav.status, "n_frontiers": len(self.frontiers)}
-        self.now_s += self.dt_s
-        return self._action(v, w)
 
     def _detect(self, grid: np.ndarray, pose: np.ndarray) -> list[GridFrontier]:
         prm = self.params
@@ -893,10 +572,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
                 continue
             cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
             x, y = self.geometry.grid_to_world(*cell)
-            if any(
-                math.dist((float(x), float(y)), b) <= self.params.blacklist_radius_m
-                for b in self.blacklist
-            ):
+            if (float(x), float(y)) in self.blacklist:
                 self._blacklist_hits += 1
                 continue
             if best is None or d[i] < best[0]:

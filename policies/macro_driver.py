@@ -17,24 +17,23 @@ The wrappers in :mod:`semexplore_gym.wrappers.frontier_choice` use this class th
 ``FrontierDriver`` protocol; they never import it (wrappers sit below policies in the layering),
 the env-id entry points in :mod:`semexplore_gym.macro_envs` join the two.
 
-The hooks override the expert's goal-commitment and replan-reason steps (``_commit``,
-``_replan_reason``); a change of those internals must keep this class working (its tests cover it).
+It uses only the expert's public hooks: it overrides
+:meth:`~policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
+:meth:`~policies.semantic_expert.SemanticExpertPolicy.on_replan_due` and
+:meth:`~policies.semantic_expert.SemanticExpertPolicy.on_replanned`, and calls
+:meth:`~policies.semantic_expert.SemanticExpertPolicy.request_replan`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from policies.semantic_expert import Segmenter, SemanticExpertParams, SemanticExpertPolicy
-from semexplore_gym.core.planning.graph_search import (
-    FrontierCandidate,
-    FrontierCostWeights,
-    search_frontier_paths,
-)
+from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
 _GOAL_DONE_REASONS = ("goal_reached", "goal_vanished", "path_done")
 
@@ -72,7 +71,7 @@ class ExpertDriver(SemanticExpertPolicy):
         """Pursue ``candidate`` (None: the expert's own choice) from the next ``act`` on."""
         self._goal = candidate
         self.goal_finished = False
-        self._next_replan_s = self._time_s  # replan at the next step
+        self.request_replan()
 
     def set_cost_weights(self, w_v: float, w_p: float, w_i: float) -> None:
         """Use these frontier cost weights from the next ``act`` on (a replan follows at once).
@@ -82,58 +81,30 @@ class ExpertDriver(SemanticExpertPolicy):
         """
         cost = replace(self.params.cost, w_v=float(w_v), w_p=float(w_p), w_i=float(w_i))
         self.params = replace(self.params, cost=cost)
-        self._next_replan_s = self._time_s
+        self.request_replan()
 
-    def frontier_candidates(
-        self, obs: dict[str, np.ndarray], weights: FrontierCostWeights | None = None
-    ) -> list[FrontierCandidate]:
-        """Scored, non-blacklisted frontier candidates of ``obs`` (cheapest ``C`` first).
-
-        Args:
-            obs: The env observation (``map``, ``pose``).
-            weights: Cost weights to score with (default: the driver's current ones).
-        """
-        if self._segmenter is None:
-            raise ValueError("frontier_candidates needs reset() first")
-        prm = self.params
-        grid = obs["map"]
-        x_m, y_m, yaw_rad = (float(v) for v in obs["pose"][:3])
-        tmap = self._segmenter(
-            grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
-        )
-        cands, _ = search_frontier_paths(
-            tmap,
-            (x_m, y_m),
-            yaw_rad,
-            weights or prm.cost,
-            prune_by=prm.prune_by,
-            min_frontier_width_m=prm.min_frontier_width_m,
-        )
-        return [c for c in cands if not self._is_blacklisted(c.goal_xy_m)]
-
-    # ------------------------------------------------------------------ overrides
-    def _commit(self, cands: list[FrontierCandidate]) -> FrontierCandidate:
+    # ------------------------------------------------------------------ expert hooks
+    def choose_goal(self, candidates: list[FrontierCandidate]) -> FrontierCandidate:
+        """The commanded frontier while it lasts, else the expert's own choice."""
         goal = self._goal
         if goal is None or self.goal_finished:
-            return super()._commit(cands)
+            return super().choose_goal(candidates)
         # Frontiers recede as they are mapped: the commanded one is the nearest candidate
         # within the commitment radius of its goal.
         r = self.params.commitment_radius_m
-        dist = [math.dist(c.goal_xy_m, goal.goal_xy_m) for c in cands]
+        dist = [math.dist(c.goal_xy_m, goal.goal_xy_m) for c in candidates]
         k = int(np.argmin(dist))
         if dist[k] <= r:
-            return cands[k]
+            return candidates[k]
         self.goal_finished = True
-        return super()._commit(cands)
+        return super().choose_goal(candidates)
 
-    def _replan_reason(self, grid: np.ndarray, pose: tuple[float, float, float]) -> str:
-        reason = super()._replan_reason(grid, pose)
+    def on_replan_due(self, reason: str) -> None:
+        """The commanded goal is finished once reached, mapped or its path used up."""
         if self._goal is not None and reason in _GOAL_DONE_REASONS:
             self.goal_finished = True
-        return reason
 
-    def _replan(self, grid: np.ndarray, pose: tuple[float, float, float], stats: Any) -> None:
-        super()._replan(grid, pose, stats)
-        plan = self._plan
-        if self._goal is not None and (plan is None or plan.source != "semantic"):
-            self.goal_finished = True  # the commanded frontier is no longer among the candidates
+    def on_replanned(self, source: Literal["semantic", "fallback"] | None) -> None:
+        """The commanded frontier is finished once it is no longer among the candidates."""
+        if self._goal is not None and source != "semantic":
+            self.goal_finished = True

@@ -14,61 +14,17 @@ Each replanning step (section II of Fredriksson et al.):
 The policy is honest: it reads only the observation (``map``, ``pose``, ``scan``) and the
 static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), never ground truth.
 
-What the paper leaves open, and how this policy handles it (parameters in
-:class:`SemanticExpertParams`, all times in simulated seconds):
+What the paper leaves open (replanning events, goal commitment, narrow frontiers, the
+grid-frontier fallback, stop confirmation, local minima, stuck recovery, blacklisting) and the
+parameters for it are described in :mod:`policies.semantic_expert_params`. Goals are
+blacklisted, progress is watched and stuck recoveries are driven by the navigation stack the
+frontier baselines share (:mod:`policies.navigation`).
 
-* **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
-  ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
-  segmentation and search run only every ``replan_period_s``, and at once when the goal is
-  reached, when it vanishes (no UNKNOWN cell is left within ``goal_check_radius_m`` of it: its
-  frontier has been mapped), when the path is used up, or when a recovery ends. A scheduled
-  replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
-  became known since the last one, e.g. while the robot crosses explored space.
-* **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
-  pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
-  old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
-  cheaper by more than ``switch_margin`` (cost units of ``C``). This stops the robot from
-  oscillating between near-equal frontiers.
-* **Narrow frontiers** (``min_frontier_width_m``, ``clearance_margin_m``): frontier openings
-  narrower than ``min_frontier_width_m`` are ignored; the segmentation's clearance
-  ``radius + clearance_margin_m`` already closes passages the robot cannot follow.
-* **Path entry check**: when the straight first leg from the robot to the map's path crosses
-  an occupied cell (the robot stands outside every area), a grid path with the robot's
-  clearance leads to the path instead.
-* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_m``,
-  ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
-  frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
-  space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
-  frontier a grid search with its clearance can reach
-  (:mod:`semexplore_gym.core.frontiers.reachable`), and keeps that goal while it lasts. Tiny
-  frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
-  inside of walls, pockets along them) are ignored.
-* **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
-  replans found no frontier from either source.
-* **Potential-field local minima** (in :class:`PotentialFieldParams`): the lookahead point
-  ``G`` needs a sight line with the robot's clearance (``lookahead_clearance_m``), so the field
-  does not pull the robot onto wall ends at corners and doorways; a collision guard
-  (``safety_margin_m``, ``contact_margin_m``, ``braking_time_s``, ``map_guard_radius_m``) caps
-  the speed before any obstacle; guard steering (``guard_steer_max_rad``) turns the robot
-  towards the nearest open heading when the guard blocks the field's direction.
-* **Local-minimum escape** (``local_min_timeout_s``, ``escape_duration_s``,
-  ``escape_repulsion_scale``): when the field has held the robot almost still (forward command
-  below 10 % of the maximum) for ``local_min_timeout_s`` (a dead end or doorway where repulsion
-  cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the collision
-  guard still keeps the robot off the walls.
-* **Stuck recovery** (``stuck_timeout_s``, ``stuck_radius_m``, ``progress_timeout_s``,
-  ``progress_min_new_cells``, ``backoff_duration_s``, ``backoff_speed_fraction``): the robot is
-  stuck when it stayed within ``stuck_radius_m`` for ``stuck_timeout_s`` while the map grew by
-  fewer than ``progress_min_new_cells`` known cells, or when for ``progress_timeout_s`` neither
-  the remaining path to its goal shrank (by 0.1 m) nor the map grew. It then backs off for
-  ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
-  space when the way back is blocked), blacklists the goal and replans.
-* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
-  blacklisted by a recovery, or reached ``max_goal_reaches`` times without their frontier
-  disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
-  the mission.
-
-``counters`` and ``events`` record how often each behaviour fired.
+Subclasses steer the expert through its public hooks: :meth:`SemanticExpertPolicy.choose_goal`
+(which scored frontier to pursue), :meth:`~SemanticExpertPolicy.on_replan_due` and
+:meth:`~SemanticExpertPolicy.on_replanned` (notifications around each replan), and
+:meth:`~SemanticExpertPolicy.request_replan`; :meth:`~SemanticExpertPolicy.frontier_candidates`
+scores the frontiers of any observation without changing the plan.
 """
 
 from __future__ import annotations
@@ -81,147 +37,45 @@ from typing import Any, Literal
 
 import numpy as np
 
-from policies.base import Policy, StepStats
-from semexplore_gym.core.planning.graph_search import (
-    FrontierCandidate,
-    FrontierCostWeights,
-    search_frontier_paths,
-)
-from semexplore_gym.core.grid import UNKNOWN, GridGeometry
-from semexplore_gym.core.planning.line_of_sight import segment_is_clear
-from semexplore_gym.core.params import require_finite
-from semexplore_gym.core.planning.potential_field import (
-    PotentialFieldCommand,
-    PotentialFieldParams,
-    RobotLimits,
-    beam_angles_rad,
-    front_free_distance,
-    nearby_obstacle_points,
-    potential_field_command,
-    resample_polyline,
-)
+from policies.base import Policy, StepStats, read_env_facts
+from policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
+from policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
 )
-from semexplore_gym.core.topometric.params import SegmentationParams
+from semexplore_gym.core.grid import UNKNOWN
+from semexplore_gym.core.planning.graph_search import (
+    FrontierCandidate,
+    FrontierCostWeights,
+    search_frontier_paths,
+)
+from semexplore_gym.core.planning.line_of_sight import segment_is_clear
+from semexplore_gym.core.planning.potential_field import (
+    PotentialFieldCommand,
+    RobotLimits,
+    beam_angles_rad,
+    potential_field_command,
+    resample_polyline,
+)
 from semexplore_gym.core.topometric.types import TopometricMap
+
+__all__ = [
+    "REPLAN_REASONS",
+    "Segmenter",
+    "SemanticExpertParams",
+    "SemanticExpertPolicy",
+    "area_type_raster",
+]
 
 Segmenter = Callable[..., TopometricMap]
 
+#: Why a replan runs (``counters["replan_<reason>"]``, :meth:`SemanticExpertPolicy.on_replan_due`).
+REPLAN_REASONS = ("no_plan", "period", "goal_reached", "path_done", "goal_vanished")
 
-@dataclass(frozen=True)
-class SemanticExpertParams:
-    """All parameters of the semantic expert (defaults: the paper's weights, then ours).
-
-    Attributes:
-        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (paper: 4, 0.2, 0.1).
-        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (paper: 30, 0.065, 1.5) and
-            the command mapping.
-        segmentation: Parameters of ``segment_map`` (the robot clearance is not one of them).
-        prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
-        clearance_margin_m: Segmentation clearance is the robot radius plus this.
-        replan_period_s: Period of the scheduled replans (segmentation + Algorithm 1).
-        resegment_min_new_m2: A scheduled replan re-segments the map only if at least this much
-            area became known since the last segmentation; otherwise it reruns Algorithm 1 on
-            the previous topometric map from the new pose.
-        goal_reached_radius_m: The goal counts as reached within this distance.
-        goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
-            left within this distance of it.
-        commitment_radius_m: A frontier this close to the current goal is the same goal.
-        switch_margin: Another frontier replaces the current one only if cheaper by this much.
-        min_frontier_width_m: Narrower frontier openings are ignored.
-        grid_fallback: Use the grid BFS frontier while the topometric map offers none.
-        fallback_min_frontier_m: Smallest frontier group the fallback considers (its cell count
-            times the resolution, metres). Smaller groups are mostly leaks through gaps in
-            rasterised walls, which no robot can clear.
-        fallback_min_unknown_depth_m: The fallback ignores frontiers without unknown space at
-            least this far from every known cell next to them (the inside of thick walls seen
-            through gaps in their mapped faces, thin pockets along walls: no scan fills them).
-        fallback_reach_m: The fallback's goal lies within this distance of the frontier.
-        stop_confirmations: Consecutive replans without any frontier before stopping.
-        local_min_timeout_s: Time almost still (forward command < 10 % of max) before escaping.
-        escape_duration_s: Duration of a local-minimum escape.
-        escape_repulsion_scale: Factor on ``f_o`` during an escape.
-        stuck_timeout_s: Time within ``stuck_radius_m`` (and no map growth) that means stuck.
-        stuck_radius_m: See ``stuck_timeout_s``.
-        progress_timeout_s: Time without path progress nor map growth that means stuck.
-        progress_min_new_cells: Known cells the map must gain to count as growth.
-        backoff_duration_s: Length of the back-off manoeuvre of a stuck recovery.
-        backoff_speed_fraction: Back-off speed as a fraction of the top speed.
-        blacklist_radius_m: Frontiers this close to a blacklisted goal are ignored.
-        max_goal_reaches: A goal reached this many times without clearing is blacklisted.
-    """
-
-    cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
-    potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
-    segmentation: SegmentationParams = field(default_factory=SegmentationParams)
-    prune_by: Literal["opening", "area"] = "opening"
-    clearance_margin_m: float = 0.05
-    replan_period_s: float = 2.0
-    resegment_min_new_m2: float = 0.1
-    goal_reached_radius_m: float = 0.35
-    goal_check_radius_m: float = 0.5
-    commitment_radius_m: float = 1.0
-    switch_margin: float = 0.5
-    min_frontier_width_m: float = 0.25
-    grid_fallback: bool = True
-    fallback_min_frontier_m: float = 0.35
-    fallback_min_unknown_depth_m: float = 0.2
-    fallback_reach_m: float = 0.1
-    stop_confirmations: int = 2
-    local_min_timeout_s: float = 3.0
-    escape_duration_s: float = 4.0
-    escape_repulsion_scale: float = 0.3
-    stuck_timeout_s: float = 8.0
-    stuck_radius_m: float = 0.25
-    progress_timeout_s: float = 30.0
-    progress_min_new_cells: int = 20
-    backoff_duration_s: float = 1.5
-    backoff_speed_fraction: float = 0.5
-    blacklist_radius_m: float = 0.5
-    max_goal_reaches: int = 2
-
-    def __post_init__(self) -> None:
-        if self.prune_by not in ("opening", "area"):
-            raise ValueError(f"prune_by must be 'opening' or 'area', got {self.prune_by!r}")
-        positive = (
-            "replan_period_s",
-            "goal_reached_radius_m",
-            "goal_check_radius_m",
-            "stuck_timeout_s",
-            "stuck_radius_m",
-            "progress_timeout_s",
-            "local_min_timeout_s",
-        )
-        require_finite(self, positive, positive=True)
-        nonneg = (
-            "clearance_margin_m",
-            "commitment_radius_m",
-            "switch_margin",
-            "min_frontier_width_m",
-            "fallback_min_frontier_m",
-            "fallback_min_unknown_depth_m",
-            "resegment_min_new_m2",
-            "fallback_reach_m",
-            "escape_duration_s",
-            "escape_repulsion_scale",
-            "backoff_duration_s",
-            "blacklist_radius_m",
-        )
-        require_finite(self, nonneg, positive=False)
-        if not 0.0 <= self.backoff_speed_fraction <= 1.0:
-            raise ValueError(
-                f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
-            )
-        for name in (
-            "stop_confirmations",
-            "max_goal_reaches",
-            "progress_min_new_cells",
-        ):
-            if int(getattr(self, name)) < 1:
-                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
+#: The rest of the path must shrink by more than this to count as progress.
+_PATH_PROGRESS_MARGIN_M = 0.1
 
 
 @dataclass
@@ -271,21 +125,15 @@ class SemanticExpertPolicy(Policy):
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
     ) -> None:
         super().reset(obs, info, seed=seed)
-        try:
-            self.geometry = GridGeometry.from_dict(info["map_geometry"])
-            robot = info["robot"]
-            lidar = info["lidar"]
-            self.dt_s = float(info["dt_s"])
-            self.limits = RobotLimits(
-                radius_m=float(robot["radius_m"]),
-                max_linear_speed_mps=float(robot["max_linear_speed_mps"]),
-                max_angular_speed_radps=float(robot["max_angular_speed_radps"]),
-                max_range_m=float(lidar["max_range_m"]),
-            )
-        except KeyError as e:
-            raise ValueError(
-                f"info lacks {e.args[0]!r}: reset needs the env's map_geometry, robot, lidar and dt_s"
-            ) from e
+        facts = read_env_facts(info, type(self).__name__)
+        self.geometry = facts.geometry
+        self.dt_s = facts.dt_s
+        self.limits = RobotLimits(
+            radius_m=facts.radius_m,
+            max_linear_speed_mps=facts.max_linear_speed_mps,
+            max_angular_speed_radps=facts.max_angular_speed_radps,
+            max_range_m=facts.max_range_m,
+        )
         if self._segmenter is None:
             # one segmenter per policy: it keeps its scratch memory between replans
             from semexplore_gym.core.topometric import TopometricSegmenter
@@ -314,21 +162,31 @@ class SemanticExpertPolicy(Policy):
         self._last_reason = ""
         self._seg_known_cells = 0
         self._empty_replans = 0
-        self._blacklist: list[tuple[float, float]] = []
+        self.blacklist = GoalBlacklist(self.params.blacklist_radius_m)
         self._reaches: list[tuple[float, float, int]] = []
         self._area_types: np.ndarray | None = None
         self._last_cmd: PotentialFieldCommand | None = None
         self._still_s = 0.0
         self._escape_until_s = -1.0
-        self._recovery_until_s = -1.0
-        self._recovery_turn = 0.0
         self._known_cells = int(np.count_nonzero(np.asarray(obs["map"]) != UNKNOWN))
-        self._anchor_xy = (float(obs["pose"][0]), float(obs["pose"][1]))
-        self._anchor_t_s = 0.0
-        self._anchor_known = self._known_cells
-        self._progress_t_s = 0.0
-        self._progress_known = self._known_cells
-        self._best_remaining_m = math.inf
+        prm = self.params
+        self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
+        # Stuck: the robot stayed near one point while the map hardly grew ...
+        self._motion_watch = ProgressWatch(
+            prm.stuck_timeout_s,
+            radius_m=prm.stuck_radius_m,
+            min_new_cells=prm.progress_min_new_cells,
+        )
+        self._motion_watch.reset(
+            0.0, (float(obs["pose"][0]), float(obs["pose"][1])), self._known_cells
+        )
+        # ... or neither its path to the goal shrank nor the map grew, for longer.
+        self._path_watch = ProgressWatch(
+            prm.progress_timeout_s,
+            min_new_cells=prm.progress_min_new_cells,
+            path_margin_m=_PATH_PROGRESS_MARGIN_M,
+        )
+        self._path_watch.reset(0.0, None, self._known_cells)
 
     # ------------------------------------------------------------------ stepping
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
@@ -345,13 +203,12 @@ class SemanticExpertPolicy(Policy):
             self._angles = beam_angles_rad(len(scan))
         self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
 
-        if self._time_s < self._recovery_until_s:
+        if self._backoff.active(self._time_s):
             v, w = self._recovery_command(grid, pose, scan)
             self.mode = "recovery"
         else:
-            if self._recovery_until_s > 0.0:
+            if self._backoff.finish():
                 # Recovery just ended: give up the goal that got us stuck, replan at once.
-                self._recovery_until_s = -1.0
                 self._blacklist_goal()
             if self._needs_replan(grid, pose):
                 self._replan(grid, pose, stats)
@@ -363,7 +220,7 @@ class SemanticExpertPolicy(Policy):
             else:
                 v, w = self._follow(grid, pose, scan)
                 self._watch_progress(pose)
-                if self._time_s < self._recovery_until_s:
+                if self._backoff.active(self._time_s):
                     v, w = self._recovery_command(grid, pose, scan)
         self._time_s += self.dt_s
         action = np.array(
@@ -386,6 +243,7 @@ class SemanticExpertPolicy(Policy):
         self._last_reason = reason
         if reason:
             self.counters[f"replan_{reason}"] = self.counters.get(f"replan_{reason}", 0) + 1
+            self.on_replan_due(reason)
         return bool(reason)
 
     def _replan_reason(self, grid: np.ndarray, pose: tuple[float, float, float]) -> str:
@@ -415,13 +273,112 @@ class SemanticExpertPolicy(Policy):
             return True  # the map's edge: beyond it is unknown
         return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())
 
+    # ------------------------------------------------------------------ hooks
+    @property
+    def goal_xy_m(self) -> tuple[float, float] | None:
+        """The goal the robot drives to (metres, world frame), or None without a plan."""
+        return self._plan.goal_xy_m if self._plan is not None else None
+
+    @property
+    def plan_source(self) -> Literal["semantic", "fallback"] | None:
+        """Where the current goal comes from: a semantic frontier, the grid fallback, or None."""
+        return self._plan.source if self._plan is not None else None
+
+    def request_replan(self) -> None:
+        """Replan (segmentation and goal selection) at the next ``act``."""
+        self._next_replan_s = self._time_s
+
+    def choose_goal(self, candidates: list[FrontierCandidate]) -> FrontierCandidate:
+        """Pick the frontier to pursue among the scored ``candidates`` (cheapest ``C`` first).
+
+        The default is goal commitment: keep the frontier pursued so far (same frontier
+        pathway, or within ``commitment_radius_m`` of the old goal) unless the best one is
+        cheaper by more than ``switch_margin``. Subclasses override it to choose otherwise.
+
+        Args:
+            candidates: The non-blacklisted candidates of this replan, at least one.
+        """
+        best = candidates[0]
+        old = self._plan
+        if old is None or old.source != "semantic" or old.candidate is None:
+            return best
+        same = [
+            c
+            for c in candidates
+            if c.frontier.area_id == old.candidate.frontier.area_id
+            or math.hypot(c.goal_xy_m[0] - old.goal_xy_m[0], c.goal_xy_m[1] - old.goal_xy_m[1])
+            <= self.params.commitment_radius_m
+        ]
+        if not same:
+            return best
+        keep = min(same, key=lambda c: c.cost)
+        return keep if keep.cost <= best.cost + self.params.switch_margin else best
+
+    def on_replan_due(self, reason: str) -> None:
+        """Called when a replan is due, just before it runs; does nothing by default.
+
+        Args:
+            reason: Why (one of :data:`REPLAN_REASONS`).
+        """
+
+    def on_replanned(self, source: Literal["semantic", "fallback"] | None) -> None:
+        """Called after every replan with :attr:`plan_source`; does nothing by default."""
+
+    def frontier_candidates(
+        self, obs: dict[str, np.ndarray], weights: FrontierCostWeights | None = None
+    ) -> list[FrontierCandidate]:
+        """Scored, non-blacklisted frontier candidates of ``obs`` (cheapest ``C`` first).
+
+        Runs the pose identification and Algorithm 1 without changing the plan.
+
+        Args:
+            obs: The env observation (``map``, ``pose``).
+            weights: Cost weights to score with (default: the policy's current ones).
+
+        Raises:
+            ValueError: called before ``reset``.
+        """
+        if self._segmenter is None:
+            raise ValueError("frontier_candidates needs reset() first")
+        prm = self.params
+        grid = obs["map"]
+        x_m, y_m, yaw_rad = (float(v) for v in obs["pose"][:3])
+        tmap = self._segmenter(
+            grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
+        )
+        return self._scored_candidates(tmap, (x_m, y_m, yaw_rad), weights or prm.cost)
+
     # ------------------------------------------------------------------ planning
     def _replan(self, grid: np.ndarray, pose: tuple[float, float, float], stats: StepStats) -> None:
+        """One replanning step: pose identification, then goal selection and its path."""
         prm = self.params
         stats.replanned = True
         self.counters["replans"] += 1
         self._next_replan_s = self._time_s + prm.replan_period_s
         t0 = time.perf_counter()
+        tmap, segmented = self._update_topometric_map(grid)
+        t1 = time.perf_counter()
+        stats.map_generation_ms = (t1 - t0) * 1e3 if segmented else 0.0
+
+        self.candidates = self._scored_candidates(tmap, pose, prm.cost)
+        new_plan, clearance = self._semantic_plan(grid, pose)
+        if new_plan is None and prm.grid_fallback:
+            if clearance is None:
+                clearance = clearance_field_m(grid, self.geometry.resolution_m)
+            new_plan = self._committed_fallback_plan(grid, pose, clearance)
+            if new_plan is None:
+                new_plan = self._nearest_fallback_plan(grid, pose, clearance)
+        stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
+
+        if new_plan is None:
+            self._give_up_plan()
+        else:
+            self._adopt_plan(new_plan)
+        self.on_replanned(self.plan_source)
+
+    def _update_topometric_map(self, grid: np.ndarray) -> tuple[TopometricMap, bool]:
+        """The topometric map to plan on, and whether it was segmented anew."""
+        prm = self.params
         assert self._segmenter is not None
         min_new = prm.resegment_min_new_m2 / self.geometry.resolution_m**2
         segmented = (
@@ -429,128 +386,137 @@ class SemanticExpertPolicy(Policy):
             or self._last_reason != "period"
             or self._known_cells - self._seg_known_cells >= min_new
         )
-        if segmented:
-            tmap = self._segmenter(
-                grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
-            )
-            self._seg_known_cells = self._known_cells
-            self.tmap = tmap
-            self._area_types = None
-            self.counters["segmentations"] += 1
-        else:
+        if not segmented:
             # Map-change gating: the map has hardly grown since the last segmentation (the
             # robot drives through explored space): search the same map from the new pose.
             assert self.tmap is not None
-            tmap = self.tmap
-        t1 = time.perf_counter()
-        stats.map_generation_ms = (t1 - t0) * 1e3 if segmented else 0.0
+            return self.tmap, False
+        self.tmap = self._segmenter(
+            grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
+        )
+        self._seg_known_cells = self._known_cells
+        self._area_types = None
+        self.counters["segmentations"] += 1
+        return self.tmap, True
 
+    def _scored_candidates(
+        self, tmap: TopometricMap, pose: tuple[float, float, float], weights: FrontierCostWeights
+    ) -> list[FrontierCandidate]:
+        """Algorithm 1 from ``pose``: the non-blacklisted candidates, cheapest first."""
+        prm = self.params
         cands, _ = search_frontier_paths(
             tmap,
             pose[:2],
             pose[2],
-            prm.cost,
+            weights,
             prune_by=prm.prune_by,
             min_frontier_width_m=prm.min_frontier_width_m,
         )
-        cands = [c for c in cands if not self._is_blacklisted(c.goal_xy_m)]
-        self.candidates = cands
-        new_plan: _Plan | None = None
+        return [c for c in cands if c.goal_xy_m not in self.blacklist]
+
+    def _semantic_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float]
+    ) -> tuple[_Plan | None, np.ndarray | None]:
+        """The plan to the chosen candidate (None: no candidate, or no way onto its path), and
+        the clearance field if the entry check computed one."""
+        if not self.candidates:
+            return None, None
+        chosen = self.choose_goal(self.candidates)
+        path: np.ndarray | None = chosen.path_m
         clearance: np.ndarray | None = None
-        if cands:
-            chosen = self._commit(cands)
-            path: np.ndarray | None = chosen.path_m
-            if len(chosen.path_m) >= 2 and not segment_is_clear(
-                grid, self.geometry, pose[:2], tuple(chosen.path_m[1])
-            ):
-                # The straight first leg crosses a wall: reach the map's path over the grid.
-                clearance = clearance_field_m(grid, self.geometry.resolution_m)
-                detour = grid_path_to(
-                    grid,
-                    self.geometry,
-                    pose[:2],
-                    tuple(chosen.path_m[1]),
-                    self.clearance_m,
-                    clearance_field=clearance,
-                )
-                path = None if detour is None else np.vstack([detour, chosen.path_m[2:]])
-                self.counters["entry_detours"] += int(detour is not None)
-            if path is not None:
-                new_plan = _Plan(
-                    "semantic",
-                    chosen.goal_xy_m,
-                    resample_polyline(path, self.geometry.resolution_m),
-                    chosen,
-                )
-        if new_plan is None and prm.grid_fallback:
-            if clearance is None:
-                clearance = clearance_field_m(grid, self.geometry.resolution_m)
-            old = self._plan
-            if (
-                old is not None
-                and old.source == "fallback"
-                and not self._is_blacklisted(old.goal_xy_m)
-                and math.hypot(pose[0] - old.goal_xy_m[0], pose[1] - old.goal_xy_m[1])
-                > prm.goal_reached_radius_m
-                and self._unknown_near(grid, old.goal_xy_m, prm.goal_check_radius_m)
-            ):
-                # Goal commitment for the fallback too: keep driving to the same frontier while
-                # it is there and reachable, rather than to whichever is nearest right now.
-                path = grid_path_to(
-                    grid,
-                    self.geometry,
-                    pose[:2],
-                    old.goal_xy_m,
-                    self.clearance_m,
-                    clearance_field=clearance,
-                )
-                if path is not None:
-                    new_plan = _Plan(
-                        "fallback",
-                        old.goal_xy_m,
-                        resample_polyline(path, self.geometry.resolution_m),
-                        None,
-                    )
-        if new_plan is None and prm.grid_fallback:
-            if clearance is None:
-                clearance = clearance_field_m(grid, self.geometry.resolution_m)
-            found = nearest_reachable_frontier(
+        if len(chosen.path_m) >= 2 and not segment_is_clear(
+            grid, self.geometry, pose[:2], tuple(chosen.path_m[1])
+        ):
+            # The straight first leg crosses a wall: reach the map's path over the grid.
+            clearance = clearance_field_m(grid, self.geometry.resolution_m)
+            detour = grid_path_to(
                 grid,
                 self.geometry,
                 pose[:2],
+                tuple(chosen.path_m[1]),
                 self.clearance_m,
-                min_frontier_cells=max(
-                    1, math.ceil(prm.fallback_min_frontier_m / self.geometry.resolution_m - 1e-9)
-                ),
-                min_unknown_depth_cells=prm.fallback_min_unknown_depth_m
-                / self.geometry.resolution_m,
-                reach_m=prm.fallback_reach_m,
-                excluded_xy_m=self._blacklist,
-                excluded_radius_m=prm.blacklist_radius_m + prm.fallback_reach_m,
                 clearance_field=clearance,
             )
-            if found is not None:
-                new_plan = _Plan(
-                    "fallback",
-                    found.goal_xy_m,
-                    resample_polyline(found.path_m, self.geometry.resolution_m),
-                    None,
-                )
-        stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
+            path = None if detour is None else np.vstack([detour, chosen.path_m[2:]])
+            self.counters["entry_detours"] += int(detour is not None)
+        if path is None:
+            return None, clearance
+        plan = _Plan(
+            "semantic",
+            chosen.goal_xy_m,
+            resample_polyline(path, self.geometry.resolution_m),
+            chosen,
+        )
+        return plan, clearance
 
-        if new_plan is None:
-            self._plan = None
-            self._empty_replans += 1
-            # Look again at the next step before giving up.
-            self._next_replan_s = self._time_s
-            if self._empty_replans >= prm.stop_confirmations:
-                self.done = True
-                self.mode = "done"
-                n_black = len(self._blacklist)
-                self.stop_reason = "no frontier left" + (
-                    f" ({n_black} unreachable frontier(s) blacklisted)" if n_black else ""
-                )
-            return
+    def _committed_fallback_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
+    ) -> _Plan | None:
+        """Goal commitment for the fallback too: keep driving to the same frontier while it is
+        there and reachable, rather than to whichever is nearest right now."""
+        prm = self.params
+        old = self._plan
+        if (
+            old is None
+            or old.source != "fallback"
+            or old.goal_xy_m in self.blacklist
+            or math.hypot(pose[0] - old.goal_xy_m[0], pose[1] - old.goal_xy_m[1])
+            <= prm.goal_reached_radius_m
+            or not self._unknown_near(grid, old.goal_xy_m, prm.goal_check_radius_m)
+        ):
+            return None
+        path = grid_path_to(
+            grid,
+            self.geometry,
+            pose[:2],
+            old.goal_xy_m,
+            self.clearance_m,
+            clearance_field=clearance,
+        )
+        if path is None:
+            return None
+        return _Plan(
+            "fallback", old.goal_xy_m, resample_polyline(path, self.geometry.resolution_m), None
+        )
+
+    def _nearest_fallback_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
+    ) -> _Plan | None:
+        """The nearest frontier a grid search with the robot's clearance reaches (or None)."""
+        prm = self.params
+        res_m = self.geometry.resolution_m
+        found = nearest_reachable_frontier(
+            grid,
+            self.geometry,
+            pose[:2],
+            self.clearance_m,
+            min_frontier_cells=max(1, math.ceil(prm.fallback_min_frontier_m / res_m - 1e-9)),
+            min_unknown_depth_cells=prm.fallback_min_unknown_depth_m / res_m,
+            reach_m=prm.fallback_reach_m,
+            excluded_xy_m=self.blacklist.points_m,
+            excluded_radius_m=prm.blacklist_radius_m + prm.fallback_reach_m,
+            clearance_field=clearance,
+        )
+        if found is None:
+            return None
+        return _Plan("fallback", found.goal_xy_m, resample_polyline(found.path_m, res_m), None)
+
+    def _give_up_plan(self) -> None:
+        """No frontier from either source: wait a step, stop after ``stop_confirmations``."""
+        self._plan = None
+        self._empty_replans += 1
+        # Look again at the next step before giving up.
+        self._next_replan_s = self._time_s
+        if self._empty_replans >= self.params.stop_confirmations:
+            self.done = True
+            self.mode = "done"
+            n_black = len(self.blacklist)
+            self.stop_reason = "no frontier left" + (
+                f" ({n_black} unreachable frontier(s) blacklisted)" if n_black else ""
+            )
+
+    def _adopt_plan(self, new_plan: _Plan) -> None:
+        """Follow ``new_plan`` from now on (logging a goal switch)."""
         self._empty_replans = 0
         old = self._plan
         if (
@@ -558,7 +524,7 @@ class SemanticExpertPolicy(Policy):
             or math.hypot(
                 old.goal_xy_m[0] - new_plan.goal_xy_m[0], old.goal_xy_m[1] - new_plan.goal_xy_m[1]
             )
-            > prm.commitment_radius_m
+            > self.params.commitment_radius_m
         ):
             if old is not None:
                 self.counters["switches"] += 1
@@ -571,27 +537,9 @@ class SemanticExpertPolicy(Policy):
         self._plan = new_plan
         # Progress is measured along each new path from its start (the robot's position): a
         # replanned route may be longer than the rest of the old one without anything being wrong.
-        self._best_remaining_m = self._remaining_m(new_plan)
+        self._path_watch.track_path(self._remaining_m(new_plan))
         self.mode = new_plan.source
         self.counters["semantic_plans" if new_plan.source == "semantic" else "fallback_plans"] += 1
-
-    def _commit(self, cands: list[FrontierCandidate]) -> FrontierCandidate:
-        """Goal commitment: keep the current frontier unless another is clearly cheaper."""
-        best = cands[0]
-        old = self._plan
-        if old is None or old.source != "semantic" or old.candidate is None:
-            return best
-        same = [
-            c
-            for c in cands
-            if c.frontier.area_id == old.candidate.frontier.area_id
-            or math.hypot(c.goal_xy_m[0] - old.goal_xy_m[0], c.goal_xy_m[1] - old.goal_xy_m[1])
-            <= self.params.commitment_radius_m
-        ]
-        if not same:
-            return best
-        keep = min(same, key=lambda c: c.cost)
-        return keep if keep.cost <= best.cost + self.params.switch_margin else best
 
     # ------------------------------------------------------------------ following
     def _follow(
@@ -644,30 +592,13 @@ class SemanticExpertPolicy(Policy):
 
     # ------------------------------------------------------------------ stuck handling
     def _watch_progress(self, pose: tuple[float, float, float]) -> None:
-        prm = self.params
-        plan = self._plan
         t = self._time_s
-        if math.hypot(
-            pose[0] - self._anchor_xy[0], pose[1] - self._anchor_xy[1]
-        ) > prm.stuck_radius_m or (
-            self._known_cells - self._anchor_known >= prm.progress_min_new_cells
-        ):
-            self._anchor_xy = (pose[0], pose[1])
-            self._anchor_t_s = t
-            self._anchor_known = self._known_cells
-        if plan is not None:
-            remaining = self._remaining_m(plan)
-            if (
-                remaining < self._best_remaining_m - 0.1
-                or self._known_cells - self._progress_known >= prm.progress_min_new_cells
-            ):
-                self._best_remaining_m = min(remaining, self._best_remaining_m)
-                self._progress_t_s = t
-                self._progress_known = self._known_cells
-        if (
-            t - self._anchor_t_s >= prm.stuck_timeout_s
-            or t - self._progress_t_s >= prm.progress_timeout_s
-        ):
+        stuck = self._motion_watch.update(t, (pose[0], pose[1]), self._known_cells)
+        if self._plan is not None:
+            self._path_watch.update(
+                t, known_cells=self._known_cells, remaining_m=self._remaining_m(self._plan)
+            )
+        if stuck or self._path_watch.stalled(t):
             self._start_recovery()
 
     def _log(self, event: str, detail: str = "") -> None:
@@ -677,55 +608,32 @@ class SemanticExpertPolicy(Policy):
         self.counters["recoveries"] += 1
         goal = self._plan.goal_xy_m if self._plan is not None else None
         self._log("recovery", f"goal={goal}")
-        self._recovery_until_s = self._time_s + self.params.backoff_duration_s
-        self._recovery_turn = 1.0 if self.rng.random() < 0.5 else -1.0
+        self._backoff.start(self._time_s, self.rng)
         self.mode = "recovery"
         self._reset_watchdogs()
 
     def _reset_watchdogs(self) -> None:
-        self._anchor_t_s = self._progress_t_s = self._time_s + self.params.backoff_duration_s
-        self._anchor_known = self._progress_known = self._known_cells
-        self._best_remaining_m = math.inf
+        until_s = self._time_s + self.params.backoff_duration_s
+        self._motion_watch.hold(until_s, self._known_cells)
+        self._path_watch.hold(until_s, self._known_cells)
         self._still_s = 0.0
 
     def _recovery_command(
         self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
     ) -> tuple[float, float]:
         assert self._angles is not None
-        lim = self.limits
-        pf = self.params.potential_field
-        near = nearby_obstacle_points(grid, self.geometry, pose, pf.map_guard_radius_m)
-        back = front_free_distance(
-            scan,
-            self._angles,
-            lim.max_range_m,
-            lim.radius_m + pf.safety_margin_m,
-            backwards=True,
-            contact_half_width_m=lim.radius_m + pf.contact_margin_m,
-            extra_points_xy=near,
-        )
-        if back > 0.05:
-            v = -self.params.backoff_speed_fraction * lim.max_linear_speed_mps
-            v = max(v, -back / pf.braking_time_s)
-            return v, 0.0
-        # The way back is blocked too: turn towards the most open direction.
-        ok = (scan > 0) & np.isfinite(scan)
-        if not ok.any():
-            return 0.0, self._recovery_turn * 0.5 * lim.max_angular_speed_radps
-        k = int(np.argmax(np.where(ok, scan, -1.0)))
-        ang = math.atan2(math.sin(self._angles[k]), math.cos(self._angles[k]))
-        return 0.0, float(
-            np.clip(2.0 * ang, -lim.max_angular_speed_radps, lim.max_angular_speed_radps)
+        return self._backoff.command(
+            grid, self.geometry, pose, scan, self._angles, self.limits, self.params.potential_field
         )
 
     def _blacklist_goal(self) -> None:
         plan = self._plan
         if plan is not None:
-            self._blacklist.append(plan.goal_xy_m)
+            self.blacklist.add(plan.goal_xy_m)
             self.counters["blacklisted"] += 1
             self._log("blacklist", f"stuck: {plan.goal_xy_m}")
         self._plan = None
-        self._next_replan_s = self._time_s
+        self.request_replan()
 
     def _register_reach(self, goal: tuple[float, float]) -> None:
         r = self.params.blacklist_radius_m
@@ -733,18 +641,14 @@ class SemanticExpertPolicy(Policy):
             if math.hypot(goal[0] - x, goal[1] - y) <= r:
                 self._reaches[i] = (x, y, n + 1)
                 if n + 1 >= self.params.max_goal_reaches:
-                    self._blacklist.append((x, y))
+                    self.blacklist.add((x, y))
                     self.counters["blacklisted"] += 1
                     self._log("blacklist", f"reached {n + 1} times: {(x, y)}")
                 return
         self._reaches.append((goal[0], goal[1], 1))
         if self.params.max_goal_reaches <= 1:
-            self._blacklist.append(goal)
+            self.blacklist.add(goal)
             self.counters["blacklisted"] += 1
-
-    def _is_blacklisted(self, xy: tuple[float, float]) -> bool:
-        r = self.params.blacklist_radius_m
-        return any(math.hypot(xy[0] - x, xy[1] - y) <= r for x, y in self._blacklist)
 
     # ------------------------------------------------------------------ drawing
     def overlay(self) -> dict[str, Any]:

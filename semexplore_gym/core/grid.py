@@ -12,11 +12,13 @@ OCCUPIED   0      observed occupied
 
 The values read like a ROS map image (white free, black walls, grey unknown), so the
 observation can be shown or fed to a CNN as it is. ROS ``OccupancyGrid`` values (-1 / 0 / 100)
-convert with :func:`from_ros_values` and :func:`to_ros_values`.
+convert with :func:`from_ros_values` and :func:`to_ros_values`. Angles are wrapped with
+:func:`wrap_angle_rad`, the one angle helper of the package.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +31,18 @@ OCCUPIED: int = 0
 ROS_UNKNOWN: int = -1
 ROS_FREE: int = 0
 ROS_OCCUPIED: int = 100
+
+
+def wrap_angle_rad(angle_rad: float) -> float:
+    """Wrap an angle to ``[-pi, pi)``.
+
+    Args:
+        angle_rad: Any finite angle in radians (a float or numpy scalar).
+
+    Returns:
+        The same direction in ``[-pi, pi)``.
+    """
+    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
@@ -308,7 +308,7 @@ class SemanticExploreEnv(gym.Env):
 
     def _obs(self) -> dict[str, np.ndarray]:
         x, y, yaw = self._est_pose
-        yaw = (yaw + math.pi) % (2 * math.pi) - math.pi
+        yaw = wrap_angle_rad(yaw)
         return {
             "map": self.grid.encoded.copy(),
             "pose": np.array([x, y, yaw], dtype=np.float32),

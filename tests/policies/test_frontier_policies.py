@@ -11,9 +11,9 @@ from policies.base import Policy
 from policies.frontier import (
     FrontierExplorationParams,
     FrontierExplorationPolicy,
-    NavStatus,
     NearestFrontierPolicy,
 )
+from policies.navigation import NavStatus
 from policies.registry import make_policy
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.params import ConfigError

@@ -203,9 +203,37 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
     pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)
     other = cand(-2.0, 0.8, 8)
     moved = cand(3.4, 1.1, 7)  # the same frontier pathway, its frontier receded
-    assert pol._commit([other, moved]) is moved
+    assert pol.choose_goal([other, moved]) is moved
     much_cheaper = cand(-2.0, 0.2, 8)
-    assert pol._commit([much_cheaper, moved]) is much_cheaper
+    assert pol.choose_goal([much_cheaper, moved]) is much_cheaper
+
+
+def test_public_hooks_report_replans_and_force_one():
+    class Recording(SemanticExpertPolicy):
+        def __init__(self) -> None:
+            super().__init__(segmenter=corridor_tmap)
+            self.calls: list[tuple[str, object]] = []
+
+        def on_replan_due(self, reason: str) -> None:
+            self.calls.append(("due", reason))
+
+        def on_replanned(self, source) -> None:  # type: ignore[no-untyped-def]
+            self.calls.append(("replanned", source))
+
+    pol = Recording()
+    obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    assert pol.goal_xy_m is None and pol.plan_source is None
+    pol.act(obs, INFO)
+    assert pol.calls == [("due", "no_plan"), ("replanned", "semantic")]
+    assert pol.goal_xy_m == (2.95, 1.0) and pol.plan_source == "semantic"
+    pol.act(obs, INFO)
+    assert not pol.last_stats.replanned and len(pol.calls) == 2
+    pol.request_replan()
+    pol.act(obs, INFO)
+    assert pol.last_stats.replanned and pol.calls[2] == ("due", "period")
+    cands = pol.frontier_candidates(obs)
+    assert [c.goal_xy_m for c in cands] == [(2.95, 1.0)]
 
 
 def test_reset_needs_the_env_facts_and_params_validate():

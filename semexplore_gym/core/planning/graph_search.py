@@ -45,6 +45,7 @@ from typing import Literal
 
 import numpy as np
 
+from semexplore_gym.core.grid import wrap_angle_rad
 from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
 
@@ -322,10 +323,6 @@ def _polyline_length(poly: np.ndarray) -> float:
     return float(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).sum())
 
 
-def _wrap_angle(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def _heading_angle(
     poly: np.ndarray, robot_xy: tuple[float, float], yaw: float, lookahead_m: float
 ) -> float:
@@ -339,7 +336,7 @@ def _heading_angle(
         if len(rest) == 0:
             return 0.0
         dx, dy = rest[0, 0] - robot_xy[0], rest[0, 1] - robot_xy[1]
-    return abs(_wrap_angle(math.atan2(dy, dx) - yaw))
+    return abs(wrap_angle_rad(math.atan2(dy, dx) - yaw))
 
 
 def point_along(poly: np.ndarray, s_m: float) -> np.ndarray:

@@ -34,9 +34,9 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from semexplore_gym.core.grid import OCCUPIED, GridGeometry
-from semexplore_gym.core.planning.line_of_sight import farthest_visible_index
+from semexplore_gym.core.grid import OCCUPIED, GridGeometry, wrap_angle_rad
 from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.planning.line_of_sight import farthest_visible_index
 
 
 @dataclass(frozen=True)
@@ -395,7 +395,7 @@ def potential_field_command(
         path, (x, y), lookahead, grid, geometry, start_index, p.lookahead_clearance_m, l_min
     )
     gx, gy = float(path[gi, 0]), float(path[gi, 1])
-    goal_angle = _wrap(math.atan2(gy - y, gx - x) - yaw)
+    goal_angle = wrap_angle_rad(math.atan2(gy - y, gx - x) - yaw)
     if math.hypot(gx - x, gy - y) < 1e-6:
         goal_angle = 0.0
     f_o = p.f_o * p.reference_n_beams / n * repulsion_scale
@@ -470,10 +470,6 @@ def _guard_args(limits: RobotLimits, params: PotentialFieldParams) -> tuple[floa
         limits.max_angular_speed_radps,
         params.braking_time_s,
     )
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 # --- numba kernels ----------------------------------------------------------------------------

@@ -1,0 +1,184 @@
+"""Parameters of the semantic expert (:class:`~policies.semantic_expert.SemanticExpertPolicy`).
+
+What the paper leaves open, and how the expert handles it (parameters in
+:class:`SemanticExpertParams`, all times in simulated seconds):
+
+* **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
+  ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
+  segmentation and search run only every ``replan_period_s``, and at once when the goal is
+  reached, when it vanishes (no UNKNOWN cell is left within ``goal_check_radius_m`` of it: its
+  frontier has been mapped), when the path is used up, or when a recovery ends. A scheduled
+  replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
+  became known since the last one, e.g. while the robot crosses explored space.
+* **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
+  pursued so far (same frontier pathway, or a frontier within ``commitment_radius_m`` of the
+  old goal: frontiers recede as the robot approaches) is kept unless the best frontier is
+  cheaper by more than ``switch_margin`` (cost units of ``C``). This stops the robot from
+  oscillating between near-equal frontiers.
+* **Narrow frontiers** (``min_frontier_width_m``, ``clearance_margin_m``): frontier openings
+  narrower than ``min_frontier_width_m`` are ignored; the segmentation's clearance
+  ``radius + clearance_margin_m`` already closes passages the robot cannot follow.
+* **Path entry check**: when the straight first leg from the robot to the map's path crosses
+  an occupied cell (the robot stands outside every area), a grid path with the robot's
+  clearance leads to the path instead.
+* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_m``,
+  ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
+  frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
+  space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
+  frontier a grid search with its clearance can reach
+  (:mod:`semexplore_gym.core.frontiers.reachable`), and keeps that goal while it lasts. Tiny
+  frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
+  inside of walls, pockets along them) are ignored.
+* **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
+  replans found no frontier from either source.
+* **Potential-field local minima** (in :class:`PotentialFieldParams`): the lookahead point
+  ``G`` needs a sight line with the robot's clearance (``lookahead_clearance_m``), so the field
+  does not pull the robot onto wall ends at corners and doorways; a collision guard
+  (``safety_margin_m``, ``contact_margin_m``, ``braking_time_s``, ``map_guard_radius_m``) caps
+  the speed before any obstacle; guard steering (``guard_steer_max_rad``) turns the robot
+  towards the nearest open heading when the guard blocks the field's direction.
+* **Local-minimum escape** (``local_min_timeout_s``, ``escape_duration_s``,
+  ``escape_repulsion_scale``): when the field has held the robot almost still (forward command
+  below 10 % of the maximum) for ``local_min_timeout_s`` (a dead end or doorway where repulsion
+  cancels attraction), the repulsion is scaled down for ``escape_duration_s``; the collision
+  guard still keeps the robot off the walls.
+* **Stuck recovery** (``stuck_timeout_s``, ``stuck_radius_m``, ``progress_timeout_s``,
+  ``progress_min_new_cells``, ``backoff_duration_s``, ``backoff_speed_fraction``): the robot is
+  stuck when it stayed within ``stuck_radius_m`` for ``stuck_timeout_s`` while the map grew by
+  fewer than ``progress_min_new_cells`` known cells, or when for ``progress_timeout_s`` neither
+  the remaining path to its goal shrank (by 0.1 m) nor the map grew. It then backs off for
+  ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
+  space when the way back is blocked), blacklists the goal and replans.
+* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
+  blacklisted by a recovery, or reached ``max_goal_reaches`` times without their frontier
+  disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
+  the mission.
+
+``counters`` and ``events`` record how often each behaviour fired.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.planning.graph_search import FrontierCostWeights
+from semexplore_gym.core.planning.potential_field import PotentialFieldParams
+from semexplore_gym.core.topometric.params import SegmentationParams
+
+__all__ = ["SemanticExpertParams"]
+
+
+@dataclass(frozen=True)
+class SemanticExpertParams:
+    """All parameters of the semantic expert (defaults: the paper's weights, then ours).
+
+    Attributes:
+        cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (defaults: the paper's, defined
+            once in :class:`FrontierCostWeights`).
+        potential_field: Potential field ``f_g``, ``f_o``, ``f_l`` (defaults: the paper's, in
+            :class:`PotentialFieldParams`) and the command mapping.
+        segmentation: Parameters of ``segment_map`` (the robot clearance is not one of them).
+        prune_by: ``A_cost`` slots of Algorithm 1: ``"opening"`` (exact) or ``"area"``.
+        clearance_margin_m: Segmentation clearance is the robot radius plus this.
+        replan_period_s: Period of the scheduled replans (segmentation + Algorithm 1).
+        resegment_min_new_m2: A scheduled replan re-segments the map only if at least this much
+            area became known since the last segmentation; otherwise it reruns Algorithm 1 on
+            the previous topometric map from the new pose.
+        goal_reached_radius_m: The goal counts as reached within this distance.
+        goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
+            left within this distance of it.
+        commitment_radius_m: A frontier this close to the current goal is the same goal.
+        switch_margin: Another frontier replaces the current one only if cheaper by this much.
+        min_frontier_width_m: Narrower frontier openings are ignored.
+        grid_fallback: Use the grid BFS frontier while the topometric map offers none.
+        fallback_min_frontier_m: Smallest frontier group the fallback considers (its cell count
+            times the resolution, metres). Smaller groups are mostly leaks through gaps in
+            rasterised walls, which no robot can clear.
+        fallback_min_unknown_depth_m: The fallback ignores frontiers without unknown space at
+            least this far from every known cell next to them (the inside of thick walls seen
+            through gaps in their mapped faces, thin pockets along walls: no scan fills them).
+        fallback_reach_m: The fallback's goal lies within this distance of the frontier.
+        stop_confirmations: Consecutive replans without any frontier before stopping.
+        local_min_timeout_s: Time almost still (forward command < 10 % of max) before escaping.
+        escape_duration_s: Duration of a local-minimum escape.
+        escape_repulsion_scale: Factor on ``f_o`` during an escape.
+        stuck_timeout_s: Time within ``stuck_radius_m`` (and no map growth) that means stuck.
+        stuck_radius_m: See ``stuck_timeout_s``.
+        progress_timeout_s: Time without path progress nor map growth that means stuck.
+        progress_min_new_cells: Known cells the map must gain to count as growth.
+        backoff_duration_s: Length of the back-off manoeuvre of a stuck recovery.
+        backoff_speed_fraction: Back-off speed as a fraction of the top speed.
+        blacklist_radius_m: Frontiers this close to a blacklisted goal are ignored.
+        max_goal_reaches: A goal reached this many times without clearing is blacklisted.
+    """
+
+    cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
+    potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
+    segmentation: SegmentationParams = field(default_factory=SegmentationParams)
+    prune_by: Literal["opening", "area"] = "opening"
+    clearance_margin_m: float = 0.05
+    replan_period_s: float = 2.0
+    resegment_min_new_m2: float = 0.1
+    goal_reached_radius_m: float = 0.35
+    goal_check_radius_m: float = 0.5
+    commitment_radius_m: float = 1.0
+    switch_margin: float = 0.5
+    min_frontier_width_m: float = 0.25
+    grid_fallback: bool = True
+    fallback_min_frontier_m: float = 0.35
+    fallback_min_unknown_depth_m: float = 0.2
+    fallback_reach_m: float = 0.1
+    stop_confirmations: int = 2
+    local_min_timeout_s: float = 3.0
+    escape_duration_s: float = 4.0
+    escape_repulsion_scale: float = 0.3
+    stuck_timeout_s: float = 8.0
+    stuck_radius_m: float = 0.25
+    progress_timeout_s: float = 30.0
+    progress_min_new_cells: int = 20
+    backoff_duration_s: float = 1.5
+    backoff_speed_fraction: float = 0.5
+    blacklist_radius_m: float = 0.5
+    max_goal_reaches: int = 2
+
+    def __post_init__(self) -> None:
+        if self.prune_by not in ("opening", "area"):
+            raise ValueError(f"prune_by must be 'opening' or 'area', got {self.prune_by!r}")
+        positive = (
+            "replan_period_s",
+            "goal_reached_radius_m",
+            "goal_check_radius_m",
+            "stuck_timeout_s",
+            "stuck_radius_m",
+            "progress_timeout_s",
+            "local_min_timeout_s",
+        )
+        require_finite(self, positive, positive=True)
+        nonneg = (
+            "clearance_margin_m",
+            "commitment_radius_m",
+            "switch_margin",
+            "min_frontier_width_m",
+            "fallback_min_frontier_m",
+            "fallback_min_unknown_depth_m",
+            "resegment_min_new_m2",
+            "fallback_reach_m",
+            "escape_duration_s",
+            "escape_repulsion_scale",
+            "backoff_duration_s",
+            "blacklist_radius_m",
+        )
+        require_finite(self, nonneg, positive=False)
+        if not 0.0 <= self.backoff_speed_fraction <= 1.0:
+            raise ValueError(
+                f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
+            )
+        for name in (
+            "stop_confirmations",
+            "max_goal_reaches",
+            "progress_min_new_cells",
+        ):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
