@@ -51,8 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     import semexplore_gym  # noqa: F401
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from policies.rollout import STAGES, run_mission
     from semexplore_gym.core.params import parse_override
+    from semexplore_gym.evaluation.rollout import STAGES, run_mission
 
     cfg = load_policy_config(args.config)
     kwargs = {".".join(k): v for k, v in (parse_override(t) for t in args.overrides)}

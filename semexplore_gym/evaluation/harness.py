@@ -110,7 +110,7 @@ def run_task(task: Task) -> dict[str, Any]:
 
     import semexplore_gym  # noqa: F401  (registers the env)
     from policies.registry import make_policy
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import run_mission
 
     env = gym.make("SemanticExplore-v0", world=task.resolved_world, config=task.env_config)
     try:

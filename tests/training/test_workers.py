@@ -11,13 +11,8 @@ import numpy as np
 import pytest
 
 from policies.base import Policy
-from policies.imitation import (
-    DAGGER_STREAM,
-    EXPERT_STREAM,
-    ImitationDataset,
-    check_workers,
-    episode_rng,
-)
+from semexplore_gym.training.dataset import ImitationDataset
+from semexplore_gym.training.workers import DAGGER_STREAM, EXPERT_STREAM, check_workers, episode_rng
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 
 WORLD = "maze:size_m=5,seed=1"
@@ -64,10 +59,10 @@ def _env() -> Any:
 def _policy(seed: int = 0) -> Any:
     from gymnasium import spaces
 
-    from policies.imitation import make_policy
+    from semexplore_gym.training.learner import make_learner_policy
     from semexplore_gym.wrappers.egocentric import egocentric_observation_space
 
-    return make_policy(
+    return make_learner_policy(
         egocentric_observation_space(PARAMS),
         spaces.Box(-1.0, 1.0, (2,), np.float32),
         seed=seed,
@@ -101,7 +96,8 @@ def test_bad_workers_are_rejected() -> None:
     for bad in (0, -1, 1.5, True, "2", None):
         with pytest.raises(ValueError, match="workers must be an integer >= 1"):
             check_workers(bad)
-    from policies.imitation import record_expert_dataset, run_dagger
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     with pytest.raises(ValueError, match="workers must be an integer >= 1, got 0"):
@@ -124,7 +120,8 @@ def test_bad_workers_are_rejected() -> None:
 
 
 def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
-    from policies.imitation import record_expert_dataset, rollout_episode
+    from semexplore_gym.training.episodes import rollout_episode
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     data = record_expert_dataset(
@@ -163,7 +160,8 @@ def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
 @pytest.mark.slow
 def test_two_workers_record_and_dagger_like_one(tmp_path: Path) -> None:
     """Same datasets, files, round facts and learner weights with workers = 1 and 2."""
-    from policies.imitation import record_expert_dataset, run_dagger
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     results = {}

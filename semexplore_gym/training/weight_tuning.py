@@ -166,7 +166,7 @@ def evaluate_weights(
         ``MissionResult.summary()`` dicts, world-major.
     """
     from policies.registry import make_policy
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import run_mission
 
     if not worlds:
         raise ValueError("no worlds given")

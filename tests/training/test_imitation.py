@@ -12,11 +12,8 @@ import numpy as np
 import pytest
 
 from policies.base import Policy
-from policies.imitation import (
-    DatasetWriter,
-    ImitationDataset,
-    beta_schedule,
-)
+from semexplore_gym.training.dagger import beta_schedule
+from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 
 WORLD = "maze:size_m=5,seed=1"
@@ -127,10 +124,10 @@ def _env() -> Any:
 def _policy(seed: int = 0) -> Any:
     from gymnasium import spaces
 
-    from policies.imitation import make_policy
+    from semexplore_gym.training.learner import make_learner_policy
     from semexplore_gym.wrappers.egocentric import egocentric_observation_space
 
-    return make_policy(
+    return make_learner_policy(
         egocentric_observation_space(PARAMS),
         spaces.Box(-1.0, 1.0, (2,), np.float32),
         seed=seed,
@@ -141,7 +138,7 @@ def _policy(seed: int = 0) -> Any:
 
 
 def test_expert_recording_writes_labelled_episodes(tmp_path: Path) -> None:
-    from policies.imitation import record_expert_dataset
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     data = record_expert_dataset(
@@ -158,7 +155,8 @@ def test_expert_recording_writes_labelled_episodes(tmp_path: Path) -> None:
 
 
 def test_bc_reduces_heldout_action_error() -> None:
-    from policies.imitation import action_error, record_expert_dataset, train_bc
+    from semexplore_gym.training.bc import action_error, train_bc
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     data = record_expert_dataset(env, ReactiveExpert(), None, 5, PARAMS, seed=0, max_steps=60)
@@ -174,7 +172,8 @@ def test_bc_reduces_heldout_action_error() -> None:
 
 
 def test_dagger_round_runs_and_grows_the_dataset(tmp_path: Path) -> None:
-    from policies.imitation import record_expert_dataset, run_dagger
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     base = record_expert_dataset(env, ReactiveExpert(), None, 1, PARAMS, seed=0, max_steps=20)
@@ -202,8 +201,8 @@ def test_dagger_round_runs_and_grows_the_dataset(tmp_path: Path) -> None:
 
 
 def test_saved_policy_runs_through_sb3_policy(tmp_path: Path) -> None:
-    from policies.imitation import save_policy
     from policies.sb3_policy import SB3Policy
+    from semexplore_gym.training.learner import save_policy
     from semexplore_gym.wrappers.egocentric import egocentric_features
 
     env = _env()
@@ -238,7 +237,7 @@ def test_sb3_policy_rejects_bad_files(tmp_path: Path) -> None:
 
 def test_registry_builds_sb3_policy(tmp_path: Path) -> None:
     registry = pytest.importorskip("policies.registry")
-    from policies.imitation import save_policy
+    from semexplore_gym.training.learner import save_policy
 
     pytest.importorskip("torch")
     path = save_policy(_policy(), tmp_path / "m.zip", PARAMS)
@@ -354,7 +353,7 @@ class ConstantExpert(Policy):
 
 
 def test_dart_noise_perturbs_execution_not_labels() -> None:
-    from policies.imitation import rollout_episode
+    from semexplore_gym.training.episodes import rollout_episode
 
     env = _env()
 
@@ -388,7 +387,8 @@ def test_dart_noise_perturbs_execution_not_labels() -> None:
 
 
 def test_select_best_restores_the_best_epoch_and_mirroring_trains() -> None:
-    from policies.imitation import action_error, record_expert_dataset, train_bc
+    from semexplore_gym.training.bc import action_error, train_bc
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     params = EgocentricParams(
@@ -398,10 +398,10 @@ def test_select_best_restores_the_best_epoch_and_mirroring_trains() -> None:
     train, held = data.split_by_episode(0.34, np.random.default_rng(0))
     from gymnasium import spaces
 
-    from policies.imitation import make_policy
+    from semexplore_gym.training.learner import make_learner_policy
     from semexplore_gym.wrappers.egocentric import egocentric_observation_space
 
-    policy = make_policy(
+    policy = make_learner_policy(
         egocentric_observation_space(params),
         spaces.Box(-1.0, 1.0, (2,), np.float32),
         net_arch=[32],
