@@ -310,7 +310,7 @@ def _make_expert(cfg: TrainConfig) -> Any:
 
 
 def _save_model(model: Any, path: Path, params: Any, algo: str) -> None:
-    from policies.imitation import tag_model_zip
+    from semexplore_gym.training.learner import tag_model_zip
 
     model.save(str(path))
     tag_model_zip(path, params, algo="ppo")
@@ -320,7 +320,9 @@ def _save_model(model: Any, path: Path, params: Any, algo: str) -> None:
 def _train_imitation(
     cfg: TrainConfig, args: argparse.Namespace, out: Path, log: ScalarLogger
 ) -> dict[str, Any]:
-    from policies.imitation import action_error, record_expert_dataset, run_dagger, train_bc
+    from semexplore_gym.training.bc import action_error, train_bc
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     params = _egocentric_params(cfg)
     raw_env = _make_raw_env(cfg)
@@ -435,7 +437,7 @@ def _train_imitation(
 
 
 def _train_ppo(cfg: TrainConfig, args: argparse.Namespace, out: Path) -> dict[str, Any]:
-    from policies.imitation import load_model
+    from policies.sb3_model import load_model
 
     params = _egocentric_params(cfg)
     vec_env = _vec_env(cfg)
