@@ -41,6 +41,23 @@ def action_error(policy: Any, dataset: ImitationDataset, batch_size: int = 512) 
     return float(np.concatenate(errs).mean())
 
 
+def _mirror_half(
+    obs: dict[str, np.ndarray],
+    actions: np.ndarray,
+    params: EgocentricParams,
+    rng: np.random.Generator,
+) -> None:
+    """Replace each sample of a minibatch by its left-right mirror image with probability 1/2."""
+    flip = rng.random(len(actions)) < 0.5
+    if flip.any():
+        m_obs, m_act = mirror_observations(
+            {k: v[flip] for k, v in obs.items()}, actions[flip], params
+        )
+        for k in obs:
+            obs[k][flip] = m_obs[k]
+        actions[flip] = m_act
+
+
 def train_bc(
     dataset: ImitationDataset,
     policy: Any,
@@ -115,14 +132,7 @@ def train_bc(
             obs_b = {k: v[idx] for k, v in dataset.obs.items()}
             act_b = dataset.actions[idx]
             if mirror_params is not None:
-                flip = rng.random(len(idx)) < 0.5
-                if flip.any():
-                    m_obs, m_act = mirror_observations(
-                        {k: v[flip] for k, v in obs_b.items()}, act_b[flip], mirror_params
-                    )
-                    for k in obs_b:
-                        obs_b[k][flip] = m_obs[k]
-                    act_b[flip] = m_act
+                _mirror_half(obs_b, act_b, mirror_params, rng)
             _values, log_prob, entropy = policy.evaluate_actions(
                 {k: th.as_tensor(v, device=policy.device) for k, v in obs_b.items()},
                 th.as_tensor(act_b, device=policy.device),

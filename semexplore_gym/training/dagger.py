@@ -118,24 +118,12 @@ def run_dagger(
     bc_kwargs = dict(bc_kwargs or {})
     epochs = int(bc_kwargs.get("epochs", 10))
     history: list[dict[str, float]] = []
-    first_seed = seed + 10_000  # away from the seeds an expert dataset usually uses
     with worker_pool(workers, episodes_per_round) as pool:
         for r in with_progress(range(rounds), progress, "DAgger rounds"):
             b = float(sched(r))
             t0 = time.perf_counter()
             first_id = int(data.episode_ids.max()) + 1 if len(data) else 0
-            jobs = []
-            for j in range(episodes_per_round):
-                k = r * episodes_per_round + j
-                jobs.append(
-                    EpisodeJob(
-                        seed=first_seed + k,
-                        rng_key=(seed, k, DAGGER_STREAM),
-                        max_steps=max_steps,
-                        episode_id=first_id + j,
-                        beta=b,
-                    )
-                )
+            jobs = _round_jobs(r, episodes_per_round, seed, first_id, b, max_steps)
             parts, covs, fracs = [], [], []
             for rec in run_jobs(jobs, env, expert, params, learner, pool, make_env, make_expert):
                 parts.append(rec.data)
@@ -169,3 +157,23 @@ def run_dagger(
                 for k in ("beta", "coverage", "expert_fraction", "dataset_size", "bc_loss"):
                     log_fn(f"dagger/{k}", float(facts[k]), r)
     return DaggerResult(data, history)
+
+
+def _round_jobs(
+    round_index: int, episodes_per_round: int, seed: int, first_id: int, beta: float, max_steps: int
+) -> list[EpisodeJob]:
+    """The episodes of DAgger round ``round_index`` (see :func:`run_dagger` for the seeds)."""
+    first_seed = seed + 10_000  # away from the seeds an expert dataset usually uses
+    jobs = []
+    for j in range(episodes_per_round):
+        k = round_index * episodes_per_round + j
+        jobs.append(
+            EpisodeJob(
+                seed=first_seed + k,
+                rng_key=(seed, k, DAGGER_STREAM),
+                max_steps=max_steps,
+                episode_id=first_id + j,
+                beta=beta,
+            )
+        )
+    return jobs
