@@ -29,14 +29,19 @@ def policy_kwargs(cfg: TrainConfig) -> dict[str, Any]:
 def new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None, algo: str = "ppo") -> Any:
     """A fresh PPO (or, with ``algo="maskable_ppo"``, sb3-contrib MaskablePPO) for ``vec_env``."""
     pc = cfg.ppo
+    algo_cls: Any
     if algo == "maskable_ppo":
         if not is_macro(cfg):
             raise ValueError(
                 f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
             )
-        from sb3_contrib import MaskablePPO as algo_cls
+        from sb3_contrib import MaskablePPO
+
+        algo_cls = MaskablePPO
     else:
-        from stable_baselines3 import PPO as algo_cls
+        from stable_baselines3 import PPO
+
+        algo_cls = PPO
     if is_macro(cfg):
         policy_name = "MlpPolicy"
         kwargs: dict[str, Any] = {
@@ -82,8 +87,8 @@ def save_tagged_model(model: Any, path: Path, params: EgocentricParams) -> None:
     tag_model_zip(path, params, algo="ppo")
 
 
-def _load_init_weights(cfg: TrainConfig, model: Any) -> None:
-    """Start ``model`` from the BC/DAgger model ``ppo.init_from`` (same features and network)."""
+def _load_init_weights(cfg: TrainConfig, model: Any, init_from: str) -> None:
+    """Start ``model`` from the BC/DAgger model ``init_from`` (same features and network)."""
     from policies.sb3_model import load_model
 
     if is_macro(cfg):
@@ -91,7 +96,7 @@ def _load_init_weights(cfg: TrainConfig, model: Any) -> None:
             f"ppo.init_from (a BC/DAgger model) only fits the egocentric env, not env.env_id={cfg.env.env_id!r}"
         )
     params = cfg.egocentric
-    init_policy, init_params = load_model(cfg.ppo.init_from)
+    init_policy, init_params = load_model(init_from)
     if init_params != params:
         raise ValueError(
             f"ppo.init_from model uses egocentric {init_params.to_dict()} but this config uses {params.to_dict()}"
@@ -109,7 +114,7 @@ def train_ppo(cfg: TrainConfig, algo: str, out: Path, progress: bool = True) -> 
     vec_env = make_vec_env(cfg)
     model = new_ppo(cfg, vec_env, str(out / "tb"), algo=algo)
     if cfg.ppo.init_from:
-        _load_init_weights(cfg, model)
+        _load_init_weights(cfg, model, cfg.ppo.init_from)
     t0 = time.perf_counter()
     model.learn(total_timesteps=cfg.ppo.total_timesteps, progress_bar=progress, tb_log_name=algo)
     metrics = {"ppo_s": time.perf_counter() - t0, "timesteps": int(model.num_timesteps)}
