@@ -122,6 +122,21 @@ class MissionResult:
         }
 
 
+def make_mission_env(world: str, env_config: Any = None, **kwargs: Any) -> Any:
+    """A ``SemanticExplore-v0`` env on ``world`` (``gym.make``; registers the env ids first).
+
+    Args:
+        world: World spelling (a name, ``family:key=value,...`` or a map file).
+        env_config: Env config (preset name, YAML path, mapping or None).
+        **kwargs: Further ``gym.make`` arguments (``overrides``, ``render_mode`` ...).
+    """
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401  (registers the env ids)
+
+    return gym.make("SemanticExplore-v0", world=world, config=env_config, **kwargs)
+
+
 def time_to_coverage(trace: list[tuple[float, float, float]], level: float) -> float | None:
     """First simulated time at which the coverage in ``trace`` reached ``level`` (None if never)."""
     for t, c, _ in trace:

@@ -91,7 +91,7 @@ def train_bc(
         step_offset: Added to the epoch index passed to ``log_fn`` (DAgger rounds).
         eval_data: Held-out samples; their :func:`action_error` is recorded after each epoch.
         mirror_params: When given, each minibatch sample is replaced by its left-right mirror
-            image (:func:`~semexplore_gym.core.egocentric.mirror_observations`) with
+            image (:func:`~semexplore_gym.core.features.egocentric.mirror_observations`) with
             probability 1/2, doubling the data for free; these are the data's parameters.
         select_best: With ``eval_data``, restore the weights of the epoch with the lowest
             held-out action error at the end (early stopping without stopping).

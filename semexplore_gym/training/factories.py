@@ -8,21 +8,13 @@ from __future__ import annotations
 
 from typing import Any
 
+from semexplore_gym.evaluation.rollout import make_mission_env
 from semexplore_gym.training.config import TrainConfig, is_macro
 
 
 def make_raw_env(cfg: TrainConfig) -> Any:
     """The base ``SemanticExplore-v0`` env of the run (raw observations)."""
-    import gymnasium as gym
-
-    import semexplore_gym  # noqa: F401  (registers the env)
-
-    return gym.make(
-        "SemanticExplore-v0",
-        world=cfg.env.world,
-        config=cfg.env.config,
-        overrides=list(cfg.env.overrides),
-    )
+    return make_mission_env(cfg.env.world, cfg.env.config, overrides=list(cfg.env.overrides))
 
 
 def make_macro_env(cfg: TrainConfig) -> Any:
