@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import functools
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from _imitation import ReactiveExpert
 
-from policies.base import Policy
 from semexplore_gym.training.dataset import ImitationDataset
 from semexplore_gym.training.workers import DAGGER_STREAM, EXPERT_STREAM, check_workers, episode_rng
 from semexplore_gym.wrappers.egocentric import EgocentricParams
@@ -24,21 +23,10 @@ PARAMS = EgocentricParams(
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
-class SteerToOpenExpert(Policy):
+class SteerToOpenExpert(ReactiveExpert):
     """Stand-in expert, a pure function of the scan: forward, turning towards the open side."""
 
     name = "steer_to_open"
-
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        scan = obs["scan"]
-        r = np.where(scan > 0, scan, float(info["lidar"]["max_range_m"]))
-        ang = (np.arange(r.size) * 2 * math.pi / r.size + math.pi) % (2 * math.pi) - math.pi
-        front = r[np.abs(ang) < 0.5].min()
-        left = r[(ang > 0.3) & (ang < 1.6)].mean()
-        right = r[(ang < -0.3) & (ang > -1.6)].mean()
-        if front < 0.45:
-            return np.array([0.0, 1.0 if left >= right else -1.0], np.float32)
-        return np.array([min(1.0, front / 1.5), np.clip(0.8 * (left - right), -1, 1)], np.float32)
 
 
 def make_env() -> Any:
