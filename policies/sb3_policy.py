@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from policies.base import Policy, StepStats
-from policies.imitation import learner_action
+from policies.sb3_model import learner_action, load_model
 from semexplore_gym.core.features.egocentric import EgocentricEncoder
 
 
@@ -40,8 +40,6 @@ class SB3Policy(Policy):
         num_threads: int | None = 1,
     ) -> None:
         super().__init__()
-        from policies.imitation import load_model
-
         if num_threads is not None:
             if not isinstance(num_threads, int) or num_threads < 1:
                 raise ValueError(

@@ -51,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     import semexplore_gym  # noqa: F401
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from policies.rollout import STAGES, run_mission
+    from semexplore_gym.evaluation.rollout import STAGES, run_mission
     from semexplore_gym.core.params import merge_overrides
 
     cfg = load_policy_config(args.policy_config)

@@ -47,7 +47,7 @@ def _split_worlds(text: str) -> list[str]:
 
 def weight_sets(tuned: dict[str, float]) -> dict[str, dict[str, float]]:
     """Label -> dotted overrides: paper, tuned and the ablations of the paper's semantic terms."""
-    from policies.weight_tuning import PAPER_WEIGHTS
+    from semexplore_gym.training.weight_tuning import PAPER_WEIGHTS
 
     return {
         PAPER: dict(PAPER_WEIGHTS),
@@ -70,7 +70,7 @@ def summarise(
     import numpy as np
     from scipy.stats import mannwhitneyu
 
-    from policies.weight_tuning import mission_score
+    from semexplore_gym.training.weight_tuning import mission_score
 
     def score(r: dict[str, Any]) -> float:
         return mission_score(
@@ -242,19 +242,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from policies.weight_tuning import (
-        PAPER_FIELD,
-        PAPER_WEIGHTS,
-        SearchSpace,
-        mission_objective,
-        tune_weights,
-    )
     from semexplore_gym.evaluation.harness import (
         expand_tasks,
         parse_seeds,
         read_runs,
         run_benchmark,
         write_manifest,
+    )
+    from semexplore_gym.training.weight_tuning import (
+        PAPER_FIELD,
+        PAPER_WEIGHTS,
+        SearchSpace,
+        mission_objective,
+        tune_weights,
     )
 
     train_worlds = _split_worlds(args.train_worlds)

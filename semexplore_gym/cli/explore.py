@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     import semexplore_gym  # noqa: F401  (registers the env)
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import run_mission
     from semexplore_gym.core.params import merge_overrides
 
     if not (args.max_time_s > 0):

@@ -1,1 +1,4 @@
-"""Benchmark harness, figures and summaries (above envs and policies; used by the CLI)."""
+"""Missions and benchmarks: ``rollout`` (one mission, its metrics), ``harness``, ``report``.
+
+Above envs and policies; used by the CLI, the scripts and ``semexplore_gym.training``.
+"""

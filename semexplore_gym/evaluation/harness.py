@@ -49,6 +49,11 @@ CSV_COLUMNS: tuple[str, ...] = (
 )
 
 
+def resolve_world(world: str, seed: int) -> str:
+    """A world spelling with a ``seed=*`` placeholder replaced by ``seed``."""
+    return world.replace("seed=*", f"seed={int(seed)}")
+
+
 @dataclass(frozen=True)
 class Task:
     """One mission to run."""
@@ -67,7 +72,7 @@ class Task:
     @property
     def resolved_world(self) -> str:
         """The world spelling with a ``seed=*`` placeholder replaced by this task's seed."""
-        return self.world.replace("seed=*", f"seed={self.seed}")
+        return resolve_world(self.world, self.seed)
 
 
 def expand_tasks(
@@ -106,13 +111,10 @@ def task_stem(world: str, policy: str, seed: int) -> str:
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
-    import gymnasium as gym
-
-    import semexplore_gym  # noqa: F401  (registers the env)
     from policies.registry import make_policy
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
 
-    env = gym.make("SemanticExplore-v0", world=task.resolved_world, config=task.env_config)
+    env = make_mission_env(task.resolved_world, task.env_config)
     try:
         policy = make_policy(task.policy, **task.policy_overrides)
         # Missions end when the policy stops itself (or at the time limit), not at the env's

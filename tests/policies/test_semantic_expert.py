@@ -278,7 +278,7 @@ def _mission(world: str, seed: int = 0, max_time_s: float = 1200.0):
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import run_mission
 
     env = gym.make("SemanticExplore-v0", world=world)
     try:

@@ -90,13 +90,13 @@ def test_real_missions_with_a_tiny_budget(tmp_path: Path, capsys: pytest.Capture
     pytest.importorskip("stable_baselines3")
     from gymnasium import spaces
 
-    from policies.imitation import make_policy, save_policy
+    from semexplore_gym.training.learner import make_learner_policy, save_policy
     from semexplore_gym.wrappers.egocentric import EgocentricParams, egocentric_observation_space
 
     params = EgocentricParams(
         crop_cells=36, crop_resolution_m=0.15, channels=("occupancy", "trail")
     )
-    policy = make_policy(
+    policy = make_learner_policy(
         egocentric_observation_space(params),
         spaces.Box(-1.0, 1.0, (2,), np.float32),
         net_arch=[16],

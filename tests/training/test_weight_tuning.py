@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from policies.weight_tuning import (
+from semexplore_gym.training.weight_tuning import (
     PAPER_WEIGHTS,
     SearchSpace,
     evaluate_weights,

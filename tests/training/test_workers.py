@@ -3,21 +3,15 @@
 from __future__ import annotations
 
 import functools
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from _imitation import ReactiveExpert
 
-from policies.base import Policy
-from policies.imitation import (
-    DAGGER_STREAM,
-    EXPERT_STREAM,
-    ImitationDataset,
-    check_workers,
-    episode_rng,
-)
+from semexplore_gym.training.dataset import ImitationDataset
+from semexplore_gym.training.workers import DAGGER_STREAM, EXPERT_STREAM, check_workers, episode_rng
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 
 WORLD = "maze:size_m=5,seed=1"
@@ -29,21 +23,10 @@ PARAMS = EgocentricParams(
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
-class SteerToOpenExpert(Policy):
+class SteerToOpenExpert(ReactiveExpert):
     """Stand-in expert, a pure function of the scan: forward, turning towards the open side."""
 
     name = "steer_to_open"
-
-    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
-        scan = obs["scan"]
-        r = np.where(scan > 0, scan, float(info["lidar"]["max_range_m"]))
-        ang = (np.arange(r.size) * 2 * math.pi / r.size + math.pi) % (2 * math.pi) - math.pi
-        front = r[np.abs(ang) < 0.5].min()
-        left = r[(ang > 0.3) & (ang < 1.6)].mean()
-        right = r[(ang < -0.3) & (ang > -1.6)].mean()
-        if front < 0.45:
-            return np.array([0.0, 1.0 if left >= right else -1.0], np.float32)
-        return np.array([min(1.0, front / 1.5), np.clip(0.8 * (left - right), -1, 1)], np.float32)
 
 
 def make_env() -> Any:
@@ -64,10 +47,10 @@ def _env() -> Any:
 def _policy(seed: int = 0) -> Any:
     from gymnasium import spaces
 
-    from policies.imitation import make_policy
+    from semexplore_gym.training.learner import make_learner_policy
     from semexplore_gym.wrappers.egocentric import egocentric_observation_space
 
-    return make_policy(
+    return make_learner_policy(
         egocentric_observation_space(PARAMS),
         spaces.Box(-1.0, 1.0, (2,), np.float32),
         seed=seed,
@@ -101,7 +84,8 @@ def test_bad_workers_are_rejected() -> None:
     for bad in (0, -1, 1.5, True, "2", None):
         with pytest.raises(ValueError, match="workers must be an integer >= 1"):
             check_workers(bad)
-    from policies.imitation import record_expert_dataset, run_dagger
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     with pytest.raises(ValueError, match="workers must be an integer >= 1, got 0"):
@@ -124,7 +108,8 @@ def test_bad_workers_are_rejected() -> None:
 
 
 def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
-    from policies.imitation import record_expert_dataset, rollout_episode
+    from semexplore_gym.training.episodes import rollout_episode
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     data = record_expert_dataset(
@@ -163,7 +148,8 @@ def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
 @pytest.mark.slow
 def test_two_workers_record_and_dagger_like_one(tmp_path: Path) -> None:
     """Same datasets, files, round facts and learner weights with workers = 1 and 2."""
-    from policies.imitation import record_expert_dataset, run_dagger
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     results = {}

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from policies.base import Policy
+from policies.base import Policy, StepStats
 
 #: Stages of the per-stage wall-time split, in the order they are reported.
 STAGES: tuple[str, ...] = (
@@ -122,12 +122,117 @@ class MissionResult:
         }
 
 
+def make_mission_env(world: str, env_config: Any = None, **kwargs: Any) -> Any:
+    """A ``SemanticExplore-v0`` env on ``world`` (``gym.make``; registers the env ids first).
+
+    Args:
+        world: World spelling (a name, ``family:key=value,...`` or a map file).
+        env_config: Env config (preset name, YAML path, mapping or None).
+        **kwargs: Further ``gym.make`` arguments (``overrides``, ``render_mode`` ...).
+    """
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401  (registers the env ids)
+
+    return gym.make("SemanticExplore-v0", world=world, config=env_config, **kwargs)
+
+
 def time_to_coverage(trace: list[tuple[float, float, float]], level: float) -> float | None:
     """First simulated time at which the coverage in ``trace`` reached ``level`` (None if never)."""
     for t, c, _ in trace:
         if c >= level - 1e-12:
             return float(t)
     return None
+
+
+class _MissionLog:
+    """What a mission accumulates: stage wall times, planning stats, coverage trace and poses."""
+
+    def __init__(self, obs: dict[str, Any], info: dict[str, Any]) -> None:
+        self.stage = dict.fromkeys(STAGES, 0.0)
+        self.trace: list[tuple[float, float, float]] = [
+            (
+                float(info.get("sim_time_s", 0.0)),
+                float(info["coverage"]),
+                float(info["explored_area_m2"]),
+            )
+        ]
+        self.poses = [np.asarray(obs["pose"], dtype=np.float64).copy()]
+        self.map_ms: list[float] = []
+        self.glob_ms: list[float] = []
+        self.n_replans = 0
+        self.steps = 0
+
+    def add_policy_stats(self, st: StepStats, act_s: float) -> None:
+        """Split one ``act`` call of ``act_s`` wall seconds into stages by its :class:`StepStats`."""
+        self.stage["map_generation"] += st.map_generation_ms / 1e3
+        self.stage["global_planning"] += st.global_planning_ms / 1e3
+        self.stage["local_planning"] += st.local_planning_ms / 1e3
+        self.stage["policy_other"] += max(
+            0.0,
+            act_s - (st.map_generation_ms + st.global_planning_ms + st.local_planning_ms) / 1e3,
+        )
+        if st.map_generation_ms > 0:
+            self.map_ms.append(st.map_generation_ms)
+        if st.replanned or st.global_planning_ms > 0:
+            self.glob_ms.append(st.global_planning_ms)
+        self.n_replans += int(st.replanned)
+
+    def add_step(self, obs: dict[str, Any], info: dict[str, Any]) -> float:
+        """Record the state after an env step; returns its simulated time."""
+        self.steps += 1
+        sim_t = float(info["sim_time_s"])
+        self.trace.append((sim_t, float(info["coverage"]), float(info["explored_area_m2"])))
+        self.poses.append(np.asarray(obs["pose"], dtype=np.float64).copy())
+        return sim_t
+
+
+class _GifRecorder:
+    """Grabs a rendered frame every ``every_s`` simulated seconds; render time goes to ``stage``."""
+
+    def __init__(self, env: Any, policy: Policy, every_s: float, stage: dict[str, float]) -> None:
+        self.env = env
+        self.policy = policy
+        self.every_s = every_s
+        self.stage = stage
+        self.frames: list[np.ndarray] = []
+        self.next_frame_s = 0.0
+
+    def grab(self) -> None:
+        tr = time.perf_counter()
+        getattr(self.env, "unwrapped", self.env).set_overlay(self.policy.overlay())
+        frame = self.env.render()
+        if frame is not None:
+            self.frames.append(np.asarray(frame))
+        self.stage["render"] += time.perf_counter() - tr
+
+    def start(self) -> None:
+        self.grab()
+        self.next_frame_s = self.every_s
+
+    def after_step(self, sim_t: float) -> None:
+        if sim_t >= self.next_frame_s - 1e-9:
+            self.grab()
+            self.next_frame_s += self.every_s
+
+    def save(self, path: str | os.PathLike, fps: float) -> None:
+        t_save = time.perf_counter()
+        save_gif(self.frames, path, fps=fps)
+        self.stage["render"] += time.perf_counter() - t_save
+
+
+def _check_mission_args(
+    env: Any, max_time_s: float | None, gif_path: str | os.PathLike | None, gif_every_s: float
+) -> None:
+    if max_time_s is not None and not (max_time_s > 0 and math.isfinite(max_time_s)):
+        raise ValueError(f"max_time_s must be a positive number or None, got {max_time_s!r}")
+    if gif_path is not None:
+        if getattr(env, "render_mode", None) != "rgb_array":
+            raise ValueError(
+                f"gif_path needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
+            )
+        if not gif_every_s > 0:
+            raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
 
 
 def run_mission(
@@ -169,121 +274,33 @@ def run_mission(
         ValueError: a non-positive ``max_time_s``, or ``gif_path`` with an env that cannot render
             RGB frames.
     """
-    if max_time_s is not None and not (max_time_s > 0 and math.isfinite(max_time_s)):
-        raise ValueError(f"max_time_s must be a positive number or None, got {max_time_s!r}")
-    if gif_path is not None:
-        if getattr(env, "render_mode", None) != "rgb_array":
-            raise ValueError(
-                f"gif_path needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
-            )
-        if not gif_every_s > 0:
-            raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
-    stage = dict.fromkeys(STAGES, 0.0)
+    _check_mission_args(env, max_time_s, gif_path, gif_every_s)
     cpu0 = time.process_time()
     wall0 = time.perf_counter()
     obs, info = env.reset(seed=seed, options=reset_options)
     t1 = time.perf_counter()
-    stage["env_reset"] = t1 - wall0
+    log = _MissionLog(obs, info)
+    log.stage["env_reset"] = t1 - wall0
     policy.reset(obs, info, seed=seed)
-    stage["policy_other"] += time.perf_counter() - t1
+    log.stage["policy_other"] += time.perf_counter() - t1
 
-    unwrapped = getattr(env, "unwrapped", env)
-    world_name = str(
-        getattr(getattr(unwrapped, "world", None), "name", getattr(unwrapped, "world_spec", "?"))
-    )
-    dt_s = float(info.get("dt_s", 0.2))
+    world_name = _world_name(env)
     limit_s = max_time_s if max_time_s is not None else math.inf
-    trace: list[tuple[float, float, float]] = [
-        (
-            float(info.get("sim_time_s", 0.0)),
-            float(info["coverage"]),
-            float(info["explored_area_m2"]),
-        )
-    ]
-    poses = [np.asarray(obs["pose"], dtype=np.float64).copy()]
-    frames: list[np.ndarray] = []
-    next_frame_s = 0.0
-    map_ms: list[float] = []
-    glob_ms: list[float] = []
-    n_replans = 0
-    steps = 0
-    terminated = truncated = False
-
-    def grab_frame() -> None:
-        tr = time.perf_counter()
-        unwrapped.set_overlay(policy.overlay())
-        frame = env.render()
-        if frame is not None:
-            frames.append(np.asarray(frame))
-        stage["render"] += time.perf_counter() - tr
-
+    gif = _GifRecorder(env, policy, gif_every_s, log.stage) if gif_path is not None else None
     bar = _progress_bar(
         progress, limit_s if math.isfinite(limit_s) else None, world_name, policy.name
     )
     try:
-        if gif_path is not None:
-            grab_frame()
-            next_frame_s = gif_every_s
-        while True:
-            ta = time.perf_counter()
-            action = policy.act(obs, info)
-            tb = time.perf_counter()
-            st = policy.last_stats
-            stage["map_generation"] += st.map_generation_ms / 1e3
-            stage["global_planning"] += st.global_planning_ms / 1e3
-            stage["local_planning"] += st.local_planning_ms / 1e3
-            stage["policy_other"] += max(
-                0.0,
-                (tb - ta)
-                - (st.map_generation_ms + st.global_planning_ms + st.local_planning_ms) / 1e3,
-            )
-            if st.map_generation_ms > 0:
-                map_ms.append(st.map_generation_ms)
-            if st.replanned or st.global_planning_ms > 0:
-                glob_ms.append(st.global_planning_ms)
-            n_replans += int(st.replanned)
-            if policy.done:
-                break
-            obs, _, terminated, truncated, info = env.step(action)
-            stage["env_step"] += time.perf_counter() - tb
-            steps += 1
-            sim_t = float(info["sim_time_s"])
-            trace.append((sim_t, float(info["coverage"]), float(info["explored_area_m2"])))
-            poses.append(np.asarray(obs["pose"], dtype=np.float64).copy())
-            if on_step is not None:
-                on_step(steps, obs, info, action, policy)
-            if gif_path is not None and sim_t >= next_frame_s - 1e-9:
-                grab_frame()
-                next_frame_s += gif_every_s
-            if bar is not None:
-                bar.update(dt_s)
-                if steps % 25 == 0:
-                    bar.set_postfix(
-                        coverage=f"{info['coverage']:.3f}",
-                        mode=str(st.extra.get("mode", "")),
-                        refresh=False,
-                    )
-            if (terminated and not ignore_terminated) or truncated or sim_t >= limit_s - 1e-9:
-                break
-        if gif_path is not None:
-            grab_frame()
+        info, terminated, truncated = _drive(
+            env, policy, obs, info, log, gif, bar, on_step, limit_s, ignore_terminated
+        )
     finally:
         if bar is not None:
             bar.close()
-    sim_t = float(info["sim_time_s"])
-    if policy.done:
-        reason = policy.stop_reason or "policy done"
-    elif terminated and not ignore_terminated:
-        reason = "env terminated (coverage goal reached)"
-    elif truncated:
-        reason = "env truncated (episode time limit)"
-    else:
-        reason = f"max_time_s reached ({max_time_s:g} s)"
+    reason = _stop_reason(policy, terminated, truncated, ignore_terminated, max_time_s)
     wall = time.perf_counter() - wall0
-    if gif_path is not None:
-        t_save = time.perf_counter()
-        save_gif(frames, gif_path, fps=gif_fps)
-        stage["render"] += time.perf_counter() - t_save
+    if gif is not None and gif_path is not None:
+        gif.save(gif_path, gif_fps)
         wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
     return MissionResult(
@@ -292,26 +309,96 @@ def run_mission(
         seed=seed,
         coverage=float(info["coverage"]),
         explored_area_m2=float(info["explored_area_m2"]),
-        mission_time_s=sim_t,
+        mission_time_s=float(info["sim_time_s"]),
         self_stopped=bool(policy.done),
         stop_reason=reason,
         path_length_m=float(info["path_length_m"]),
         collisions=int(info["collisions"]),
         wall_time_s=wall,
         cpu_time_s=cpu,
-        steps=steps,
+        steps=log.steps,
         terminated=bool(terminated),
         truncated=bool(truncated or (not terminated and not policy.done)),
-        t90_s=time_to_coverage(trace, 0.90),
-        t99_s=time_to_coverage(trace, 0.99),
-        mean_map_generation_ms=float(np.mean(map_ms)) if map_ms else 0.0,
-        mean_global_planning_ms=float(np.mean(glob_ms)) if glob_ms else 0.0,
-        n_replans=n_replans,
-        stage_time_s=stage,
-        coverage_trace=trace,
-        trajectory=np.asarray(poses),
+        t90_s=time_to_coverage(log.trace, 0.90),
+        t99_s=time_to_coverage(log.trace, 0.99),
+        mean_map_generation_ms=float(np.mean(log.map_ms)) if log.map_ms else 0.0,
+        mean_global_planning_ms=float(np.mean(log.glob_ms)) if log.glob_ms else 0.0,
+        n_replans=log.n_replans,
+        stage_time_s=log.stage,
+        coverage_trace=log.trace,
+        trajectory=np.asarray(log.poses),
         policy_counters=dict(getattr(policy, "counters", {}) or {}),
     )
+
+
+def _drive(
+    env: Any,
+    policy: Policy,
+    obs: dict[str, Any],
+    info: dict[str, Any],
+    log: _MissionLog,
+    gif: _GifRecorder | None,
+    bar: Any,
+    on_step: Callable[[int, dict[str, Any], dict[str, Any], np.ndarray, Policy], None] | None,
+    limit_s: float,
+    ignore_terminated: bool,
+) -> tuple[dict[str, Any], bool, bool]:
+    """The act / step loop of :func:`run_mission`; returns the last info, terminated, truncated."""
+    dt_s = float(info.get("dt_s", 0.2))
+    terminated = truncated = False
+    if gif is not None:
+        gif.start()
+    while True:
+        ta = time.perf_counter()
+        action = policy.act(obs, info)
+        tb = time.perf_counter()
+        st = policy.last_stats
+        log.add_policy_stats(st, tb - ta)
+        if policy.done:
+            break
+        obs, _, terminated, truncated, info = env.step(action)
+        log.stage["env_step"] += time.perf_counter() - tb
+        sim_t = log.add_step(obs, info)
+        if on_step is not None:
+            on_step(log.steps, obs, info, action, policy)
+        if gif is not None:
+            gif.after_step(sim_t)
+        if bar is not None:
+            bar.update(dt_s)
+            if log.steps % 25 == 0:
+                bar.set_postfix(
+                    coverage=f"{info['coverage']:.3f}",
+                    mode=str(st.extra.get("mode", "")),
+                    refresh=False,
+                )
+        if (terminated and not ignore_terminated) or truncated or sim_t >= limit_s - 1e-9:
+            break
+    if gif is not None:
+        gif.grab()
+    return info, terminated, truncated
+
+
+def _world_name(env: Any) -> str:
+    unwrapped = getattr(env, "unwrapped", env)
+    return str(
+        getattr(getattr(unwrapped, "world", None), "name", getattr(unwrapped, "world_spec", "?"))
+    )
+
+
+def _stop_reason(
+    policy: Policy,
+    terminated: bool,
+    truncated: bool,
+    ignore_terminated: bool,
+    max_time_s: float | None,
+) -> str:
+    if policy.done:
+        return policy.stop_reason or "policy done"
+    if terminated and not ignore_terminated:
+        return "env terminated (coverage goal reached)"
+    if truncated:
+        return "env truncated (episode time limit)"
+    return f"max_time_s reached ({max_time_s:g} s)"
 
 
 def save_gif(frames: list[np.ndarray], path: str | os.PathLike, fps: float = 10.0) -> Path:

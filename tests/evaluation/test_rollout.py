@@ -11,7 +11,7 @@ import pytest
 import semexplore_gym  # noqa: F401
 from policies.base import Policy, StepStats
 from policies.random_policy import RandomPolicy
-from policies.rollout import STAGES, run_mission, time_to_coverage
+from semexplore_gym.evaluation.rollout import STAGES, run_mission, time_to_coverage
 
 
 class StopAfter(Policy):

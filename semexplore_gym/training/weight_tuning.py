@@ -18,6 +18,7 @@ rerun with the same paths resumes (it runs only the missing trials).
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -26,6 +27,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from semexplore_gym.evaluation.harness import resolve_world
+from semexplore_gym.evaluation.rollout import make_mission_env
 
 #: The paper's weights (Table I of Fredriksson et al.), as dotted overrides.
 PAPER_WEIGHTS: dict[str, float] = {
@@ -128,22 +132,6 @@ def mission_score(
     return float(mission_time_s + penalty_s * max(0.0, target_coverage - float(coverage)))
 
 
-def resolve_world(world: str, seed: int) -> str:
-    """A world spelling with a ``seed=*`` placeholder replaced by ``seed`` (as the harness does)."""
-    return world.replace("seed=*", f"seed={int(seed)}")
-
-
-def _default_env_factory(env_config: Any) -> Callable[[str], Any]:
-    def make(world: str) -> Any:
-        import gymnasium as gym
-
-        import semexplore_gym  # noqa: F401  (registers the env ids)
-
-        return gym.make("SemanticExplore-v0", world=world, config=env_config)
-
-    return make
-
-
 def evaluate_weights(
     weights: Mapping[str, float],
     worlds: Sequence[str],
@@ -160,19 +148,19 @@ def evaluate_weights(
         seeds: Seeds for ``env.reset`` and the policy (and ``seed=*`` worlds).
         max_time_s: Simulated time limit per mission.
         env_config: Env config for ``gym.make`` (preset, path, mapping or None).
-        env_factory: ``world -> env`` (default: ``gym.make("SemanticExplore-v0", ...)``).
+        env_factory: ``world -> env`` (default: :func:`make_mission_env` with ``env_config``).
 
     Returns:
         ``MissionResult.summary()`` dicts, world-major.
     """
     from policies.registry import make_policy
-    from policies.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import run_mission
 
     if not worlds:
         raise ValueError("no worlds given")
     if not seeds:
         raise ValueError("no seeds given")
-    make_env = env_factory or _default_env_factory(env_config)
+    make_env = env_factory or functools.partial(make_mission_env, env_config=env_config)
     out = []
     for world in worlds:
         for seed in seeds:

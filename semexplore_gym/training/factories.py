@@ -1,0 +1,55 @@
+"""The envs and the expert of a training run, built from its :class:`TrainConfig`.
+
+The factories are module-level functions of the config alone, so ``functools.partial`` of them
+pickles and the roll-out workers build their own envs and experts.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from semexplore_gym.evaluation.rollout import make_mission_env
+from semexplore_gym.training.config import TrainConfig, is_macro
+
+
+def make_raw_env(cfg: TrainConfig) -> Any:
+    """The base ``SemanticExplore-v0`` env of the run (raw observations)."""
+    return make_mission_env(cfg.env.world, cfg.env.config, overrides=list(cfg.env.overrides))
+
+
+def make_macro_env(cfg: TrainConfig) -> Any:
+    """The macro-action env ``cfg.env.env_id`` with its ``macro`` and ``expert`` settings."""
+    import gymnasium as gym
+
+    import semexplore_gym  # noqa: F401  (registers the env ids)
+
+    return gym.make(
+        cfg.env.env_id,
+        world=cfg.env.world,
+        config=cfg.env.config,
+        overrides=list(cfg.env.overrides),
+        macro=dict(cfg.env.macro),
+        expert=dict(cfg.env.expert),
+    )
+
+
+def make_learner_env(cfg: TrainConfig, max_episode_steps: int | None = None) -> Any:
+    """The env the learner trains in: egocentric observations, or the macro env's own."""
+    from gymnasium.wrappers import TimeLimit
+
+    from semexplore_gym.wrappers.egocentric import EgocentricObservation
+
+    if is_macro(cfg):
+        env = make_macro_env(cfg)
+    else:
+        env = EgocentricObservation(make_raw_env(cfg), params=cfg.egocentric)
+    if max_episode_steps:
+        env = TimeLimit(env, max_episode_steps=max_episode_steps)
+    return env
+
+
+def make_expert(cfg: TrainConfig) -> Any:
+    """The labelling expert ``cfg.expert.spec`` (a ``policies.registry`` spec)."""
+    from policies.registry import make_policy
+
+    return make_policy(cfg.expert.spec)
