@@ -17,7 +17,9 @@ def _components(mask: np.ndarray) -> int:
 @pytest.mark.parametrize("seed", range(60))
 def test_forest_gaps_are_at_least_min_gap_and_free_space_is_one_piece(seed: int) -> None:
     size = float(6 + seed % 5 * 6)
-    params = ForestParams(seed=seed, size_m=size, density=4 + seed % 4 * 6, min_gap_m=0.45 + 0.05 * (seed % 4))
+    params = ForestParams(
+        seed=seed, size_m=size, density=4 + seed % 4 * 6, min_gap_m=0.45 + 0.05 * (seed % 4)
+    )
     trunks = place_trunks(params, np.random.default_rng(seed))
     assert len(trunks) > 0
     x, y, r = trunks.T
