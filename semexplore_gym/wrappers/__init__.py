@@ -5,5 +5,6 @@ from semexplore_gym.wrappers.egocentric import (
     EgocentricParams,
     egocentric_features,
 )
+from semexplore_gym.wrappers.fixed_size import FixedSizeMap
 
-__all__ = ["EgocentricObservation", "EgocentricParams", "egocentric_features"]
+__all__ = ["EgocentricObservation", "EgocentricParams", "FixedSizeMap", "egocentric_features"]

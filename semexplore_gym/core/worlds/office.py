@@ -24,6 +24,7 @@ from semexplore_gym.core.worlds.build import world_from_free_mask
 from semexplore_gym.core.worlds.grid_maze import check_range
 from semexplore_gym.core.worlds.world import World
 
+_CLUTTER_GAP_M = 0.6
 _RES_M = 0.05
 _WALL_CELLS = 2  # 0.1 m walls
 _MIN_ROOM_DEPTH_M = 3.0
@@ -44,6 +45,10 @@ class OfficeParams:
         corridor_width_m: Width of every corridor (wall face to wall face).
         door_width_m: Width of every door opening.
         room_link_prob: Probability that two neighbouring rooms get a door between them.
+        clutter: Furniture boxes per 10 m^2 of room floor (0: empty rooms). Boxes are 0.3-0.8 m
+            a side and stay at least ``_CLUTTER_GAP_M`` from walls and each other, so every
+            room stays reachable; they come from their own random stream, so the floor plan
+            is the same as without clutter.
     """
 
     seed: int = 0
@@ -51,6 +56,7 @@ class OfficeParams:
     corridor_width_m: float = 1.5
     door_width_m: float = 0.9
     room_link_prob: float = 0.3
+    clutter: float = 0.0
 
     def __post_init__(self) -> None:
         if (
@@ -63,6 +69,37 @@ class OfficeParams:
         check_range("office", "corridor_width_m", self.corridor_width_m, 0.8, 4.0)
         check_range("office", "door_width_m", self.door_width_m, 0.7, 2.0)
         check_range("office", "room_link_prob", self.room_link_prob, 0.0, 1.0)
+        check_range("office", "clutter", self.clutter, 0.0, 5.0)
+
+
+def _add_clutter(
+    free: np.ndarray, room_rows: list[tuple[int, int, str]], params: OfficeParams
+) -> None:
+    """Put furniture boxes into the rooms of ``free`` (in place), from their own random stream.
+
+    A box is kept only where every cell of it is at least ``_CLUTTER_GAP_M`` from any non-free
+    cell (walls and boxes placed before), so no passage closes.
+    """
+    rng = np.random.default_rng([params.seed, 1])
+    gap = _cells(_CLUTTER_GAP_M)
+    lo, hi = _cells(0.3), _cells(0.8)
+    rows = [(y0, y1) for y0, y1, _side in room_rows if y1 - y0 > hi + 2 * gap]
+    floor_m2 = sum(int(free[y0:y1].sum()) for y0, y1 in rows) * _RES_M**2
+    target = int(round(params.clutter * floor_m2 / 10.0))
+    placed = 0
+    for _ in range(target * 30):
+        if placed >= target or not rows:
+            break
+        y0, y1 = rows[int(rng.integers(len(rows)))]
+        h, w = (int(v) for v in rng.integers(lo, hi + 1, 2))
+        r = int(rng.integers(y0, y1 - h))
+        c = int(rng.integers(0, free.shape[1] - w))
+        window = free[max(r - gap, 0) : r + h + gap, max(c - gap, 0) : c + w + gap]
+        if r - gap < 0 or c - gap < 0 or window.shape != (h + 2 * gap, w + 2 * gap):
+            continue
+        if window.all():
+            free[r : r + h, c : c + w] = False
+            placed += 1
 
 
 def _cells(length_m: float) -> int:
@@ -185,12 +222,15 @@ def generate_office(params: OfficeParams, name: str | None = None) -> World:
                     dy = int(rng.integers(ry0 + margin, ry1 - margin - dw + 1))
                     free[dy : dy + dw, wall_col : wall_col + t] = True
 
+    if params.clutter > 0:
+        _add_clutter(free, room_rows, params)
     cy0, cy1 = corridors[0]
     start_col = (verticals[0][0] + verticals[0][1]) / 2 if verticals else n / 2
     start = (start_col * _RES_M, 0.5 * (cy0 + cy1) * _RES_M, 0.0)
     spec = (
         f"office:seed={params.seed},size_m={params.size_m:g},corridor_width_m={params.corridor_width_m:g},"
         f"door_width_m={params.door_width_m:g},room_link_prob={params.room_link_prob:g}"
+        + (f",clutter={params.clutter:g}" if params.clutter > 0 else "")
     )
     return world_from_free_mask(
         name if name is not None else spec,

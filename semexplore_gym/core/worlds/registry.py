@@ -13,6 +13,7 @@ import numpy as np
 from semexplore_gym.core.worlds.catalogue import resolve_map_file
 from semexplore_gym.core.worlds.cave import CaveParams, generate_cave
 from semexplore_gym.core.worlds.fixed_mazes import make_maze1, make_maze2
+from semexplore_gym.core.worlds.forest import ForestParams, generate_forest
 from semexplore_gym.core.worlds.grid_maze import MazeParams, generate_maze
 from semexplore_gym.core.worlds.houseexpo import load_houseexpo_world
 from semexplore_gym.core.worlds.office import OfficeParams, generate_office
@@ -24,6 +25,7 @@ _FAMILIES: dict[str, tuple[type, Callable[..., World]]] = {
     "maze": (MazeParams, generate_maze),
     "office": (OfficeParams, generate_office),
     "cave": (CaveParams, generate_cave),
+    "forest": (ForestParams, generate_forest),
 }
 _ROS_SUFFIXES = (".yaml", ".yml")
 _JSON_SUFFIXES = (".json",)
@@ -104,7 +106,7 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
 
     - ``"maze1"``, ``"maze2"``: the fixed test mazes (:mod:`.fixed_mazes`).
     - ``"maze:seed=3,size_m=10,corridor_width_m=0.8,braid=0.3"``, ``"office:seed=3,size_m=20"``,
-      ``"cave:seed=1,size_m=15"``: procedural families; any parameter may be left out (see
+      ``"cave:seed=1,size_m=15"``, ``"forest:seed=1,size_m=12,density=8"``: procedural families; any parameter may be left out (see
       :func:`world_family_parameters` for the defaults). Without ``seed=`` the seed is drawn from
       ``rng``, so an env's RNG makes the world reproducible; with neither, seed 0 is used.
       ``World.metadata["spec"]`` is the fully resolved spec (seed included).

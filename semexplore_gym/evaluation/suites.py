@@ -1,0 +1,218 @@
+"""Named, versioned benchmark suites: a YAML file lists the worlds, runs and time limits.
+
+A suite is data (``configs/suites/NAME.yaml``; add your own file there or pass a path)::
+
+    name: caves
+    version: 1
+    description: Procedural caves from 8 m to 30 m.
+    runs: 2                 # seeds per (world, policy): each seed draws a start pose
+    random_start: true
+    time_per_m2_s: 6.0      # per-world time limit: this x the world's free area ...
+    min_time_s: 600.0       # ... but at least this (or give a fixed max_time_s instead)
+    worlds:
+      - cave:seed=400,size_m=8,min_passage_m=0.5
+      - {world: map:intel_lab, max_time_s: 3000}   # a per-world limit overrides the rule
+
+``semexplore benchmark --suite caves --policies semantic,nearest --out runs/caves`` runs it. The
+family of a world (its spelling before ``:``, or the file name of a map) groups the summary.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+#: Where named suites live (the repository's ``configs/suites``), unless
+#: ``SEMEXPLORE_SUITES_DIR`` names another directory.
+SUITES_DIR = Path(__file__).resolve().parents[2] / "configs" / "suites"
+
+_KEYS = {
+    "name",
+    "version",
+    "description",
+    "runs",
+    "random_start",
+    "max_time_s",
+    "time_per_m2_s",
+    "min_time_s",
+    "worlds",
+}
+_MAX_WORLDS = 10_000
+
+
+@dataclass(frozen=True)
+class SuiteWorld:
+    """One world of a suite, with its own time limit if it sets one."""
+
+    world: str
+    max_time_s: float | None = None
+
+
+@dataclass(frozen=True)
+class Suite:
+    """A benchmark suite (see the module docstring for the YAML fields)."""
+
+    name: str
+    version: int
+    worlds: tuple[SuiteWorld, ...]
+    description: str = ""
+    runs: int = 1
+    random_start: bool = True
+    max_time_s: float | None = None
+    time_per_m2_s: float | None = None
+    min_time_s: float = 0.0
+    source: str = field(default="", compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The YAML mapping of this suite (``load_suite(save_suite(s))`` gives ``s`` back)."""
+        out: dict[str, Any] = {
+            "name": self.name,
+            "version": self.version,
+            "description": self.description,
+            "runs": self.runs,
+            "random_start": self.random_start,
+        }
+        if self.max_time_s is not None:
+            out["max_time_s"] = self.max_time_s
+        if self.time_per_m2_s is not None:
+            out["time_per_m2_s"] = self.time_per_m2_s
+            out["min_time_s"] = self.min_time_s
+        out["worlds"] = [
+            w.world if w.max_time_s is None else {"world": w.world, "max_time_s": w.max_time_s}
+            for w in self.worlds
+        ]
+        return out
+
+
+def list_suites(directory: str | os.PathLike | None = None) -> list[str]:
+    """Names of the suites in ``directory`` (default: :data:`SUITES_DIR` or the env var)."""
+    d = Path(directory or os.environ.get("SEMEXPLORE_SUITES_DIR") or SUITES_DIR)
+    return sorted(p.stem for p in d.glob("*.yaml")) if d.is_dir() else []
+
+
+def _number(data: dict[str, Any], key: str, src: str, *, minimum: float) -> float | None:
+    v = data.get(key)
+    if v is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, int | float) or not v == v or v < minimum:
+        raise ValueError(f"suite {src}: {key} must be a number >= {minimum}, got {v!r}")
+    if v == float("inf"):
+        raise ValueError(f"suite {src}: {key} must be finite, got {v!r}")
+    return float(v)
+
+
+def _world(item: Any, src: str, i: int) -> SuiteWorld:
+    if isinstance(item, str) and item.strip():
+        return SuiteWorld(item.strip())
+    if isinstance(item, dict) and set(item) <= {"world", "max_time_s"} and "world" in item:
+        w = item["world"]
+        if not isinstance(w, str) or not w.strip():
+            raise ValueError(f"suite {src}: worlds[{i}].world must be a world spelling, got {w!r}")
+        return SuiteWorld(w.strip(), _number(item, "max_time_s", f"{src} worlds[{i}]", minimum=1.0))
+    raise ValueError(
+        f"suite {src}: worlds[{i}] must be a world spelling or {{world: ..., max_time_s: ...}}, "
+        f"got {str(item)[:80]!r}"
+    )
+
+
+def suite_from_dict(data: Any, source: str = "<dict>") -> Suite:
+    """Validate a suite mapping; errors name the file and the bad key or value."""
+    if not isinstance(data, dict):
+        raise ValueError(f"suite {source}: must be a mapping, got {type(data).__name__}")
+    unknown = sorted(set(map(str, data)) - _KEYS)
+    if unknown:
+        raise ValueError(f"suite {source}: unknown key(s) {unknown}; valid: {sorted(_KEYS)}")
+    name = data.get("name")
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f"suite {source}: 'name' must be a non-empty string, got {name!r}")
+    version = data.get("version", 1)
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        raise ValueError(f"suite {source}: version must be an integer >= 1, got {version!r}")
+    runs = data.get("runs", 1)
+    if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= 1000:
+        raise ValueError(f"suite {source}: runs must be an integer in [1, 1000], got {runs!r}")
+    worlds = data.get("worlds")
+    if not isinstance(worlds, list) or not worlds:
+        raise ValueError(f"suite {source}: 'worlds' must be a non-empty list")
+    if len(worlds) > _MAX_WORLDS:
+        raise ValueError(f"suite {source}: {len(worlds)} worlds; at most {_MAX_WORLDS}")
+    random_start = data.get("random_start", True)
+    if not isinstance(random_start, bool):
+        raise ValueError(
+            f"suite {source}: random_start must be true or false, got {random_start!r}"
+        )
+    fixed = _number(data, "max_time_s", source, minimum=1.0)
+    per_m2 = _number(data, "time_per_m2_s", source, minimum=0.0)
+    if fixed is not None and per_m2 is not None:
+        raise ValueError(f"suite {source}: give max_time_s or time_per_m2_s, not both")
+    return Suite(
+        name=name.strip(),
+        version=version,
+        worlds=tuple(_world(w, source, i) for i, w in enumerate(worlds)),
+        description=str(data.get("description", "")),
+        runs=runs,
+        random_start=random_start,
+        max_time_s=fixed,
+        time_per_m2_s=per_m2,
+        min_time_s=_number(data, "min_time_s", source, minimum=0.0) or 0.0,
+        source=source,
+    )
+
+
+def load_suite(name_or_path: str | os.PathLike) -> Suite:
+    """A suite by name (a file in the suites directory) or by path to a YAML file.
+
+    Raises:
+        FileNotFoundError: no such suite; the message lists the known names.
+        ValueError: a malformed suite (the message names the file and the key).
+    """
+    text = str(name_or_path)
+    path = Path(text)
+    if not (text.endswith((".yaml", ".yml")) or path.is_file()):
+        d = Path(os.environ.get("SEMEXPLORE_SUITES_DIR") or SUITES_DIR)
+        path = d / f"{text}.yaml"
+        if not path.is_file():
+            known = ", ".join(list_suites(d)) or "none"
+            raise FileNotFoundError(
+                f"unknown suite {text!r}; known suites: {known} (or a .yaml path)"
+            )
+    if not path.is_file():
+        raise FileNotFoundError(f"suite file not found: {text!r}")
+    if path.stat().st_size > 1_000_000:
+        raise ValueError(f"suite file {text!r} is over 1 MB")
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as e:
+        first = str(e).splitlines()[0][:200] if str(e) else type(e).__name__
+        raise ValueError(f"suite file {text!r} is not valid YAML: {first}") from None
+    return suite_from_dict(data, source=str(path))
+
+
+def save_suite(suite: Suite, path: str | os.PathLike) -> Path:
+    """Write ``suite`` as YAML (round-trips through :func:`load_suite`)."""
+    p = Path(path)
+    p.write_text(yaml.safe_dump(suite.to_dict(), sort_keys=False, width=100), encoding="utf-8")
+    return p
+
+
+def world_family(world: str) -> str:
+    """The family a world belongs to in a summary: ``maze``, ``office``, ..., or the map's file."""
+    if world.lower().endswith((".yaml", ".yml", ".json")):
+        return Path(world).stem
+    name = world.partition(":")[0]
+    return "paper mazes" if name in ("maze1", "maze2") else name
+
+
+def world_time_limit_s(suite: Suite, entry: SuiteWorld, free_area_m2: float | None) -> float | None:
+    """The mission time limit of ``entry``: its own, the suite's fixed one, or the area rule."""
+    if entry.max_time_s is not None:
+        return entry.max_time_s
+    if suite.max_time_s is not None:
+        return suite.max_time_s
+    if suite.time_per_m2_s is not None and free_area_m2 is not None:
+        return max(suite.min_time_s, suite.time_per_m2_s * free_area_m2)
+    return None
