@@ -1,6 +1,7 @@
 """Build any policy from a short spec string: ``make_policy("semantic", **overrides)``.
 
-Specs: ``"semantic"`` (the scripted expert), ``"frontier"`` (ROS frontier_exploration
+Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
+every addition of ours off), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
 agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
@@ -30,6 +31,19 @@ def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
     if arg:
         raise ValueError(f"policy 'semantic' takes no argument, got 'semantic:{arg}'")
     params = build_params(SemanticExpertParams, base, overrides)
+    return SemanticExpertPolicy(params, segmenter=segmenter)
+
+
+def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
+    """The paper's method alone: :data:`~policies.semantic_expert_params.PAPER_PURE`."""
+    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+    from policies.semantic_expert_params import PAPER_PURE
+
+    segmenter = overrides.pop("segmenter", None)
+    base = overrides.pop("params", None)
+    if arg:
+        raise ValueError(f"policy 'semantic-paper' takes no argument, got 'semantic-paper:{arg}'")
+    params = build_params(SemanticExpertParams, PAPER_PURE, base, overrides)
     return SemanticExpertPolicy(params, segmenter=segmenter)
 
 
@@ -147,6 +161,7 @@ def policy_factories() -> dict[str, Factory]:
     """The known policy names and their factories ``(argument, overrides) -> Policy``."""
     return {
         "semantic": _semantic,
+        "semantic-paper": _semantic_paper,
         "frontier": _frontier,
         "nearest": _nearest,
         "random": _random,

@@ -40,6 +40,7 @@ import numpy as np
 from policies.base import Policy, StepStats, read_env_facts
 from policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
 from policies.semantic_expert_params import SemanticExpertParams
+from policies.semantic_expert_persistence import TRAIL_CELL_M, GoalPersistence
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
@@ -78,13 +79,19 @@ REPLAN_REASONS = ("no_plan", "period", "goal_reached", "path_done", "goal_vanish
 _PATH_PROGRESS_MARGIN_M = 0.1
 
 
+#: Where a plan's goal comes from: a semantic frontier, the grid fallback, a retry of a failed
+#: goal by another approach, or a look at a frontier too narrow to reach.
+PlanSource = Literal["semantic", "fallback", "retry", "look"]
+
+
 @dataclass
 class _Plan:
-    source: Literal["semantic", "fallback"]
+    source: PlanSource
     goal_xy_m: tuple[float, float]
     path_m: np.ndarray
     candidate: FrontierCandidate | None
     progress: int = 0
+    frontier_xy_m: tuple[float, float] | None = None
     arc_m: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     def __post_init__(self) -> None:
@@ -92,7 +99,7 @@ class _Plan:
         self.arc_m = np.concatenate(([0.0], np.cumsum(seg)))
 
 
-class SemanticExpertPolicy(Policy):
+class SemanticExpertPolicy(GoalPersistence, Policy):
     """The paper's exploration strategy (semantic goal selection + modified potential field).
 
     Args:
@@ -119,6 +126,8 @@ class SemanticExpertPolicy(Policy):
         self.mode = "idle"
         self.counters: dict[str, int] = {}
         self.events: list[tuple[float, str, str]] = []
+        self.memory = self._new_memory()
+        self._time_s = 0.0
 
     # ------------------------------------------------------------------ lifecycle
     def reset(
@@ -154,6 +163,10 @@ class SemanticExpertPolicy(Policy):
             "recoveries": 0,
             "blacklisted": 0,
             "switches": 0,
+            "retries": 0,
+            "revived": 0,
+            "looks": 0,
+            "oscillations_blocked": 0,
         }
         self._angles: np.ndarray | None = None
         self._time_s = 0.0
@@ -163,6 +176,11 @@ class SemanticExpertPolicy(Policy):
         self._seg_known_cells = 0
         self._empty_replans = 0
         self.blacklist = GoalBlacklist(self.params.blacklist_radius_m)
+        self.memory = self._new_memory()
+        self._retry: tuple[tuple[float, float], int, tuple[float, float]] | None = None
+        # Where the robot has been, on a coarse lattice: a narrow frontier it already passed
+        # close to has had its closer look.
+        self._trail: set[tuple[int, int]] = set()
         self._reaches: list[tuple[float, float, int]] = []
         self._area_types: np.ndarray | None = None
         self._last_cmd: PotentialFieldCommand | None = None
@@ -202,14 +220,15 @@ class SemanticExpertPolicy(Policy):
         if self._angles is None or len(self._angles) != len(scan):
             self._angles = beam_angles_rad(len(scan))
         self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
+        self._trail.add((int(pose[0] // TRAIL_CELL_M), int(pose[1] // TRAIL_CELL_M)))
 
         if self._backoff.active(self._time_s):
             v, w = self._recovery_command(grid, pose, scan)
             self.mode = "recovery"
         else:
             if self._backoff.finish():
-                # Recovery just ended: give up the goal that got us stuck, replan at once.
-                self._blacklist_goal()
+                # Recovery just ended: retry the goal that got us stuck another way, or drop it.
+                self._goal_failed(grid, pose)
             if self._needs_replan(grid, pose):
                 self._replan(grid, pose, stats)
             if self.done:
@@ -219,7 +238,8 @@ class SemanticExpertPolicy(Policy):
                 self.mode = "waiting"
             else:
                 v, w = self._follow(grid, pose, scan)
-                self._watch_progress(pose)
+                if self.params.stuck_recovery:
+                    self._watch_progress(pose)
                 if self._backoff.active(self._time_s):
                     v, w = self._recovery_command(grid, pose, scan)
         self._time_s += self.dt_s
@@ -256,7 +276,7 @@ class SemanticExpertPolicy(Policy):
             math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
             <= self.params.goal_reached_radius_m
         ):
-            self._register_reach(plan.goal_xy_m)
+            self._on_goal_reached(grid, plan)
             return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
             return "path_done"
@@ -280,8 +300,8 @@ class SemanticExpertPolicy(Policy):
         return self._plan.goal_xy_m if self._plan is not None else None
 
     @property
-    def plan_source(self) -> Literal["semantic", "fallback"] | None:
-        """Where the current goal comes from: a semantic frontier, the grid fallback, or None."""
+    def plan_source(self) -> PlanSource | None:
+        """Where the current goal comes from (see :data:`PlanSource`), or None without a plan."""
         return self._plan.source if self._plan is not None else None
 
     def request_replan(self) -> None:
@@ -300,7 +320,12 @@ class SemanticExpertPolicy(Policy):
         """
         best = candidates[0]
         old = self._plan
-        if old is None or old.source != "semantic" or old.candidate is None:
+        if (
+            not self.params.goal_commitment
+            or old is None
+            or old.source != "semantic"
+            or old.candidate is None
+        ):
             return best
         same = [
             c
@@ -312,7 +337,16 @@ class SemanticExpertPolicy(Policy):
         if not same:
             return best
         keep = min(same, key=lambda c: c.cost)
-        return keep if keep.cost <= best.cost + self.params.switch_margin else best
+        if keep.cost <= best.cost + self.params.switch_margin:
+            return keep
+        if self.params.oscillation_guard and self.memory.recently_abandoned(
+            best.goal_xy_m, self._time_s, self.params.oscillation_window_s
+        ):
+            # Switching back to a goal given up a moment ago would start a shuttle between two
+            # frontiers whose costs trade places as the robot moves: finish this one first.
+            self.counters["oscillations_blocked"] += 1
+            return keep
+        return best
 
     def on_replan_due(self, reason: str) -> None:
         """Called when a replan is due, just before it runs; does nothing by default.
@@ -321,7 +355,7 @@ class SemanticExpertPolicy(Policy):
             reason: Why (one of :data:`REPLAN_REASONS`).
         """
 
-    def on_replanned(self, source: Literal["semantic", "fallback"] | None) -> None:
+    def on_replanned(self, source: PlanSource | None) -> None:
         """Called after every replan with :attr:`plan_source`; does nothing by default."""
 
     def frontier_candidates(
@@ -360,8 +394,14 @@ class SemanticExpertPolicy(Policy):
         t1 = time.perf_counter()
         stats.map_generation_ms = (t1 - t0) * 1e3 if segmented else 0.0
 
+        if segmented and self.memory.dropped:
+            self._revive_dropped(grid)
         self.candidates = self._scored_candidates(tmap, pose, prm.cost)
-        new_plan, clearance = self._semantic_plan(grid, pose)
+        new_plan, clearance = None, None
+        if self._retry is not None:
+            new_plan, clearance = self._retry_plan(grid, pose)
+        if new_plan is None:
+            new_plan, clearance = self._semantic_plan(grid, pose)
         if new_plan is None and prm.grid_fallback:
             if clearance is None:
                 clearance = clearance_field_m(grid, self.geometry.resolution_m)
@@ -370,6 +410,10 @@ class SemanticExpertPolicy(Policy):
                 new_plan = self._nearest_fallback_plan(grid, pose, clearance)
         stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
 
+        if new_plan is None and prm.grid_fallback and prm.look_at_narrow_frontiers:
+            if clearance is None:
+                clearance = clearance_field_m(grid, self.geometry.resolution_m)
+            new_plan = self._look_plan(grid, pose, clearance)
         if new_plan is None:
             self._give_up_plan()
         else:
@@ -424,8 +468,10 @@ class SemanticExpertPolicy(Policy):
         chosen = self.choose_goal(self.candidates)
         path: np.ndarray | None = chosen.path_m
         clearance: np.ndarray | None = None
-        if len(chosen.path_m) >= 2 and not segment_is_clear(
-            grid, self.geometry, pose[:2], tuple(chosen.path_m[1])
+        if (
+            self.params.entry_detour
+            and len(chosen.path_m) >= 2
+            and not segment_is_clear(grid, self.geometry, pose[:2], tuple(chosen.path_m[1]))
         ):
             # The straight first leg crosses a wall: reach the map's path over the grid.
             clearance = clearance_field_m(grid, self.geometry.resolution_m)
@@ -493,7 +539,7 @@ class SemanticExpertPolicy(Policy):
             min_frontier_cells=max(1, math.ceil(prm.fallback_min_frontier_m / res_m - 1e-9)),
             min_unknown_depth_cells=prm.fallback_min_unknown_depth_m / res_m,
             reach_m=prm.fallback_reach_m,
-            excluded_xy_m=self.blacklist.points_m,
+            excluded_xy_m=self.memory.active_points(),
             excluded_radius_m=prm.blacklist_radius_m + prm.fallback_reach_m,
             clearance_field=clearance,
         )
@@ -510,10 +556,7 @@ class SemanticExpertPolicy(Policy):
         if self._empty_replans >= self.params.stop_confirmations:
             self.done = True
             self.mode = "done"
-            n_black = len(self.blacklist)
-            self.stop_reason = "no frontier left" + (
-                f" ({n_black} unreachable frontier(s) blacklisted)" if n_black else ""
-            )
+            self.stop_reason = self._stop_reason()
 
     def _adopt_plan(self, new_plan: _Plan) -> None:
         """Follow ``new_plan`` from now on (logging a goal switch)."""
@@ -528,6 +571,7 @@ class SemanticExpertPolicy(Policy):
         ):
             if old is not None:
                 self.counters["switches"] += 1
+                self.memory.abandon(old.goal_xy_m, self._time_s)
             self._log("goal", f"{new_plan.source} {tuple(round(v, 2) for v in new_plan.goal_xy_m)}")
         if old is None or old.source != new_plan.source:
             self._log(
@@ -568,7 +612,7 @@ class SemanticExpertPolicy(Policy):
                 self._still_s += self.dt_s
             else:
                 self._still_s = 0.0
-            if self._still_s >= prm.local_min_timeout_s:
+            if prm.local_min_escape and self._still_s >= prm.local_min_timeout_s:
                 self._still_s = 0.0
                 self._escape_until_s = self._time_s + prm.escape_duration_s
                 self.counters["escapes"] += 1
@@ -625,30 +669,6 @@ class SemanticExpertPolicy(Policy):
         return self._backoff.command(
             grid, self.geometry, pose, scan, self._angles, self.limits, self.params.potential_field
         )
-
-    def _blacklist_goal(self) -> None:
-        plan = self._plan
-        if plan is not None:
-            self.blacklist.add(plan.goal_xy_m)
-            self.counters["blacklisted"] += 1
-            self._log("blacklist", f"stuck: {plan.goal_xy_m}")
-        self._plan = None
-        self.request_replan()
-
-    def _register_reach(self, goal: tuple[float, float]) -> None:
-        r = self.params.blacklist_radius_m
-        for i, (x, y, n) in enumerate(self._reaches):
-            if math.hypot(goal[0] - x, goal[1] - y) <= r:
-                self._reaches[i] = (x, y, n + 1)
-                if n + 1 >= self.params.max_goal_reaches:
-                    self.blacklist.add((x, y))
-                    self.counters["blacklisted"] += 1
-                    self._log("blacklist", f"reached {n + 1} times: {(x, y)}")
-                return
-        self._reaches.append((goal[0], goal[1], 1))
-        if self.params.max_goal_reaches <= 1:
-            self.blacklist.add(goal)
-            self.counters["blacklisted"] += 1
 
     # ------------------------------------------------------------------ drawing
     def overlay(self) -> dict[str, Any]:

@@ -49,10 +49,33 @@ What the paper leaves open, and how the expert handles it (parameters in
   the remaining path to its goal shrank (by 0.1 m) nor the map grew. It then backs off for
   ``backoff_duration_s`` at ``backoff_speed_fraction`` of the top speed (turning towards open
   space when the way back is blocked), blacklists the goal and replans.
-* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``): goals
-  blacklisted by a recovery, or reached ``max_goal_reaches`` times without their frontier
-  disappearing, are ignored (frontiers within ``blacklist_radius_m`` of them) for the rest of
-  the mission.
+* **Unreachable / unclearable goals** (``blacklist_radius_m``, ``max_goal_reaches``,
+  ``max_goal_attempts``): a goal whose approach failed (a stuck recovery) is tried again by
+  other approaches before it is dropped: first along a grid route on the current map, then
+  from another side of the frontier (a standable point round it, away from where the robot got
+  stuck). A goal is dropped after ``max_goal_attempts`` failed approaches, when the grid
+  planner finds no path for the robot's disc to it, or when it was reached
+  ``max_goal_reaches`` times without its frontier disappearing. Frontiers within
+  ``blacklist_radius_m`` of a dropped goal are ignored.
+* **Dropped frontiers come back** (``revive_window_m``, ``revive_min_changed_cells``,
+  ``max_revivals``): when at least ``revive_min_changed_cells`` cells within
+  ``revive_window_m`` of a dropped goal changed since it was dropped (the map around it grew or
+  was corrected), it is considered again, at most ``max_revivals`` times.
+* **The stop rule**: the mission stops only when the grid fallback (a clearance-aware grid
+  search, the final check) finds no frontier the robot's disc can reach, besides dropped goals;
+  the stop reason names the rule and counts what was dropped and why.
+* **A closer look at narrow frontiers** (``look_at_narrow_frontiers``, ``look_reach_m``,
+  ``look_min_unknown_depth_m``): frontiers too narrow for the robot at first sight are not
+  discarded: before stopping, the robot drives to a standable point within ``look_reach_m`` of
+  one with unknown space behind it to look closer, once per place; if the gap widens it is
+  explored, otherwise it is dropped as looked-at.
+* **Oscillation guard** (``oscillation_guard``, ``oscillation_window_s``): the robot does not
+  switch back to a goal it abandoned less than ``oscillation_window_s`` ago while its current
+  goal is still a candidate (two far frontiers whose costs trade places as the robot moves
+  would otherwise keep it shuttling between them, as on open ground).
+
+Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
+switches them all off: the paper's method alone).
 
 ``counters`` and ``events`` record how often each behaviour fired.
 """
@@ -67,7 +90,7 @@ from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.core.topometric.params import SegmentationParams
 
-__all__ = ["SemanticExpertParams"]
+__all__ = ["PAPER_PURE", "SemanticExpertParams"]
 
 
 @dataclass(frozen=True)
@@ -112,6 +135,26 @@ class SemanticExpertParams:
         backoff_speed_fraction: Back-off speed as a fraction of the top speed.
         blacklist_radius_m: Frontiers this close to a blacklisted goal are ignored.
         max_goal_reaches: A goal reached this many times without clearing is blacklisted.
+        max_goal_attempts: Failed approaches (stuck recoveries) before a goal is dropped; 1
+            drops it at the first failure.
+        revive_window_m: Radius round a dropped goal watched for map changes.
+        revive_min_changed_cells: Changed cells in that window that bring a dropped goal back.
+        max_revivals: How often one place may come back.
+        look_at_narrow_frontiers: Drive close to frontiers too narrow to reach, to look again
+            (an extension of the grid fallback's final check: needs ``grid_fallback``).
+        look_reach_m: The look point lies within this distance of the frontier.
+        look_min_unknown_depth_m: Unknown depth behind a narrow frontier worth a look.
+        look_min_frontier_m: Smallest narrow frontier worth a look (cells x resolution); one-
+            or two-cell groups are leaks through rasterised walls.
+        look_seen_radius_m: A narrow frontier the robot already passed this close to had its
+            look (the LiDAR resolved it then).
+        oscillation_guard: Do not switch back to a recently abandoned goal.
+        oscillation_window_s: How long an abandoned goal stays "recent".
+        entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
+        goal_commitment: Keep the current frontier unless another is clearly cheaper.
+        local_min_escape: Lower the repulsion when the field holds the robot still.
+        stuck_recovery: Watch progress; back off, retry or drop the goal when stuck.
+        reach_blacklist: Drop goals reached ``max_goal_reaches`` times without clearing.
     """
 
     cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
@@ -142,6 +185,22 @@ class SemanticExpertParams:
     backoff_speed_fraction: float = 0.5
     blacklist_radius_m: float = 0.5
     max_goal_reaches: int = 2
+    max_goal_attempts: int = 3
+    revive_window_m: float = 0.75
+    revive_min_changed_cells: int = 40
+    max_revivals: int = 2
+    look_at_narrow_frontiers: bool = True
+    look_reach_m: float = 1.0
+    look_min_unknown_depth_m: float = 0.3
+    look_min_frontier_m: float = 0.15
+    look_seen_radius_m: float = 2.0
+    oscillation_guard: bool = True
+    oscillation_window_s: float = 120.0
+    entry_detour: bool = True
+    goal_commitment: bool = True
+    local_min_escape: bool = True
+    stuck_recovery: bool = True
+    reach_blacklist: bool = True
 
     def __post_init__(self) -> None:
         if self.prune_by not in ("opening", "area"):
@@ -169,6 +228,12 @@ class SemanticExpertParams:
             "escape_repulsion_scale",
             "backoff_duration_s",
             "blacklist_radius_m",
+            "revive_window_m",
+            "look_min_unknown_depth_m",
+            "look_min_frontier_m",
+            "look_seen_radius_m",
+            "look_reach_m",
+            "oscillation_window_s",
         )
         require_finite(self, nonneg, positive=False)
         if not 0.0 <= self.backoff_speed_fraction <= 1.0:
@@ -179,6 +244,35 @@ class SemanticExpertParams:
             "stop_confirmations",
             "max_goal_reaches",
             "progress_min_new_cells",
+            "max_goal_attempts",
+            "revive_min_changed_cells",
         ):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
+        if int(self.max_revivals) < 0:
+            raise ValueError(f"max_revivals must be >= 0, got {self.max_revivals!r}")
+
+
+#: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level
+#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_pure.yaml`` restates it
+#: (tests/policies/test_policy_config.py compares them); ``--policy semantic-paper`` uses it.
+PAPER_PURE: dict[str, object] = {
+    "prune_by": "area",
+    "min_frontier_width_m": 0.0,
+    "resegment_min_new_m2": 0.0,
+    "stop_confirmations": 1,
+    "grid_fallback": False,
+    "look_at_narrow_frontiers": False,
+    "oscillation_guard": False,
+    "entry_detour": False,
+    "goal_commitment": False,
+    "local_min_escape": False,
+    "stuck_recovery": False,
+    "reach_blacklist": False,
+    "potential_field": {
+        "lookahead_clearance_m": 0.0,
+        "map_guard_radius_m": 0.0,
+        "guard_steer_max_rad": 0.0,
+        "braking_guard": False,
+    },
+}

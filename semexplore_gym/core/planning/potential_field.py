@@ -72,6 +72,8 @@ class PotentialFieldParams:
         guard_steer_step_rad: See ``guard_steer_max_rad``.
         guard_steer_min_free_m: See ``guard_steer_max_rad``.
         braking_time_s: The guard allows ``v <= free_distance / braking_time_s``.
+        braking_guard: Cap the speed by the free distance ahead (the collision guard); False
+            leaves the speed to the field alone, as in the paper.
     """
 
     f_g: float = 30.0
@@ -90,6 +92,7 @@ class PotentialFieldParams:
     guard_steer_step_rad: float = 0.1
     guard_steer_min_free_m: float = 0.1
     braking_time_s: float = 0.6
+    braking_guard: bool = True
 
     def __post_init__(self) -> None:
         require_finite(
@@ -469,6 +472,7 @@ def _guard_args(limits: RobotLimits, params: PotentialFieldParams) -> tuple[floa
         limits.max_linear_speed_mps,
         limits.max_angular_speed_radps,
         params.braking_time_s,
+        bool(params.braking_guard),
     )
 
 
@@ -529,6 +533,7 @@ def _to_velocity(
     vmax,
     wmax,
     braking,
+    brake,
 ):  # pragma: no cover - numba
     phi = math.atan2(fy, fx) if (fx != 0.0 or fy != 0.0) else 0.0
     front = _free_along(px, py, 0.0, soft, hard)
@@ -552,7 +557,8 @@ def _to_velocity(
         v = 0.0
     else:
         v = vmax * max(0.0, math.cos(phi))
-    v = min(v, front / braking)
+    if brake:
+        v = min(v, front / braking)
     return v, omega, front
 
 

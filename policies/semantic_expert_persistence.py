@@ -1,0 +1,226 @@
+"""The semantic expert's goal persistence: retries, dropped goals that come back, looks at
+narrow frontiers, and the stop rule (issue #13: never give up on a reachable frontier).
+
+:class:`GoalPersistence` is a mixin of :class:`~policies.semantic_expert.SemanticExpertPolicy`:
+it holds the methods that decide what happens when the approach to a goal fails, when a goal is
+reached without clearing its frontier, and when no frontier is left. The parameters are
+documented in :mod:`policies.semantic_expert_params`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from policies.navigation.approaches import side_approach
+from policies.navigation.frontier_memory import FrontierMemory
+from semexplore_gym.core.frontiers.reachable import (
+    clearance_field_m,
+    grid_path_to,
+    nearest_reachable_frontier,
+)
+from semexplore_gym.core.planning.potential_field import resample_polyline
+
+if TYPE_CHECKING:
+    from policies.semantic_expert import _Plan
+
+__all__ = ["GoalPersistence"]
+
+#: Lattice of the robot's trail (metres per cell).
+TRAIL_CELL_M = 0.25
+
+#: Narrow frontiers checked against the trail before one is worth driving to.
+_MAX_LOOK_CANDIDATES = 8
+
+
+class GoalPersistence:
+    """Mixin: failed approaches are retried, dropped goals come back, narrow frontiers get a
+    look, and the mission stops only when the grid check finds nothing reachable."""
+
+    # Provided by the policy class this is mixed into.
+    params: Any
+    geometry: Any
+    clearance_m: float
+    counters: dict[str, int]
+    memory: FrontierMemory
+    blacklist: Any
+    _plan: Any
+    _retry: tuple[tuple[float, float], int, tuple[float, float]] | None
+    _reaches: list[tuple[float, float, int]]
+    _trail: set[tuple[int, int]]
+
+    def _log(self, event: str, detail: str = "") -> None: ...
+    def request_replan(self) -> None: ...
+    def _unknown_near(self, grid: np.ndarray, xy: tuple[float, float], radius_m: float) -> bool: ...
+
+    def _new_memory(self) -> FrontierMemory:
+        prm = self.params
+        return FrontierMemory(
+            prm.blacklist_radius_m,
+            prm.revive_window_m,
+            prm.revive_min_changed_cells,
+            prm.max_revivals,
+            prm.max_goal_attempts,
+        )
+
+    def _drop(self, grid: np.ndarray, xy_m: tuple[float, float], reason: str) -> None:
+        """Give up on the goal at ``xy_m`` until the map round it changes."""
+        self.memory.drop(xy_m, reason, grid, self.geometry)
+        self.blacklist.points_m[:] = self.memory.active_points()
+        self.counters["blacklisted"] += 1
+        self._log("blacklist", f"{reason}: {xy_m}")
+
+    def _goal_failed(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        """A stuck recovery ended: retry the goal by another approach, or drop it."""
+        plan = self._plan
+        self._plan = None
+        self.request_replan()
+        if plan is None:
+            return
+        # A retry's target may be a point beside the goal: the goal itself is what failed.
+        goal = (
+            plan.frontier_xy_m if plan.source == "retry" and plan.frontier_xy_m else plan.goal_xy_m
+        )
+        n, failed_at = self.memory.record_failure(goal, (pose[0], pose[1]))
+        if n >= self.params.max_goal_attempts or plan.source == "look":
+            self._retry = None
+            self._drop(grid, goal, "attempts")
+            return
+        self._retry = (goal, n, failed_at)
+        self.counters["retries"] += 1
+        self._log("retry", f"attempt {n + 1} at {goal}")
+
+    def _on_goal_reached(self, grid: np.ndarray, plan: _Plan) -> None:
+        if plan.source == "retry":
+            self._retry = None
+        if plan.source == "look" and plan.frontier_xy_m is not None:
+            # Looked from close by and the frontier is still there: the gap stays closed.
+            self.counters["looks"] += 1
+            self._drop(grid, plan.frontier_xy_m, "looked")
+        elif self.params.reach_blacklist:
+            self._register_reach(grid, plan.goal_xy_m)
+
+    def _register_reach(self, grid: np.ndarray, goal: tuple[float, float]) -> None:
+        r = self.params.blacklist_radius_m
+        for i, (x, y, n) in enumerate(self._reaches):
+            if math.hypot(goal[0] - x, goal[1] - y) <= r:
+                self._reaches[i] = (x, y, n + 1)
+                if n + 1 >= self.params.max_goal_reaches:
+                    self._reaches[i] = (x, y, 0)
+                    self._drop(grid, (x, y), "reached")
+                return
+        self._reaches.append((goal[0], goal[1], 1))
+        if self.params.max_goal_reaches <= 1:
+            self._drop(grid, goal, "reached")
+
+    def _revive_dropped(self, grid: np.ndarray) -> None:
+        back = self.memory.revive(grid, self.geometry)
+        if back:
+            self.blacklist.points_m[:] = self.memory.active_points()
+            self.counters["revived"] += len(back)
+            for xy in back:
+                self._log("revive", f"map changed round {xy}")
+
+    def _retry_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float]
+    ) -> tuple[_Plan | None, np.ndarray | None]:
+        """The next approach to a failed goal: a grid route, then another side (or drop it)."""
+        assert self._retry is not None
+        goal, n, failed_at = self._retry
+        res_m = self.geometry.resolution_m
+        if not self._unknown_near(grid, goal, self.params.goal_check_radius_m):
+            self._retry = None  # its frontier got mapped meanwhile
+            return None, None
+        clearance = clearance_field_m(grid, res_m)
+        target, path = goal, None
+        if n == 1:
+            path = grid_path_to(
+                grid, self.geometry, pose[:2], goal, self.clearance_m, clearance_field=clearance
+            )
+        else:
+            found = side_approach(
+                grid, self.geometry, pose[:2], goal, failed_at, self.clearance_m, clearance
+            )
+            if found is not None:
+                target, path = found
+        if path is None:
+            # The grid planner finds no way for the robot's disc: the goal is unreachable now.
+            self._retry = None
+            self._drop(grid, goal, "grid")
+            return None, clearance
+        from policies.semantic_expert import _Plan
+
+        plan = _Plan("retry", target, resample_polyline(path, res_m), None, frontier_xy_m=goal)
+        return plan, clearance
+
+    def _look_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
+    ) -> _Plan | None:
+        """Before stopping: drive close to a frontier too narrow to reach, to look again.
+
+        The grid fallback already found no frontier the robot's disc can reach; a frontier with
+        unknown space behind it that is only *near* a reachable cell (a gap narrower than the
+        robot at first sight) gets one look from within ``look_reach_m``, unless the robot has
+        already passed within ``look_seen_radius_m`` of it (at that range the LiDAR resolves a
+        gap the robot could pass: it had its look, and the frontier is dropped at once).
+        """
+        prm = self.params
+        res_m = self.geometry.resolution_m
+        for _ in range(_MAX_LOOK_CANDIDATES):
+            found = nearest_reachable_frontier(
+                grid,
+                self.geometry,
+                pose[:2],
+                self.clearance_m,
+                min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
+                min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
+                reach_m=prm.look_reach_m,
+                excluded_xy_m=self.memory.active_points(),
+                excluded_radius_m=prm.blacklist_radius_m,
+                clearance_field=clearance,
+            )
+            if found is None:
+                return None
+            if not self._been_near(found.frontier_xy_m, prm.look_seen_radius_m):
+                from policies.semantic_expert import _Plan
+
+                path = resample_polyline(found.path_m, res_m)
+                plan = _Plan("look", found.goal_xy_m, path, None)
+                plan.frontier_xy_m = found.frontier_xy_m
+                return plan
+            self.counters["looks"] += 1
+            self._drop(grid, found.frontier_xy_m, "looked")
+        return None
+
+    def _been_near(self, xy_m: tuple[float, float], radius_m: float) -> bool:
+        """Whether the robot's trail passed within ``radius_m`` of ``xy_m``."""
+        c = TRAIL_CELL_M
+        k = int(math.ceil(radius_m / c))
+        ix, iy = int(xy_m[0] // c), int(xy_m[1] // c)
+        for i in range(ix - k, ix + k + 1):
+            for j in range(iy - k, iy + k + 1):
+                if (i, j) in self._trail and math.dist(((i + 0.5) * c, (j + 0.5) * c), xy_m) <= (
+                    radius_m
+                ):
+                    return True
+        return False
+
+    def _stop_reason(self) -> str:
+        """Which rule ended the mission, and what was left behind."""
+        if not self.params.grid_fallback:
+            n = self.memory.count()
+            return "no semantic frontier left" + (f" ({n} frontier(s) dropped)" if n else "")
+        parts = []
+        for reason, text in (
+            ("attempts", f"failed {self.params.max_goal_attempts} approaches"),
+            ("grid", "no grid path"),
+            ("reached", f"reached {self.params.max_goal_reaches} times, not cleared"),
+            ("looked", "looked at, gap closed"),
+        ):
+            n = self.memory.count(reason)
+            if n:
+                parts.append(f"{n} {text}")
+        tail = f"; dropped: {', '.join(parts)}" if parts else ""
+        return f"no frontier left (grid check: none reachable{tail})"

@@ -1,0 +1,237 @@
+"""The expert never gives up on a reachable frontier (#13): winding passages, sealed-off and
+narrow-at-first-sight frontiers, retries, dropped goals that come back, the paper-pure preset."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import semexplore_gym  # noqa: F401
+from policies.navigation.approaches import side_approach
+from policies.navigation.frontier_memory import FrontierMemory
+from policies.registry import make_policy
+from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+from policies.semantic_expert_params import PAPER_PURE
+from semexplore_gym.core.frontiers.reachable import clearance_field_m
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.params import build_params
+from semexplore_gym.core.worlds.build import world_from_free_mask
+from semexplore_gym.evaluation.rollout import run_mission
+
+RES = 0.05
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _world(name: str, size_m: tuple[float, float], rects: list, start: tuple) -> object:
+    """A raster world: free rectangles ``(x0, y0, x1, y1)`` in metres on a 0.05 m grid."""
+    h, w = int(round(size_m[1] / RES)), int(round(size_m[0] / RES))
+    free = np.zeros((h, w), dtype=bool)
+    for x0, y0, x1, y1 in rects:
+        free[
+            int(round(y0 / RES)) : int(round(y1 / RES)), int(round(x0 / RES)) : int(round(x1 / RES))
+        ] = True
+    return world_from_free_mask(name, free, GridGeometry(RES, 0.0, 0.0, h, w), start_pose=start)
+
+
+def _mission(world: object, policy: SemanticExpertPolicy, max_time_s: float = 900.0):
+    env = gym.make("SemanticExplore-v0", world=world)
+    try:
+        return run_mission(
+            env, policy, seed=0, max_time_s=max_time_s, progress=False, ignore_terminated=True
+        )
+    finally:
+        env.close()
+
+
+def test_a_frontier_behind_a_winding_passage_is_reached() -> None:
+    # Two rooms joined by an S-shaped passage 0.5 m wide with four turns.
+    rects = [
+        (0.3, 0.3, 1.8, 3.7),  # room A (start)
+        (1.8, 0.3, 2.6, 0.8),
+        (2.1, 0.3, 2.6, 3.4),
+        (2.1, 2.9, 3.6, 3.4),
+        (3.1, 0.6, 3.6, 3.4),
+        (3.1, 0.6, 4.3, 1.1),
+        (4.2, 0.3, 5.7, 3.7),  # room B, seen only through the passage
+    ]
+    world = _world("winding", (6.0, 4.0), rects, (1.0, 2.0, 0.0))
+    res = _mission(world, SemanticExpertPolicy())
+    assert res.self_stopped, res.stop_reason
+    assert res.coverage >= 0.97, (res.coverage, res.stop_reason)
+    assert res.collisions == 0
+    assert max(x for x, _y, _t in res.trajectory) > 4.3  # it drove into room B
+
+
+def test_a_sealed_off_frontier_ends_the_mission_by_the_grid_check() -> None:
+    # Room B lies behind a 0.1 m slit the LiDAR sees through but no robot passes.
+    rects = [(0.3, 0.3, 2.8, 2.7), (2.8, 1.45, 3.0, 1.55), (3.0, 0.3, 5.7, 2.7)]
+    world = _world("sealed", (6.0, 3.0), rects, (1.0, 1.5, 0.0))
+    pol = SemanticExpertPolicy()
+    res = _mission(world, pol)
+    assert res.self_stopped, res.stop_reason
+    assert "grid check: none reachable" in res.stop_reason
+    assert res.coverage >= 0.97  # of the reachable area: room A
+    assert max(x for x, _y, _t in res.trajectory) < 2.8
+    assert pol.memory.count() >= 1  # what it saw through the slit was dropped, with a reason
+
+
+GEOM = GridGeometry(RES, 0.0, 0.0, 60, 100)  # 5 m x 3 m
+INFO = {
+    "map_geometry": GEOM.to_dict(),
+    "robot": {"radius_m": 0.105, "max_linear_speed_mps": 0.22, "max_angular_speed_radps": 2.84},
+    "lidar": {"n_beams": 360, "min_range_m": 0.12, "max_range_m": 3.5},
+    "dt_s": 0.2,
+}
+
+
+def _two_rooms(gap_m: float) -> np.ndarray:
+    """Room A known (x < 2.4 m), a wall at x 2.4-2.5 m with a gap of ``gap_m`` at y = 1.5 m,
+    unknown beyond: a frontier in the gap."""
+    g = np.full(GEOM.shape, UNKNOWN, dtype=np.uint8)
+    g[:, :50] = OCCUPIED
+    g[4:56, 4:48] = FREE
+    half = int(round(gap_m / RES / 2))
+    g[30 - half : 30 + half, 48:51] = FREE
+    return g
+
+
+def _empty_tmap(grid: np.ndarray, *_: object, **__: object) -> object:
+    from semexplore_gym.core.topometric.types import TopometricMap
+
+    return TopometricMap(GEOM, np.full(grid.shape, -1, np.int32), {}, [], [], [], math.nan, 0.155)
+
+
+def _obs(grid: np.ndarray, x: float, y: float) -> dict[str, np.ndarray]:
+    return {
+        "map": grid,
+        "pose": np.array([x, y, 0.0], dtype=np.float32),
+        "scan": np.full(360, 3.5, dtype=np.float32),
+    }
+
+
+def test_a_narrow_at_first_sight_opening_gets_a_closer_look_then_is_explored() -> None:
+    pol = SemanticExpertPolicy(segmenter=_empty_tmap)
+    # 0.2 m: too narrow for the robot's 0.31 m, first seen from 2.2 m away (farther than
+    # look_seen_radius_m, so it has not had its closer look yet).
+    narrow = _obs(_two_rooms(0.2), 0.3, 1.5)
+    pol.reset(narrow, INFO, seed=0)
+    pol.act(narrow, INFO)
+    assert pol.plan_source == "look" and not pol.done
+    goal = pol.goal_xy_m
+    assert goal is not None and math.dist(goal, (2.45, 1.5)) <= 1.0 + 0.2
+    # Seen from close by the opening is wider than it looked: the grid reaches through it.
+    wide = _obs(_two_rooms(0.6), goal[0], goal[1])
+    pol.request_replan()
+    pol.act(wide, INFO)
+    assert pol.plan_source == "fallback" and pol.goal_xy_m[0] > 2.3
+    # Had it stayed narrow, reaching the look point drops it as looked-at and the mission ends.
+    pol2 = SemanticExpertPolicy(segmenter=_empty_tmap)
+    pol2.reset(narrow, INFO, seed=0)
+    pol2.act(narrow, INFO)
+    at_goal = _obs(_two_rooms(0.2), *pol2.goal_xy_m)
+    for _ in range(5):
+        pol2.act(at_goal, INFO)
+        if pol2.done:
+            break
+    assert pol2.done and "looked at" in pol2.stop_reason
+
+
+def test_a_failed_goal_is_retried_by_other_approaches_before_it_is_dropped() -> None:
+    prm = SemanticExpertParams(stuck_timeout_s=1.0, backoff_duration_s=0.4, local_min_timeout_s=99)
+    pol = SemanticExpertPolicy(prm, segmenter=_empty_tmap)
+    obs = _obs(_two_rooms(0.6), 0.6, 1.5)
+    pol.reset(obs, INFO, seed=0)
+    sources = []
+    for _ in range(300):  # the pose never changes: every approach gets stuck
+        pol.act(obs, INFO)
+        sources.append(pol.plan_source)
+        if pol.done:
+            break
+    assert pol.counters["retries"] == prm.max_goal_attempts - 1
+    assert "retry" in sources
+    assert pol.done and f"failed {prm.max_goal_attempts} approaches" in pol.stop_reason
+
+
+def test_frontier_memory_drops_revives_and_caps_revivals() -> None:
+    grid = _two_rooms(0.6)
+    mem = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3)
+    assert mem.record_failure((2.5, 1.5), (1.0, 1.5)) == (1, (1.0, 1.5))
+    assert mem.record_failure((2.6, 1.6), (2.0, 1.5)) == (2, (1.0, 1.5))  # same place
+    mem.drop((2.5, 1.5), "attempts", grid, GEOM)
+    assert mem.is_dropped((2.7, 1.5)) and not mem.is_dropped((3.2, 1.5))
+    assert mem.revive(grid, GEOM) == []  # nothing changed round it
+    changed = grid.copy()
+    changed[20:40, 51:60] = FREE  # the space behind the gap got mapped
+    assert mem.revive(changed, GEOM) == [(2.5, 1.5)]
+    assert not mem.is_dropped((2.5, 1.5))
+    assert mem.record_failure((2.5, 1.5), (1.0, 1.5))[0] == 1  # counting starts afresh
+    mem.drop((2.5, 1.5), "attempts", changed, GEOM)
+    assert mem.revive(grid, GEOM) == []  # at most max_revivals per place
+    assert mem.count("attempts") == 1 and mem.count("looked") == 0
+
+
+def test_abandoned_goals_are_remembered_for_the_oscillation_window() -> None:
+    mem = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3)
+    mem.abandon((1.0, 1.0), 10.0)
+    assert mem.recently_abandoned((1.2, 1.0), 100.0, 120.0)
+    assert not mem.recently_abandoned((3.0, 1.0), 100.0, 120.0)
+    assert not mem.recently_abandoned((1.2, 1.0), 200.0, 120.0)
+
+
+def test_side_approach_comes_from_away_from_the_failure() -> None:
+    grid = np.full(GEOM.shape, OCCUPIED, dtype=np.uint8)
+    grid[4:56, 4:96] = FREE
+    clearance = clearance_field_m(grid, RES)
+    found = side_approach(grid, GEOM, (0.5, 1.5), (2.5, 1.5), (1.9, 1.5), 0.155, clearance)
+    assert found is not None
+    target, path = found
+    assert math.dist(target, (2.5, 1.5)) <= 0.85 and target[0] > 2.5
+    assert math.dist(tuple(path[-1]), target) <= 0.15 + RES  # grid_path_to's goal radius
+
+
+def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
+    from policies.config import load_policy_config
+
+    cfg = load_policy_config(REPO / "configs" / "expert" / "paper_pure.yaml")
+    from_yaml = build_params(SemanticExpertParams, cfg.params)
+    assert from_yaml == build_params(SemanticExpertParams, PAPER_PURE)
+    pol = make_policy("semantic-paper")
+    assert pol.params == from_yaml
+    assert pol.params.cost == SemanticExpertParams().cost  # the paper's weights
+    flags = (
+        "grid_fallback look_at_narrow_frontiers oscillation_guard entry_detour goal_commitment "
+        "local_min_escape stuck_recovery reach_blacklist"
+    ).split()
+    assert not any(getattr(pol.params, f) for f in flags)
+    assert all(getattr(SemanticExpertParams(), f) for f in flags)  # the robust default
+    assert not pol.params.potential_field.braking_guard and pol.params.prune_by == "area"
+    with pytest.raises(ValueError, match="semantic-paper"):
+        make_policy("semantic-paper:x")
+
+
+def test_without_the_braking_guard_only_the_field_sets_the_speed() -> None:
+    from semexplore_gym.core.planning.potential_field import (
+        PotentialFieldParams,
+        RobotLimits,
+        force_to_velocity,
+    )
+
+    lim = RobotLimits(0.105, 0.22, 2.84, 3.5)
+    scan = np.full(360, 3.5)
+    scan[:6] = scan[-6:] = 0.2  # a wall 0.2 m ahead
+    angles = np.arange(360) * 2 * math.pi / 360
+    no_steer = PotentialFieldParams(guard_steer_max_rad=0.0)
+    guarded = force_to_velocity(1.0, 0.0, scan, angles, lim, no_steer)[0]
+    free = force_to_velocity(
+        1.0,
+        0.0,
+        scan,
+        angles,
+        lim,
+        PotentialFieldParams(guard_steer_max_rad=0.0, braking_guard=False),
+    )[0]
+    assert guarded < 0.22 and free == pytest.approx(0.22)
