@@ -148,6 +148,8 @@ class SemanticExpertParams:
             or two-cell groups are leaks through rasterised walls.
         look_seen_radius_m: A narrow frontier the robot already passed this close to had its
             look (the LiDAR resolved it then).
+        look_clearance_fraction: A frontier a robot with this fraction of the clearance could
+            reach is narrow at first sight and worth a look; narrower gaps are leaks.
         oscillation_guard: Do not switch back to a recently abandoned goal.
         oscillation_window_s: How long an abandoned goal stays "recent".
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
@@ -193,7 +195,8 @@ class SemanticExpertParams:
     look_reach_m: float = 1.0
     look_min_unknown_depth_m: float = 0.3
     look_min_frontier_m: float = 0.15
-    look_seen_radius_m: float = 2.0
+    look_seen_radius_m: float = 1.5
+    look_clearance_fraction: float = 0.5
     oscillation_guard: bool = True
     oscillation_window_s: float = 120.0
     entry_detour: bool = True
@@ -232,6 +235,7 @@ class SemanticExpertParams:
             "look_min_unknown_depth_m",
             "look_min_frontier_m",
             "look_seen_radius_m",
+            "look_clearance_fraction",
             "look_reach_m",
             "oscillation_window_s",
         )

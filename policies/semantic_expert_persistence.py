@@ -158,13 +158,15 @@ class GoalPersistence:
     def _look_plan(
         self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
     ) -> _Plan | None:
-        """Before stopping: drive close to a frontier too narrow to reach, to look again.
+        """Before stopping: drive towards a frontier too narrow to reach, to look again.
 
-        The grid fallback already found no frontier the robot's disc can reach; a frontier with
-        unknown space behind it that is only *near* a reachable cell (a gap narrower than the
-        robot at first sight) gets one look from within ``look_reach_m``, unless the robot has
-        already passed within ``look_seen_radius_m`` of it (at that range the LiDAR resolves a
-        gap the robot could pass: it had its look, and the frontier is dropped at once).
+        The grid fallback already found no frontier the robot's disc can reach. A frontier that
+        a thinner robot (``look_clearance_fraction`` of the clearance) could reach is a gap
+        narrower than the robot *at first sight* (a door seen at a grazing angle, a passage
+        seen through a narrow slot); leaks through rasterised walls, one or two cells wide, are
+        not. The robot follows the thin robot's path as far as its own clearance allows, and
+        looks from there, once per place; if the robot already passed within
+        ``look_seen_radius_m`` of the frontier it had its look, and the frontier is dropped.
         """
         prm = self.params
         res_m = self.geometry.resolution_m
@@ -173,26 +175,38 @@ class GoalPersistence:
                 grid,
                 self.geometry,
                 pose[:2],
-                self.clearance_m,
+                self.clearance_m * prm.look_clearance_fraction,
                 min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
                 min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
-                reach_m=prm.look_reach_m,
+                reach_m=prm.fallback_reach_m,
                 excluded_xy_m=self.memory.active_points(),
                 excluded_radius_m=prm.blacklist_radius_m,
                 clearance_field=clearance,
             )
             if found is None:
                 return None
-            if not self._been_near(found.frontier_xy_m, prm.look_seen_radius_m):
+            path = self._standable_prefix(found.path_m, clearance)
+            near = math.dist(tuple(path[-1]), found.frontier_xy_m) <= prm.look_reach_m
+            if len(path) >= 2 and near and not self._been_near(
+                found.frontier_xy_m, prm.look_seen_radius_m
+            ):
                 from policies.semantic_expert import _Plan
 
-                path = resample_polyline(found.path_m, res_m)
-                plan = _Plan("look", found.goal_xy_m, path, None)
+                plan = _Plan("look", (float(path[-1, 0]), float(path[-1, 1])), path, None)
                 plan.frontier_xy_m = found.frontier_xy_m
                 return plan
             self.counters["looks"] += 1
             self._drop(grid, found.frontier_xy_m, "looked")
         return None
+
+    def _standable_prefix(self, path_m: np.ndarray, clearance: np.ndarray) -> np.ndarray:
+        """The part of ``path_m`` from its start on which the robot's own clearance holds."""
+        res_m = self.geometry.resolution_m
+        dense = resample_polyline(path_m, res_m)
+        rows, cols = self.geometry.world_to_grid(dense[:, 0], dense[:, 1])
+        ok = clearance[rows, cols] >= self.clearance_m - 1e-9
+        bad = np.flatnonzero(~ok[1:])  # the start may sit closer to a wall than the clearance
+        return dense if len(bad) == 0 else dense[: int(bad[0]) + 1]
 
     def _been_near(self, xy_m: tuple[float, float], radius_m: float) -> bool:
         """Whether the robot's trail passed within ``radius_m`` of ``xy_m``."""
