@@ -97,6 +97,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    import math
+
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
@@ -104,9 +106,18 @@ def run(args: argparse.Namespace) -> int:
     from policies.registry import make_policy
     from policies.rollout import run_mission
     from semexplore_gym.core.params import parse_override
+    from semexplore_gym.core.safe_io import check_output_file
 
-    if not (args.max_time_s > 0):
-        raise ValueError(f"--max-time-s must be positive, got {args.max_time_s!r}")
+    if not (0 < args.max_time_s <= 1e7):
+        raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")
+    if not (math.isfinite(args.gif_every_s) and args.gif_every_s > 0):
+        raise ValueError(
+            f"--gif-every-s must be a positive finite number, got {args.gif_every_s!r}"
+        )
+    if not (0 <= args.seed <= 2**32 - 1):
+        raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
+    if args.gif is not None:
+        check_output_file(args.gif, "--gif", (".gif",))
     cfg = load_policy_config(args.config)
     spec = args.policy or cfg.policy or "semantic"
     overrides: dict[str, Any] = {}

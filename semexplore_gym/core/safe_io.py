@@ -31,7 +31,9 @@ MAX_YAML_BYTES = 1 << 20
 MAX_JSON_BYTES = 16 << 20
 #: Deepest nesting of lists / mappings.
 MAX_DEPTH = 64
-#: Most values (scalars + containers) a document may hold once aliases are expanded.
+#: Most values (scalars + containers) a YAML document may hold once aliases are expanded
+#: (configs and map yamls hold tens), and a JSON document (a HouseExpo plan: ~3 per vertex).
+MAX_YAML_NODES = 100_000
 MAX_NODES = 1_000_000
 
 
@@ -127,7 +129,7 @@ def load_yaml_text(
     *,
     max_bytes: int = MAX_YAML_BYTES,
     max_depth: int = MAX_DEPTH,
-    max_nodes: int = MAX_NODES,
+    max_nodes: int = MAX_YAML_NODES,
 ) -> Any:
     """``yaml.safe_load`` with bounds on size, depth and alias expansion.
 
@@ -138,7 +140,10 @@ def load_yaml_text(
         raise UnsafeInputError(
             f"{source}: {len(text)} characters is more than the {max_bytes} limit"
         )
-    loader = yaml.SafeLoader(text)
+    try:
+        loader = yaml.SafeLoader(text)
+    except yaml.YAMLError as e:  # the reader refuses control characters at once
+        raise UnsafeInputError(f"{source}: malformed YAML: {one_line(str(e))}") from None
     try:
         try:
             node = loader.get_single_node()
@@ -238,3 +243,31 @@ def load_json_file(path: str | os.PathLike, what: str = "JSON file", **bounds: i
     max_bytes = bounds.pop("max_bytes", MAX_JSON_BYTES)
     text = _read_text(path, max_bytes, what)
     return load_json_text(text, str(path), max_bytes=max_bytes, **bounds)
+
+
+def check_output_file(path: str, flag: str, suffixes: tuple[str, ...] = ()) -> None:
+    """Refuse an output file path that cannot be written as asked, before any work is done.
+
+    Raises:
+        ValueError: ``path`` is empty, a directory, has another suffix than ``suffixes``, its
+            name is too long, or its parent directory does not exist (named with ``flag``).
+    """
+    if not path or not str(path).strip():
+        raise ValueError(f"{flag} is empty; give a file path")
+    p = Path(path)
+    shown = short_repr(str(path), 120)
+    if len(p.name.encode()) > 255:
+        raise ValueError(f"{flag} {shown}: the file name is longer than 255 bytes")
+    try:
+        is_dir = p.is_dir()
+        parent_ok = p.parent.is_dir()
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{flag} {shown}: {one_line(str(e))}") from None
+    if is_dir:
+        raise ValueError(f"{flag} {shown} is a directory; give a file path")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise ValueError(f"{flag} {shown} must end in {' or '.join(suffixes)}")
+    if not parent_ok:
+        raise ValueError(
+            f"{flag} {shown}: directory {short_repr(str(p.parent), 120)} does not exist"
+        )
