@@ -117,7 +117,8 @@ def run(args: argparse.Namespace) -> int:
     if not (0 <= args.seed <= 2**32 - 1):
         raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     if args.gif is not None:
-        check_output_file(args.gif, "--gif", (".gif",))
+        # the GIF writer creates missing parent directories
+        check_output_file(args.gif, "--gif", (".gif",), parent_must_exist=False)
     cfg = load_policy_config(args.config)
     spec = args.policy or cfg.policy or "semantic"
     overrides: dict[str, Any] = {}

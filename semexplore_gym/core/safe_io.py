@@ -245,12 +245,15 @@ def load_json_file(path: str | os.PathLike, what: str = "JSON file", **bounds: i
     return load_json_text(text, str(path), max_bytes=max_bytes, **bounds)
 
 
-def check_output_file(path: str, flag: str, suffixes: tuple[str, ...] = ()) -> None:
+def check_output_file(
+    path: str, flag: str, suffixes: tuple[str, ...] = (), *, parent_must_exist: bool = True
+) -> None:
     """Refuse an output file path that cannot be written as asked, before any work is done.
 
     Raises:
         ValueError: ``path`` is empty, a directory, has another suffix than ``suffixes``, its
-            name is too long, or its parent directory does not exist (named with ``flag``).
+            name is too long, or (``parent_must_exist``) its parent directory does not exist;
+            the message names ``flag``.
     """
     if not path or not str(path).strip():
         raise ValueError(f"{flag} is empty; give a file path")
@@ -267,7 +270,7 @@ def check_output_file(path: str, flag: str, suffixes: tuple[str, ...] = ()) -> N
         raise ValueError(f"{flag} {shown} is a directory; give a file path")
     if suffixes and p.suffix.lower() not in suffixes:
         raise ValueError(f"{flag} {shown} must end in {' or '.join(suffixes)}")
-    if not parent_ok:
+    if parent_must_exist and not parent_ok:
         raise ValueError(
             f"{flag} {shown}: directory {short_repr(str(p.parent), 120)} does not exist"
         )
