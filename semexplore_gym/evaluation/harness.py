@@ -16,7 +16,6 @@ start pose (and the same procedural world for ``family:seed=*`` spellings) to ev
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
 import json
 import math
@@ -268,52 +267,73 @@ FINGERPRINT_FILE = "fingerprint.json"
 
 
 def run_fingerprint(tasks: Sequence[Task]) -> dict[str, Any]:
-    """What makes rows comparable beyond (world, policy, seed): time limit, env config and
-    policy overrides. Stored next to ``runs.csv`` and checked on resume."""
+    """What makes rows comparable beyond (world, policy, seed): the time limit, the env config
+    and each policy's overrides. Stored next to ``runs.csv`` and checked on resume."""
     from semexplore_gym.core.params import to_dict
 
-    def one(t: Task) -> dict[str, Any]:
-        cfg = t.env_config
-        return {
-            "max_time_s": t.max_time_s,
-            "env_config": to_dict(cfg) if cfg is not None else None,
-            "policy_overrides": t.policy_overrides,
-        }
+    def canon(value: Any) -> Any:
+        return json.loads(json.dumps(value, sort_keys=True, default=str))
 
-    setups = {json.dumps(one(t), sort_keys=True, default=str) for t in tasks}
-    if len(setups) > 1:
-        raise ValueError("tasks of one benchmark must share max_time_s, env_config and overrides")
-    fp = json.loads(next(iter(setups))) if setups else {}
-    fp["digest"] = hashlib.sha256(json.dumps(fp, sort_keys=True).encode()).hexdigest()[:16]
+    shared = {
+        json.dumps(
+            canon(
+                {
+                    "max_time_s": t.max_time_s,
+                    "env_config": to_dict(t.env_config) if t.env_config is not None else None,
+                }
+            ),
+            sort_keys=True,
+        )
+        for t in tasks
+    }
+    if len(shared) > 1:
+        raise ValueError("the missions of one benchmark must share max_time_s and env_config")
+    fp: dict[str, Any] = json.loads(next(iter(shared))) if shared else {}
+    overrides: dict[str, Any] = {}
+    for t in tasks:
+        o = canon(t.policy_overrides)
+        if overrides.setdefault(t.policy, o) != o:
+            raise ValueError(f"policy {short_repr(t.policy)} is listed with two sets of overrides")
+    fp["policy_overrides"] = {k: overrides[k] for k in sorted(overrides)}
     return fp
 
 
 def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool) -> None:
-    """Store ``fingerprint`` in ``out_dir``, or refuse to resume rows made with another one."""
+    """Store ``fingerprint`` in ``out_dir``, or refuse to resume rows made with other settings.
+
+    Adding worlds, seeds or policies to a run is fine; changing ``max_time_s``, the env config
+    or the overrides of a policy that already has rows is not.
+    """
     path = out_dir / FINGERPRINT_FILE
-    if path.exists() and has_rows:
+    old: dict[str, Any] | None = None
+    if has_rows and path.exists():
         try:
             old = json.loads(path.read_text())
         except (ValueError, OSError):
             old = {}
-        if old.get("digest") != fingerprint["digest"]:
-            changed = [
-                k
-                for k in ("max_time_s", "env_config", "policy_overrides")
-                if old.get(k) != fingerprint.get(k)
-            ] or ["the stored fingerprint is unreadable"]
+    if old is not None:
+        changed = [
+            (k, old.get(k), fingerprint.get(k))
+            for k in ("max_time_s", "env_config")
+            if old.get(k) != fingerprint.get(k)
+        ]
+        old_over = old.get("policy_overrides") or {}
+        new_over = fingerprint["policy_overrides"]
+        changed += [
+            (f"overrides of {p}", old_over[p], new_over[p])
+            for p in sorted(set(old_over) & set(new_over))
+            if old_over[p] != new_over[p]
+        ]
+        if changed:
             detail = ", ".join(
-                f"{k}: {short_repr(old.get(k), 60)} -> {short_repr(fingerprint.get(k), 60)}"
-                if k in fingerprint
-                else k
-                for k in changed
+                f"{k}: {short_repr(a, 60)} -> {short_repr(b, 60)}" for k, a, b in changed
             )
             raise ValueError(
                 f"{out_dir} holds missions run with different settings ({detail}); "
                 "rerun with the same settings to resume, or use a new --out directory"
             )
-    elif not has_rows or not path.exists():
-        path.write_text(json.dumps(fingerprint, indent=2, sort_keys=True))
+        fingerprint = dict(fingerprint, policy_overrides={**old_over, **new_over})
+    path.write_text(json.dumps(fingerprint, indent=2, sort_keys=True))
 
 
 def _die_with_parent() -> None:

@@ -98,6 +98,17 @@ def test_changed_max_time_is_refused_on_resume(tmp_path) -> None:
     assert res == {"ran": 1, "skipped": 2, "failed": []}
 
 
+def test_adding_policies_and_seeds_resumes_but_changed_overrides_do_not(tmp_path) -> None:
+    run = lambda tasks: run_benchmark(tasks, tmp_path, progress=False, task_fn=fake_task)  # noqa: E731
+    run(expand_tasks(["w"], ["a"], [0], max_time_s=5.0, policy_overrides={"x": 1}))
+    res = run(expand_tasks(["w"], ["a"], [0, 1], max_time_s=5.0, policy_overrides={"x": 1}))
+    assert res["ran"] == 1 and res["skipped"] == 1
+    res = run(expand_tasks(["w"], ["b"], [0], max_time_s=5.0, policy_overrides={"x": 2}))
+    assert res["ran"] == 1
+    with pytest.raises(ValueError, match="overrides of a"):
+        run(expand_tasks(["w"], ["a"], [0], max_time_s=5.0, policy_overrides={"x": 3}))
+
+
 def test_changed_env_config_is_refused_through_the_cli(tmp_path, capsys, monkeypatch) -> None:
     import semexplore_gym.evaluation.harness as harness
 
