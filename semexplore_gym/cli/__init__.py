@@ -54,15 +54,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args._run(args) or 0)
-    except (ValueError, FileNotFoundError, KeyError) as e:
-        print(f"semexplore {args.command}: error: {e}", file=sys.stderr)
-        return 2
     except BrokenPipeError:
         # The reader went away (``semexplore segment ... --json | head``): stop quietly; point
         # stdout at /dev/null so the interpreter's final flush does not raise again.
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except (ValueError, OSError, KeyError, RecursionError, MemoryError) as e:
+        # Bad input ends here as one short line; never a traceback or a flood of output.
+        from semexplore_gym.core.safe_io import one_line
+
+        text = one_line(str(e), 600) or type(e).__name__
+        if isinstance(e, (RecursionError, MemoryError)):
+            text = f"{type(e).__name__}: input too large or too deeply nested ({text})"
+        print(f"semexplore {args.command}: error: {text}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

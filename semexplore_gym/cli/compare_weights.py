@@ -34,9 +34,36 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.core.safe_io import short_repr
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
+
+
+def validate_args(args: argparse.Namespace) -> None:
+    """Check every number and the output path before anything is loaded or tuned.
+
+    Raises:
+        ValueError: naming the argument and its value.
+    """
+    checks = (
+        ("--max-time-s", args.max_time_s, 0 < args.max_time_s <= 1e7),
+        ("--target-coverage", args.target_coverage, 0.0 < args.target_coverage <= 1.0),
+        ("--penalty-s", args.penalty_s, math.isfinite(args.penalty_s) and args.penalty_s >= 0),
+        ("--trials", args.trials, 1 <= args.trials <= 100_000),
+        ("--runs", args.runs, 1 <= args.runs <= 100_000),
+        ("--train-runs", args.train_runs, 1 <= args.train_runs <= 100_000),
+        ("--workers", args.workers, 1 <= args.workers <= 256),
+        ("--train-seed0", args.train_seed0, 0 <= args.train_seed0 <= 2**31),
+        ("--test-seed0", args.test_seed0, 0 <= args.test_seed0 <= 2**31),
+        ("--seed", args.seed, 0 <= args.seed <= 2**32 - 1),
+    )
+    for flag, value, ok in checks:
+        if not ok:
+            raise ValueError(f"{flag}: {value!r} is out of range (see --help)")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {short_repr(args.out)} is an existing file; give a directory")
 
 
 def _split_worlds(text: str) -> list[str]:
@@ -257,12 +284,31 @@ def run(args: argparse.Namespace) -> int:
         tune_weights,
     )
 
+    validate_args(args)
     train_worlds = _split_worlds(args.train_worlds)
     test_worlds = _split_worlds(args.test_worlds)
     if not train_worlds or not test_worlds:
         raise ValueError("--train-worlds and --test-worlds must each name at least one world")
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
     test_seeds = parse_seeds(args.runs, args.test_seed0)
+    # Everything is checked before the tuning starts: a typo must not cost an Optuna run.
+    from semexplore_gym.cli.benchmark import _check_worlds
+
+    for flag, worlds, seeds in (
+        ("--train-worlds", train_worlds, train_seeds),
+        ("--test-worlds", test_worlds, test_seeds),
+    ):
+        dup = next((w for i, w in enumerate(worlds) if w in worlds[:i]), None)
+        if dup is not None:
+            raise ValueError(f"{flag} lists {short_repr(dup)} twice")
+        try:
+            _check_worlds(worlds, seeds[0])
+        except (ValueError, FileNotFoundError) as e:
+            raise ValueError(f"{flag}: {e}") from None
+    if args.config is not None:
+        from semexplore_gym.envs.config import load_env_config
+
+        load_env_config(args.config)
     overlap = set(train_seeds) & set(test_seeds)
     if overlap and set(train_worlds) & set(test_worlds):
         raise ValueError(

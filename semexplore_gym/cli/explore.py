@@ -105,16 +105,28 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    import math
+
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from semexplore_gym.evaluation.rollout import run_mission
     from semexplore_gym.core.params import merge_overrides
+    from semexplore_gym.evaluation.rollout import run_mission
+    from semexplore_gym.core.safe_io import check_output_file
 
-    if not (args.max_time_s > 0):
-        raise ValueError(f"--max-time-s must be positive, got {args.max_time_s!r}")
+    if not (0 < args.max_time_s <= 1e7):
+        raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")
+    if not (math.isfinite(args.gif_every_s) and args.gif_every_s > 0):
+        raise ValueError(
+            f"--gif-every-s must be a positive finite number, got {args.gif_every_s!r}"
+        )
+    if not (0 <= args.seed <= 2**32 - 1):
+        raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
+    if args.gif is not None:
+        # the GIF writer creates missing parent directories
+        check_output_file(args.gif, "--gif", (".gif",), parent_must_exist=False)
     cfg = load_policy_config(args.policy_config)
     spec = args.policy or cfg.policy or "semantic"
     policy_kwargs: dict[str, Any] = merge_overrides(None, args.overrides)  # nested by key path

@@ -14,6 +14,7 @@ from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
+from semexplore_gym.core.safe_io import short_repr
 from semexplore_gym.core.worlds import make_world
 from semexplore_gym.core.worlds.start import (
     reachable_free_mask,
@@ -275,22 +276,24 @@ class SemanticExploreEnv(gym.Env):
         return self._obs(), reward, terminated, truncated, info
 
     def _scale_action(self, action: Any) -> tuple[float, float]:
-        if isinstance(action, np.ndarray) and action.shape == (2,):
+        if isinstance(action, np.ndarray) and action.shape == (2,) and action.dtype.kind in "fiub":
             a0, a1 = float(action[0]), float(action[1])
         else:
             try:
-                a = np.asarray(action, dtype=np.float64).reshape(-1)
+                raw = np.asarray(action)
+                # float() would drop an imaginary part or parse a string: only real numbers.
+                if raw.dtype.kind not in "fiubO" or np.iscomplexobj(action):
+                    raise TypeError(f"dtype {raw.dtype}")
+                a = raw.astype(np.float64).reshape(-1)
             except (TypeError, ValueError) as e:
                 raise ValueError(
-                    f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}"
+                    f"action must be 2 numbers [v, omega] in [-1, 1], got {short_repr(action)}"
                 ) from e
             if a.shape != (2,):
-                raise ValueError(
-                    f"action must have shape (2,), got shape {np.shape(action)}: {action!r}"
-                )
+                raise ValueError(f"action must have shape (2,), got {short_repr(action)}")
             a0, a1 = float(a[0]), float(a[1])
         if not (math.isfinite(a0) and math.isfinite(a1)):
-            raise ValueError(f"action contains NaN or inf: {action!r}")
+            raise ValueError(f"action contains NaN or inf: {short_repr(action)}")
         rp = self.config.robot
         v = min(1.0, max(-1.0, a0)) * rp.max_linear_speed_mps
         if not rp.allow_reverse:

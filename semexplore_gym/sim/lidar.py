@@ -42,9 +42,9 @@ class LidarParams:
             raise ValueError(
                 f"lidar.min_range_m must be in [0, max_range_m), got {self.min_range_m!r}"
             )
-        if not (self.range_noise_std_m >= 0 and math.isfinite(self.range_noise_std_m)):
+        if not (0 <= self.range_noise_std_m <= 1.0):
             raise ValueError(
-                f"lidar.range_noise_std_m must be >= 0, got {self.range_noise_std_m!r}"
+                f"lidar.range_noise_std_m must be in [0, 1] m, got {self.range_noise_std_m!r}"
             )
         if not (0 <= self.dropout_prob < 1):
             raise ValueError(f"lidar.dropout_prob must be in [0, 1), got {self.dropout_prob!r}")
