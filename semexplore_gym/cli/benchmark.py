@@ -12,6 +12,8 @@ import json
 import shlex
 import sys
 
+from semexplore_gym.cli import describe
+
 
 def _split(text: str) -> list[str]:
     return [t.strip() for t in text.split(",") if t.strip()] if text else []
@@ -50,7 +52,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "benchmark",
         help="run exploration missions for several worlds, policies and seeds; write runs.csv, plots, summary.md",
-        description=__doc__,
+        description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

@@ -471,7 +471,14 @@ def _train_ppo(cfg: TrainConfig, args: argparse.Namespace, out: Path) -> dict[st
 
 # ---------------------------------------------------------------------- CLI glue
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("train", help="train a learning agent (behaviour cloning, DAgger or PPO)")
+    from semexplore_gym.cli import describe
+
+    p = sub.add_parser(
+        "train",
+        help="train a learning agent (behaviour cloning, DAgger or PPO)",
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument(
         "--algo",
         required=True,
