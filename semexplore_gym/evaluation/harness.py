@@ -111,7 +111,14 @@ def run_task(task: Task) -> dict[str, Any]:
     import semexplore_gym  # noqa: F401  (registers the env)
     from policies.registry import make_policy
     from policies.rollout import run_mission
+    from semexplore_gym.evaluation.warmup import warm_up
 
+    # Kernels compiled or loaded before the mission's clocks start.
+    warm_up(
+        lambda: make_policy(task.policy, **task.policy_overrides),
+        task.env_config,
+        key=(task.policy, repr(task.env_config), repr(task.policy_overrides)),
+    )
     env = gym.make("SemanticExplore-v0", world=task.resolved_world, config=task.env_config)
     try:
         policy = make_policy(task.policy, **task.policy_overrides)
