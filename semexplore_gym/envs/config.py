@@ -19,11 +19,13 @@ from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 class RewardParams:
     """Weights of the named reward terms; ``reward = sum(weight * term)``.
 
-    Terms: ``new_area`` = free area newly added to the map this step (m^2), ``time`` = the
-    control period (s), ``collision`` = 1 when a new wall contact began this step.
+    Terms: ``free_area_change`` = the net change of the map's free area this step (m^2): cells
+    newly mapped free minus free cells re-marked occupied, so it is negative on some steps (about
+    a quarter of random-action steps, where a wall's edge is re-observed); ``time`` = the control
+    period (s); ``collision`` = 1 when a new wall contact began this step.
     """
 
-    new_area_weight: float = 1.0
+    free_area_change_weight: float = 1.0
     time_weight: float = -0.01
     collision_weight: float = -1.0
 
@@ -77,6 +79,24 @@ class EnvConfig:
     episode: EpisodeParams = field(default_factory=EpisodeParams)
 
 
+#: Config keys renamed since they were published: old dotted path -> new one.
+RENAMED_KEYS: dict[str, str] = {
+    # "new area" read as m^2 newly mapped, but the term is a net change (it can be negative).
+    "reward.new_area_weight": "reward.free_area_change_weight",
+}
+
+
+def _reject_renamed_keys(data: dict[str, Any]) -> None:
+    for old, new in RENAMED_KEYS.items():
+        section, key = old.split(".")
+        if isinstance(data.get(section), dict) and key in data[section]:
+            raise ConfigError(
+                f"config key {old!r} was renamed {new!r} (the term is the net change of the map's "
+                "free area per step, negative when free cells are re-marked occupied); "
+                f"use {new}={data[section][key]!r}"
+            )
+
+
 #: Named configurations; ``configs/<name>.yaml`` in the repository holds the same values.
 PRESETS: dict[str, dict[str, Any]] = {
     "default": {},
@@ -123,4 +143,5 @@ def load_env_config(
             f"config must be None, a preset name, a YAML path, a dict or an EnvConfig; got {type(config).__name__}"
         )
     data = merge_overrides(data, overrides or [])
+    _reject_renamed_keys(data)
     return from_dict(EnvConfig, data)
