@@ -30,4 +30,3 @@ def test_gymnasium_check_env(render_mode, headless) -> None:
             check_env(env.unwrapped, skip_render_check=False)
     finally:
         env.close()
-
