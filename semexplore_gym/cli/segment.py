@@ -160,7 +160,15 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         from semexplore_gym.rendering.topometric_plot import save_topometric_png
 
-        save_topometric_png(tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids)
+        c = tmap.counts()
+        # No time in the picture: it is the machine's, printed below; a figure keeps its title.
+        title = (
+            f"{name}: {c['intersections']} intersections, {c['pathways']} pathways, "
+            f"{c['dead_ends']} dead ends, {c['frontier_pathways']} frontier pathways"
+        )
+        save_topometric_png(
+            tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids, title=title
+        )
     if args.export:
         from semexplore_gym.core.topometric.export import to_json_dict
 
