@@ -25,7 +25,7 @@ from typing import Any, TextIO
 #: The world of the warm-up mission: corridors, 3- and 4-way junctions and dead ends.
 WARMUP_WORLD = "maze1"
 #: Simulated seconds of the warm-up mission (stops earlier when the policy is done).
-WARMUP_TIME_S = 20.0
+WARMUP_TIME_S = 10.0
 COMPILE_MESSAGE = "compiling numba kernels (first run only, ~2 min on 2 cores)..."
 #: Keys of the warm-ups this process has done (a process loads a kernel once; the set only
 #: saves repeating the warm-up mission, it changes no result).
