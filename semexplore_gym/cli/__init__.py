@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 from collections.abc import Sequence
 
@@ -22,6 +23,16 @@ SUBCOMMANDS: dict[str, str] = {
     "compare-weights": "compare_weights",
     "maps": "maps",
 }
+
+
+def describe(doc: str | None) -> str:
+    """A subcommand's ``--help`` description from its module docstring: reST markup made plain
+    (no double backticks, ``Example::`` as ``Example:``), paragraphs and indentation kept (use
+    with ``argparse.RawDescriptionHelpFormatter``)."""
+    text = (doc or "").strip()
+    text = re.sub(r"``(.+?)``", r"\1", text, flags=re.DOTALL)
+    text = re.sub(r":(?:func|class|meth|mod|data):`~?([^`]+)`", r"\1", text)
+    return text.replace("::\n", ":\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -14,6 +14,7 @@ import sys
 
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.cli import describe
 
 
 def _split(text: str) -> list[str]:
@@ -79,7 +80,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "benchmark",
         help="run exploration missions for several worlds, policies and seeds; write runs.csv, plots, summary.md",
-        description=__doc__,
+        description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

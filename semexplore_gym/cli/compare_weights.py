@@ -1,13 +1,14 @@
 """``semexplore compare-weights``: paper vs tuned planner weights, with a semantic-term ablation.
 
-1. Tune ``w_v``, ``w_p``, ``w_I`` (``--tune-field``: also ``f_g``, ``f_o``, ``f_l``) with Optuna
+1. Tune the frontier cost weights w_v, w_p, w_I of the paper (config keys ``cost.w_v``,
+   ``cost.w_p``, ``cost.w_i``; ``--tune-field``: also ``potential_field.f_g/f_o/f_l``) with Optuna
    TPE on the training worlds x training seeds (objective: mean of
    ``mission_time_s + penalty_s * max(0, target_coverage - coverage)``). The study is kept in
    ``OUT/tuning/study.sqlite`` and every trial in ``OUT/tuning/trials.jsonl``.
 2. Run every weight set on the test worlds x test seeds through the benchmark harness
    (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` and the ablations
    of the paper weights ``semantic[paper,w_p=0]``, ``semantic[paper,w_I=0]``,
-   ``semantic[paper,w_p=w_I=0]``.
+   ``semantic[paper,w_p=w_I=0]`` (w_I=0: ``cost.w_i=0``).
    ``--agents`` adds learned agents (any policy spec, e.g. a ``SemanticExploreWeights-v0`` PPO
    model that chooses the weights at every decision: ``sb3:runs/pw/model.zip[learned]``) on the
    same test worlds and seeds.
@@ -35,6 +36,7 @@ from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.cli import describe
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
@@ -205,7 +207,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "compare-weights",
         help="tune the planner weights with Optuna and compare them with the paper's (and ablations)",
-        description=__doc__,
+        description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

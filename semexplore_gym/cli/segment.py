@@ -1,5 +1,8 @@
 """``semexplore segment MAP_OR_WORLD --out seg.png [--json]``: segment a map and draw it.
 
+The map is split into intersections, pathways, dead ends and pathways leading to frontiers (the
+semantic topometric map of the paper); the time of the segmentation itself is printed.
+
 ``MAP_OR_WORLD`` is a ROS map (``.yaml``, unknown cells kept) or any world spec accepted by
 :func:`semexplore_gym.core.worlds.registry.make_world` (``maze1``, ``office:seed=3``, a HouseExpo
 ``.json``); a world is rasterised from its ground-truth free space (free inside, occupied
@@ -18,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from semexplore_gym.cli import describe
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
 from semexplore_gym.core.safe_io import check_output_file, short_repr
 
@@ -26,7 +30,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "segment",
         help="segment a map into intersections, pathways, dead ends and frontier pathways; draw it to a PNG",
-        description=__doc__.split("\n\n")[0],
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "map",
@@ -195,11 +200,20 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         from semexplore_gym.rendering.topometric_plot import save_topometric_png
 
-        save_topometric_png(tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids)
+        c = tmap.counts()
+        # No time in the picture: it is the machine's, printed below; a figure keeps its title.
+        title = (
+            f"{name}: {c['intersections']} intersections, {c['pathways']} pathways, "
+            f"{c['dead_ends']} dead ends, {c['frontier_pathways']} frontier pathways"
+        )
+        save_topometric_png(
+            tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids, title=title
+        )
     if args.export:
         from semexplore_gym.core.topometric.export import to_json_dict
 
         Path(args.export).write_text(json.dumps(to_json_dict(tmap)))
+        print(f"wrote {args.export}", file=sys.stderr)
     if args.json:
         print(json.dumps(summary(tmap, name)))
     else:

@@ -10,7 +10,7 @@ from typing import Any
 
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
-from semexplore_gym.core.params import build_params
+from semexplore_gym.core.params import ConfigError, build_params
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 
@@ -26,11 +26,13 @@ MAX_SUBSTEP_TRAVEL_M = 0.005
 class RewardParams:
     """Weights of the named reward terms; ``reward = sum(weight * term)``.
 
-    Terms: ``new_area`` = free area newly added to the map this step (m^2), ``time`` = the
-    control period (s), ``collision`` = 1 when a new wall contact began this step.
+    Terms: ``free_area_change`` = the net change of the map's free area this step (m^2): cells
+    newly mapped free minus free cells re-marked occupied, so it is negative on some steps (about
+    a quarter of random-action steps, where a wall's edge is re-observed); ``time`` = the control
+    period (s); ``collision`` = 1 when a new wall contact began this step.
     """
 
-    new_area_weight: float = 1.0
+    free_area_change_weight: float = 1.0
     time_weight: float = -0.01
     collision_weight: float = -1.0
 
@@ -117,6 +119,12 @@ class EnvConfig:
                 f"physics.max_substep_travel_m={self.physics.max_substep_travel_m:g}"
             )
 
+#: Config keys renamed since they were published: old dotted path -> new one.
+RENAMED_KEYS: dict[str, str] = {
+    # "new area" read as m^2 newly mapped, but the term is a net change (it can be negative).
+    "reward.new_area_weight": "reward.free_area_change_weight",
+}
+
 
 #: Named configurations, the layers ``config="<name>"`` stands for. ``configs/<name>.yaml`` in
 #: the repository holds the same values (tests/envs/test_env_config.py compares them).
@@ -143,4 +151,13 @@ def load_env_config(
         ConfigError: unknown preset, unknown key (named with its dotted path) or a bad value.
         FileNotFoundError: a config path that does not exist.
     """
-    return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)
+    try:
+        return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)
+    except ConfigError as e:
+        for old, new in RENAMED_KEYS.items():
+            if repr(old) in str(e) or repr(old.split(".")[-1]) in str(e):
+                raise ConfigError(
+                    f"config key {old!r} was renamed {new!r} (the term is the net change of the "
+                    "map's free area per step, negative when free cells are re-marked occupied)"
+                ) from None
+        raise

@@ -70,9 +70,11 @@ class SemanticExploreEnv(gym.Env):
 
     ## Rewards
     ``reward = sum(weight * term)`` over named terms (weights in ``RewardParams``):
-    ``new_area`` (m^2 of free space newly mapped this step, weight 1), ``time`` (the control
-    period in s, weight -0.01) and ``collision`` (1 when a wall contact begins, weight -1).
-    ``info["reward_terms"]`` holds each weighted term.
+    ``free_area_change`` (the net change of the map's free area this step in m^2, weight 1: cells
+    newly mapped free minus free cells re-marked occupied, so a step that re-observes a wall's
+    edge can score below zero), ``time`` (the control period in s, weight -0.01) and
+    ``collision`` (1 when a wall contact begins, weight -1). ``info["reward_terms"]`` holds each
+    weighted term.
 
     ## Starting State
     The world's start pose, ``episode.start_pose``, ``reset(options={"start_pose": ...})``, or
@@ -105,7 +107,8 @@ class SemanticExploreEnv(gym.Env):
     paths and goal on the next frames (keys in :mod:`semexplore_gym.rendering.renderer`).
 
     ## Version History
-    - v0: initial version.
+    - v0: initial version. (The ``new_area`` reward term was renamed ``free_area_change``, and
+      its weight ``reward.free_area_change_weight``, to say what it is; values unchanged.)
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
@@ -237,7 +240,7 @@ class SemanticExploreEnv(gym.Env):
         self._overlay = {}
         self._true_pose = self.sim.pose
         self._scan = self._sense_and_map(self._true_pose)
-        info = self._info({"new_area": 0.0, "time": 0.0, "collision": 0.0})
+        info = self._info({"free_area_change": 0.0, "time": 0.0, "collision": 0.0})
         if self.render_mode == "human":
             self.render()
         return self._obs(), info
@@ -260,10 +263,10 @@ class SemanticExploreEnv(gym.Env):
         )
         n_free_before = self.grid.n_free_cells
         self._scan = self._sense_and_map(after)
-        new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
+        free_area_change_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
         rw = cfg.reward
         terms = {
-            "new_area": rw.new_area_weight * new_area_m2,
+            "free_area_change": rw.free_area_change_weight * free_area_change_m2,
             "time": rw.time_weight * cfg.episode.dt_s,
             "collision": rw.collision_weight * float(new_collision),
         }

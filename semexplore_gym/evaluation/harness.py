@@ -125,7 +125,14 @@ def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
     from policies.registry import make_policy
     from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
+    from semexplore_gym.evaluation.warmup import warm_up
 
+    # Kernels compiled or loaded before the mission's clocks start.
+    warm_up(
+        lambda: make_policy(task.policy, **task.policy_overrides),
+        task.env_config,
+        key=(task.policy, repr(task.env_config), repr(task.policy_overrides)),
+    )
     env = make_mission_env(task.resolved_world, task.env_config)
     try:
         policy = make_policy(task.policy, **task.policy_overrides)
