@@ -538,7 +538,7 @@ ENV_KEYS = {
         "trans_from_rot",
         "min_translation_m",
     ],
-    "reward": ["new_area_weight", "time_weight", "collision_weight"],
+    "reward": ["free_area_change_weight", "time_weight", "collision_weight"],
     "episode": ["dt_s", "max_time_s", "coverage_goal", "start_clearance_margin_m"],
     "mapping": [],
 }

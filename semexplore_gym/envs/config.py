@@ -37,7 +37,7 @@ class RewardParams:
     collision_weight: float = -1.0
 
     def __post_init__(self) -> None:
-        for name in ("new_area_weight", "time_weight", "collision_weight"):
+        for name in ("free_area_change_weight", "time_weight", "collision_weight"):
             v = getattr(self, name)
             if not (math.isfinite(v) and abs(v) <= MAX_REWARD_WEIGHT):
                 raise ValueError(
