@@ -14,7 +14,7 @@ from numba.core.dispatcher import Dispatcher
 import semexplore_gym  # noqa: F401  (registers the env)
 from policies.base import Policy, StepStats
 from policies.registry import make_policy
-from policies.rollout import run_mission
+from semexplore_gym.evaluation.rollout import run_mission
 from semexplore_gym.evaluation.warmup import COMPILE_MESSAGE, warm_up
 
 
