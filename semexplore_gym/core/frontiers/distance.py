@@ -66,13 +66,91 @@ def frontier_distance_m(grid: np.ndarray, resolution_m: float, clearance_m: floa
         raise ValueError(f"resolution_m must be a positive number, got {resolution_m!r}")
     if not (math.isfinite(clearance_m) and clearance_m >= 0):
         raise ValueError(f"clearance_m must be a finite number >= 0, got {clearance_m!r}")
-    off_r, off_c = clearance_offsets(resolution_m, clearance_m)
-    dist = np.empty(a.shape, np.float64)
-    if not _frontier_distance_kernel(
-        np.ascontiguousarray(a), float(resolution_m), off_r, off_c, dist
-    ):
-        validate_encoded_grid(a)  # a value outside UNKNOWN/FREE/OCCUPIED: raises naming it
-    return dist
+    field = FrontierDistanceField(a.shape, resolution_m, clearance_m)
+    field.update(np.ascontiguousarray(a))
+    return field.distance_m()
+
+
+class FrontierDistanceField:
+    """The frontier distance of one grid shape, kept up to date as the map changes.
+
+    Holds the search's buffers (allocated once, reused by every :meth:`update`) and a copy of
+    the last map: an update with an unchanged map costs one comparison pass. The distances
+    live in :attr:`dist_padded`, a flat array over the grid with a one-cell border of ``inf``
+    (cell ``(r, c)`` at ``(r + 1) * (W + 2) + c + 1``), which kernels read without copying.
+
+    Args:
+        shape: ``(H, W)`` of the grids to come.
+        resolution_m: Cell side in metres.
+        clearance_m: Minimum distance of a path cell from walls.
+    """
+
+    def __init__(self, shape: tuple[int, int], resolution_m: float, clearance_m: float) -> None:
+        if not (math.isfinite(resolution_m) and resolution_m > 0):
+            raise ValueError(f"resolution_m must be a positive number, got {resolution_m!r}")
+        if not (math.isfinite(clearance_m) and clearance_m >= 0):
+            raise ValueError(f"clearance_m must be a finite number >= 0, got {clearance_m!r}")
+        h, w = (int(v) for v in shape)
+        self.shape = (h, w)
+        self.row_stride = w + 2
+        n = (h + 2) * (w + 2)
+        self.off_r, self.off_c = clearance_offsets(resolution_m, clearance_m)
+        # The same products as the general Dijkstra's step costs (side, diagonal).
+        self._w_side = 1.0 * float(resolution_m)
+        self._w_diag = math.sqrt(2.0) * float(resolution_m)
+        self.dist_padded = np.full(n, np.inf)
+        self._state = np.zeros(n, np.uint8)
+        self._queue0 = np.empty(h * w, np.int32)
+        # A cell enters each step queue at most 4 times (once per neighbour of that kind).
+        self._q1_node = np.empty(4 * n, np.int32)
+        self._q1_key = np.empty(4 * n, np.float64)
+        self._q2_node = np.empty(4 * n, np.int32)
+        self._q2_key = np.empty(4 * n, np.float64)
+        self._last_map = np.zeros((h, w), np.uint8)
+        self._valid = False
+
+    def update(self, grid: np.ndarray) -> bool:
+        """Bring the distances up to date with ``grid`` (C-contiguous uint8 of :attr:`shape`).
+
+        Returns:
+            True when the field was recomputed, False when ``grid`` equals the last map.
+
+        Raises:
+            ValueError: ``grid`` holds a value other than UNKNOWN, FREE or OCCUPIED.
+        """
+        if self._valid:
+            if not _copy_if_changed(grid, self._last_map):
+                return False
+            self._valid = False
+        else:
+            self._last_map[...] = grid
+        if not _frontier_distance_kernel(
+            grid, self.off_r, self.off_c, self._w_side, self._w_diag, self.dist_padded,
+            self._state, self._queue0, self._q1_node, self._q1_key, self._q2_node, self._q2_key,
+        ):  # fmt: skip
+            validate_encoded_grid(grid)  # a value outside UNKNOWN/FREE/OCCUPIED: raises naming it
+        self._valid = True
+        return True
+
+    def distance_m(self) -> np.ndarray:
+        """``(H, W)`` float64 copy of the distances (``inf`` where no frontier is reachable)."""
+        h, w = self.shape
+        return self.dist_padded.reshape(h + 2, w + 2)[1:-1, 1:-1].copy()
+
+
+@njit(cache=True)
+def _copy_if_changed(src, dst):  # pragma: no cover - numba
+    """Copy ``src`` into ``dst`` (same shape); False, copying nothing, when they are equal."""
+    a = src.ravel()
+    b = dst.ravel()
+    n = a.shape[0]
+    i = 0
+    while i < n and a[i] == b[i]:
+        i += 1
+    if i == n:
+        return False
+    b[i:] = a[i:]
+    return True
 
 
 def relative_distance_image(
@@ -98,22 +176,26 @@ def relative_distance_image(
 
 
 @njit(cache=True)
-def _frontier_distance_kernel(grid, res, off_r, off_c, dist):  # pragma: no cover - numba
-    """Fill ``dist`` (H, W) with the frontier distance; False if ``grid`` holds a bad value."""
+def _frontier_distance_kernel(
+    grid, off_r, off_c, w_side, w_diag, dp, state, queue0, q1_node, q1_key, q2_node, q2_key
+):  # pragma: no cover - numba
+    """Fill the padded flat ``dp`` with the frontier distance; False if ``grid`` has a bad value.
+
+    ``dp`` and ``state`` carry a one-cell blocked border (``inf`` and 0, never written here), so
+    neighbours need no bounds checks; every interior cell is rewritten.
+    """
     h, w = grid.shape
-    # Work on flat arrays with a one-cell blocked border: neighbours need no bounds checks.
     wp = w + 2
-    n = (h + 2) * wp
     # state: 0 blocked, 1 passable, 2 frontier (passable, never blocked), 3 settled.
-    state = np.zeros(n, np.uint8)
-    dp = np.full(n, np.inf)
-    queue0 = np.empty(h * w, np.int32)
     n_src = 0
     for r in range(h):
+        base = (r + 1) * wp + 1
         for c in range(w):
             v = grid[r, c]
+            i = base + c
+            dp[i] = np.inf
+            state[i] = 0
             if v == FREE:
-                i = (r + 1) * wp + c + 1
                 if (
                     (r > 0 and grid[r - 1, c] == UNKNOWN)
                     or (r < h - 1 and grid[r + 1, c] == UNKNOWN)
@@ -143,10 +225,7 @@ def _frontier_distance_kernel(grid, res, off_r, off_c, dist):  # pragma: no cove
                                     state[i] = 0
         for i in range(n_src):
             state[queue0[i]] = 1
-        _settle(state, dp, queue0, n_src, wp, 1.0 * res, math.sqrt(2.0) * res)
-    for r in range(h):
-        for c in range(w):
-            dist[r, c] = dp[(r + 1) * wp + c + 1]
+        _settle(state, dp, queue0, n_src, wp, w_side, w_diag, q1_node, q1_key, q2_node, q2_key)
     return True
 
 
@@ -163,19 +242,15 @@ def _relax(state, dp, v, nd, q_node, q_key, t):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def _settle(state, dp, queue0, n_src, wp, w_side, w_diag):  # pragma: no cover - numba
+def _settle(
+    state, dp, queue0, n_src, wp, w_side, w_diag, q1_node, q1_key, q2_node, q2_key
+):  # pragma: no cover - numba
     """Multi-source Dijkstra over the padded flat grid from the ``n_src`` sources at distance 0.
 
     ``w_side`` and ``w_diag`` are the same products (step times cell cost) as the general
     Dijkstra's. Pops come from three queues whose keys never decrease: the sources, the cells
     reached by a side step and those reached by a diagonal step.
     """
-    n = state.shape[0]
-    # A cell has 4 side and 4 diagonal neighbours, so it enters each queue at most 4 times.
-    q1_node = np.empty(4 * n, np.int32)
-    q1_key = np.empty(4 * n, np.float64)
-    q2_node = np.empty(4 * n, np.int32)
-    q2_key = np.empty(4 * n, np.float64)
     h0, h1, t1, h2, t2 = 0, 0, 0, 0, 0
     while True:
         if h0 < n_src:
