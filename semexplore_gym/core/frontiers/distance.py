@@ -366,9 +366,12 @@ def _update_kernel(
 
 
 @njit(cache=True, inline="always")
-def _relax(state, dp, settled, g, v, nd, q_node, q_key, t):  # pragma: no cover - numba
-    """Lower ``dp[v]`` to ``nd`` and queue ``v`` when that is shorter; returns the new tail."""
-    if state[v] != 0 and settled[v] != g:
+def _relax(state, dp, v, nd, q_node, q_key, t):  # pragma: no cover - numba
+    """Lower ``dp[v]`` to ``nd`` and queue ``v`` when that is shorter; returns the new tail.
+
+    A settled cell is never lowered (every later key is larger), so it needs no test here.
+    """
+    if state[v] != 0:
         if nd < dp[v]:
             dp[v] = nd
             q_node[t] = v
@@ -423,10 +426,10 @@ def _settle(
         settled[u] = g
         du = dp[u]
         nd = du + w_side
-        t1 = _relax(state, dp, settled, g, u + 1, nd, q1_node, q1_key, t1)
-        t1 = _relax(state, dp, settled, g, u - 1, nd, q1_node, q1_key, t1)
-        t1 = _relax(state, dp, settled, g, u + wp, nd, q1_node, q1_key, t1)
-        t1 = _relax(state, dp, settled, g, u - wp, nd, q1_node, q1_key, t1)
+        t1 = _relax(state, dp, u + 1, nd, q1_node, q1_key, t1)
+        t1 = _relax(state, dp, u - 1, nd, q1_node, q1_key, t1)
+        t1 = _relax(state, dp, u + wp, nd, q1_node, q1_key, t1)
+        t1 = _relax(state, dp, u - wp, nd, q1_node, q1_key, t1)
         # No corner cutting: both side cells of a diagonal step must be passable.
         nd = du + w_diag
         up, dn, rt, lf = (
@@ -436,13 +439,13 @@ def _settle(
             state[u - 1] != 0,
         )
         if up and rt:
-            t2 = _relax(state, dp, settled, g, u + wp + 1, nd, q2_node, q2_key, t2)
+            t2 = _relax(state, dp, u + wp + 1, nd, q2_node, q2_key, t2)
         if up and lf:
-            t2 = _relax(state, dp, settled, g, u + wp - 1, nd, q2_node, q2_key, t2)
+            t2 = _relax(state, dp, u + wp - 1, nd, q2_node, q2_key, t2)
         if dn and rt:
-            t2 = _relax(state, dp, settled, g, u - wp + 1, nd, q2_node, q2_key, t2)
+            t2 = _relax(state, dp, u - wp + 1, nd, q2_node, q2_key, t2)
         if dn and lf:
-            t2 = _relax(state, dp, settled, g, u - wp - 1, nd, q2_node, q2_key, t2)
+            t2 = _relax(state, dp, u - wp - 1, nd, q2_node, q2_key, t2)
 
 
 def relative_distance_image(
