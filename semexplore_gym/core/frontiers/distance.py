@@ -224,16 +224,23 @@ def _update_kernel(
     if full:
         r0, r1, c0, c1 = 0, h - 1, 0, w - 1
     else:
-        for r in range(h):
-            for c in range(w):
-                if grid[r, c] != last[r, c]:
-                    if r < r0:
-                        r0 = r
-                    r1 = r
-                    if c < c0:
-                        c0 = c
-                    if c > c1:
-                        c1 = c
+        # Compare 8 cells at a time, then the cells of the words that differ.
+        a = grid.ravel()
+        b = last.ravel()
+        n = a.shape[0]
+        n8 = n - n % 8
+        a8 = a[:n8].view(np.uint64)
+        b8 = b[:n8].view(np.uint64)
+        for q in range(n8 // 8):
+            if a8[q] != b8[q]:
+                for i in range(8 * q, 8 * q + 8):
+                    if a[i] != b[i]:
+                        r, c = i // w, i % w
+                        r0, r1, c0, c1 = min(r0, r), max(r1, r), min(c0, c), max(c1, c)
+        for i in range(n8, n):
+            if a[i] != b[i]:
+                r, c = i // w, i % w
+                r0, r1, c0, c1 = min(r0, r), max(r1, r), min(c0, c), max(c1, c)
         if r1 < 0:
             return 0
     for r in range(r0, r1 + 1):
