@@ -122,8 +122,6 @@ class FrontierDistanceField:
         # 0 blocked, 1 passable, 2 frontier (passable); the border stays 0.
         self._state = np.zeros(n, np.uint8)
         self._inv = np.zeros(n, np.uint8)
-        self._settled = np.zeros(n, np.int32)  # == self._gen[0]: settled in this search
-        self._gen = np.zeros(1, np.int32)
         self._cells = np.empty(n, np.int32)  # invalidated cells, then sources
         self._seed_node = np.empty(n, np.int32)
         self._seed_key = np.empty(n, np.float64)
@@ -148,7 +146,7 @@ class FrontierDistanceField:
         self._valid = False
         status = _update_kernel(
             grid, self._last_map, full, self.off_r, self.off_c, self._w_side, self._w_diag,
-            self.dist_padded, self._state, self._inv, self._settled, self._gen, self._cells,
+            self.dist_padded, self._state, self._inv, self._cells,
             self._seed_node, self._seed_key, self._q1_node, self._q1_key, self._q2_node,
             self._q2_key,
         )  # fmt: skip
@@ -201,8 +199,6 @@ def _update_kernel(
     dp,
     state,
     inv,
-    settled,
-    gen,
     cells,
     seed_node,
     seed_key,
@@ -252,8 +248,6 @@ def _update_kernel(
         reach = max(reach, abs(off_r[k]), abs(off_c[k]))
     r0, r1 = max(0, r0 - reach), min(h - 1, r1 + reach)
     c0, c1 = max(0, c0 - reach), min(w - 1, c1 + reach)
-    gen[0] += 1
-    g = gen[0]
     n_seed = 0
     if full:
         for r in range(h):
@@ -367,7 +361,7 @@ def _update_kernel(
             dp[cells[k]] = seed_key[order[k]]
         for k in range(n_seed):
             seed_key[k] = dp[seed_node[k]]
-    _settle(state, dp, settled, g, seed_node, seed_key, n_seed, wp, w_side, w_diag,
+    _settle(state, dp, seed_node, seed_key, n_seed, wp, w_side, w_diag,
             q1_node, q1_key, q2_node, q2_key)  # fmt: skip
     return 1
 
@@ -391,8 +385,6 @@ def _relax(state, dp, v, nd, q_node, q_key, t):  # pragma: no cover - numba
 def _settle(
     state,
     dp,
-    settled,
-    g,
     q0_node,
     q0_key,
     n0,
@@ -408,8 +400,9 @@ def _settle(
 
     ``w_side`` and ``w_diag`` are the same products (step times cell cost) as the general
     Dijkstra's. Pops come from three queues whose keys never decrease: the seeds, the cells
-    reached by a side step and those reached by a diagonal step. Settled cells get
-    ``settled == g``.
+    reached by a side step and those reached by a diagonal step. Every push lowers its
+    cell's distance, so the one entry whose key still equals it settles the cell and the
+    others are stale.
     """
     h0, h1, t1, h2, t2 = 0, 0, 0, 0, 0
     inf = np.inf
@@ -418,20 +411,18 @@ def _settle(
         k1 = q1_key[h1] if h1 < t1 else inf
         k2 = q2_key[h2] if h2 < t2 else inf
         if h0 < n0 and k0 <= k1 and k0 <= k2:
-            u = q0_node[h0]
+            u, du = q0_node[h0], k0
             h0 += 1
         elif h1 < t1 and k1 <= k2:
-            u = q1_node[h1]
+            u, du = q1_node[h1], k1
             h1 += 1
         elif h2 < t2:
-            u = q2_node[h2]
+            u, du = q2_node[h2], k2
             h2 += 1
         else:
             break
-        if settled[u] == g:
-            continue  # a stale entry: the cell was settled from a smaller key
-        settled[u] = g
-        du = dp[u]
+        if du != dp[u]:
+            continue  # a stale entry: the cell was lowered since (and settled from there)
         nd = du + w_side
         t1 = _relax(state, dp, u + 1, nd, q1_node, q1_key, t1)
         t1 = _relax(state, dp, u - 1, nd, q1_node, q1_key, t1)
