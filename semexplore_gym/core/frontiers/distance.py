@@ -239,6 +239,10 @@ def _update_kernel(
                 r0, r1, c0, c1 = min(r0, r), max(r1, r), min(c0, c), max(c1, c)
         if r1 < 0:
             return 0
+        if 4 * (r1 - r0 + 1) * (c1 - c0 + 1) > h * w:
+            # A new map rather than a scan's worth of changes: a fresh search is cheaper.
+            full = True
+            r0, r1, c0, c1 = 0, h - 1, 0, w - 1
     for r in range(r0, r1 + 1):
         for c in range(c0, c1 + 1):
             last[r, c] = grid[r, c]

@@ -179,6 +179,12 @@ def test_incremental_field_equals_a_fresh_search(clearance_m: float) -> None:
             np.testing.assert_array_equal(
                 field.distance_m(), frontier_distance_m(grid, 0.05, clearance_m)
             )
+        # A whole new map (searched afresh rather than repaired).
+        grid = _partly_explored_maze(seed + 40)
+        field.update(grid)
+        np.testing.assert_array_equal(
+            field.distance_m(), frontier_distance_m(grid, 0.05, clearance_m)
+        )
         # A bad value raises and the next valid map is searched afresh.
         bad = grid.copy()
         bad[0, 0] = 7
