@@ -5,9 +5,11 @@ every step. Composed from general tools (a scipy dilation for the wall clearance
 heap-based Dijkstra of :func:`semexplore_gym.core.grid_search.distance_field`) it cost most of
 an encode. The kernel here fuses the frontier test, the clearance mask and the search, and
 replaces the binary heap by three FIFO queues: the search has only two edge weights (a side
-step ``res`` and a diagonal step ``sqrt(2) * res``) and every source starts at 0, so the keys
-pushed through each weight leave in the order they were pushed and the smallest of the three
-queue heads is the global minimum (Dijkstra's settle order without a heap).
+step ``res`` and a diagonal step ``sqrt(2) * res``) and the sources are taken in order of
+their keys, so the keys pushed through each weight leave in the order they were pushed and the
+smallest of the three queue heads is the global minimum (Dijkstra's settle order without a
+heap). Between steps a map changes in a few cells: :class:`FrontierDistanceField` keeps the
+field and its buffers and repairs only what the change invalidated.
 
 Every distance is the same floating-point sum as the general Dijkstra's (``d[u] + step * res``
 with the same two step values): both settle cells in non-decreasing order, so both reach the
