@@ -610,7 +610,7 @@ def env_config_cases(rng: random.Random) -> list[Case]:
                     argv = [*explore, "--env-config", "{d}/c.yaml"]
                     files = {"c.yaml": f"{section}:\n  {key}: {v}\n".encode()}
                 else:
-                    argv = [*CLI_FOR_MAP["bench"]("maze1"), "--set", f"{dotted}={v}"]
+                    argv = [*CLI_FOR_MAP["bench"]("maze1"), "--env-set", f"{dotted}={v}"]
                     files = {}
                 out.append(Case("env_config", f"{dotted}={v[:20]}/{how}", argv, files, expect))
     for text in [
@@ -688,7 +688,7 @@ def env_config_cases(rng: random.Random) -> list[Case]:
                     "--max-time-s",
                     "1",
                     "--no-progress",
-                    "--set",
+                    "--policy-set",
                     f"cost.w_v={v}",
                 ],
                 expect=ANY if v in ("-1", "1e300", "-1e300") else REJECT,
@@ -698,7 +698,7 @@ def env_config_cases(rng: random.Random) -> list[Case]:
         Case(
             "env_config",
             "policy-config-bomb",
-            [*explore, "--config", "{d}/p.yaml"],
+            [*explore, "--policy-config", "{d}/p.yaml"],
             {"p.yaml": alias_bomb(9, 9, "params").encode()},
         )
     )
@@ -942,7 +942,7 @@ def cli_cases(rng: random.Random) -> list[Case]:
         ("--train-seed0", ["-5"]),
         ("--seed", ["-1"]),
         ("--agents", ["semantic", "unknown", "sb3:{d}/missing.zip"]),
-        ("--config", ["nosuchpreset", "{d}/missing.yaml"]),
+        ("--env-config", ["nosuchpreset", "{d}/missing.yaml"]),
     ):
         for v in vals:
             out.append(Case("cli", f"compare-weights{flag}={v[:20]}", cw_with(flag, v)))
@@ -952,9 +952,9 @@ def cli_cases(rng: random.Random) -> list[Case]:
     for a in (
         ["train", "--algo", "nope", "--out", "{d}/t"],
         ["train", "--out", "{d}/f.txt"],
-        ["train", "--config", "{d}/missing.yaml", "--out", "{d}/t"],
-        ["train", "--set", "foo.bar=1", "--out", "{d}/t"],
-        ["train", "--set", "robot.radius_m=" + nested(3000), "--out", "{d}/t"],
+        ["train", "--train-config", "{d}/missing.yaml", "--out", "{d}/t"],
+        ["train", "--train-set", "foo.bar=1", "--out", "{d}/t"],
+        ["train", "--train-set", "robot.radius_m=" + nested(3000), "--out", "{d}/t"],
     ):
         out.append(Case("cli", f"train-{' '.join(a[1:3])[:30]}", a, {"f.txt": b"x"}))
     for a in (

@@ -307,10 +307,10 @@ def run(args: argparse.Namespace) -> int:
             _check_worlds(worlds, seeds[0])
         except (ValueError, FileNotFoundError) as e:
             raise ValueError(f"{flag}: {e}") from None
-    if args.config is not None:
+    if args.env_config is not None:
         from semexplore_gym.envs.config import load_env_config
 
-        load_env_config(args.config)
+        load_env_config(args.env_config)
     overlap = set(train_seeds) & set(test_seeds)
     if overlap and set(train_worlds) & set(test_worlds):
         raise ValueError(

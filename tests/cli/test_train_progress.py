@@ -24,7 +24,7 @@ def test_ppo_training_with_the_progress_bar(
     args = [a for a in tiny_macro_train_args(2) if a != "--no-progress"]
     out = tmp_path / algo
     code = main(
-        ["train", "--algo", algo, "--config", str(CONFIGS / config), "--out", str(out), *args]
+        ["train", "--algo", algo, "--train-config", str(CONFIGS / config), "--out", str(out), *args]
     )
     assert code == 0
     assert json.loads((out / "metrics.json").read_text())["timesteps"] == 8

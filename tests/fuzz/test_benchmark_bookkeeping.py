@@ -134,7 +134,7 @@ def test_changed_env_config_is_refused_through_the_cli(tmp_path, capsys, monkeyp
     ]
     assert main(base) == 0
     capsys.readouterr()
-    assert main([*base, "--set", "lidar.n_beams=90"]) == 2
+    assert main([*base, "--env-set", "lidar.n_beams=90"]) == 2
     assert "different settings" in capsys.readouterr().err
     assert main([*base[:-1], "7"]) == 2
     assert "max_time_s: 5.0 -> 7.0" in capsys.readouterr().err
