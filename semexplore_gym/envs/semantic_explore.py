@@ -298,13 +298,7 @@ class SemanticExploreEnv(gym.Env):
         return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
     def _sense_and_map(self, true_pose: tuple[float, float, float]) -> np.ndarray:
-        x, y, yaw = true_pose
-        scan = self.lidar.scan(x, y, yaw, self.np_random)
-        ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
-        self.grid.integrate_scan(
-            ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m
-        )
-        return scan
+        return self.lidar.sense_and_map(true_pose, self._est_pose, self.grid, self.np_random)
 
     def _obs(self) -> dict[str, np.ndarray]:
         x, y, yaw = self._est_pose

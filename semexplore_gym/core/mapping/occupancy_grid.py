@@ -252,17 +252,13 @@ class OccupancyGrid:
             raise ValueError(
                 f"beam_angles_rad and ranges_m must be 1-D of equal length, got shapes {beams.shape} and {ranges.shape}"
             )
-        if self._scan_id >= _MAX_SCAN_ID:
-            self._stamp.fill(0)
-            self._scan_id = 0
-        self._scan_id += 1
         g = self.geometry
         status, d_free, d_free_mask = _integrate_kernel(
             self._log_odds,
             self._encoded,
             self._stamp,
             self._count_mask,
-            self._scan_id,
+            self._begin_scan(),
             float(x_m),
             float(y_m),
             float(yaw_rad),
@@ -285,6 +281,14 @@ class OccupancyGrid:
         self.n_free_cells += d_free
         self.n_free_in_mask += d_free_mask
         return int(d_free)
+
+    def _begin_scan(self) -> int:
+        """The stamp of a new scan (stamps are cleared every ``_MAX_SCAN_ID`` scans)."""
+        if self._scan_id >= _MAX_SCAN_ID:
+            self._stamp.fill(0)
+            self._scan_id = 0
+        self._scan_id += 1
+        return self._scan_id
 
     def __repr__(self) -> str:
         h, w = self.geometry.shape
