@@ -161,7 +161,9 @@ def pymunk_reference(env: Any, true_p: list, n_scans: int) -> float:
     return (time.perf_counter() - t0) / len(poses)
 
 
-def bench_world(world: str, n_steps: int, repeats: int, pymunk_scans: int) -> dict[str, float]:
+def bench_world(
+    world: str, n_steps: int, repeats: int, pymunk_scans: int, stages: bool = True
+) -> dict[str, float]:
     env = _make(world)
     actions = _actions(n_steps, 0)
     run_steps(env, actions[: min(300, n_steps)])  # warm-up: numba caches, allocator
@@ -169,9 +171,12 @@ def bench_world(world: str, n_steps: int, repeats: int, pymunk_scans: int) -> di
     for _ in range(repeats):
         dt, true_p, _est_p, scans = run_steps(env, actions)
         rows.setdefault("step", []).append(dt)
-        for k, v in time_stages(env, actions, true_p, scans).items():
-            rows.setdefault(k, []).append(v)
+        if stages:
+            for k, v in time_stages(env, actions, true_p, scans).items():
+                rows.setdefault(k, []).append(v)
     med = {k: float(np.median(v)) / n_steps * 1e6 for k, v in rows.items()}  # us per step
+    if not stages:
+        return {"step": med["step"], "steps_per_s": 1e6 / med["step"]}
     med["rest"] = med["step"] - med.get("fused", med["lidar"] + med["map"]) - med["physics"]
     med["steps_per_s"] = 1e6 / med["step"]
     med["pymunk_scan"] = pymunk_reference(env, true_p, pymunk_scans) * 1e6
@@ -203,7 +208,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeats", type=int, default=3, help="timed runs (median reported)")
     p.add_argument("--pymunk-scans", type=int, default=100, help="scans for the pymunk reference")
     p.add_argument("--envs", type=int, default=0, help="also measure memory per env with N envs")
+    p.add_argument("--no-stages", action="store_true", help="only the step loop (one line per world)")
     args = p.parse_args(argv)
+    if args.no_stages:
+        for w in args.world:
+            m = bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, 0, stages=False)
+            print(f"{w}: {m['steps_per_s']:.0f} steps/s ({m['step']:.1f} us per step)")
+        return 0
     res = {w: bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, args.pymunk_scans) for w in args.world}
     print(f"Env step along a {args.steps}-step random trajectory, median of {args.repeats} (us per step)\n")
     print("| world | segments | map cells | steps/s | step | physics | LiDAR | map | LiDAR+map fused | rest | cell visits/scan | distinct cells/scan | pymunk scan | LiDAR x vs pymunk |")
