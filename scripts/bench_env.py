@@ -54,7 +54,7 @@ def _make(world: str) -> Any:
 
     import semexplore_gym  # noqa: F401
 
-    cfg = {"episode": {"max_time_s": 1e9, "coverage_goal": 1.0}}
+    cfg = {"episode": {"max_time_s": 1e7, "coverage_goal": 1.0}}
     return gym.make("SemanticExplore-v0", world=world, config=cfg).unwrapped
 
 

@@ -33,7 +33,7 @@ def _env_fn(world: str) -> Callable[[], Any]:
 
         import semexplore_gym  # noqa: F401
 
-        cfg = {"episode": {"max_time_s": 1e9, "coverage_goal": 1.0}}
+        cfg = {"episode": {"max_time_s": 1e7, "coverage_goal": 1.0}}
         return gym.make("SemanticExplore-v0", world=world, config=cfg)
 
     return make
