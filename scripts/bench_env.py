@@ -91,7 +91,10 @@ def time_stages(env: Any, actions: np.ndarray, true_p: list, scans: list) -> dic
     env.reset(seed=0)
     sim, dt_s = env.sim, env.config.episode.dt_s
     rp = env.config.robot
-    cmds = [(float(a[0]) * rp.max_linear_speed_mps, float(a[1]) * rp.max_angular_speed_radps) for a in actions]
+    cmds = [
+        (float(a[0]) * rp.max_linear_speed_mps, float(a[1]) * rp.max_angular_speed_radps)
+        for a in actions
+    ]
     t0 = time.perf_counter()
     for v, w in cmds:
         sim.step(v, w, dt_s)
@@ -133,8 +136,12 @@ def count_visits(env: Any, true_p: list, scans: list, stride: int = 10) -> tuple
         for b, rr in zip(beams[ok], r[ok], strict=True):
             n = max(2, int(math.ceil(rr / g.resolution_m * 4)))
             t = np.linspace(0.0, rr, n, endpoint=False)
-            col = np.floor((x + t * math.cos(yaw + b) - g.origin_x_m) / g.resolution_m).astype(np.int64)
-            row = np.floor((y + t * math.sin(yaw + b) - g.origin_y_m) / g.resolution_m).astype(np.int64)
+            col = np.floor((x + t * math.cos(yaw + b) - g.origin_x_m) / g.resolution_m).astype(
+                np.int64
+            )
+            row = np.floor((y + t * math.sin(yaw + b) - g.origin_y_m) / g.resolution_m).astype(
+                np.int64
+            )
             lin = np.unique(row * g.width + col)
             cells.append(lin)
         allc = np.concatenate(cells) if cells else np.zeros(0, np.int64)
@@ -203,21 +210,34 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     p.add_argument("--world", nargs="+", default=["maze1"], help="worlds; also intel_lab, willow")
-    p.add_argument("--maps-dir", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "maps"))
+    p.add_argument(
+        "--maps-dir", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "maps")
+    )
     p.add_argument("--steps", type=int, default=5000, help="steps per timed run")
     p.add_argument("--repeats", type=int, default=3, help="timed runs (median reported)")
     p.add_argument("--pymunk-scans", type=int, default=100, help="scans for the pymunk reference")
     p.add_argument("--envs", type=int, default=0, help="also measure memory per env with N envs")
-    p.add_argument("--no-stages", action="store_true", help="only the step loop (one line per world)")
+    p.add_argument(
+        "--no-stages", action="store_true", help="only the step loop (one line per world)"
+    )
     args = p.parse_args(argv)
     if args.no_stages:
         for w in args.world:
-            m = bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, 0, stages=False)
+            m = bench_world(
+                _world_spec(w, args.maps_dir), args.steps, args.repeats, 0, stages=False
+            )
             print(f"{w}: {m['steps_per_s']:.0f} steps/s ({m['step']:.1f} us per step)")
         return 0
-    res = {w: bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, args.pymunk_scans) for w in args.world}
-    print(f"Env step along a {args.steps}-step random trajectory, median of {args.repeats} (us per step)\n")
-    print("| world | segments | map cells | steps/s | step | physics | LiDAR | map | LiDAR+map fused | rest | cell visits/scan | distinct cells/scan | pymunk scan | LiDAR x vs pymunk |")
+    res = {
+        w: bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, args.pymunk_scans)
+        for w in args.world
+    }
+    print(
+        f"Env step along a {args.steps}-step random trajectory, median of {args.repeats} (us per step)\n"
+    )
+    print(
+        "| world | segments | map cells | steps/s | step | physics | LiDAR | map | LiDAR+map fused | rest | cell visits/scan | distinct cells/scan | pymunk scan | LiDAR x vs pymunk |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for w, m in res.items():
         fused = f"{m['fused']:.1f}" if "fused" in m else "-"

@@ -71,30 +71,38 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     p.add_argument("--world", default="maze1", help="world spec; also intel_lab, willow")
-    p.add_argument("--maps-dir", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "maps"))
+    p.add_argument(
+        "--maps-dir", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "maps")
+    )
     p.add_argument("--envs", type=int, nargs="+", default=[1, 2, 4], help="numbers of envs")
     p.add_argument("--steps", type=int, default=1500, help="vector steps per timed run")
     p.add_argument("--repeats", type=int, default=3, help="round-robin repeats (median reported)")
     p.add_argument("--no-async", action="store_true", help="skip AsyncVectorEnv")
     args = p.parse_args(argv)
-    world = os.path.join(args.maps_dir, REAL_MAPS[args.world]) if args.world in REAL_MAPS else args.world
+    world = (
+        os.path.join(args.maps_dir, REAL_MAPS[args.world])
+        if args.world in REAL_MAPS
+        else args.world
+    )
     fn = _env_fn(world)
 
-    print(f"Aggregate env steps/s, {args.world}, {args.steps} vector steps, median of {args.repeats}\n")
+    print(
+        f"Aggregate env steps/s, {args.world}, {args.steps} vector steps, median of {args.repeats}\n"
+    )
     print("| envs | method | steps/s | x plain loop |")
     print("|---:|---|---:|---:|")
     for n in args.envs:
         actions = _actions(args.steps, n)
         methods: dict[str, Callable[[], float]] = {}
         envs = [fn() for _ in range(n)]
-        methods["plain loop"] = lambda envs=envs: time_loop(envs, actions)
+        methods["plain loop"] = lambda envs=envs, a=actions: time_loop(envs, a)
         sync = gym.vector.SyncVectorEnv([fn] * n)
-        methods["SyncVectorEnv"] = lambda v=sync: time_vector(v, actions)
+        methods["SyncVectorEnv"] = lambda v=sync, a=actions: time_vector(v, a)
         sync_nc = gym.vector.SyncVectorEnv([fn] * n, copy=False)
-        methods["SyncVectorEnv copy=False"] = lambda v=sync_nc: time_vector(v, actions)
+        methods["SyncVectorEnv copy=False"] = lambda v=sync_nc, a=actions: time_vector(v, a)
         if not args.no_async:
             asy = gym.vector.AsyncVectorEnv([fn] * n, shared_memory=True)
-            methods["AsyncVectorEnv"] = lambda v=asy: time_vector(v, actions)
+            methods["AsyncVectorEnv"] = lambda v=asy, a=actions: time_vector(v, a)
         for f in methods.values():  # warm-up: numba caches, worker start-up
             f()
         times: dict[str, list[float]] = {k: [] for k in methods}

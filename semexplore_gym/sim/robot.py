@@ -234,7 +234,11 @@ class RobotSim:
         # ``body.angle``, ``control.velocity = ...`` and ``space.step(h)``, without their Python
         # wrappers (nothing is added or removed and no post-step callback is registered here).
         body_p, control_p, space_p = body._body, control._body, space._space
-        get_angle, set_velocity, cp_step = _cp.cpBodyGetAngle, _cp.cpBodySetVelocity, _cp.cpSpaceStep
+        get_angle, set_velocity, cp_step = (
+            _cp.cpBodyGetAngle,
+            _cp.cpBodySetVelocity,
+            _cp.cpSpaceStep,
+        )
         space._locked = True
         try:
             for _ in range(n):

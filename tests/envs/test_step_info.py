@@ -32,8 +32,14 @@ def test_static_entries_are_shared_read_only_and_equal_to_plain_dicts() -> None:
             info1[k]["x"] = 1  # type: ignore[index]
     assert info1 is not info0 and info1["reward_terms"] is not info0["reward_terms"]
     assert set(info1) == {
-        *STATIC, "dt_s", "coverage", "explored_area_m2", "collisions", "sim_time_s",
-        "path_length_m", "reward_terms",
+        *STATIC,
+        "dt_s",
+        "coverage",
+        "explored_area_m2",
+        "collisions",
+        "sim_time_s",
+        "path_length_m",
+        "reward_terms",
     }
 
 

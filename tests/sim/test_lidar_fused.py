@@ -23,15 +23,21 @@ from semexplore_gym.sim.lidar import Lidar, LidarParams
         (LidarParams(n_beams=90, range_noise_std_m=0.01), 0.01),
     ],
 )
-def test_fused_scan_and_map_match_the_separate_calls(params: LidarParams, odometry_offset: float) -> None:
+def test_fused_scan_and_map_match_the_separate_calls(
+    params: LidarParams, odometry_offset: float
+) -> None:
     world = make_world("maze1")
     geometry = GridGeometry.covering(*world.bounds_m, 0.05, 0.5)
     lidar = Lidar(params, SegmentIndex(world.segments_m))
     mp = MappingParams()
     separate, fused = OccupancyGrid(geometry, mp), OccupancyGrid(geometry, mp)
-    rng_a, rng_b, poses_rng = (np.random.default_rng(5), np.random.default_rng(5), np.random.default_rng(1))
+    rng_a, rng_b, poses_rng = (
+        np.random.default_rng(5),
+        np.random.default_rng(5),
+        np.random.default_rng(1),
+    )
     xmin, ymin, xmax, ymax = world.bounds_m
-    for i in range(300):  # more than 255 scans: the stamp reset happens on both
+    for _ in range(300):  # more than 255 scans: the stamp reset happens on both
         pose = (
             float(poses_rng.uniform(xmin, xmax)),
             float(poses_rng.uniform(ymin, ymax)),
@@ -47,7 +53,10 @@ def test_fused_scan_and_map_match_the_separate_calls(params: LidarParams, odomet
         np.testing.assert_array_equal(scan_a, scan_b)
     np.testing.assert_array_equal(separate.log_odds, fused.log_odds)
     np.testing.assert_array_equal(separate.encoded, fused.encoded)
-    assert (separate.n_free_cells, separate.n_free_in_mask) == (fused.n_free_cells, fused.n_free_in_mask)
+    assert (separate.n_free_cells, separate.n_free_in_mask) == (
+        fused.n_free_cells,
+        fused.n_free_in_mask,
+    )
 
 
 def test_fused_call_rejects_a_non_finite_pose() -> None:
@@ -55,4 +64,6 @@ def test_fused_call_rejects_a_non_finite_pose() -> None:
     lidar = Lidar(LidarParams(), SegmentIndex(world.segments_m))
     grid = OccupancyGrid(GridGeometry.covering(*world.bounds_m, 0.05, 0.5))
     with pytest.raises(ValueError, match="finite"):
-        lidar.sense_and_map((1.0, float("nan"), 0.0), (1.0, 1.0, 0.0), grid, np.random.default_rng(0))
+        lidar.sense_and_map(
+            (1.0, float("nan"), 0.0), (1.0, 1.0, 0.0), grid, np.random.default_rng(0)
+        )

@@ -327,8 +327,21 @@ def _integrate_kernel(
         cos_b[j] = math.cos(th)
         sin_b[j] = math.sin(th)
     d_free, d_mask = integrate_dirs(
-        log_odds, encoded, stamp, mask, scan_id, ox, oy, cos_b, sin_b, ranges, max_range,
-        gx0, gy0, res, consts,
+        log_odds,
+        encoded,
+        stamp,
+        mask,
+        scan_id,
+        ox,
+        oy,
+        cos_b,
+        sin_b,
+        ranges,
+        max_range,
+        gx0,
+        gy0,
+        res,
+        consts,
     )
     return 0, d_free, d_mask
 
@@ -475,7 +488,9 @@ def integrate_dirs(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _update_flat(lo, enc, msk, k, delta, l_min, l_max, thr_free, thr_occ):  # pragma: no cover - numba
+def _update_flat(
+    lo, enc, msk, k, delta, l_min, l_max, thr_free, thr_occ
+):  # pragma: no cover - numba
     """Add ``delta`` to flat cell ``k``; return the changes of (n_free, n_free_in_mask)."""
     v = min(max(lo[k] + delta, l_min), l_max)
     lo[k] = v

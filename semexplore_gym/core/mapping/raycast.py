@@ -324,7 +324,22 @@ def _cast_kernel(
         th = angles[j] + yaw
         dxs[j] = math.cos(th)
         dys[j] = math.sin(th)
-    cast_dirs(seg, bucket_start, bucket_items, x0, y0, cell, n_rows, n_cols, ox, oy, dxs, dys, max_range, out)
+    cast_dirs(
+        seg,
+        bucket_start,
+        bucket_items,
+        x0,
+        y0,
+        cell,
+        n_rows,
+        n_cols,
+        ox,
+        oy,
+        dxs,
+        dys,
+        max_range,
+        out,
+    )
 
 
 @njit(cache=True, error_model="numpy")

@@ -167,8 +167,20 @@ def _cast_and_integrate(
         dirs[0, j] = math.cos(th)
         dirs[1, j] = math.sin(th)
     cast_dirs(
-        seg, bucket_start, bucket_items, bx0, by0, bcell, n_rows, n_cols, sx, sy,
-        dirs[0], dirs[1], max_r, cast,
+        seg,
+        bucket_start,
+        bucket_items,
+        bx0,
+        by0,
+        bcell,
+        n_rows,
+        n_cols,
+        sx,
+        sy,
+        dirs[0],
+        dirs[1],
+        max_r,
+        cast,
     )
     # The sensor's post-processing (sim.lidar.Lidar.scan), in float64, then stored as float32.
     has_noise = noise.shape[0] == n
@@ -194,7 +206,20 @@ def _cast_and_integrate(
         cos_m = dirs[2]
         sin_m = dirs[3]
     d_free, d_mask = integrate_dirs(
-        log_odds, encoded, stamp, mask, scan_id, mx, my, cos_m, sin_m, map_ranges, max_r,
-        gx0, gy0, res, map_consts,
+        log_odds,
+        encoded,
+        stamp,
+        mask,
+        scan_id,
+        mx,
+        my,
+        cos_m,
+        sin_m,
+        map_ranges,
+        max_r,
+        gx0,
+        gy0,
+        res,
+        map_consts,
     )
     return 0, d_free, d_mask
