@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import gymnasium as gym
@@ -34,6 +35,36 @@ def _is_unseeded_procedural(spec: Any) -> bool:
         return False
     family, _, params = spec.partition(":")
     return family in PROCEDURAL_FAMILIES and "seed=" not in params
+
+
+class FrozenInfo(Mapping):
+    """A read-only mapping: the static ``info`` entries, built once per env.
+
+    Every step's ``info`` shares the same instances, so nothing is rebuilt per step and no
+    caller can change what the next step reports. It is not a ``dict``, so gymnasium's vector
+    envs collect it as one object per env instead of one array per field (much cheaper per
+    step). ``dict(info["robot"])`` gives a plain, mutable copy.
+    """
+
+    __slots__ = ("_d",)
+
+    def __init__(self, entries: Mapping[str, Any]) -> None:
+        self._d = dict(entries)
+
+    def __getitem__(self, key: str) -> Any:
+        return self._d[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._d)
+
+    def __len__(self) -> int:
+        return len(self._d)
+
+    def __repr__(self) -> str:
+        return f"FrozenInfo({self._d!r})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (FrozenInfo, (self._d,))
 
 
 class SemanticExploreEnv(gym.Env):
@@ -109,6 +140,12 @@ class SemanticExploreEnv(gym.Env):
     ## Version History
     - v0: initial version. (The ``new_area`` reward term was renamed ``free_area_change``, and
       its weight ``reward.free_area_change_weight``, to say what it is; values unchanged.)
+    - v0, issue #17 (no change to observations, rewards or dynamics): ``info["map_geometry"]``,
+      ``info["robot"]`` and ``info["lidar"]`` are read-only mappings (:class:`FrozenInfo`)
+      built once per env and shared by every step, instead of fresh dicts each step. Same
+      keys and values; mutating them raises ``TypeError`` (take ``dict(...)`` for a copy).
+      In gymnasium vector envs each is collected as an object array of mappings rather than
+      a dict of per-field arrays.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
@@ -160,23 +197,28 @@ class SemanticExploreEnv(gym.Env):
             }
         )
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-        self._static_info = {
-            "map_geometry": self.map_geometry.to_dict(),
-            "robot": {
-                "radius_m": cfg.robot.radius_m,
-                "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
-                "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
-            },
-            "lidar": {
-                "n_beams": cfg.lidar.n_beams,
-                "min_range_m": cfg.lidar.min_range_m,
-                "max_range_m": cfg.lidar.max_range_m,
-                "angle_increment_rad": cfg.lidar.angle_increment_rad,
-                "mount_x_m": cfg.lidar.mount_x_m,
-                "mount_y_m": cfg.lidar.mount_y_m,
-            },
+        self._static_info: dict[str, Any] = {
+            "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
+            "robot": FrozenInfo(
+                {
+                    "radius_m": cfg.robot.radius_m,
+                    "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
+                    "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
+                }
+            ),
+            "lidar": FrozenInfo(
+                {
+                    "n_beams": cfg.lidar.n_beams,
+                    "min_range_m": cfg.lidar.min_range_m,
+                    "max_range_m": cfg.lidar.max_range_m,
+                    "angle_increment_rad": cfg.lidar.angle_increment_rad,
+                    "mount_x_m": cfg.lidar.mount_x_m,
+                    "mount_y_m": cfg.lidar.mount_y_m,
+                }
+            ),
             "dt_s": cfg.episode.dt_s,
         }
+        self._area_per_cell_m2 = cfg.mapping.resolution_m**2
         self._overlay: dict[str, Any] = {}
         self._renderer: Any = None
         self._started = False
@@ -304,13 +346,7 @@ class SemanticExploreEnv(gym.Env):
         return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
     def _sense_and_map(self, true_pose: tuple[float, float, float]) -> np.ndarray:
-        x, y, yaw = true_pose
-        scan = self.lidar.scan(x, y, yaw, self.np_random)
-        ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
-        self.grid.integrate_scan(
-            ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m
-        )
-        return scan
+        return self.lidar.sense_and_map(true_pose, self._est_pose, self.grid, self.np_random)
 
     def _obs(self) -> dict[str, np.ndarray]:
         x, y, yaw = self._est_pose
@@ -322,16 +358,15 @@ class SemanticExploreEnv(gym.Env):
         }
 
     def _info(self, terms: dict[str, float]) -> dict[str, Any]:
-        # Fresh nested dicts each call: callers may keep and mutate what they are given.
-        info = {k: dict(v) if isinstance(v, dict) else v for k, v in self._static_info.items()}
-        info.update(
-            coverage=self.grid.n_free_in_mask / self._n_reachable,
-            explored_area_m2=self.grid.n_free_cells * self.config.mapping.resolution_m**2,
-            collisions=self.sim.collisions,
-            sim_time_s=self.sim_time_s,
-            path_length_m=self.path_length_m,
-            reward_terms=terms,
-        )
+        # The static entries are shared read-only mappings; the top level is a fresh dict.
+        info = self._static_info.copy()
+        grid = self.grid
+        info["coverage"] = grid.n_free_in_mask / self._n_reachable
+        info["explored_area_m2"] = grid.n_free_cells * self._area_per_cell_m2
+        info["collisions"] = self.sim.collisions
+        info["sim_time_s"] = self.sim_time_s
+        info["path_length_m"] = self.path_length_m
+        info["reward_terms"] = terms
         return info
 
     # ------------------------------------------------------------- rendering

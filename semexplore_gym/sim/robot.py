@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pymunk
+from pymunk._chipmunk import lib as _cp
 
 from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.worlds.world import World
@@ -216,8 +217,9 @@ class RobotSim:
 
     @property
     def pose(self) -> tuple[float, float, float]:
-        p = self.body.position
-        return (float(p.x), float(p.y), float(self.body.angle))
+        b = self.body._body
+        p = _cp.cpBodyGetPosition(b)
+        return (p.x, p.y, _cp.cpBodyGetAngle(b))
 
     def step(self, linear_mps: float, angular_radps: float, dt_s: float) -> bool:
         """Drive with body-frame (v, omega) for ``dt_s``; return True if a new collision began.
@@ -243,11 +245,26 @@ class RobotSim:
         # matter; keeping it on the robot avoids a large lever arm in the pivot constraint.
         control.position = body.position
         control.angular_velocity = angular_radps
-        space_step = self.space.step
-        for _ in range(n):
-            yaw = body.angle
-            control.velocity = (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw))
-            space_step(h)
+        space = self.space
+        if space._bodies_to_check:  # pymunk checks new bodies' masses once, in Space.step
+            space.step(0.0)
+        # The substeps call Chipmunk through pymunk's own binding: the same C calls as
+        # ``body.angle``, ``control.velocity = ...`` and ``space.step(h)``, without their Python
+        # wrappers (nothing is added or removed and no post-step callback is registered here).
+        body_p, control_p, space_p = body._body, control._body, space._space
+        get_angle, set_velocity, cp_step = (
+            _cp.cpBodyGetAngle,
+            _cp.cpBodySetVelocity,
+            _cp.cpSpaceStep,
+        )
+        space._locked = True
+        try:
+            for _ in range(n):
+                yaw = get_angle(body_p)
+                set_velocity(control_p, (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw)))
+                cp_step(space_p, h)
+        finally:
+            space._locked = False
         self._suppress_begin = False
         new_collision = self._began
         if new_collision:
