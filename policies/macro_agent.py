@@ -63,12 +63,11 @@ def read_macro_run(model_path: str | os.PathLike) -> dict[str, Any] | None:
     cfg_path = run_dir / "config.yaml"
     if not cfg_path.is_file():
         return None
-    import yaml
+    from semexplore_gym.core.safe_io import load_yaml_file
 
-    try:
-        cfg = yaml.safe_load(cfg_path.read_text()) or {}
-    except yaml.YAMLError as e:
-        raise ValueError(f"{cfg_path} is not valid YAML: {e}") from None
+    cfg = load_yaml_file(cfg_path, "run config") or {}  # bounded; ValueError names the file
+    if not isinstance(cfg, dict) or not isinstance(cfg.get("env") or {}, dict):
+        raise ValueError(f"{cfg_path} must hold a mapping with an 'env' mapping")
     env = cfg.get("env") or {}
     env_id = env.get("env_id")
     if env_id not in MACRO_ENV_KINDS:

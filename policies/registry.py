@@ -91,12 +91,19 @@ def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.macro_agent import MacroAgentPolicy, read_macro_run
 
     # A model trained on a macro-action env id decides frontiers or weights; the expert drives.
-    run = read_macro_run(arg)
-    if run is not None:
-        return MacroAgentPolicy(arg, run=run, **overrides)
-    from policies.sb3_policy import SB3Policy
+    try:
+        run = read_macro_run(arg)
+        if run is not None:
+            return MacroAgentPolicy(arg, run=run, **overrides)
+        from policies.sb3_policy import SB3Policy
 
-    return SB3Policy(arg, **overrides)
+        return SB3Policy(arg, **overrides)
+    except (ValueError, FileNotFoundError, ImportError):
+        raise
+    except Exception as e:  # noqa: BLE001 - a corrupt zip fails in zipfile, pickle, torch, ...
+        raise ValueError(
+            f"policy 'sb3:{arg}': cannot load the model ({type(e).__name__}: {str(e)[:200]})"
+        ) from None
 
 
 def _python(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -131,8 +138,13 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
             sys.modules[mod_name] = module
             try:
                 spec.loader.exec_module(module)
-            except BaseException:
+            except BaseException as e:
                 del sys.modules[mod_name]
+                if isinstance(e, (Exception, SystemExit)):
+                    raise ValueError(
+                        f"policy 'py:{arg}': running {path.name} raised {type(e).__name__}: "
+                        f"{str(e)[:200]}"
+                    ) from None
                 raise
     else:
         try:
@@ -141,6 +153,10 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
             raise ValueError(
                 f"policy 'py:{arg}': cannot import module {source!r} ({e}); is it on PYTHONPATH?"
             ) from None
+        except (Exception, SystemExit) as e:  # noqa: BLE001 - the user's module failed
+            raise ValueError(
+                f"policy 'py:{arg}': importing {source!r} raised {type(e).__name__}: {str(e)[:200]}"
+            ) from None
     if not hasattr(module, attr):
         raise ValueError(f"policy 'py:{arg}': module {source!r} has no attribute {attr!r}")
     target = getattr(module, attr)
@@ -148,7 +164,12 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
         raise ValueError(
             f"policy 'py:{arg}': {attr!r} is a {type(target).__name__}, not a class or function"
         )
-    policy = target(**overrides)
+    try:
+        policy = target(**overrides)
+    except (Exception, SystemExit) as e:  # noqa: BLE001 - SystemExit: py:sys:exit must not exit 0
+        raise ValueError(
+            f"policy 'py:{arg}': {attr}() raised {type(e).__name__}: {str(e)[:200]}"
+        ) from None
     if not isinstance(policy, Policy):
         raise ValueError(
             f"policy 'py:{arg}': {attr}() returned a {type(policy).__name__}, "

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 from collections.abc import Sequence
 
@@ -22,6 +23,16 @@ SUBCOMMANDS: dict[str, str] = {
     "compare-weights": "compare_weights",
     "maps": "maps",
 }
+
+
+def describe(doc: str | None) -> str:
+    """A subcommand's ``--help`` description from its module docstring: reST markup made plain
+    (no double backticks, ``Example::`` as ``Example:``), paragraphs and indentation kept (use
+    with ``argparse.RawDescriptionHelpFormatter``)."""
+    text = (doc or "").strip()
+    text = re.sub(r"``(.+?)``", r"\1", text, flags=re.DOTALL)
+    text = re.sub(r":(?:func|class|meth|mod|data):`~?([^`]+)`", r"\1", text)
+    return text.replace("::\n", ":\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -54,15 +65,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args._run(args) or 0)
-    except (ValueError, FileNotFoundError, KeyError) as e:
-        print(f"semexplore {args.command}: error: {e}", file=sys.stderr)
-        return 2
     except BrokenPipeError:
         # The reader went away (``semexplore segment ... --json | head``): stop quietly; point
         # stdout at /dev/null so the interpreter's final flush does not raise again.
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except (ValueError, OSError, KeyError, RecursionError, MemoryError) as e:
+        # Bad input ends here as one short line; never a traceback or a flood of output.
+        from semexplore_gym.core.safe_io import one_line
+
+        text = one_line(str(e), 600) or type(e).__name__
+        if isinstance(e, (RecursionError, MemoryError)):
+            text = f"{type(e).__name__}: input too large or too deeply nested ({text})"
+        print(f"semexplore {args.command}: error: {text}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -13,6 +13,8 @@ import shlex
 import sys
 
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.cli import describe
 
 
 def _split(text: str) -> list[str]:
@@ -48,11 +50,37 @@ def _check_worlds(worlds: list[str], seed: int) -> None:
             raise ValueError(f"--worlds {world!r}: {e}") from None
 
 
+#: Bounds of the benchmark's counts: beyond them a typo, not a plan.
+MAX_RUNS = 100_000
+MAX_WORKERS = 256
+
+
+def validate_args(args: argparse.Namespace) -> None:
+    """Check the numbers and the output path before anything is loaded or run.
+
+    Raises:
+        ValueError: naming the argument and its value.
+    """
+    from pathlib import Path
+
+    if not (1 <= args.runs <= MAX_RUNS):
+        raise ValueError(f"--runs must be in 1..{MAX_RUNS}, got {args.runs}")
+    if not (0 <= args.seed0 <= 2**32 - 1 - args.runs):
+        raise ValueError(f"--seed0 must be in 0..2**32-1-runs, got {args.seed0}")
+    if not (1 <= args.workers <= MAX_WORKERS):
+        raise ValueError(f"--workers must be in 1..{MAX_WORKERS}, got {args.workers}")
+    if args.max_time_s is not None and not (0 < args.max_time_s <= 1e7):
+        raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {short_repr(args.out)} is an existing file; give a directory")
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "benchmark",
         help="run exploration missions for several worlds, policies and seeds; write runs.csv, plots, summary.md",
-        description=__doc__,
+        description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
@@ -119,9 +147,19 @@ def run(args: argparse.Namespace) -> int:
     )
     from semexplore_gym.evaluation.report import write_plots, write_summary
 
+    validate_args(args)
     worlds = _split_worlds(args.worlds)
     policies = _split(args.policies)
     seeds = parse_seeds(args.runs, args.seed0)
+    for what, items in (("worlds", worlds), ("policies", policies)):
+        if not items:
+            raise ValueError(f"--{what} is empty")
+        dup = next((x for i, x in enumerate(items) if x in items[:i]), None)
+        if dup is not None:
+            raise ValueError(
+                f"--{what} lists {short_repr(dup)} twice; each must appear once "
+                "(a repeat would count the same missions twice)"
+            )
     _check_worlds(worlds, seeds[0])
     from policies.registry import policy_factories, strip_label
 

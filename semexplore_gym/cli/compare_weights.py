@@ -1,13 +1,14 @@
 """``semexplore compare-weights``: paper vs tuned planner weights, with a semantic-term ablation.
 
-1. Tune ``w_v``, ``w_p``, ``w_I`` (``--tune-field``: also ``f_g``, ``f_o``, ``f_l``) with Optuna
+1. Tune the frontier cost weights w_v, w_p, w_I of the paper (config keys ``cost.w_v``,
+   ``cost.w_p``, ``cost.w_i``; ``--tune-field``: also ``potential_field.f_g/f_o/f_l``) with Optuna
    TPE on the training worlds x training seeds (objective: mean of
    ``mission_time_s + penalty_s * max(0, target_coverage - coverage)``). The study is kept in
    ``OUT/tuning/study.sqlite`` and every trial in ``OUT/tuning/trials.jsonl``.
 2. Run every weight set on the test worlds x test seeds through the benchmark harness
    (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` and the ablations
    of the paper weights ``semantic[paper,w_p=0]``, ``semantic[paper,w_I=0]``,
-   ``semantic[paper,w_p=w_I=0]``.
+   ``semantic[paper,w_p=w_I=0]`` (w_I=0: ``cost.w_i=0``).
    ``--agents`` adds learned agents (any policy spec, e.g. a ``SemanticExploreWeights-v0`` PPO
    model that chooses the weights at every decision: ``sb3:runs/pw/model.zip[learned]``) on the
    same test worlds and seeds.
@@ -34,9 +35,37 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.cli import describe
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
+
+
+def validate_args(args: argparse.Namespace) -> None:
+    """Check every number and the output path before anything is loaded or tuned.
+
+    Raises:
+        ValueError: naming the argument and its value.
+    """
+    checks = (
+        ("--max-time-s", args.max_time_s, 0 < args.max_time_s <= 1e7),
+        ("--target-coverage", args.target_coverage, 0.0 < args.target_coverage <= 1.0),
+        ("--penalty-s", args.penalty_s, math.isfinite(args.penalty_s) and args.penalty_s >= 0),
+        ("--trials", args.trials, 1 <= args.trials <= 100_000),
+        ("--runs", args.runs, 1 <= args.runs <= 100_000),
+        ("--train-runs", args.train_runs, 1 <= args.train_runs <= 100_000),
+        ("--workers", args.workers, 1 <= args.workers <= 256),
+        ("--train-seed0", args.train_seed0, 0 <= args.train_seed0 <= 2**31),
+        ("--test-seed0", args.test_seed0, 0 <= args.test_seed0 <= 2**31),
+        ("--seed", args.seed, 0 <= args.seed <= 2**32 - 1),
+    )
+    for flag, value, ok in checks:
+        if not ok:
+            raise ValueError(f"{flag}: {value!r} is out of range (see --help)")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {short_repr(args.out)} is an existing file; give a directory")
 
 
 def _split_worlds(text: str) -> list[str]:
@@ -178,7 +207,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "compare-weights",
         help="tune the planner weights with Optuna and compare them with the paper's (and ablations)",
-        description=__doc__,
+        description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
@@ -257,12 +286,31 @@ def run(args: argparse.Namespace) -> int:
         tune_weights,
     )
 
+    validate_args(args)
     train_worlds = _split_worlds(args.train_worlds)
     test_worlds = _split_worlds(args.test_worlds)
     if not train_worlds or not test_worlds:
         raise ValueError("--train-worlds and --test-worlds must each name at least one world")
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
     test_seeds = parse_seeds(args.runs, args.test_seed0)
+    # Everything is checked before the tuning starts: a typo must not cost an Optuna run.
+    from semexplore_gym.cli.benchmark import _check_worlds
+
+    for flag, worlds, seeds in (
+        ("--train-worlds", train_worlds, train_seeds),
+        ("--test-worlds", test_worlds, test_seeds),
+    ):
+        dup = next((w for i, w in enumerate(worlds) if w in worlds[:i]), None)
+        if dup is not None:
+            raise ValueError(f"{flag} lists {short_repr(dup)} twice")
+        try:
+            _check_worlds(worlds, seeds[0])
+        except (ValueError, FileNotFoundError) as e:
+            raise ValueError(f"{flag}: {e}") from None
+    if args.env_config is not None:
+        from semexplore_gym.envs.config import load_env_config
+
+        load_env_config(args.env_config)
     overlap = set(train_seeds) & set(test_seeds)
     if overlap and set(train_worlds) & set(test_worlds):
         raise ValueError(

@@ -1,5 +1,8 @@
 """``semexplore segment MAP_OR_WORLD --out seg.png [--json]``: segment a map and draw it.
 
+The map is split into intersections, pathways, dead ends and pathways leading to frontiers (the
+semantic topometric map of the paper); the time of the segmentation itself is printed.
+
 ``MAP_OR_WORLD`` is a ROS map (``.yaml``, unknown cells kept) or any world spec accepted by
 :func:`semexplore_gym.core.worlds.registry.make_world` (``maze1``, ``office:seed=3``, a HouseExpo
 ``.json``); a world is rasterised from its ground-truth free space (free inside, occupied
@@ -18,14 +21,17 @@ from pathlib import Path
 
 import numpy as np
 
+from semexplore_gym.cli import describe
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
+from semexplore_gym.core.safe_io import check_output_file, short_repr
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "segment",
         help="segment a map into intersections, pathways, dead ends and frontier pathways; draw it to a PNG",
-        description=__doc__.split("\n\n")[0],
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "map",
@@ -91,6 +97,12 @@ def load_grid(
     world = make_world(spec, rng=np.random.default_rng(seed))
     g0 = world.free_geometry
     k = max(1, int(round(resolution_m / g0.resolution_m)))
+    if abs(k * g0.resolution_m - resolution_m) > 1e-6 * resolution_m:
+        raise ValueError(
+            f"--resolution {resolution_m:g} m: world {short_repr(world.name)} is stored at "
+            f"{g0.resolution_m:g} m cells; give a whole multiple of it (e.g. "
+            f"{g0.resolution_m:g}, {2 * g0.resolution_m:g}, {4 * g0.resolution_m:g})"
+        )
     free = _pool_min(world.free_mask, k) if k > 1 else world.free_mask
     geometry = GridGeometry(
         g0.resolution_m * k, g0.origin_x_m, g0.origin_y_m, free.shape[0], free.shape[1]
@@ -144,22 +156,64 @@ def summary(tmap, name: str) -> dict:
     }
 
 
+#: Accepted ``--resolution`` and ``--clearance`` (metres): beyond them the result is empty or
+#: meaningless for a robot of ~0.1 m.
+RESOLUTION_RANGE_M = (1e-3, 1.0)
+CLEARANCE_RANGE_M = (0.0, 5.0)
+
+
+def validate_args(args: argparse.Namespace) -> None:
+    """Check the numbers and output paths before loading anything.
+
+    Raises:
+        ValueError: naming the argument and its value.
+    """
+    lo, hi = RESOLUTION_RANGE_M
+    if not (lo <= args.resolution <= hi):
+        raise ValueError(f"--resolution must be in [{lo:g}, {hi:g}] m, got {args.resolution!r}")
+    lo, hi = CLEARANCE_RANGE_M
+    if not (lo < args.clearance <= hi):
+        raise ValueError(f"--clearance must be in ({lo:g}, {hi:g}] m, got {args.clearance!r}")
+    if args.seed < 0 or args.seed > 2**32 - 1:
+        raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
+    if args.out is not None:
+        check_output_file(args.out, "--out", (".png",))
+    if args.export is not None:
+        check_output_file(args.export, "--export", (".json",))
+
+
 def run(args: argparse.Namespace) -> int:
     from semexplore_gym.core.topometric import segment_map
 
+    validate_args(args)
     grid, geometry, name = load_grid(args.map, args.resolution, args.seed)
     # The first call of a process loads the compiled kernels (~0.3 s): do that on a tiny grid so
     # the reported time_ms is the segmentation's own.
     segment_map(np.full((8, 8), FREE, np.uint8), geometry.resolution_m, args.clearance)
     tmap = segment_map(grid, geometry, args.clearance)
+    if not tmap.areas:
+        raise ValueError(
+            f"{short_repr(name)}: no area is left at --clearance {args.clearance:g} m and "
+            f"{geometry.resolution_m:g} m cells (the free space is narrower than the clearance, "
+            "or the map has none); lower --clearance or use a finer --resolution"
+        )
     if args.out:
         from semexplore_gym.rendering.topometric_plot import save_topometric_png
 
-        save_topometric_png(tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids)
+        c = tmap.counts()
+        # No time in the picture: it is the machine's, printed below; a figure keeps its title.
+        title = (
+            f"{name}: {c['intersections']} intersections, {c['pathways']} pathways, "
+            f"{c['dead_ends']} dead ends, {c['frontier_pathways']} frontier pathways"
+        )
+        save_topometric_png(
+            tmap, grid, args.out, show_edges=args.edges, show_ids=args.ids, title=title
+        )
     if args.export:
         from semexplore_gym.core.topometric.export import to_json_dict
 
         Path(args.export).write_text(json.dumps(to_json_dict(tmap)))
+        print(f"wrote {args.export}", file=sys.stderr)
     if args.json:
         print(json.dumps(summary(tmap, name)))
     else:

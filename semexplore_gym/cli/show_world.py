@@ -1,4 +1,12 @@
-"""``semexplore show-world WORLD --out FILE.png``: draw a world's walls, free space and start."""
+"""``semexplore show-world WORLD --out FILE.png``: draw a world's walls, free space and start.
+
+The world is drawn as if fully mapped: walls, free space and the start pose (sampled with
+``--seed`` when the world has none). ``--json`` prints its size, free area and load time.
+
+Example::
+
+    semexplore show-world maze1 --out maze1.png
+"""
 
 from __future__ import annotations
 
@@ -9,9 +17,16 @@ import time
 
 import numpy as np
 
+from semexplore_gym.cli import describe
+
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("show-world", help="draw a world (walls, free space, start pose) to a PNG")
+    p = sub.add_parser(
+        "show-world",
+        help="draw a world (walls, free space, start pose) to a PNG",
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument(
         "world",
         help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json",
@@ -28,8 +43,12 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
+    from semexplore_gym.core.safe_io import check_output_file
     from semexplore_gym.rendering.renderer import Renderer, RenderSnapshot
 
+    check_output_file(args.out, "--out", (".png",))
+    if not (0 <= args.seed <= 2**32 - 1):
+        raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     t0 = time.perf_counter()
     env = gym.make("SemanticExplore-v0", world=args.world)
     base = env.unwrapped

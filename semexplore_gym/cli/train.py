@@ -34,7 +34,14 @@ ALGOS = ("bc", "dagger", "ppo", "maskable_ppo")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("train", help="train a learning agent (behaviour cloning, DAgger or PPO)")
+    from semexplore_gym.cli import describe
+
+    p = sub.add_parser(
+        "train",
+        help="train a learning agent (behaviour cloning, DAgger or PPO)",
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument(
         "--algo",
         required=True,

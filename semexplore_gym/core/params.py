@@ -24,7 +24,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
-import yaml
+from semexplore_gym.core.safe_io import UnsafeInputError, load_yaml_file, load_yaml_text, short_repr
 
 T = TypeVar("T")
 
@@ -38,9 +38,13 @@ def require_finite(obj: Any, names: Iterable[str], *, positive: bool, prefix: st
     number ``> 0`` (``positive``) or ``>= 0``: the ``__post_init__`` check of parameter sets."""
     for name in names:
         v = getattr(obj, name)
-        if not (math.isfinite(v) and (v > 0.0 if positive else v >= 0.0)):
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, (int, float))
+            or not (math.isfinite(v) and (v > 0.0 if positive else v >= 0.0))
+        ):
             what = "a positive finite number" if positive else "a finite number >= 0"
-            raise ValueError(f"{prefix}{name} must be {what}, got {v!r}")
+            raise ValueError(f"{prefix}{name} must be {what}, got {short_repr(v)}")
 
 
 def _field_types(cls: type) -> dict[str, Any]:
@@ -54,7 +58,9 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
         if isinstance(value, tp):
             return value
         if not isinstance(value, Mapping):
-            raise ConfigError(f"{path}: expected a mapping for {tp.__name__}, got {value!r}")
+            raise ConfigError(
+                f"{path}: expected a mapping for {tp.__name__}, got {short_repr(value)}"
+            )
         return from_dict(tp, value, _prefix=path)
     if origin in (typing.Union, types.UnionType):
         if value is None and type(None) in args:
@@ -67,14 +73,14 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
                 return _coerce(value, a, path)
             except ConfigError as e:
                 errors.append(str(e))
-        raise ConfigError(f"{path}: {value!r} does not fit {tp}")
+        raise ConfigError(f"{path}: {short_repr(value)} does not fit {tp}")
     if origin is typing.Literal:
         if value not in args:
-            raise ConfigError(f"{path}: {value!r} is not one of {list(args)}")
+            raise ConfigError(f"{path}: {short_repr(value)} is not one of {list(args)}")
         return value
     if origin in (tuple, list):
         if not isinstance(value, (list, tuple)):
-            raise ConfigError(f"{path}: expected a list, got {value!r}")
+            raise ConfigError(f"{path}: expected a list, got {short_repr(value)}")
         if origin is tuple and args and args[-1] is not Ellipsis:
             if len(args) != len(value):
                 raise ConfigError(f"{path}: expected {len(args)} items, got {len(value)}")
@@ -92,10 +98,10 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
             return value
         if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
             return value.lower() in ("true", "1", "yes")
-        raise ConfigError(f"{path}: expected true/false, got {value!r}")
+        raise ConfigError(f"{path}: expected true/false, got {short_repr(value)}")
     if tp is int:
         if isinstance(value, bool):
-            raise ConfigError(f"{path}: expected an integer, got {value!r}")
+            raise ConfigError(f"{path}: expected an integer, got {short_repr(value)}")
         if isinstance(value, int):
             return value
         if isinstance(value, float) and value.is_integer():
@@ -105,10 +111,10 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
                 return int(value)
             except ValueError:
                 pass
-        raise ConfigError(f"{path}: expected an integer, got {value!r}")
+        raise ConfigError(f"{path}: expected an integer, got {short_repr(value)}")
     if tp is float:
         if isinstance(value, bool):
-            raise ConfigError(f"{path}: expected a number, got {value!r}")
+            raise ConfigError(f"{path}: expected a number, got {short_repr(value)}")
         if isinstance(value, (int, float)):
             return float(value)
         if isinstance(value, str):
@@ -116,11 +122,11 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
                 return float(value)
             except ValueError:
                 pass
-        raise ConfigError(f"{path}: expected a number, got {value!r}")
+        raise ConfigError(f"{path}: expected a number, got {short_repr(value)}")
     if tp is str:
         if isinstance(value, str):
             return value
-        raise ConfigError(f"{path}: expected a string, got {value!r}")
+        raise ConfigError(f"{path}: expected a string, got {short_repr(value)}")
     return value
 
 
@@ -133,7 +139,7 @@ def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -
     if data is None:
         return cls()
     if not isinstance(data, Mapping):
-        raise ConfigError(f"{_prefix or cls.__name__}: expected a mapping, got {data!r}")
+        raise ConfigError(f"{_prefix or cls.__name__}: expected a mapping, got {short_repr(data)}")
     hints = _field_types(cls)
     names = [f.name for f in dataclasses.fields(cls) if f.init]  # type: ignore[arg-type]
     kwargs: dict[str, Any] = {}
@@ -141,7 +147,7 @@ def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -
         path = f"{_prefix}.{key}" if _prefix else str(key)
         if key not in names:
             raise ConfigError(
-                f"unknown config key {path!r}; valid keys here: {', '.join(sorted(names))}"
+                f"unknown config key {short_repr(path)}; valid keys here: {', '.join(sorted(names))}"
             )
         kwargs[key] = _coerce(value, hints[key], path)
     try:
@@ -164,15 +170,19 @@ def to_dict(obj: Any) -> Any:
 def parse_override(text: str) -> tuple[list[str], Any]:
     """Split ``"a.b=value"`` into (["a", "b"], parsed value); the value is read as YAML scalar."""
     if "=" not in text:
-        raise ConfigError(f"override {text!r} must look like key.path=value")
+        raise ConfigError(f"override {short_repr(text)} must look like key.path=value")
     key, raw = text.split("=", 1)
     key = key.strip()
     if not key:
-        raise ConfigError(f"override {text!r} has an empty key")
+        raise ConfigError(f"override {short_repr(text)} has an empty key")
     try:
-        value = yaml.safe_load(raw) if raw.strip() else ""
-    except yaml.YAMLError as e:
-        raise ConfigError(f"override {text!r}: cannot parse value: {e}") from e
+        value = (
+            load_yaml_text(raw, f"override {short_repr(key)}", max_bytes=64 << 10)
+            if raw.strip()
+            else ""
+        )
+    except UnsafeInputError as e:
+        raise ConfigError(str(e)) from None
     return key.split("."), value
 
 
@@ -297,11 +307,11 @@ def load_yaml(path: str | os.PathLike) -> dict[str, Any]:
     """Read a YAML mapping with ``safe_load``; clear errors for a missing or malformed file."""
     p = Path(path)
     if not p.is_file():
-        raise FileNotFoundError(f"config file not found: {str(p)!r}")
+        raise FileNotFoundError(f"config file not found: {short_repr(str(p), 200)}")
     try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as e:
-        raise ConfigError(f"malformed YAML in {str(p)!r}: {e}") from e
+        data = load_yaml_file(p, "config file")
+    except UnsafeInputError as e:
+        raise ConfigError(str(e)) from None
     if data is None:
         return {}
     if not isinstance(data, dict):

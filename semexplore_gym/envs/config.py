@@ -10,22 +10,40 @@ from typing import Any
 
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
-from semexplore_gym.core.params import build_params
+from semexplore_gym.core.params import ConfigError, build_params
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams
+
+#: Largest reward weight magnitude: beyond it sums of terms lose precision or overflow.
+MAX_REWARD_WEIGHT = 1e6
+
+#: Largest travel per physics substep near walls that keeps wall penetration under 1 cm (the
+#: no-penetration promise) with the solver's own slack on top; measured, see tests/fuzz.
+MAX_SUBSTEP_TRAVEL_M = 0.005
 
 
 @dataclass(frozen=True)
 class RewardParams:
     """Weights of the named reward terms; ``reward = sum(weight * term)``.
 
-    Terms: ``new_area`` = free area newly added to the map this step (m^2), ``time`` = the
-    control period (s), ``collision`` = 1 when a new wall contact began this step.
+    Terms: ``free_area_change`` = the net change of the map's free area this step (m^2): cells
+    newly mapped free minus free cells re-marked occupied, so it is negative on some steps (about
+    a quarter of random-action steps, where a wall's edge is re-observed); ``time`` = the control
+    period (s); ``collision`` = 1 when a new wall contact began this step.
     """
 
-    new_area_weight: float = 1.0
+    free_area_change_weight: float = 1.0
     time_weight: float = -0.01
     collision_weight: float = -1.0
+
+    def __post_init__(self) -> None:
+        for name in ("free_area_change_weight", "time_weight", "collision_weight"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and abs(v) <= MAX_REWARD_WEIGHT):
+                raise ValueError(
+                    f"reward.{name} must be a finite number in [-{MAX_REWARD_WEIGHT:g}, "
+                    f"{MAX_REWARD_WEIGHT:g}], got {v!r}"
+                )
 
 
 @dataclass(frozen=True)
@@ -52,13 +70,15 @@ class EpisodeParams:
     def __post_init__(self) -> None:
         if not (0 < self.dt_s <= 2.0):
             raise ValueError(f"episode.dt_s must be in (0, 2] s, got {self.dt_s!r}")
-        if not (self.max_time_s > 0 and math.isfinite(self.max_time_s)):
-            raise ValueError(f"episode.max_time_s must be positive, got {self.max_time_s!r}")
+        if not (0 < self.max_time_s <= 1e7):
+            raise ValueError(
+                f"episode.max_time_s must be positive and at most 1e7 s, got {self.max_time_s!r}"
+            )
         if not (0 < self.coverage_goal <= 1):
             raise ValueError(f"episode.coverage_goal must be in (0, 1], got {self.coverage_goal!r}")
-        if self.start_clearance_margin_m < 0:
+        if not (0 <= self.start_clearance_margin_m <= 10.0):
             raise ValueError(
-                f"episode.start_clearance_margin_m must be >= 0, got {self.start_clearance_margin_m!r}"
+                f"episode.start_clearance_margin_m must be in [0, 10] m, got {self.start_clearance_margin_m!r}"
             )
         if self.start_pose is not None and not all(math.isfinite(v) for v in self.start_pose):
             raise ValueError(f"episode.start_pose must be finite, got {self.start_pose!r}")
@@ -75,6 +95,35 @@ class EnvConfig:
     odometry: OdometryNoiseParams = field(default_factory=OdometryNoiseParams)
     reward: RewardParams = field(default_factory=RewardParams)
     episode: EpisodeParams = field(default_factory=EpisodeParams)
+
+    def __post_init__(self) -> None:
+        # Substeps per control step are ceil(speed * dt / max_substep_travel_m), capped at
+        # max_substeps; past the cap each substep travels further and the robot can sink into
+        # (or pass) a wall. Refuse such combinations instead of silently capping.
+        travel_m = self.robot.max_linear_speed_mps * self.episode.dt_s
+        needed = math.ceil(travel_m / MAX_SUBSTEP_TRAVEL_M - 1e-9)
+        pp = self.physics
+        used = min(pp.max_substeps, max(1, math.ceil(travel_m / pp.max_substep_travel_m)))
+        if used < needed:
+            raise ValueError(
+                f"robot.max_linear_speed_mps={self.robot.max_linear_speed_mps:g} x "
+                f"episode.dt_s={self.episode.dt_s:g} = {travel_m:.3g} m per step needs at least "
+                f"{needed} physics substeps of <= {MAX_SUBSTEP_TRAVEL_M:g} m to keep wall "
+                f"penetration under 0.01 m, but physics.max_substeps={pp.max_substeps} and "
+                f"physics.max_substep_travel_m={pp.max_substep_travel_m:g} give {used}; raise "
+                "physics.max_substeps (or lower max_substep_travel_m, the speed or dt_s)"
+            )
+        if self.robot.radius_m <= 2.0 * self.physics.max_substep_travel_m:
+            raise ValueError(
+                f"robot.radius_m={self.robot.radius_m:g} must exceed twice "
+                f"physics.max_substep_travel_m={self.physics.max_substep_travel_m:g}"
+            )
+
+#: Config keys renamed since they were published: old dotted path -> new one.
+RENAMED_KEYS: dict[str, str] = {
+    # "new area" read as m^2 newly mapped, but the term is a net change (it can be negative).
+    "reward.new_area_weight": "reward.free_area_change_weight",
+}
 
 
 #: Named configurations, the layers ``config="<name>"`` stands for. ``configs/<name>.yaml`` in
@@ -102,4 +151,13 @@ def load_env_config(
         ConfigError: unknown preset, unknown key (named with its dotted path) or a bad value.
         FileNotFoundError: a config path that does not exist.
     """
-    return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)
+    try:
+        return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)
+    except ConfigError as e:
+        for old, new in RENAMED_KEYS.items():
+            if repr(old) in str(e) or repr(old.split(".")[-1]) in str(e):
+                raise ConfigError(
+                    f"config key {old!r} was renamed {new!r} (the term is the net change of the "
+                    "map's free area per step, negative when free cells are re-marked occupied)"
+                ) from None
+        raise

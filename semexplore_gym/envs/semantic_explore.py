@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import gymnasium as gym
@@ -14,6 +15,7 @@ from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
+from semexplore_gym.core.safe_io import short_repr
 from semexplore_gym.core.worlds import make_world
 from semexplore_gym.core.worlds.start import (
     reachable_free_mask,
@@ -33,6 +35,36 @@ def _is_unseeded_procedural(spec: Any) -> bool:
         return False
     family, _, params = spec.partition(":")
     return family in PROCEDURAL_FAMILIES and "seed=" not in params
+
+
+class FrozenInfo(Mapping):
+    """A read-only mapping: the static ``info`` entries, built once per env.
+
+    Every step's ``info`` shares the same instances, so nothing is rebuilt per step and no
+    caller can change what the next step reports. It is not a ``dict``, so gymnasium's vector
+    envs collect it as one object per env instead of one array per field (much cheaper per
+    step). ``dict(info["robot"])`` gives a plain, mutable copy.
+    """
+
+    __slots__ = ("_d",)
+
+    def __init__(self, entries: Mapping[str, Any]) -> None:
+        self._d = dict(entries)
+
+    def __getitem__(self, key: str) -> Any:
+        return self._d[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._d)
+
+    def __len__(self) -> int:
+        return len(self._d)
+
+    def __repr__(self) -> str:
+        return f"FrozenInfo({self._d!r})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (FrozenInfo, (self._d,))
 
 
 class SemanticExploreEnv(gym.Env):
@@ -69,9 +101,11 @@ class SemanticExploreEnv(gym.Env):
 
     ## Rewards
     ``reward = sum(weight * term)`` over named terms (weights in ``RewardParams``):
-    ``new_area`` (m^2 of free space newly mapped this step, weight 1), ``time`` (the control
-    period in s, weight -0.01) and ``collision`` (1 when a wall contact begins, weight -1).
-    ``info["reward_terms"]`` holds each weighted term.
+    ``free_area_change`` (the net change of the map's free area this step in m^2, weight 1: cells
+    newly mapped free minus free cells re-marked occupied, so a step that re-observes a wall's
+    edge can score below zero), ``time`` (the control period in s, weight -0.01) and
+    ``collision`` (1 when a wall contact begins, weight -1). ``info["reward_terms"]`` holds each
+    weighted term.
 
     ## Starting State
     The world's start pose, ``episode.start_pose``, ``reset(options={"start_pose": ...})``, or
@@ -104,7 +138,14 @@ class SemanticExploreEnv(gym.Env):
     paths and goal on the next frames (keys in :mod:`semexplore_gym.rendering.renderer`).
 
     ## Version History
-    - v0: initial version.
+    - v0: initial version. (The ``new_area`` reward term was renamed ``free_area_change``, and
+      its weight ``reward.free_area_change_weight``, to say what it is; values unchanged.)
+    - v0, issue #17 (no change to observations, rewards or dynamics): ``info["map_geometry"]``,
+      ``info["robot"]`` and ``info["lidar"]`` are read-only mappings (:class:`FrozenInfo`)
+      built once per env and shared by every step, instead of fresh dicts each step. Same
+      keys and values; mutating them raises ``TypeError`` (take ``dict(...)`` for a copy).
+      In gymnasium vector envs each is collected as an object array of mappings rather than
+      a dict of per-field arrays.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
@@ -156,23 +197,28 @@ class SemanticExploreEnv(gym.Env):
             }
         )
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-        self._static_info = {
-            "map_geometry": self.map_geometry.to_dict(),
-            "robot": {
-                "radius_m": cfg.robot.radius_m,
-                "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
-                "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
-            },
-            "lidar": {
-                "n_beams": cfg.lidar.n_beams,
-                "min_range_m": cfg.lidar.min_range_m,
-                "max_range_m": cfg.lidar.max_range_m,
-                "angle_increment_rad": cfg.lidar.angle_increment_rad,
-                "mount_x_m": cfg.lidar.mount_x_m,
-                "mount_y_m": cfg.lidar.mount_y_m,
-            },
+        self._static_info: dict[str, Any] = {
+            "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
+            "robot": FrozenInfo(
+                {
+                    "radius_m": cfg.robot.radius_m,
+                    "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
+                    "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
+                }
+            ),
+            "lidar": FrozenInfo(
+                {
+                    "n_beams": cfg.lidar.n_beams,
+                    "min_range_m": cfg.lidar.min_range_m,
+                    "max_range_m": cfg.lidar.max_range_m,
+                    "angle_increment_rad": cfg.lidar.angle_increment_rad,
+                    "mount_x_m": cfg.lidar.mount_x_m,
+                    "mount_y_m": cfg.lidar.mount_y_m,
+                }
+            ),
             "dt_s": cfg.episode.dt_s,
         }
+        self._area_per_cell_m2 = cfg.mapping.resolution_m**2
         self._overlay: dict[str, Any] = {}
         self._renderer: Any = None
         self._started = False
@@ -236,7 +282,7 @@ class SemanticExploreEnv(gym.Env):
         self._overlay = {}
         self._true_pose = self.sim.pose
         self._scan = self._sense_and_map(self._true_pose)
-        info = self._info({"new_area": 0.0, "time": 0.0, "collision": 0.0})
+        info = self._info({"free_area_change": 0.0, "time": 0.0, "collision": 0.0})
         if self.render_mode == "human":
             self.render()
         return self._obs(), info
@@ -259,10 +305,10 @@ class SemanticExploreEnv(gym.Env):
         )
         n_free_before = self.grid.n_free_cells
         self._scan = self._sense_and_map(after)
-        new_area_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
+        free_area_change_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
         rw = cfg.reward
         terms = {
-            "new_area": rw.new_area_weight * new_area_m2,
+            "free_area_change": rw.free_area_change_weight * free_area_change_m2,
             "time": rw.time_weight * cfg.episode.dt_s,
             "collision": rw.collision_weight * float(new_collision),
         }
@@ -275,22 +321,24 @@ class SemanticExploreEnv(gym.Env):
         return self._obs(), reward, terminated, truncated, info
 
     def _scale_action(self, action: Any) -> tuple[float, float]:
-        if isinstance(action, np.ndarray) and action.shape == (2,):
+        if isinstance(action, np.ndarray) and action.shape == (2,) and action.dtype.kind in "fiub":
             a0, a1 = float(action[0]), float(action[1])
         else:
             try:
-                a = np.asarray(action, dtype=np.float64).reshape(-1)
+                raw = np.asarray(action)
+                # float() would drop an imaginary part or parse a string: only real numbers.
+                if raw.dtype.kind not in "fiubO" or np.iscomplexobj(action):
+                    raise TypeError(f"dtype {raw.dtype}")
+                a = raw.astype(np.float64).reshape(-1)
             except (TypeError, ValueError) as e:
                 raise ValueError(
-                    f"action must be 2 numbers [v, omega] in [-1, 1], got {action!r}"
+                    f"action must be 2 numbers [v, omega] in [-1, 1], got {short_repr(action)}"
                 ) from e
             if a.shape != (2,):
-                raise ValueError(
-                    f"action must have shape (2,), got shape {np.shape(action)}: {action!r}"
-                )
+                raise ValueError(f"action must have shape (2,), got {short_repr(action)}")
             a0, a1 = float(a[0]), float(a[1])
         if not (math.isfinite(a0) and math.isfinite(a1)):
-            raise ValueError(f"action contains NaN or inf: {action!r}")
+            raise ValueError(f"action contains NaN or inf: {short_repr(action)}")
         rp = self.config.robot
         v = min(1.0, max(-1.0, a0)) * rp.max_linear_speed_mps
         if not rp.allow_reverse:
@@ -298,13 +346,7 @@ class SemanticExploreEnv(gym.Env):
         return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
     def _sense_and_map(self, true_pose: tuple[float, float, float]) -> np.ndarray:
-        x, y, yaw = true_pose
-        scan = self.lidar.scan(x, y, yaw, self.np_random)
-        ex, ey, eyaw = self.lidar.sensor_pose(*self._est_pose)
-        self.grid.integrate_scan(
-            ex, ey, eyaw, self.lidar.beam_angles_rad, scan, self.config.lidar.max_range_m
-        )
-        return scan
+        return self.lidar.sense_and_map(true_pose, self._est_pose, self.grid, self.np_random)
 
     def _obs(self) -> dict[str, np.ndarray]:
         x, y, yaw = self._est_pose
@@ -316,16 +358,15 @@ class SemanticExploreEnv(gym.Env):
         }
 
     def _info(self, terms: dict[str, float]) -> dict[str, Any]:
-        # Fresh nested dicts each call: callers may keep and mutate what they are given.
-        info = {k: dict(v) if isinstance(v, dict) else v for k, v in self._static_info.items()}
-        info.update(
-            coverage=self.grid.n_free_in_mask / self._n_reachable,
-            explored_area_m2=self.grid.n_free_cells * self.config.mapping.resolution_m**2,
-            collisions=self.sim.collisions,
-            sim_time_s=self.sim_time_s,
-            path_length_m=self.path_length_m,
-            reward_terms=terms,
-        )
+        # The static entries are shared read-only mappings; the top level is a fresh dict.
+        info = self._static_info.copy()
+        grid = self.grid
+        info["coverage"] = grid.n_free_in_mask / self._n_reachable
+        info["explored_area_m2"] = grid.n_free_cells * self._area_per_cell_m2
+        info["collisions"] = self.sim.collisions
+        info["sim_time_s"] = self.sim_time_s
+        info["path_length_m"] = self.path_length_m
+        info["reward_terms"] = terms
         return info
 
     # ------------------------------------------------------------- rendering

@@ -16,6 +16,7 @@ start pose (and the same procedural world for ``family:seed=*`` spellings) to ev
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
@@ -28,6 +29,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from semexplore_gym.core.safe_io import short_repr
 
 CSV_COLUMNS: tuple[str, ...] = (
     "world",
@@ -92,7 +95,16 @@ def expand_tasks(
         raise ValueError("no seeds given (runs must be >= 1)")
     for p in policies:
         if not isinstance(p, str) or not p.strip():
-            raise ValueError(f"bad policy name {p!r}")
+            raise ValueError(f"bad policy name {short_repr(p)}")
+    for what, items in (("worlds", worlds), ("policies", policies), ("seeds", seeds)):
+        seen: set = set()
+        for item in items:
+            if item in seen:
+                raise ValueError(
+                    f"--{what} lists {short_repr(item)} twice; each must appear once "
+                    "(a repeat would count the same missions twice)"
+                )
+            seen.add(item)
     return [
         Task(w, p, int(s), max_time_s, env_config, dict(policy_overrides or {}))
         for s in seeds
@@ -113,7 +125,14 @@ def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
     from policies.registry import make_policy
     from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
+    from semexplore_gym.evaluation.warmup import warm_up
 
+    # Kernels compiled or loaded before the mission's clocks start.
+    warm_up(
+        lambda: make_policy(task.policy, **task.policy_overrides),
+        task.env_config,
+        key=(task.policy, repr(task.env_config), repr(task.policy_overrides)),
+    )
     env = make_mission_env(task.resolved_world, task.env_config)
     try:
         policy = make_policy(task.policy, **task.policy_overrides)
@@ -155,27 +174,51 @@ def run_task(task: Task) -> dict[str, Any]:
     }
 
 
+def _parse_row(raw: dict[str, Any], where: str) -> dict[str, Any]:
+    if None in raw or any(raw.get(k) is None for k in CSV_COLUMNS):
+        raise ValueError(f"{where}: expected {len(CSV_COLUMNS)} cells")
+    row: dict[str, Any] = {}
+    for k, v in raw.items():
+        if k in ("world", "policy", "stop_reason"):
+            row[k] = v
+        elif k == "self_stopped":
+            if v not in ("True", "False"):
+                raise ValueError(
+                    f"{where}: self_stopped must be True or False, got {short_repr(v)}"
+                )
+            row[k] = v == "True"
+        elif v in ("", "None"):
+            if k in ("world", "policy", "seed"):
+                raise ValueError(f"{where}: empty {k}")
+            row[k] = None
+        else:
+            try:
+                row[k] = int(v) if k in ("seed", "collisions", "steps") else float(v)
+            except ValueError:
+                raise ValueError(f"{where}: {k} is not a number: {short_repr(v)}") from None
+    return row
+
+
+def complete_csv_bytes(path: Path) -> int:
+    """Length of ``path`` up to its last newline: a row cut by a kill has no newline yet."""
+    data = path.read_bytes()
+    return data.rfind(b"\n") + 1
+
+
 def read_runs(path: str | os.PathLike) -> list[dict[str, Any]]:
-    """Rows of a ``runs.csv`` with numbers parsed (empty cells become None)."""
+    """Rows of a ``runs.csv`` with numbers parsed (empty cells become None).
+
+    A last line without its newline (the process was killed while writing it) is not a
+    finished mission and is ignored; any other malformed row raises a ValueError naming it.
+    """
     p = Path(path)
     if not p.exists():
         return []
+    text = p.read_bytes()[: complete_csv_bytes(p)].decode("utf-8", errors="replace")
     out = []
-    with p.open(newline="") as f:
-        for raw in csv.DictReader(f):
-            row: dict[str, Any] = {}
-            for k, v in raw.items():
-                if k in ("world", "policy", "stop_reason"):
-                    row[k] = v
-                elif k == "self_stopped":
-                    row[k] = v == "True"
-                elif v in ("", "None", None):
-                    row[k] = None
-                elif k in ("seed", "collisions", "steps"):
-                    row[k] = int(float(v))
-                else:
-                    row[k] = float(v)
-            out.append(row)
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    for i, raw in enumerate(reader, start=2):
+        out.append(_parse_row(raw, f"{p} line {i}"))
     return out
 
 
@@ -187,13 +230,19 @@ class ResultWriter:
         (self.out / "traces").mkdir(parents=True, exist_ok=True)
         (self.out / "trajectories").mkdir(parents=True, exist_ok=True)
         self.csv_path = self.out / "runs.csv"
+        if self.csv_path.exists():
+            # Drop a row torn by a kill mid-write, so that mission runs again.
+            keep = complete_csv_bytes(self.csv_path)
+            if keep < self.csv_path.stat().st_size:
+                with self.csv_path.open("r+b") as f:
+                    f.truncate(keep)
         new = not self.csv_path.exists() or self.csv_path.stat().st_size == 0
         if not new:
             with self.csv_path.open(newline="") as f:
                 header = next(csv.reader(f), [])
             if tuple(header) != CSV_COLUMNS:
                 raise ValueError(
-                    f"{self.csv_path} has columns {header}, expected {list(CSV_COLUMNS)}; use a new --out directory"
+                    f"{self.csv_path} has columns {short_repr(header)}, expected {list(CSV_COLUMNS)}; use a new --out directory"
                 )
         self._f = self.csv_path.open("a", newline="")
         self._w = csv.DictWriter(self._f, fieldnames=list(CSV_COLUMNS))
@@ -223,6 +272,109 @@ class ResultWriter:
         self._f.close()
 
 
+FINGERPRINT_FILE = "fingerprint.json"
+
+
+def run_fingerprint(tasks: Sequence[Task]) -> dict[str, Any]:
+    """What makes rows comparable beyond (world, policy, seed): the time limit, the env config
+    and each policy's overrides. Stored next to ``runs.csv`` and checked on resume."""
+    from semexplore_gym.core.params import to_dict
+
+    def canon(value: Any) -> Any:
+        return json.loads(json.dumps(value, sort_keys=True, default=str))
+
+    shared = {
+        json.dumps(
+            canon(
+                {
+                    "max_time_s": t.max_time_s,
+                    "env_config": to_dict(t.env_config) if t.env_config is not None else None,
+                }
+            ),
+            sort_keys=True,
+        )
+        for t in tasks
+    }
+    if len(shared) > 1:
+        raise ValueError("the missions of one benchmark must share max_time_s and env_config")
+    fp: dict[str, Any] = json.loads(next(iter(shared))) if shared else {}
+    overrides: dict[str, Any] = {}
+    for t in tasks:
+        o = canon(t.policy_overrides)
+        if overrides.setdefault(t.policy, o) != o:
+            raise ValueError(f"policy {short_repr(t.policy)} is listed with two sets of overrides")
+    fp["policy_overrides"] = {k: overrides[k] for k in sorted(overrides)}
+    return fp
+
+
+def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool) -> None:
+    """Store ``fingerprint`` in ``out_dir``, or refuse to resume rows made with other settings.
+
+    Adding worlds, seeds or policies to a run is fine; changing ``max_time_s``, the env config
+    or the overrides of a policy that already has rows is not.
+    """
+    path = out_dir / FINGERPRINT_FILE
+    old: dict[str, Any] | None = None
+    if has_rows and path.exists():
+        try:
+            old = json.loads(path.read_text())
+        except (ValueError, OSError):
+            old = {}
+    if old is not None:
+        changed = [
+            (k, old.get(k), fingerprint.get(k))
+            for k in ("max_time_s", "env_config")
+            if old.get(k) != fingerprint.get(k)
+        ]
+        old_over = old.get("policy_overrides") or {}
+        new_over = fingerprint["policy_overrides"]
+        changed += [
+            (f"overrides of {p}", old_over[p], new_over[p])
+            for p in sorted(set(old_over) & set(new_over))
+            if old_over[p] != new_over[p]
+        ]
+        if changed:
+            detail = ", ".join(
+                f"{k}: {short_repr(a, 60)} -> {short_repr(b, 60)}" for k, a, b in changed
+            )
+            raise ValueError(
+                f"{out_dir} holds missions run with different settings ({detail}); "
+                "rerun with the same settings to resume, or use a new --out directory"
+            )
+        fingerprint = dict(fingerprint, policy_overrides={**old_over, **new_over})
+    path.write_text(json.dumps(fingerprint, indent=2, sort_keys=True))
+
+
+def _die_with_parent() -> None:
+    """Worker initializer: end this process when the benchmark process dies, even by SIGKILL.
+
+    Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)``; elsewhere (and as a backstop) a thread that
+    exits when the parent process id changes.
+    """
+    import signal
+    import threading
+
+    parent = os.getppid()
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="die-with-parent").start()
+
+
 def _run_sequential(
     tasks: list[Task], fn: Callable[[Task], dict[str, Any]]
 ) -> Iterable[tuple[Task, dict[str, Any] | BaseException]]:
@@ -241,7 +393,9 @@ def _run_processes(
 
     # Fork would copy numba/pymunk state of the parent; spawn gives clean workers.
     ctx = mp.get_context("spawn")
-    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+    with cf.ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_die_with_parent
+    ) as pool:
         futures = {pool.submit(run_task, t): t for t in tasks}
         for fut in cf.as_completed(futures):
             t = futures[fut]
@@ -311,8 +465,17 @@ def run_benchmark(
         raise ValueError(f"backend must be 'process' or 'ray', got {backend!r}")
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers!r}")
+    if len({t.key for t in tasks}) != len(tasks):
+        raise ValueError("the same (world, policy, seed) mission is listed twice")
+    fingerprint = run_fingerprint(tasks)
     writer = ResultWriter(out_dir)
-    done = {(r["world"], r["policy"], int(r["seed"])) for r in read_runs(writer.csv_path)}
+    try:
+        rows = read_runs(writer.csv_path)
+        check_fingerprint(writer.out, fingerprint, has_rows=bool(rows))
+    except BaseException:
+        writer.close()
+        raise
+    done = {(r["world"], r["policy"], int(r["seed"])) for r in rows}
     todo = [t for t in tasks if t.key not in done]
     skipped = len(tasks) - len(todo)
     failed: list[tuple[tuple[str, str, int], str]] = []

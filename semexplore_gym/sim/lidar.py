@@ -7,7 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.mapping.scan_fusion import ScanFuser
 
 
 @dataclass(frozen=True)
@@ -42,9 +44,9 @@ class LidarParams:
             raise ValueError(
                 f"lidar.min_range_m must be in [0, max_range_m), got {self.min_range_m!r}"
             )
-        if not (self.range_noise_std_m >= 0 and math.isfinite(self.range_noise_std_m)):
+        if not (0 <= self.range_noise_std_m <= 1.0):
             raise ValueError(
-                f"lidar.range_noise_std_m must be >= 0, got {self.range_noise_std_m!r}"
+                f"lidar.range_noise_std_m must be in [0, 1] m, got {self.range_noise_std_m!r}"
             )
         if not (0 <= self.dropout_prob < 1):
             raise ValueError(f"lidar.dropout_prob must be in [0, 1), got {self.dropout_prob!r}")
@@ -73,6 +75,7 @@ class Lidar:
         self.params = params
         self.index = index
         self.beam_angles_rad = params.beam_angles_rad()
+        self._fuser = ScanFuser(index, self.beam_angles_rad, params.max_range_m, params.min_range_m)
 
     def sensor_pose(self, x_m: float, y_m: float, yaw_rad: float) -> tuple[float, float, float]:
         p = self.params
@@ -98,3 +101,23 @@ class Lidar:
             invalid |= rng.random(ranges.shape) < p.dropout_prob
         ranges[invalid] = 0.0
         return ranges.astype(np.float32)
+
+    def sense_and_map(
+        self,
+        true_pose: tuple[float, float, float],
+        map_pose: tuple[float, float, float],
+        grid: OccupancyGrid,
+        rng: np.random.Generator,
+    ) -> np.ndarray:
+        """:meth:`scan` at ``true_pose`` fused into ``grid`` from ``map_pose``, in one call.
+
+        The same scan, the same random draws and the same map as :meth:`scan` followed by
+        ``grid.integrate_scan`` at the sensor pose of ``map_pose``.
+        """
+        p = self.params
+        n = p.n_beams
+        noise = rng.normal(0.0, p.range_noise_std_m, size=n) if p.range_noise_std_m > 0 else None
+        dropped = rng.random(n) < p.dropout_prob if p.dropout_prob > 0 else None
+        return self._fuser.scan_and_integrate(
+            grid, self.sensor_pose(*true_pose), self.sensor_pose(*map_pose), noise, dropped
+        )

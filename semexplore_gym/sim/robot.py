@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pymunk
+from pymunk._chipmunk import lib as _cp
 
 from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.worlds.world import World
@@ -59,6 +60,24 @@ class RobotParams:
             positive=True,
             prefix="robot.",
         )
+        # Below twice the wall skin the disc slips between wall shapes; extreme mass or drive
+        # force make the drive constraint overpower the contact solver.
+        for name, lo, hi in (
+            ("radius_m", 2.0 * WALL_SKIN_M, 2.0),
+            ("mass_kg", 0.1, 1000.0),
+            ("max_angular_speed_radps", 0.0, 100.0),
+            ("max_drive_force_n", 0.0, 1e5),
+            ("max_turn_torque_nm", 0.0, 1e4),
+        ):
+            v = getattr(self, name)
+            if not (lo <= v <= hi):
+                raise ValueError(f"robot.{name} must be in [{lo:g}, {hi:g}], got {v!r}")
+        if self.max_drive_force_n / self.mass_kg > 200.0:
+            raise ValueError(
+                f"robot.max_drive_force_n / robot.mass_kg = "
+                f"{self.max_drive_force_n / self.mass_kg:.3g} m/s^2 is beyond the 200 the "
+                "contact solver holds against"
+            )
         if self.max_linear_speed_mps > 5.0:
             raise ValueError(
                 f"robot.max_linear_speed_mps={self.max_linear_speed_mps} is beyond what the physics is tuned for (<= 5 m/s)"
@@ -93,15 +112,15 @@ class PhysicsParams:
             raise ValueError(
                 f"physics.max_substep_travel_m must be in (0, 0.05] m, got {self.max_substep_travel_m!r}"
             )
-        if self.max_substeps < 1:
-            raise ValueError(f"physics.max_substeps must be >= 1, got {self.max_substeps!r}")
-        if not (0 <= self.collision_slop_m < 0.05):
+        if not (1 <= self.max_substeps <= 10_000):
+            raise ValueError(f"physics.max_substeps must be in 1..10000, got {self.max_substeps!r}")
+        if not (0 <= self.collision_slop_m <= 0.005):
             raise ValueError(
-                f"physics.collision_slop_m must be in [0, 0.05) m, got {self.collision_slop_m!r}"
+                f"physics.collision_slop_m must be in [0, 0.005] m, got {self.collision_slop_m!r}"
             )
-        if self.solver_iterations < 1:
+        if not (5 <= self.solver_iterations <= 1000):
             raise ValueError(
-                f"physics.solver_iterations must be >= 1, got {self.solver_iterations!r}"
+                f"physics.solver_iterations must be in 5..1000, got {self.solver_iterations!r}"
             )
 
 
@@ -198,8 +217,9 @@ class RobotSim:
 
     @property
     def pose(self) -> tuple[float, float, float]:
-        p = self.body.position
-        return (float(p.x), float(p.y), float(self.body.angle))
+        b = self.body._body
+        p = _cp.cpBodyGetPosition(b)
+        return (p.x, p.y, _cp.cpBodyGetAngle(b))
 
     def step(self, linear_mps: float, angular_radps: float, dt_s: float) -> bool:
         """Drive with body-frame (v, omega) for ``dt_s``; return True if a new collision began.
@@ -225,11 +245,26 @@ class RobotSim:
         # matter; keeping it on the robot avoids a large lever arm in the pivot constraint.
         control.position = body.position
         control.angular_velocity = angular_radps
-        space_step = self.space.step
-        for _ in range(n):
-            yaw = body.angle
-            control.velocity = (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw))
-            space_step(h)
+        space = self.space
+        if space._bodies_to_check:  # pymunk checks new bodies' masses once, in Space.step
+            space.step(0.0)
+        # The substeps call Chipmunk through pymunk's own binding: the same C calls as
+        # ``body.angle``, ``control.velocity = ...`` and ``space.step(h)``, without their Python
+        # wrappers (nothing is added or removed and no post-step callback is registered here).
+        body_p, control_p, space_p = body._body, control._body, space._space
+        get_angle, set_velocity, cp_step = (
+            _cp.cpBodyGetAngle,
+            _cp.cpBodySetVelocity,
+            _cp.cpSpaceStep,
+        )
+        space._locked = True
+        try:
+            for _ in range(n):
+                yaw = get_angle(body_p)
+                set_velocity(control_p, (linear_mps * math.cos(yaw), linear_mps * math.sin(yaw)))
+                cp_step(space_p, h)
+        finally:
+            space._locked = False
         self._suppress_begin = False
         new_collision = self._began
         if new_collision:

@@ -111,13 +111,13 @@ def test_reward_terms_sum_to_reward_and_new_area_is_positive_while_exploring() -
     spin = []
     for _ in range(5):  # a 360-degree LiDAR sees nothing new by turning on the spot
         _, r, _, _, info = env.step(np.array([0.0, 1.0], np.float32))
-        spin.append(info["reward_terms"]["new_area"])
+        spin.append(info["reward_terms"]["free_area_change"])
     assert info["path_length_m"] == pytest.approx(0.0, abs=1e-9)
     assert sum(spin) == pytest.approx(0.0, abs=0.05)
     for _ in range(15):
         _, r, _, _, info = env.step(np.array([1.0, 0.0], np.float32))
         assert r == pytest.approx(sum(info["reward_terms"].values()))
-        total_new += info["reward_terms"]["new_area"]
+        total_new += info["reward_terms"]["free_area_change"]
     assert total_new > 0.0
     assert info["sim_time_s"] == pytest.approx(4.0)
     assert info["path_length_m"] > 0.2

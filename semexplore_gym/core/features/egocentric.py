@@ -47,14 +47,23 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from semexplore_gym.core.frontiers.distance import frontier_distance_m, relative_distance_image
-from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
+from semexplore_gym.core.frontiers.distance import (
+    FrontierDistanceField,
+    frontier_distance_m,
+    relative_distance_image,
+)
+from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry, validate_encoded_grid
 
 #: Number of scalar features in the ``features`` entry.
 N_FEATURES = 3
 
 #: Image channels an :class:`EgocentricEncoder` can produce (see the module docstring).
 CHANNELS: tuple[str, ...] = ("occupancy", "frontier_distance", "trail")
+
+# Stand-ins for the frontier field and the trail when their channel is off (never read; the
+# kernel is compiled once for these types).
+_NO_FIELD = np.full(1, np.inf)
+_NO_TRAIL = np.full((1, 1), 255, np.uint8)
 
 
 @dataclass(frozen=True)
@@ -194,12 +203,153 @@ def _stamp_disc(trail, r0, c0, radius_cells):  # pragma: no cover - numba
                     trail[r, c] = 0
 
 
+@njit(cache=True)
+def _robot_distance(dp, wp, h, w, row, col):  # pragma: no cover - numba
+    """Frontier distance of the robot's cell ``(row, col)`` in the padded flat field ``dp``.
+
+    The cell's own when in the map and finite, else the smallest finite one in the 5 x 5 window
+    round it (clipped to the map), else 0: as :func:`relative_distance_image`.
+    """
+    if 0 <= row < h and 0 <= col < w:
+        d = dp[(row + 1) * wp + col + 1]
+        if d < np.inf:
+            return d
+    best = np.inf
+    for r in range(max(0, row - 2), min(h, max(0, row + 3))):
+        for c in range(max(0, col - 2), min(w, max(0, col + 3))):
+            d = dp[(r + 1) * wp + c + 1]
+            if d < best:
+                best = d
+    return best if best < np.inf else 0.0
+
+
+@njit(cache=True)
+def _encode_kernel(
+    grid,
+    dp,
+    wp,
+    trail,
+    x_cells,
+    y_cells,
+    cos_y,
+    sin_y,
+    cells_per_crop_cell,
+    k,
+    ch_occ,
+    ch_fd,
+    ch_trail,
+    trail_radius_cells,
+    scale,
+    scan,
+    max_range,
+    shift,
+    image,
+    pooled,
+    features,
+):  # pragma: no cover - numba
+    """One egocentric observation: stamp the trail, crop every channel, pool the scan.
+
+    The crops sample the rotated map exactly as :func:`_crop_kernel` does (same lattice, same
+    floating-point operations, min over ``k`` x ``k`` samples per crop cell), reading the map,
+    the frontier field ``dp`` (padded flat, row stride ``wp``) and the trail at each sample
+    once. The frontier channel takes the minimum *distance* per crop cell and maps it to grey
+    levels afterwards: the mapping is non-decreasing (255 for ``inf`` above every finite level),
+    so this equals the minimum of the mapped map-frame layer. A channel index < 0 skips it.
+    """
+    h, w = grid.shape
+    row = int(math.floor(y_cells))
+    col = int(math.floor(x_cells))
+    if ch_trail >= 0:
+        _stamp_disc(trail, row, col, trail_radius_cells)
+    d_robot = _robot_distance(dp, wp, h, w, row, col) if ch_fd >= 0 else 0.0
+    c = image.shape[1]
+    n = c * k
+    step = cells_per_crop_cell / k
+    centre = (n - 1) / 2.0
+    du_x, du_y = -step * cos_y, -step * sin_y
+    dv_x, dv_y = step * sin_y, -step * cos_y
+    x00 = x_cells + centre * step * cos_y - centre * step * sin_y
+    y00 = y_cells + centre * step * sin_y + centre * step * cos_y
+    unknown = np.uint8(UNKNOWN)
+    n_known = 0
+    n_free = 0
+    for i in range(c):
+        for j in range(c):
+            occ = np.uint8(255)
+            tr = np.uint8(255)
+            dmin = np.inf
+            for a in range(k):
+                u = i * k + a
+                xs = x00 + u * du_x
+                ys = y00 + u * du_y
+                for b in range(k):
+                    v = j * k + b
+                    xf = xs + v * dv_x
+                    yf = ys + v * dv_y
+                    if xf >= 0.0 and yf >= 0.0 and xf < w and yf < h:
+                        r = int(yf)
+                        cc = int(xf)
+                        g = grid[r, cc]
+                        if g < occ:
+                            occ = g
+                        if ch_fd >= 0:
+                            d = dp[(r + 1) * wp + cc + 1]
+                            if d < dmin:
+                                dmin = d
+                        if ch_trail >= 0:
+                            t = trail[r, cc]
+                            if t < tr:
+                                tr = t
+                    elif unknown < occ:
+                        occ = unknown  # outside the map: unknown (and 255 for the others)
+            if occ != UNKNOWN:
+                n_known += 1
+                if occ == FREE:
+                    n_free += 1
+            if ch_occ >= 0:
+                image[ch_occ, i, j] = occ
+            if ch_trail >= 0:
+                image[ch_trail, i, j] = tr
+            if ch_fd >= 0:
+                if dmin < np.inf:
+                    lv = np.rint(128.0 + scale * (dmin - d_robot))
+                    image[ch_fd, i, j] = np.uint8(min(max(lv, 0.0), 254.0))
+                else:
+                    image[ch_fd, i, j] = 255
+    # The scan: invalid returns (0: too close or dropout) read as max range; bin b pools beams
+    # b * per - shift .. (b + 1) * per - shift - 1 (np.roll by shift, then consecutive beams).
+    n_beams = scan.shape[0]
+    n_bins = pooled.shape[0]
+    per = n_beams // n_bins
+    mr = np.float32(max_range)
+    n_open = 0
+    for b in range(n_bins):
+        m = np.float32(np.inf)
+        for q in range(b * per, (b + 1) * per):
+            x = scan[(q - shift) % n_beams]
+            if not x > 0.0:
+                x = mr
+            if x < m:
+                m = x
+        p = np.float32(m / mr)
+        p = min(max(p, np.float32(0.0)), np.float32(1.0))
+        pooled[b] = p
+        if p >= 1.0:
+            n_open += 1
+    n_cells = c * c
+    features[0] = n_known / n_cells
+    features[1] = n_free / n_cells
+    features[2] = n_open / n_bins
+
+
 class EgocentricEncoder:
     """Precomputed sampling pattern that maps raw observations to egocentric ones.
 
-    Build once per (params, map geometry, LiDAR); :meth:`encode` then costs a few vectorised
-    numpy operations per observation. With a ``trail`` channel the encoder remembers the poses
-    it encoded: call :meth:`reset` at the start of every episode.
+    Build once per (params, map geometry, LiDAR); :meth:`encode` then costs one fused kernel
+    per observation (every channel's crop, the trail stamp, the pooled scan, the features),
+    plus, with a ``frontier_distance`` channel, the frontier search when the map changed since
+    the previous call (its buffers are kept between calls). With a ``trail`` channel the encoder
+    remembers the poses it encoded: call :meth:`reset` at the start of every episode.
 
     Args:
         params: Crop and scan settings.
@@ -228,8 +378,21 @@ class EgocentricEncoder:
         # Sub-samples per crop cell side: enough that no map cell falls between samples.
         self.supersample = max(1, math.ceil(res_crop / res_map - 1e-9))
         self._cells_per_crop_cell = res_crop / res_map
+        channels = params.channels
+        self._ch_occ, self._ch_fd, self._ch_trail = (
+            channels.index(name) if name in channels else -1 for name in CHANNELS
+        )
+        self._scan_shift = (n_beams // params.n_scan_bins) // 2 if params.scan_bins_centred else 0
+        self._trail_radius_cells = params.trail_radius_m / geometry.resolution_m
+        self._field: FrontierDistanceField | None = None
         self._trail: np.ndarray | None = None
         self.reset()
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The frontier field is a cache with large search buffers: rebuilt on first use.
+        state = self.__dict__.copy()
+        state["_field"] = None
+        return state
 
     def reset(self) -> None:
         """Forget the pose history (the ``trail`` channel); call at every episode start."""
@@ -310,39 +473,44 @@ class EgocentricEncoder:
             raise ValueError(
                 f"obs must be the env's observation dict with map, pose, scan; got {type(obs).__name__}"
             ) from e
-        x_m, y_m, yaw_rad = (float(v) for v in np.asarray(pose).reshape(-1)[:3])
-        grid = np.asarray(grid)
+        x_m, y_m, yaw_rad = np.asarray(pose).reshape(-1)[:3].tolist()
         g = self.geometry
-        if self._trail is not None:
-            row, col = g.world_to_grid(x_m, y_m)
-            _stamp_disc(
-                self._trail, int(row), int(col), self.params.trail_radius_m / g.resolution_m
+        if not (type(grid) is np.ndarray and grid.dtype == np.uint8 and grid.flags.c_contiguous):
+            grid = np.asarray(grid)
+            if self._ch_fd >= 0 and grid.dtype != np.uint8:
+                validate_encoded_grid(grid)  # raises naming the dtype
+            grid = np.ascontiguousarray(grid, dtype=np.uint8)
+        if grid.shape != g.shape:
+            raise ValueError(f"map has shape {grid.shape} but the encoder was built for {g.shape}")
+        if not (type(scan) is np.ndarray and scan.dtype == np.float32):
+            scan = np.ascontiguousarray(scan, dtype=np.float32)
+        if scan.shape != (self.n_beams,):
+            raise ValueError(
+                f"scan has shape {scan.shape} but the encoder expects ({self.n_beams},)"
             )
-        layers = []
-        for name in self.params.channels:
-            if name == "occupancy":
-                layers.append(self.crop(grid, x_m, y_m, yaw_rad, UNKNOWN))
-            elif name == "frontier_distance":
-                layer = self.frontier_distance_image(grid, x_m, y_m)
-                layers.append(self.crop(layer, x_m, y_m, yaw_rad, 255))
-            else:
-                assert self._trail is not None
-                layers.append(self.crop(self._trail, x_m, y_m, yaw_rad, 255))
-        occ = (
-            layers[self.params.channels.index("occupancy")]
-            if "occupancy" in self.params.channels
-            else self.crop(grid, x_m, y_m, yaw_rad, UNKNOWN)
-        )
-        n = occ.size
-        known_crop = np.count_nonzero(occ != UNKNOWN) / n
-        free_crop = np.count_nonzero(occ == FREE) / n
-        pooled = self.pool_scan(np.asarray(scan, dtype=np.float32))
-        open_bins = np.count_nonzero(pooled >= 1.0) / pooled.size
-        return {
-            "image": np.stack(layers),
-            "scan": pooled,
-            "features": np.array([known_crop, free_crop, open_bins], dtype=np.float32),
-        }
+        if self._ch_fd >= 0:
+            if self._field is None:
+                self._field = FrontierDistanceField(
+                    g.shape, g.resolution_m, self.params.frontier_clearance_m
+                )
+            self._field.update(grid)
+            dp, wp = self._field.dist_padded, self._field.row_stride
+        else:
+            dp, wp = _NO_FIELD, 0
+        c = self.params.crop_cells
+        image = np.empty((self.params.n_channels, c, c), np.uint8)
+        pooled = np.empty(self.params.n_scan_bins, np.float32)
+        features = np.empty(N_FEATURES, np.float32)
+        _encode_kernel(
+            grid, dp, wp, _NO_TRAIL if self._trail is None else self._trail,
+            (x_m - g.origin_x_m) / g.resolution_m, (y_m - g.origin_y_m) / g.resolution_m,
+            math.cos(yaw_rad), math.sin(yaw_rad), self._cells_per_crop_cell, self.supersample,
+            self._ch_occ, self._ch_fd, self._ch_trail, self._trail_radius_cells,
+            float(self.params.distance_scale_per_m), scan, self.max_range_m, self._scan_shift,
+            image, pooled, features,
+        )  # fmt: skip
+        # Fresh arrays every call: recorders keep them (a dataset is a list of these).
+        return {"image": image, "scan": pooled, "features": features}
 
 
 def mirror_observations(

@@ -252,17 +252,13 @@ class OccupancyGrid:
             raise ValueError(
                 f"beam_angles_rad and ranges_m must be 1-D of equal length, got shapes {beams.shape} and {ranges.shape}"
             )
-        if self._scan_id >= _MAX_SCAN_ID:
-            self._stamp.fill(0)
-            self._scan_id = 0
-        self._scan_id += 1
         g = self.geometry
         status, d_free, d_free_mask = _integrate_kernel(
             self._log_odds,
             self._encoded,
             self._stamp,
             self._count_mask,
-            self._scan_id,
+            self._begin_scan(),
             float(x_m),
             float(y_m),
             float(yaw_rad),
@@ -285,6 +281,14 @@ class OccupancyGrid:
         self.n_free_cells += d_free
         self.n_free_in_mask += d_free_mask
         return int(d_free)
+
+    def _begin_scan(self) -> int:
+        """The stamp of a new scan (stamps are cleared every ``_MAX_SCAN_ID`` scans)."""
+        if self._scan_id >= _MAX_SCAN_ID:
+            self._stamp.fill(0)
+            self._scan_id = 0
+        self._scan_id += 1
+        return self._scan_id
 
     def __repr__(self) -> str:
         h, w = self.geometry.shape
@@ -316,7 +320,63 @@ def _integrate_kernel(
             return 1, 0, 0
         if ranges[j] < 0.0:
             return 2, 0, 0
+    cos_b = np.empty(n)
+    sin_b = np.empty(n)
+    for j in range(n):
+        th = yaw + beams[j]
+        cos_b[j] = math.cos(th)
+        sin_b[j] = math.sin(th)
+    d_free, d_mask = integrate_dirs(
+        log_odds,
+        encoded,
+        stamp,
+        mask,
+        scan_id,
+        ox,
+        oy,
+        cos_b,
+        sin_b,
+        ranges,
+        max_range,
+        gx0,
+        gy0,
+        res,
+        consts,
+    )
+    return 0, d_free, d_mask
+
+
+@njit(cache=True, error_model="numpy")
+def integrate_dirs(
+    log_odds,
+    encoded,
+    stamp,
+    mask,
+    scan_id,
+    ox,
+    oy,
+    cos_b,
+    sin_b,
+    ranges,
+    max_range,
+    gx0,
+    gy0,
+    res,
+    consts,
+):  # pragma: no cover - numba
+    """The update of one scan given each beam's world-frame direction; returns (d_free, d_mask).
+
+    Inputs are trusted (checked by the caller): ranges >= 0 or NaN, directions finite. The grids
+    are walked through flat views; each beam's traversal keeps the exact float operations of
+    the Amanatides-Woo walk (the same cells for the same inputs, to the last bit).
+    """
+    n = cos_b.shape[0]
     height, width = log_odds.shape
+    size = height * width
+    lo = log_odds.reshape(size)
+    enc = encoded.reshape(size)
+    st = stamp.reshape(size)
+    msk = mask.reshape(size)
     l_free = consts[0]
     l_occ = consts[1]
     l_min = consts[2]
@@ -328,12 +388,7 @@ def _integrate_kernel(
     gy1 = gy0 + height * res
     d_free = 0
     d_mask = 0
-    cos_b = np.empty(n)
-    sin_b = np.empty(n)
-    for j in range(n):
-        th = yaw + beams[j]
-        cos_b[j] = math.cos(th)
-        sin_b[j] = math.sin(th)
+    sid = np.uint8(scan_id)
 
     # Pass 1: end-point cells first, so the occupied update wins within this scan.
     for j in range(n):
@@ -344,14 +399,11 @@ def _integrate_kernel(
         fr = math.floor((oy + r * sin_b[j] - gy0) * inv_res)
         if fc < 0 or fr < 0 or fc >= width or fr >= height:
             continue
-        row = int(fr)
-        col = int(fc)
-        if stamp[row, col] == scan_id:
+        k = int(fr) * width + int(fc)
+        if st[k] == sid:
             continue
-        stamp[row, col] = scan_id
-        a, b = _update_cell(
-            log_odds, encoded, mask, row, col, l_occ, l_min, l_max, thr_free, thr_occ
-        )
+        st[k] = sid
+        a, b = _update_flat(lo, enc, msk, k, l_occ, l_min, l_max, thr_free, thr_occ)
         d_free += a
         d_mask += b
 
@@ -405,48 +457,53 @@ def _integrate_kernel(
             step_r = 0
             t_next_y = np.inf
             t_dy = 0.0
+        # The walk leaves the grid when col or row would; the last column/row it may enter.
+        col_end = width if step_c > 0 else -1
+        row_end = height if step_r > 0 else -1
+        k = row * width + col
+        step_k = step_r * width
         while True:
-            if stamp[row, col] != scan_id:
-                stamp[row, col] = scan_id
-                a, b = _update_cell(
-                    log_odds, encoded, mask, row, col, l_free, l_min, l_max, thr_free, thr_occ
-                )
+            if st[k] != sid:
+                st[k] = sid
+                a, b = _update_flat(lo, enc, msk, k, l_free, l_min, l_max, thr_free, thr_occ)
                 d_free += a
                 d_mask += b
             if t_next_x < t_next_y:
                 if t_next_x >= t1:
                     break
                 col += step_c
-                if col < 0 or col >= width:
+                if col == col_end:
                     break
+                k += step_c
                 t_next_x += t_dx
             else:
                 if t_next_y >= t1:
                     break
                 row += step_r
-                if row < 0 or row >= height:
+                if row == row_end:
                     break
+                k += step_k
                 t_next_y += t_dy
-    return 0, d_free, d_mask
+    return d_free, d_mask
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _update_cell(
-    log_odds, encoded, mask, row, col, delta, l_min, l_max, thr_free, thr_occ
+def _update_flat(
+    lo, enc, msk, k, delta, l_min, l_max, thr_free, thr_occ
 ):  # pragma: no cover - numba
-    """Add ``delta`` to one cell; return the changes of (n_free, n_free_in_mask)."""
-    v = min(max(log_odds[row, col] + delta, l_min), l_max)
-    log_odds[row, col] = v
+    """Add ``delta`` to flat cell ``k``; return the changes of (n_free, n_free_in_mask)."""
+    v = min(max(lo[k] + delta, l_min), l_max)
+    lo[k] = v
     new = FREE if v < thr_free else (OCCUPIED if v > thr_occ else UNKNOWN)
-    old = encoded[row, col]
+    old = enc[k]
     if new == old:
         return 0, 0
-    encoded[row, col] = new
+    enc[k] = new
     d = 0
     if old == FREE:
         d = -1
     elif new == FREE:
         d = 1
-    if mask[row, col]:
+    if msk[k]:
         return d, d
     return d, 0

@@ -71,6 +71,10 @@ class OdometryNoiseParams:
                 raise ValueError(
                     f"OdometryNoiseParams.{f.name} must be a finite number >= 0, got {v!r}"
                 )
+            # Beyond these a single step's noise is metres or many turns: not odometry.
+            hi = 1.0 if f.name == "min_translation_m" else 10.0
+            if v > hi:
+                raise ValueError(f"odometry.{f.name} must be <= {hi:g}, got {v!r}")
 
     @property
     def is_perfect(self) -> bool:

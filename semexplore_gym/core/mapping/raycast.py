@@ -318,6 +318,49 @@ def _cast_kernel(
     out,
 ):  # pragma: no cover - numba
     n_rays = angles.shape[0]
+    dxs = np.empty(n_rays)
+    dys = np.empty(n_rays)
+    for j in range(n_rays):
+        th = angles[j] + yaw
+        dxs[j] = math.cos(th)
+        dys[j] = math.sin(th)
+    cast_dirs(
+        seg,
+        bucket_start,
+        bucket_items,
+        x0,
+        y0,
+        cell,
+        n_rows,
+        n_cols,
+        ox,
+        oy,
+        dxs,
+        dys,
+        max_range,
+        out,
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def cast_dirs(
+    seg,
+    bucket_start,
+    bucket_items,
+    x0,
+    y0,
+    cell,
+    n_rows,
+    n_cols,
+    ox,
+    oy,
+    dxs,
+    dys,
+    max_range,
+    out,
+):  # pragma: no cover - numba
+    """:func:`cast_rays` on trusted inputs, each ray given by its unit direction ``(dxs, dys)``."""
+    n_rays = dxs.shape[0]
     n_seg = seg.shape[0]
     for j in range(n_rays):
         out[j] = np.inf
@@ -394,10 +437,7 @@ def _cast_kernel(
     if m < _MIN_CANDIDATES_FOR_BINS:
         every = np.arange(m)
         for j in range(n_rays):
-            th = angles[j] + yaw
-            out[j] = _first_hit(
-                math.cos(th), math.sin(th), cax, cay, cbx, cby, ck, 0, m, every, max_range
-            )
+            out[j] = _first_hit(dxs[j], dys[j], cax, cay, cbx, cby, ck, 0, m, every, max_range)
         return
 
     # Angular bins: each candidate goes into every bin its angular extent touches, padded by
@@ -448,9 +488,8 @@ def _cast_kernel(
             items[cursor[b]] = q
             cursor[b] += 1
     for j in range(n_rays):
-        th = angles[j] + yaw
-        dx = math.cos(th)
-        dy = math.sin(th)
+        dx = dxs[j]
+        dy = dys[j]
         b = int(_pseudo_angle(dx, dy) / w)
         if b >= nb:
             b = nb - 1

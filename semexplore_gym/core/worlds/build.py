@@ -21,6 +21,55 @@ DEFAULT_MIN_FREE_CELLS = 4
 #: Native resolution of the free mask of vector worlds (mazes, caves, HouseExpo JSON).
 DEFAULT_VECTOR_RESOLUTION_M = 0.025
 
+#: Most cells of a world's native raster (a map image, or the grid a vector world is
+#: rasterised on): the env's own map check uses the same figure.
+MAX_WORLD_CELLS = 40_000_000
+
+#: Most wall segments a world may have (the largest real map we know has ~23 k). Each is a
+#: pymunk shape and a LiDAR candidate; millions (a noise image) take minutes and gigabytes.
+MAX_WALL_SEGMENTS = 200_000
+
+
+class WorldTooLargeError(ValueError):
+    """A world is beyond :data:`MAX_WORLD_CELLS` or :data:`MAX_WALL_SEGMENTS`; says what to do."""
+
+
+def check_world_cells(name: str, n_rows: float, n_cols: float, resolution_m: float) -> None:
+    """Refuse a raster of ``n_rows x n_cols`` cells beyond :data:`MAX_WORLD_CELLS`, before
+    anything of that size is allocated."""
+    cells = float(n_rows) * float(n_cols)
+    if not np.isfinite(cells) or cells > MAX_WORLD_CELLS:
+        raise WorldTooLargeError(
+            f"world {name!r}: {n_cols:.0f} x {n_rows:.0f} cells at {resolution_m:g} m "
+            f"({cells:.3g} cells) is more than the {MAX_WORLD_CELLS:,} cell limit; use a coarser "
+            "resolution or crop the map"
+        )
+
+
+def count_wall_runs(free: np.ndarray) -> int:
+    """Number of maximal wall segments :func:`raster_to_segments` would make of ``free``
+    (counted with numpy, without building them)."""
+    h, w = free.shape
+    padded = np.zeros((h + 2, w + 2), dtype=bool)
+    padded[1:-1, 1:-1] = free
+    total = 0
+    for a, b in ((padded[1:], padded[:-1]), (padded[:, 1:].T, padded[:, :-1].T)):
+        for face in (a & ~b, b & ~a):  # the two orientations are separate segments
+            starts = face.copy()
+            starts[:, 1:] &= ~face[:, :-1]
+            total += int(np.count_nonzero(starts))
+    return total
+
+
+def check_wall_segments(name: str, n_segments: int, resolution_m: float) -> None:
+    """Refuse a world with more than :data:`MAX_WALL_SEGMENTS` wall segments."""
+    if n_segments > MAX_WALL_SEGMENTS:
+        raise WorldTooLargeError(
+            f"world {name!r}: {n_segments:,} wall segments at {resolution_m:g} m is more than the "
+            f"{MAX_WALL_SEGMENTS:,} limit (a noisy image?); clean the map (fewer specks), use a "
+            "coarser resolution or crop it"
+        )
+
 
 def _resolve_bounds(
     name: str, segments: np.ndarray, bounds_m: tuple[float, float, float, float] | None
@@ -68,6 +117,7 @@ def world_from_free_mask(
         raise ValueError(
             f"world {name!r}: free_mask shape {free.shape} != geometry shape {geometry.shape}"
         )
+    check_world_cells(name, free.shape[0], free.shape[1], geometry.resolution_m)
     free = remove_small_free_components(free, min_free_cells)
     if not free.any():
         raise ValueError(
@@ -87,6 +137,7 @@ def world_from_free_mask(
         cropped.shape[0],
         cropped.shape[1],
     )
+    check_wall_segments(name, count_wall_runs(cropped), res)
     segments = raster_to_segments(cropped, crop_geometry)
     return World(
         name=name,
@@ -121,7 +172,14 @@ def world_from_segments(
     segments = as_segments(segments_m)
     if segments.shape[0] == 0:
         raise ValueError(f"world {name!r}: no wall segments")
+    check_wall_segments(name, segments.shape[0], resolution_m)
     bounds = _resolve_bounds(name, segments, bounds_m)
+    check_world_cells(
+        name,
+        (bounds[3] - bounds[1]) / resolution_m + 3,
+        (bounds[2] - bounds[0]) / resolution_m + 3,
+        resolution_m,
+    )
     geometry = GridGeometry.covering(*bounds, resolution_m=resolution_m, margin_m=resolution_m)
     free = rasterize_free(segments, geometry, interior_points_m=interior_points_m)
     if not free.any():

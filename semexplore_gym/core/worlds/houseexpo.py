@@ -14,14 +14,18 @@ a cell of a wall (with the tie rule of :func:`~semexplore_gym.core.worlds.raster
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
 import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.worlds.build import DEFAULT_VECTOR_RESOLUTION_M
+from semexplore_gym.core.safe_io import load_json_file, one_line, short_repr
+from semexplore_gym.core.worlds.build import (
+    DEFAULT_VECTOR_RESOLUTION_M,
+    check_wall_segments,
+    check_world_cells,
+)
 from semexplore_gym.core.worlds.geometry import (
     crossed_links,
     merge_polyline_edges,
@@ -30,6 +34,9 @@ from semexplore_gym.core.worlds.geometry import (
 )
 from semexplore_gym.core.worlds.raster import cells_near_walls, mark_walls
 from semexplore_gym.core.worlds.world import World
+
+#: Largest coordinate of a plan (metres): a house is tens of metres across.
+MAX_COORDINATE_M = 1e5
 
 
 def read_houseexpo_json(path: str | os.PathLike) -> dict:
@@ -43,12 +50,13 @@ def read_houseexpo_json(path: str | os.PathLike) -> dict:
         ValueError: not JSON, not an object, or ``verts`` missing or not >= 3 finite points.
     """
     p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"HouseExpo JSON not found: {p}")
     try:
-        doc = json.loads(p.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{p}: malformed JSON: {exc}") from exc
+        exists = p.is_file()
+    except (OSError, ValueError):  # a name too long for the file system
+        exists = False
+    if not exists:
+        raise FileNotFoundError(f"HouseExpo JSON not found: {short_repr(str(p), 200)}")
+    doc = load_json_file(p, "HouseExpo JSON")
     if not isinstance(doc, dict):
         raise ValueError(
             f"{p}: expected a JSON object with a 'verts' key, got {type(doc).__name__}"
@@ -57,14 +65,21 @@ def read_houseexpo_json(path: str | os.PathLike) -> dict:
         raise ValueError(f"{p}: missing required key 'verts'")
     try:
         verts = np.asarray(doc["verts"], dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{p}: key 'verts' must be a list of [x, y] numbers: {exc}") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ValueError(
+            f"{p}: key 'verts' must be a list of [x, y] numbers: {one_line(str(exc))}"
+        ) from None
     if verts.ndim != 2 or verts.shape[1] != 2 or verts.shape[0] < 3:
         raise ValueError(
             f"{p}: key 'verts' must hold at least 3 [x, y] points, got shape {verts.shape}"
         )
     if not np.isfinite(verts).all():
         raise ValueError(f"{p}: key 'verts' contains NaN or inf")
+    if np.abs(verts).max() > MAX_COORDINATE_M:
+        raise ValueError(
+            f"{p}: key 'verts' has a coordinate beyond {MAX_COORDINATE_M:g} m "
+            f"({np.abs(verts).max():.3g}); not a floor plan in metres"
+        )
     out = dict(doc)
     out["verts"] = verts
     return out
@@ -89,6 +104,13 @@ def load_houseexpo_world(
     if segments.shape[0] < 3:
         raise ValueError(f"{path}: key 'verts' does not outline an area")
     bounds = segments_bounds_m(segments)
+    check_wall_segments(str(path), segments.shape[0], resolution_m)
+    check_world_cells(
+        str(path),
+        (bounds[3] - bounds[1]) / resolution_m + 3,
+        (bounds[2] - bounds[0]) / resolution_m + 3,
+        resolution_m,
+    )
     geometry = GridGeometry.covering(*bounds, resolution_m=resolution_m, margin_m=resolution_m)
     inside = polygon_inside_mask(verts, geometry)
     free = mark_walls(

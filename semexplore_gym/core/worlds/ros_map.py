@@ -27,15 +27,21 @@ only carries anti-aliasing); 16-bit images are scaled to 0..255. Image row 0 is 
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 from PIL import Image
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from semexplore_gym.core.worlds.build import DEFAULT_MIN_FREE_CELLS, world_from_free_mask
+from semexplore_gym.core.safe_io import load_yaml_file, one_line, short_repr
+from semexplore_gym.core.worlds.build import (
+    DEFAULT_MIN_FREE_CELLS,
+    MAX_WORLD_CELLS,
+    WorldTooLargeError,
+    world_from_free_mask,
+)
 from semexplore_gym.core.worlds.world import World
 
 _MODES = ("trinary", "scale", "raw")
@@ -68,6 +74,25 @@ class RosMapMetadata:
     mode: str
 
 
+#: A map_server yaml holds a handful of keys; anything larger is not one.
+MAX_MAP_YAML_BYTES = 64 << 10
+
+
+#: Cell sizes accepted from a map yaml: a robot of ~0.1 m needs cells well below a metre.
+MIN_RESOLUTION_M = 1e-3
+MAX_RESOLUTION_M = 1.0
+#: Largest origin coordinate (metres) kept exact enough in float64 at millimetre cells.
+MAX_ORIGIN_M = 1e6
+
+
+def _is_file(p: Path) -> bool:
+    """``p.is_file()``, False instead of an OSError for a name too long or otherwise unusable."""
+    try:
+        return p.is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def _number(doc: dict, key: str, path: Path, default: float | None = None) -> float:
     if key not in doc:
         if default is None:
@@ -75,9 +100,9 @@ def _number(doc: dict, key: str, path: Path, default: float | None = None) -> fl
         return default
     value = doc[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{path}: key {key!r} must be a number, got {value!r}")
+        raise ValueError(f"{path}: key {key!r} must be a number, got {short_repr(value)}")
     if not np.isfinite(value):
-        raise ValueError(f"{path}: key {key!r} must be finite, got {value!r}")
+        raise ValueError(f"{path}: key {key!r} must be finite, got {short_repr(value)}")
     return float(value)
 
 
@@ -91,12 +116,9 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
             mode. The message names the file and the key.
     """
     yaml_path = Path(path)
-    if not yaml_path.is_file():
-        raise FileNotFoundError(f"ROS map yaml not found: {yaml_path}")
-    try:
-        doc = yaml.safe_load(yaml_path.read_text())
-    except yaml.YAMLError as exc:
-        raise ValueError(f"{yaml_path}: malformed YAML: {exc}") from exc
+    if not _is_file(yaml_path):
+        raise FileNotFoundError(f"ROS map yaml not found: {short_repr(str(yaml_path), 200)}")
+    doc = load_yaml_file(yaml_path, "ROS map yaml", max_bytes=MAX_MAP_YAML_BYTES)
     if not isinstance(doc, dict):
         raise ValueError(
             f"{yaml_path}: expected a mapping of map_server keys, got {type(doc).__name__}"
@@ -106,12 +128,15 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
         raise ValueError(f"{yaml_path}: missing required key 'image'")
     image = doc["image"]
     if not isinstance(image, str) or not image.strip():
-        raise ValueError(f"{yaml_path}: key 'image' must be a file name, got {image!r}")
+        raise ValueError(f"{yaml_path}: key 'image' must be a file name, got {short_repr(image)}")
     image_path = _resolve_image(yaml_path, image.strip())
 
     resolution_m = _number(doc, "resolution", yaml_path)
-    if resolution_m <= 0:
-        raise ValueError(f"{yaml_path}: key 'resolution' must be positive, got {resolution_m!r}")
+    if not (MIN_RESOLUTION_M <= resolution_m <= MAX_RESOLUTION_M):
+        raise ValueError(
+            f"{yaml_path}: key 'resolution' must be positive, between {MIN_RESOLUTION_M} and "
+            f"{MAX_RESOLUTION_M} m per cell, got {resolution_m!r}"
+        )
 
     if "origin" not in doc:
         raise ValueError(f"{yaml_path}: missing required key 'origin'")
@@ -124,15 +149,22 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
             for v in origin
         )
     ):
-        raise ValueError(f"{yaml_path}: key 'origin' must be [x, y, yaw] numbers, got {origin!r}")
+        raise ValueError(
+            f"{yaml_path}: key 'origin' must be [x, y, yaw] numbers, got {short_repr(origin)}"
+        )
+    if max(abs(float(v)) for v in origin[:2]) > MAX_ORIGIN_M:
+        raise ValueError(
+            f"{yaml_path}: key 'origin' {short_repr(origin)} is more than {MAX_ORIGIN_M:g} m "
+            "from 0 (float precision); move the origin"
+        )
     if len(origin) == 3 and abs(float(origin[2])) > 1e-9:
         raise ValueError(
-            f"{yaml_path}: key 'origin' has yaw {origin[2]!r}; only yaw 0 maps are supported"
+            f"{yaml_path}: key 'origin' has yaw {short_repr(origin[2])}; only yaw 0 maps are supported"
         )
 
     negate_raw = doc.get("negate", 0)
     if negate_raw not in (0, 1):
-        raise ValueError(f"{yaml_path}: key 'negate' must be 0 or 1, got {negate_raw!r}")
+        raise ValueError(f"{yaml_path}: key 'negate' must be 0 or 1, got {short_repr(negate_raw)}")
     occupied_thresh = _number(doc, "occupied_thresh", yaml_path, default=0.65)
     free_thresh = _number(doc, "free_thresh", yaml_path, default=0.196)
     if not (0.0 <= free_thresh <= occupied_thresh <= 1.0):
@@ -143,7 +175,7 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
     mode = doc.get("mode", "trinary")
     if not isinstance(mode, str) or mode.strip().lower() not in _MODES:
         raise ValueError(
-            f"{yaml_path}: key 'mode' must be one of {', '.join(_MODES)}, got {mode!r}"
+            f"{yaml_path}: key 'mode' must be one of {', '.join(_MODES)}, got {short_repr(mode)}"
         )
     return RosMapMetadata(
         yaml_path=yaml_path,
@@ -166,10 +198,10 @@ def _resolve_image(yaml_path: Path, image: str) -> Path:
     if fallback not in candidates:
         candidates.append(fallback)
     for candidate in candidates:
-        if candidate.is_file():
+        if _is_file(candidate):
             return candidate
-    tried = ", ".join(str(c) for c in candidates)
-    raise FileNotFoundError(f"{yaml_path}: image {image!r} not found (tried {tried})")
+    tried = ", ".join(short_repr(str(c), 120) for c in candidates)
+    raise FileNotFoundError(f"{yaml_path}: image {short_repr(image)} not found (tried {tried})")
 
 
 def read_grey_image(path: str | os.PathLike) -> np.ndarray:
@@ -180,7 +212,15 @@ def read_grey_image(path: str | os.PathLike) -> np.ndarray:
         are, otherwise float32 (RGB(A): the mean of R, G and B, alpha ignored; 16-bit: scaled).
     """
     try:
-        with Image.open(path) as im:
+        with warnings.catch_warnings(), Image.open(path) as im:
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            # Checked before decoding: a small compressed file can hold a huge image.
+            w, h = im.size
+            if w * h > MAX_WORLD_CELLS:
+                raise WorldTooLargeError(
+                    f"{path}: image of {w} x {h} pixels is more than the {MAX_WORLD_CELLS:,} "
+                    "pixel limit; crop it or scale it down (and scale the yaml's resolution up)"
+                )
             im.load()
             mode = im.mode
             if mode in ("P", "PA"):
@@ -190,8 +230,12 @@ def read_grey_image(path: str | os.PathLike) -> np.ndarray:
                 im = im.convert("L")
                 mode = "L"
             arr = np.asarray(im)
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read image: {exc}") from exc
+    except WorldTooLargeError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - PIL raises many types on a corrupt file
+        raise ValueError(
+            f"{path}: cannot read image: {type(exc).__name__}: {one_line(str(exc))}"
+        ) from None
     if mode == "L":
         grey = arr
     elif mode in ("RGB", "RGBA", "RGBX"):

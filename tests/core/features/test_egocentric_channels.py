@@ -168,3 +168,22 @@ def test_mirror_needs_centred_bins() -> None:
     obs = {"image": np.zeros((1, 1, 8, 8), np.uint8), "scan": np.zeros((1, 60), np.float32)}
     with pytest.raises(ValueError, match="scan_bins_centred"):
         mirror_observations(obs, np.zeros((1, 2), np.float32), EgocentricParams())
+
+
+def test_encoder_pickles_mid_episode_and_encodes_on_alike() -> None:
+    import pickle
+
+    grid = np.full((41, 41), 128, np.uint8)
+    grid[10:30, 10:30] = FREE
+    grid[20, 12:28] = OCCUPIED
+    params = EgocentricParams(crop_cells=CROP, channels=("occupancy", "frontier_distance", "trail"))
+    enc = EgocentricEncoder.from_info(params, INFO)
+    enc.encode(_obs(grid, 1.5, 1.5, 0.3))
+    grid2 = grid.copy()
+    grid2[25:30, 25:35] = FREE
+    twin = pickle.loads(pickle.dumps(enc))
+    a, b = enc.encode(_obs(grid2, 1.8, 1.6, 0.5)), twin.encode(_obs(grid2, 1.8, 1.6, 0.5))
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k])
+    assert (a["image"][2] == 0).sum() > 0  # the trail survived the round trip
+    assert len(pickle.dumps(enc)) < 20_000  # the frontier search's buffers are not pickled

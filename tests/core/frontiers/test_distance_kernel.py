@@ -9,8 +9,12 @@ import pytest
 from scipy import ndimage
 
 from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
-from semexplore_gym.core.frontiers.distance import frontier_distance_m, relative_distance_image
 from semexplore_gym.core.frontiers.detection import frontier_cell_mask
+from semexplore_gym.core.frontiers.distance import (
+    FrontierDistanceField,
+    frontier_distance_m,
+    relative_distance_image,
+)
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, parse_ascii_grid
 from semexplore_gym.core.planning.grid_search import distance_field
 from semexplore_gym.core.worlds.grid_maze import carve_maze
@@ -137,6 +141,59 @@ def test_kernel_edge_cases() -> None:
     assert d[1, 1] == 0.0 and d[2, 1] == 1.0 and d[2, 2] == 2.0 and d[2, 3] == 3.0
     corner[2, 1] = OCCUPIED  # both sides of the diagonal walled: (2, 2) is cut off
     assert np.isinf(frontier_distance_m(corner, 1.0, 0.0)[2:4, 2:4]).all()
+
+
+def _edit(grid: np.ndarray, rng: np.random.Generator, truth: np.ndarray) -> None:
+    """Change ``grid`` in place the way mapping does, and the ways it should not."""
+    h, w = grid.shape
+    kind = rng.integers(0, 4)
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    rad = int(rng.integers(0, 12))
+    rr, cc = np.mgrid[:h, :w]
+    disc = np.hypot(rr - r0, cc - c0) <= rad
+    if kind == 0:  # a scan: reveal the truth round a point
+        grid[disc] = truth[disc]
+    elif kind == 1:  # a few cells, any value (phantom walls, forgotten cells, new frontiers)
+        for _ in range(int(rng.integers(1, 6))):
+            r, c = int(rng.integers(0, h)), int(rng.integers(0, w))
+            grid[r, c] = rng.choice(VALUES)
+    elif kind == 2:  # a patch falls back to unknown
+        grid[disc & (rng.random((h, w)) < 0.5)] = UNKNOWN
+    else:  # a wall segment appears
+        grid[r0, max(0, c0 - rad) : c0 + rad + 1] = OCCUPIED
+
+
+@pytest.mark.parametrize("clearance_m", [0.1, 0.0, 0.15])
+def test_incremental_field_equals_a_fresh_search(clearance_m: float) -> None:
+    """Repairing after each edit gives the field of a search from scratch, bit for bit."""
+    rng = np.random.default_rng(11)
+    for seed in range(3):
+        truth = _partly_explored_maze(seed + 20)
+        truth[truth == UNKNOWN] = FREE
+        grid = _partly_explored_maze(seed + 20)
+        field = FrontierDistanceField(grid.shape, 0.05, clearance_m)
+        assert field.update(grid) and not field.update(grid.copy())  # unchanged: skipped
+        for _ in range(60):
+            _edit(grid, rng, truth)
+            field.update(grid)
+            np.testing.assert_array_equal(
+                field.distance_m(), frontier_distance_m(grid, 0.05, clearance_m)
+            )
+        # A whole new map (searched afresh rather than repaired).
+        grid = _partly_explored_maze(seed + 40)
+        field.update(grid)
+        np.testing.assert_array_equal(
+            field.distance_m(), frontier_distance_m(grid, 0.05, clearance_m)
+        )
+        # A bad value raises and the next valid map is searched afresh.
+        bad = grid.copy()
+        bad[0, 0] = 7
+        with pytest.raises(ValueError, match="value 7"):
+            field.update(bad)
+        field.update(grid)
+        np.testing.assert_array_equal(
+            field.distance_m(), frontier_distance_m(grid, 0.05, clearance_m)
+        )
 
 
 def test_kernel_rejects_bad_grids() -> None:

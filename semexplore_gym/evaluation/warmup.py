@@ -1,0 +1,141 @@
+"""Load (or, on a fresh clone, compile) the numba kernels before a mission's clocks start.
+
+Every hot loop is ``@njit(cache=True)``: the first run of a checkout compiles them (a minute or
+two on 2 cores) and writes them to ``__pycache__``; later processes load them from there (a
+second or two). Either cost lands in whatever calls a kernel first. :func:`warm_up` pays it up
+front, so that a mission's reported wall time and per-call timings are the planners' own: it
+runs a short mission of a fresh policy, then loads every other kernel the disk cache holds for
+the modules now imported, and says on stderr what is going on when numba really compiles
+(numba's ``numba:compile`` event fires only on a cache miss).
+
+Why not ahead-of-time compilation: numba's AOT (``numba.pycc``) is deprecated, needs explicit
+signatures for every kernel and a compiler at install time, and its extension modules would
+replace the ``@njit`` functions the tests and callers use; the disk cache gives the same
+steady state after one run. Kernels a warm-up mission does not reach (rare branches) still
+compile lazily on a fresh clone, once.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Hashable
+from typing import Any, TextIO
+
+#: The world of the warm-up mission: a 3 m maze the semantic expert finishes in 53 s, passing
+#: through its semantic plans, grid-frontier fallback, a stuck recovery and its stop.
+WARMUP_WORLD = "maze:seed=0,size_m=3"
+#: Simulated seconds of the warm-up mission at most (it stops when the policy is done).
+WARMUP_TIME_S = 60.0
+COMPILE_MESSAGE = "compiling numba kernels (first run only, ~2 min on 2 cores)..."
+#: Keys of the warm-ups this process has done (a process loads a kernel once; the set only
+#: saves repeating the warm-up mission, it changes no result).
+_WARMED_UP: set[Hashable] = set()
+
+
+def warm_up(
+    make_policy: Callable[[], Any],
+    config: Any = None,
+    overrides: list[str] | None = None,
+    *,
+    key: Hashable | None = None,
+    stream: TextIO | None = None,
+) -> dict[str, float]:
+    """Run a short throw-away mission so the kernels of the env and the policy are loaded.
+
+    Args:
+        make_policy: Returns a fresh policy of the kind the real mission runs (the warm-up
+            mission must not change the real policy's state).
+        config: The env config of the real mission (so the kernels see the same types).
+        overrides: Its env overrides (``episode.max_time_s`` is replaced).
+        key: Skip the warm-up when this process already did one with the same key (e.g. the
+            policy spec and env config of every mission of a benchmark).
+        stream: Where the compile message goes (default: ``sys.stderr``).
+
+    Returns:
+        ``{"wall_s": ..., "compiled": n, "loaded": n}``: the warm-up's wall time, the number
+        of kernels numba compiled (0 when the on-disk cache had them all) and the number of
+        further cached kernels loaded.
+    """
+    import gymnasium as gym
+    from numba.core import event
+
+    import semexplore_gym  # noqa: F401  (registers the env)
+
+    if key is not None and key in _WARMED_UP:
+        return {"wall_s": 0.0, "compiled": 0.0, "loaded": 0.0}
+    out = stream if stream is not None else sys.stderr
+    compiled = 0
+
+    class _OnCompile(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            nonlocal compiled
+            if compiled == 0:
+                print(COMPILE_MESSAGE, file=out, flush=True)
+            compiled += 1
+
+        def on_end(self, ev: Any) -> None:
+            pass
+
+    t0 = time.perf_counter()
+    env_overrides = [
+        *(o for o in (overrides or []) if not o.startswith("episode.")),
+        f"episode.max_time_s={WARMUP_TIME_S!r}",
+    ]
+    with event.install_listener("numba:compile", _OnCompile()):
+        env = gym.make(
+            "SemanticExplore-v0", world=WARMUP_WORLD, config=config, overrides=env_overrides
+        )
+        try:
+            policy = make_policy()
+            obs, info = env.reset(seed=0)
+            policy.reset(obs, info, seed=0)
+            while True:
+                action = policy.act(obs, info)
+                if policy.done:
+                    break
+                obs, _, terminated, truncated, info = env.step(action)
+                if terminated or truncated:
+                    break
+        finally:
+            env.close()
+    loaded = load_cached_kernels()
+    if key is not None:
+        _WARMED_UP.add(key)
+    wall_s = time.perf_counter() - t0
+    if compiled:
+        print(
+            f"compiled {compiled} numba kernels in {wall_s:.0f} s (cached for later runs)",
+            file=out,
+            flush=True,
+        )
+    return {"wall_s": wall_s, "compiled": float(compiled), "loaded": float(loaded)}
+
+
+def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym", "policies")) -> int:
+    """Load every signature the disk cache holds for the kernels of the imported modules.
+
+    Returns:
+        How many were loaded (0 where numba's cache layout is not the one this reads).
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    n = 0
+    for name, module in list(sys.modules.items()):
+        if module is None or not name.startswith(prefixes):
+            continue
+        for obj in list(vars(module).values()):
+            if not isinstance(obj, Dispatcher) or obj._cache is None:
+                continue
+            try:  # numba internals: the cache index maps (signature, ...) -> data file
+                signatures = [key[0] for key in obj._cache._cache_file._load_index()]
+            except Exception:  # noqa: BLE001 - another numba version: the mission loads lazily
+                continue
+            for sig in signatures:
+                if tuple(sig) not in obj.overloads:
+                    try:
+                        obj.compile(sig)
+                    except Exception:  # noqa: BLE001 - a stale entry: compiled lazily if used
+                        continue
+                    n += 1
+    return n

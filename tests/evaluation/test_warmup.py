@@ -1,0 +1,87 @@
+"""The numba warm-up before a mission: kernels loaded before the clocks start, a message only
+when numba really compiles."""
+
+from __future__ import annotations
+
+import gc
+import io
+
+import gymnasium as gym
+import numpy as np
+from numba import njit
+from numba.core.dispatcher import Dispatcher
+
+import semexplore_gym  # noqa: F401  (registers the env)
+from policies.base import Policy, StepStats
+from policies.registry import make_policy
+from semexplore_gym.evaluation.rollout import run_mission
+from semexplore_gym.evaluation.warmup import COMPILE_MESSAGE, warm_up
+
+
+def _kernel_calls() -> dict[int, int]:
+    """Per project kernel: signatures loaded from the disk cache or compiled so far."""
+    out = {}
+    for d in gc.get_objects():
+        if isinstance(d, Dispatcher) and d.py_func.__module__.startswith(
+            ("semexplore_gym", "policies")
+        ):
+            out[id(d)] = sum(d._cache_hits.values()) + sum(d._cache_misses.values())
+    return out
+
+
+def test_after_warm_up_a_mission_loads_and_compiles_no_kernel() -> None:
+    out = io.StringIO()
+    warm_up(lambda: make_policy("semantic"), stream=out)
+    before = _kernel_calls()
+    env = gym.make("SemanticExplore-v0", world="maze2")
+    try:
+        run_mission(env, make_policy("semantic"), seed=0, max_time_s=60, progress=False)
+    finally:
+        env.close()
+    after = _kernel_calls()
+    new = {k: v - before.get(k, 0) for k, v in after.items() if v != before.get(k, 0)}
+    assert new == {}, "kernels loaded or compiled inside the mission's clocks"
+
+
+class _FreshKernelPolicy(Policy):
+    """A policy whose ``act`` calls a kernel numba has never compiled."""
+
+    name = "fresh-kernel"
+
+    def __init__(self) -> None:
+        super().__init__()
+
+        @njit
+        def double(x):  # a new function object each time: always a compile
+            return 2.0 * x
+
+        self._double = double
+
+    def act(self, obs, info):
+        self.last_stats = StepStats()
+        self.done = True
+        return np.array([self._double(0.0), 0.0], dtype=np.float32)
+
+
+def test_compile_message_only_when_numba_compiles() -> None:
+    out = io.StringIO()
+    res = warm_up(_FreshKernelPolicy, stream=out)
+    assert res["compiled"] >= 1
+    assert COMPILE_MESSAGE in out.getvalue()
+
+    quiet = io.StringIO()
+    res = warm_up(lambda: make_policy("random"), stream=quiet)
+    assert res["compiled"] == 0
+    assert quiet.getvalue() == ""
+
+
+def test_warm_up_with_a_key_runs_once_per_process() -> None:
+    calls = []
+
+    def factory():
+        calls.append(1)
+        return make_policy("random")
+
+    warm_up(factory, key=("test-key", 1), stream=io.StringIO())
+    warm_up(factory, key=("test-key", 1), stream=io.StringIO())
+    assert len(calls) == 1
