@@ -166,6 +166,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             "retries": 0,
             "revived": 0,
             "looks": 0,
+            "look_drives": 0,
             "oscillations_blocked": 0,
         }
         self._angles: np.ndarray | None = None

@@ -150,6 +150,9 @@ class SemanticExpertParams:
             look (the LiDAR resolved it then).
         look_clearance_fraction: A frontier a robot with this fraction of the clearance could
             reach is narrow at first sight and worth a look; narrower gaps are leaks.
+        max_look_drives: Drives to look points per mission. A gap seen narrow that opens up is
+            rare; most candidates are the mixed cells along a wall's unseen far side, so the
+            drives are capped (frontiers the trail already passed close to are dropped free).
         oscillation_guard: Do not switch back to a recently abandoned goal.
         oscillation_window_s: How long an abandoned goal stays "recent".
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
@@ -197,6 +200,7 @@ class SemanticExpertParams:
     look_min_frontier_m: float = 0.15
     look_seen_radius_m: float = 1.5
     look_clearance_fraction: float = 0.5
+    max_look_drives: int = 2
     oscillation_guard: bool = True
     oscillation_window_s: float = 120.0
     entry_detour: bool = True
@@ -253,6 +257,8 @@ class SemanticExpertParams:
         ):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
+        if int(self.max_look_drives) < 0:
+            raise ValueError(f"max_look_drives must be >= 0, got {self.max_look_drives!r}")
         if int(self.max_revivals) < 0:
             raise ValueError(f"max_revivals must be >= 0, got {self.max_revivals!r}")
 

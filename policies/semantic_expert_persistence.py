@@ -170,6 +170,8 @@ class GoalPersistence:
         """
         prm = self.params
         res_m = self.geometry.resolution_m
+        if self.counters["look_drives"] >= prm.max_look_drives:
+            return None
         for _ in range(_MAX_LOOK_CANDIDATES):
             found = nearest_reachable_frontier(
                 grid,
@@ -187,13 +189,16 @@ class GoalPersistence:
                 return None
             path = self._standable_prefix(found.path_m, clearance)
             near = math.dist(tuple(path[-1]), found.frontier_xy_m) <= prm.look_reach_m
-            if len(path) >= 2 and near and not self._been_near(
-                found.frontier_xy_m, prm.look_seen_radius_m
+            if (
+                len(path) >= 2
+                and near
+                and not self._been_near(found.frontier_xy_m, prm.look_seen_radius_m)
             ):
                 from policies.semantic_expert import _Plan
 
                 plan = _Plan("look", (float(path[-1, 0]), float(path[-1, 1])), path, None)
                 plan.frontier_xy_m = found.frontier_xy_m
+                self.counters["look_drives"] += 1
                 return plan
             self.counters["looks"] += 1
             self._drop(grid, found.frontier_xy_m, "looked")
@@ -205,8 +210,10 @@ class GoalPersistence:
         dense = resample_polyline(path_m, res_m)
         rows, cols = self.geometry.world_to_grid(dense[:, 0], dense[:, 1])
         ok = clearance[rows, cols] >= self.clearance_m - 1e-9
-        bad = np.flatnonzero(~ok[1:])  # the start may sit closer to a wall than the clearance
-        return dense if len(bad) == 0 else dense[: int(bad[0]) + 1]
+        # The robot may start closer to a wall than its clearance: skip that first stretch.
+        first = int(np.argmax(ok)) if ok.any() else len(ok)
+        bad = np.flatnonzero(~ok[first:])
+        return dense if len(bad) == 0 else dense[: first + int(bad[0])]
 
     def _been_near(self, xy_m: tuple[float, float], radius_m: float) -> bool:
         """Whether the robot's trail passed within ``radius_m`` of ``xy_m``."""
