@@ -32,11 +32,11 @@ FAMILIES: dict[str, list[str]] = {
         "size_m=14,corridor_width_m=1.2",
     ],
     "office": [
-        "size_m=12",
-        "size_m=16,clutter=1",
+        "size_m=10",
+        "size_m=12,clutter=1",
+        "size_m=14",
+        "size_m=16,clutter=0.5",
         "size_m=20",
-        "size_m=24,clutter=0.5",
-        "size_m=30",
     ],
     "cave": [
         "size_m=8,min_passage_m=0.5",
@@ -46,13 +46,17 @@ FAMILIES: dict[str, list[str]] = {
         "size_m=15",
     ],
     "forest": [
-        "size_m=8,density=10",
-        "size_m=12",
-        "size_m=12,density=15,min_gap_m=0.5",
-        "size_m=16,density=6,trunk_radius_max_m=0.8",
-        "size_m=20,density=10",
+        "size_m=6,density=10",
+        "size_m=8",
+        "size_m=8,density=15,min_gap_m=0.5",
+        "size_m=10,density=6,trunk_radius_max_m=0.8",
+        "size_m=12,density=10",
     ],
 }
+
+#: Per-world time limit: this many simulated seconds per m^2 of free area, at least the floor.
+TIME_PER_M2_S = 6.0
+MIN_TIME_S = 600.0
 
 
 def sweep_worlds(families: list[str], per_family: int, seed0: int) -> list[str]:
@@ -148,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--per-family", type=int, default=75, help="worlds per family (default: %(default)s)")
     ap.add_argument("--policies", default="semantic", help="comma-separated policy specs (default: %(default)s)")
     ap.add_argument("--seed0", type=int, default=1000, help="seed of the first world (default: %(default)s)")
-    ap.add_argument("--max-time-s", type=float, default=None, help="mission time limit (default: the env's 1200 s)")
+    ap.add_argument("--max-time-s", type=float, default=None, help="mission time limit (default: 6 s per m^2 of free area, at least 600 s)")
     ap.add_argument("--ok-coverage", type=float, default=0.97, help="coverage a mission must reach (default: %(default)s)")
     ap.add_argument("--workers", type=int, default=1, help="missions in parallel (default: %(default)s)")
     ap.add_argument("--gifs", action="store_true", help="animate every failure of the first policy")
@@ -169,14 +173,20 @@ def main(argv: list[str] | None = None) -> int:
     from semexplore_gym.envs.config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
 
-    env_config = load_env_config(None, ["episode.random_start=true"])
+    from semexplore_gym.core.worlds import make_world
+
     worlds = sweep_worlds(families, args.per_family, args.seed0)
-    # One mission per world and policy: the world's own seed also seeds the start pose.
-    tasks = [
-        Task(w, p, int(w.split("seed=")[1].split(",")[0]), args.max_time_s, env_config)
-        for w in worlds
-        for p in policies
-    ]
+    tasks = []
+    for w in worlds:
+        world = make_world(w)
+        area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
+        limit_s = args.max_time_s or max(MIN_TIME_S, TIME_PER_M2_S * area_m2)
+        env_config = load_env_config(
+            None, ["episode.random_start=true", f"episode.max_time_s={limit_s:.0f}"]
+        )
+        # One mission per world and policy: the world's own seed also seeds the start pose.
+        seed = int(w.split("seed=")[1].split(",")[0])
+        tasks += [Task(w, p, seed, limit_s, env_config) for p in policies]
     out = Path(args.out)
     res = run_benchmark(tasks, out, workers=args.workers, progress=not args.no_progress)
     rows = [r for r in read_runs(out / "runs.csv") if r["world"] in set(worlds)]
