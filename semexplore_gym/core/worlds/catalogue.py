@@ -8,7 +8,7 @@ Every file has a sha256 and a size. Upstream files are fetched from
 ``raw.githubusercontent.com/OWNER/REPO/COMMIT/PATH`` at the commit given (as recorded in the
 collection the checksums were taken from; some commits are abbreviated). Maps whose source
 has no map_server yaml (a bare image plus a scale in a Stage world file) get a sidecar yaml
-written by us; it ships in this package (``map_sidecars/``), since there is nothing upstream to
+written by us; this package generates it from the fields recorded below, since there is nothing upstream to
 download, and is checksummed like the rest.
 
 Where maps are looked for, in order:
@@ -27,13 +27,11 @@ import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 #: Where upstream files are fetched from; ``OWNER/REPO/COMMIT/PATH`` follows.
 RAW_GITHUB_BASE = "https://raw.githubusercontent.com"
 _NAME_RE = re.compile(r"^[a-z0-9][a-z0-9-]*$")
-_SIDECAR_DIR = "map_sidecars"
 
 
 @dataclass(frozen=True)
@@ -100,8 +98,137 @@ def _up(directory: str, filename: str, sha256: str, size_bytes: int) -> MapFile:
     return MapFile(filename, sha256, size_bytes, f"{directory}/{filename}")
 
 
-def _ours(filename: str, sha256: str, size_bytes: int) -> MapFile:
-    return MapFile(filename, sha256, size_bytes, None)
+#: map_server fields of the sidecar yamls we write for sources that have none (our reading of
+#: each source: scale from its world file or paper, thresholds fitted to its grey levels).
+_SIDECAR_FIELDS: dict[str, dict[str, object]] = {
+    "08d4ecc49835d0bd677138765d90a035.yaml": {
+        "image": "08d4ecc49835d0bd677138765d90a035.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "15ded3a168cd9513b876ab36600b5650.yaml": {
+        "image": "15ded3a168cd9513b876ab36600b5650.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "1dfb7bd5d9a447175a9719096fbacea7.yaml": {
+        "image": "1dfb7bd5d9a447175a9719096fbacea7.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "1eb932a28c3b80449c06b59a35fbf549.yaml": {
+        "image": "1eb932a28c3b80449c06b59a35fbf549.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "20ec9ec7f8783ee18b3c9da7bff12b0e.yaml": {
+        "image": "20ec9ec7f8783ee18b3c9da7bff12b0e.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "237f80139e1659ec0232b6c7e6bd3e21.yaml": {
+        "image": "237f80139e1659ec0232b6c7e6bd3e21.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "9cea230f67d0a5a2fb1dd857e1f4393d.yaml": {
+        "image": "9cea230f67d0a5a2fb1dd857e1f4393d.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "Freiburg79_scan.yaml": {
+        "image": "Freiburg79_scan.png",
+        "resolution": 0.05,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "SFU_1200x615.yaml": {
+        "image": "SFU_1200x615.png",
+        "resolution": 1.0,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "c4513f5dfd084681ed2d0c24e85b9cf7.yaml": {
+        "image": "c4513f5dfd084681ed2d0c24e85b9cf7.png",
+        "resolution": 0.01,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "cave.yaml": {
+        "image": "cave.png",
+        "resolution": 0.032,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "freiburg_building79.yaml": {
+        "image": "freiburg_building79.png",
+        "resolution": 0.05,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    },
+    "intel_map.yaml": {
+        "image": "intel_map.png",
+        "resolution": 0.05,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.2,
+        "free_thresh": 0.05,
+    },
+    "willow-full.yaml": {
+        "image": "willow-full.pgm",
+        "resolution": 0.1,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.1,
+    },
+}
+
+
+def _sidecar_text(filename: str) -> str:
+    """The sidecar yaml we write for ``filename`` (map_server fields, one per line)."""
+    f = _SIDECAR_FIELDS[filename]
+    out = [
+        "# map_server metadata written by semexplore: the source ships the image without one.",
+        *(f"{k}: {list(v) if isinstance(v, tuple) else v}" for k, v in f.items()),
+    ]
+    return "\n".join(out) + "\n"
+
+
+def _ours(filename: str, *_legacy: object) -> MapFile:
+    data = _sidecar_text(filename).encode()
+    return MapFile(filename, hashlib.sha256(data).hexdigest(), len(data), None)
 
 
 _TB3 = ("ROBOTIS-GIT/turtlebot3", "Apache-2.0")
@@ -341,10 +468,10 @@ def resolve_map_file(
 
 
 def sidecar_bytes(file: MapFile) -> bytes:
-    """The bytes of a sidecar yaml shipped in this package."""
+    """The bytes of a sidecar yaml this package writes (the source has none)."""
     if file.upstream_path is not None:
         raise ValueError(f"{file.filename} is an upstream file, not a packaged sidecar")
-    return (resources.files(__package__) / _SIDECAR_DIR / file.filename).read_bytes()
+    return _sidecar_text(file.filename).encode()
 
 
 def sha256_file(path: Path) -> str:
