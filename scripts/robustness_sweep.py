@@ -54,9 +54,8 @@ FAMILIES: dict[str, list[str]] = {
     ],
 }
 
-#: Per-world time limit: this many simulated seconds per m^2 of free area, at least the floor.
-TIME_PER_M2_S = 6.0
-MIN_TIME_S = 600.0
+#: One time limit for every mission of the sweep (its largest worlds need ~900 s at 0.22 m/s).
+DEFAULT_MAX_TIME_S = 1500.0
 
 
 def sweep_worlds(families: list[str], per_family: int, seed0: int) -> list[str]:
@@ -152,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--per-family", type=int, default=75, help="worlds per family (default: %(default)s)")
     ap.add_argument("--policies", default="semantic", help="comma-separated policy specs (default: %(default)s)")
     ap.add_argument("--seed0", type=int, default=1000, help="seed of the first world (default: %(default)s)")
-    ap.add_argument("--max-time-s", type=float, default=None, help="mission time limit (default: 6 s per m^2 of free area, at least 600 s)")
+    ap.add_argument("--max-time-s", type=float, default=DEFAULT_MAX_TIME_S, help="mission time limit (default: %(default)s s)")
     ap.add_argument("--ok-coverage", type=float, default=0.97, help="coverage a mission must reach (default: %(default)s)")
     ap.add_argument("--workers", type=int, default=1, help="missions in parallel (default: %(default)s)")
     ap.add_argument("--gifs", action="store_true", help="animate every failure of the first policy")
@@ -173,20 +172,17 @@ def main(argv: list[str] | None = None) -> int:
     from semexplore_gym.envs.config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
 
-    from semexplore_gym.core.worlds import make_world
-
     worlds = sweep_worlds(families, args.per_family, args.seed0)
-    tasks = []
-    for w in worlds:
-        world = make_world(w)
-        area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
-        limit_s = args.max_time_s or max(MIN_TIME_S, TIME_PER_M2_S * area_m2)
-        env_config = load_env_config(
-            None, ["episode.random_start=true", f"episode.max_time_s={limit_s:.0f}"]
-        )
-        # One mission per world and policy: the world's own seed also seeds the start pose.
-        seed = int(w.split("seed=")[1].split(",")[0])
-        tasks += [Task(w, p, seed, limit_s, env_config) for p in policies]
+    limit_s = args.max_time_s or DEFAULT_MAX_TIME_S
+    env_config = load_env_config(
+        None, ["episode.random_start=true", f"episode.max_time_s={limit_s:g}"]
+    )
+    # One mission per world and policy: the world's own seed also seeds the start pose.
+    tasks = [
+        Task(w, p, int(w.split("seed=")[1].split(",")[0]), limit_s, env_config)
+        for w in worlds
+        for p in policies
+    ]
     out = Path(args.out)
     res = run_benchmark(tasks, out, workers=args.workers, progress=not args.no_progress)
     rows = [r for r in read_runs(out / "runs.csv") if r["world"] in set(worlds)]
