@@ -28,11 +28,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-from policies.semantic_expert import Segmenter, SemanticExpertParams, SemanticExpertPolicy
+from policies.semantic_expert import (
+    PlanSource,
+    Segmenter,
+    SemanticExpertParams,
+    SemanticExpertPolicy,
+)
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
 _GOAL_DONE_REASONS = ("goal_reached", "goal_vanished", "path_done")
@@ -104,7 +109,7 @@ class ExpertDriver(SemanticExpertPolicy):
         if self._goal is not None and reason in _GOAL_DONE_REASONS:
             self.goal_finished = True
 
-    def on_replanned(self, source: Literal["semantic", "fallback"] | None) -> None:
+    def on_replanned(self, source: PlanSource | None) -> None:
         """The commanded frontier is finished once it is no longer among the candidates."""
         if self._goal is not None and source != "semantic":
             self.goal_finished = True

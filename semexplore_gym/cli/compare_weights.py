@@ -34,9 +34,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
-from semexplore_gym.cli import describe
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
@@ -270,21 +270,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import (
-        expand_tasks,
-        parse_seeds,
-        read_runs,
-        run_benchmark,
-        write_manifest,
-    )
-    from semexplore_gym.training.weight_tuning import (
-        PAPER_FIELD,
-        PAPER_WEIGHTS,
-        SearchSpace,
-        mission_objective,
-        tune_weights,
-    )
+def _check_run_args(
+    args: argparse.Namespace,
+) -> tuple[list[str], list[str], list[int], list[int], list[str]]:
+    """Everything is checked before the tuning starts: a typo must not cost an Optuna run.
+
+    Returns:
+        ``(train_worlds, test_worlds, train_seeds, test_seeds, agents)``.
+    """
+    from semexplore_gym.evaluation.harness import parse_seeds
 
     validate_args(args)
     train_worlds = _split_worlds(args.train_worlds)
@@ -293,7 +287,6 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--train-worlds and --test-worlds must each name at least one world")
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
     test_seeds = parse_seeds(args.runs, args.test_seed0)
-    # Everything is checked before the tuning starts: a typo must not cost an Optuna run.
     from semexplore_gym.cli.benchmark import _check_worlds
 
     for flag, worlds, seeds in (
@@ -332,6 +325,25 @@ def run(args: argparse.Namespace) -> int:
                 make_policy(spec)  # a bad path or spec fails now, not after the tuning
             except (ValueError, FileNotFoundError) as e:
                 raise ValueError(f"--agents {spec!r}: {e}") from None
+    return train_worlds, test_worlds, train_seeds, test_seeds, agents
+
+
+def run(args: argparse.Namespace) -> int:
+    from semexplore_gym.evaluation.harness import (
+        expand_tasks,
+        read_runs,
+        run_benchmark,
+        write_manifest,
+    )
+    from semexplore_gym.training.weight_tuning import (
+        PAPER_FIELD,
+        PAPER_WEIGHTS,
+        SearchSpace,
+        mission_objective,
+        tune_weights,
+    )
+
+    train_worlds, test_worlds, train_seeds, test_seeds, agents = _check_run_args(args)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_manifest(

@@ -18,6 +18,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -75,7 +76,7 @@ def _pool_min(mask: np.ndarray, k: int) -> np.ndarray:
     H, W = -(-h // k), -(-w // k)
     pad = np.zeros((H * k, W * k), dtype=bool)
     pad[:h, :w] = mask
-    return pad.reshape(H, k, W, k).all(axis=(1, 3))
+    return cast(np.ndarray, pad.reshape(H, k, W, k).all(axis=(1, 3)))
 
 
 def load_grid(

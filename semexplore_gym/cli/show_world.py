@@ -14,10 +14,14 @@ import argparse
 import json
 import sys
 import time
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from semexplore_gym.cli import describe
+
+if TYPE_CHECKING:
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -51,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     t0 = time.perf_counter()
     env = gym.make("SemanticExplore-v0", world=args.world)
-    base = env.unwrapped
+    base = cast("SemanticExploreEnv", env.unwrapped)
     base.reset(seed=args.seed)
     load_s = time.perf_counter() - t0
     world = base.world

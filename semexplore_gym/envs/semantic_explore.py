@@ -274,7 +274,7 @@ class SemanticExploreEnv(gym.Env):
         self._n_reachable = max(1, int(reach.sum()))
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping, count_mask=reach)
         self.odometry.reset(pose)
-        self._est_pose = pose
+        self._est_pose: tuple[float, float, float] | np.ndarray = pose
         self.sim_time_s = 0.0
         self._n_steps = 0
         self.path_length_m = 0.0

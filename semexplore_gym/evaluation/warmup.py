@@ -20,7 +20,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable, Hashable
-from typing import Any, TextIO
+from typing import Any, TextIO, cast
 
 #: The world of the warm-up mission: a 3 m maze the semantic expert finishes in 53 s, passing
 #: through its semantic plans, grid-frontier fallback, a stuck recovery and its stop.
@@ -125,10 +125,10 @@ def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym", "policies
         if module is None or not name.startswith(prefixes):
             continue
         for obj in list(vars(module).values()):
-            if not isinstance(obj, Dispatcher) or obj._cache is None:
+            if not isinstance(obj, Dispatcher) or cast(Any, obj)._cache is None:
                 continue
             try:  # numba internals: the cache index maps (signature, ...) -> data file
-                signatures = [key[0] for key in obj._cache._cache_file._load_index()]
+                signatures = [key[0] for key in cast(Any, obj)._cache._cache_file._load_index()]
             except Exception:  # noqa: BLE001 - another numba version: the mission loads lazily
                 continue
             for sig in signatures:

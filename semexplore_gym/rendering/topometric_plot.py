@@ -117,10 +117,10 @@ def plot_topometric_map(
                 if len(p) >= 2:
                     ax.plot(p[:, 0], p[:, 1], color=col, lw=lw)
     for o in tmap.openings:
-        e = np.asarray(o.endpoints_m)
+        ends = np.asarray(o.endpoints_m)
         ax.plot(
-            e[:, 0],
-            e[:, 1],
+            ends[:, 0],
+            ends[:, 1],
             color=(0.85, 0.1, 0.75) if o.is_frontier else (0.1, 0.1, 0.1),
             lw=2.0 if o.is_frontier else 1.5,
         )
@@ -163,7 +163,8 @@ def plot_topometric_map(
     from matplotlib.patches import Patch
 
     handles = [
-        Patch(color=np.asarray(TYPE_COLOURS[t]) / 255.0, label=_TYPE_LABELS[t])
+        # matplotlib's stubs leave out the RGB arrays it accepts as colours.
+        Patch(color=np.asarray(TYPE_COLOURS[t]) / 255.0, label=_TYPE_LABELS[t])  # type: ignore[arg-type]
         for t in TYPE_COLOURS
     ]
     ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8)

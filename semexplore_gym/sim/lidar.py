@@ -105,7 +105,7 @@ class Lidar:
     def sense_and_map(
         self,
         true_pose: tuple[float, float, float],
-        map_pose: tuple[float, float, float],
+        map_pose: tuple[float, float, float] | np.ndarray,
         grid: OccupancyGrid,
         rng: np.random.Generator,
     ) -> np.ndarray:

@@ -23,13 +23,16 @@ dc]`` where both exist.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any, SupportsFloat, cast
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from semexplore_gym.core.grid import UNKNOWN
+
+if TYPE_CHECKING:
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 
 ANCHORS = ("world", "robot")
 
@@ -71,7 +74,7 @@ class FixedSizeMap(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         half = self.map_size // 2
         if self.anchor == "world":
             return (grid_shape[0] // 2 - half, grid_shape[1] // 2 - half)
-        geometry = self.env.unwrapped.map_geometry
+        geometry = cast("SemanticExploreEnv", self.env.unwrapped).map_geometry
         row, col = geometry.world_to_grid(float(pose[0]), float(pose[1]))
         return (int(row) - half, int(col) - half)
 
@@ -96,7 +99,7 @@ class FixedSizeMap(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         obs = self.observation(obs)
         return obs, dict(info, map_offset_cells=self._offset)
 
-    def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+    def step(self, action: Any) -> tuple[dict[str, Any], SupportsFloat, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
         obs = self.observation(obs)
         return obs, reward, terminated, truncated, dict(info, map_offset_cells=self._offset)

@@ -27,14 +27,12 @@ where the features, :class:`MacroParams` and :func:`action_to_weights` live (re-
 
 from __future__ import annotations
 
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
-from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.features.macro import (  # noqa: F401  (re-exported)
     N_CANDIDATE_FEATURES,
     N_GLOBAL_FEATURES,
@@ -46,6 +44,8 @@ from semexplore_gym.core.features.macro import (  # noqa: F401  (re-exported)
     observation_size,
     observation_vector,
 )
+from semexplore_gym.core.grid import UNKNOWN
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 
 class FrontierDriver(Protocol):
@@ -151,7 +151,7 @@ class _MacroWrapper(gym.Wrapper):
         # The episode is over: the candidate search would be wasted work.
         self.candidates = []
         self._n_all = 0
-        vec = np.zeros(self.observation_space.shape, dtype=np.float32)
+        vec = np.zeros(cast(tuple[int, ...], self.observation_space.shape), dtype=np.float32)
         grid = self._obs["map"] if self._obs is not None else None
         if grid is not None:
             vec[-N_GLOBAL_FEATURES] = 1.0 - float(np.count_nonzero(grid == UNKNOWN)) / grid.size

@@ -40,6 +40,8 @@ from dataclasses import dataclass, fields
 import numpy as np
 import numpy.typing as npt
 
+from semexplore_gym.core.grid import wrap_angle_rad as wrap_angle
+
 
 @dataclass(frozen=True)
 class OdometryNoiseParams:
@@ -86,11 +88,6 @@ class OdometryNoiseParams:
             == self.trans_from_rot
             == 0.0
         )
-
-
-def wrap_angle(angle_rad: float) -> float:
-    """Wrap an angle to ``[-pi, pi)``."""
-    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def decompose_motion(

@@ -151,36 +151,7 @@ def cast_rays(
     Raises:
         ValueError: on a non-finite pose or angle, a non-positive range, or a bad ``out``.
     """
-    if not isinstance(index, SegmentIndex):
-        raise TypeError(f"index must be a SegmentIndex, got {type(index).__name__}")
-    if not (math.isfinite(x_m) and math.isfinite(y_m)):
-        raise ValueError(f"sensor position must be finite, got ({x_m!r}, {y_m!r})")
-    max_range = float(max_range_m)
-    if not max_range > 0:
-        raise ValueError(f"max_range_m must be positive, got {max_range_m!r}")
-    angles = np.asarray(angles_rad, dtype=np.float64)
-    if angles.ndim != 1:
-        raise ValueError(f"angles_rad must be 1-D, got shape {angles.shape}")
-    if not np.isfinite(angles).all():
-        raise ValueError("angles_rad contains NaN or inf")
-    out = _check_out(out, angles.shape[0])
-    _cast_kernel(
-        index.segments_m,
-        index.bucket_start,
-        index.bucket_items,
-        index.origin_x_m,
-        index.origin_y_m,
-        index.cell_size_m,
-        index.n_rows,
-        index.n_cols,
-        float(x_m),
-        float(y_m),
-        0.0,
-        angles,
-        max_range,
-        out,
-    )
-    return out
+    return _cast_checked(index, x_m, y_m, 0.0, angles_rad, "angles_rad", max_range_m, out)
 
 
 def cast_scan(
@@ -208,6 +179,22 @@ def cast_scan(
     """
     if not math.isfinite(yaw_rad):
         raise ValueError(f"yaw_rad must be finite, got {yaw_rad!r}")
+    return _cast_checked(
+        index, x_m, y_m, float(yaw_rad), beam_angles_rad, "beam_angles_rad", max_range_m, out
+    )
+
+
+def _cast_checked(
+    index: SegmentIndex,
+    x_m: float,
+    y_m: float,
+    yaw_rad: float,
+    angles_rad: npt.ArrayLike,
+    angles_name: str,
+    max_range_m: float,
+    out: np.ndarray | None,
+) -> np.ndarray:
+    """Check the arguments of :func:`cast_rays` / :func:`cast_scan` and cast the rays."""
     if not isinstance(index, SegmentIndex):
         raise TypeError(f"index must be a SegmentIndex, got {type(index).__name__}")
     if not (math.isfinite(x_m) and math.isfinite(y_m)):
@@ -215,12 +202,12 @@ def cast_scan(
     max_range = float(max_range_m)
     if not max_range > 0:
         raise ValueError(f"max_range_m must be positive, got {max_range_m!r}")
-    beams = np.asarray(beam_angles_rad, dtype=np.float64)
-    if beams.ndim != 1:
-        raise ValueError(f"beam_angles_rad must be 1-D, got shape {beams.shape}")
-    if not np.isfinite(beams).all():
-        raise ValueError("beam_angles_rad contains NaN or inf")
-    out = _check_out(out, beams.shape[0])
+    angles = np.asarray(angles_rad, dtype=np.float64)
+    if angles.ndim != 1:
+        raise ValueError(f"{angles_name} must be 1-D, got shape {angles.shape}")
+    if not np.isfinite(angles).all():
+        raise ValueError(f"{angles_name} contains NaN or inf")
+    out = _check_out(out, angles.shape[0])
     _cast_kernel(
         index.segments_m,
         index.bucket_start,
@@ -232,8 +219,8 @@ def cast_scan(
         index.n_cols,
         float(x_m),
         float(y_m),
-        float(yaw_rad),
-        beams,
+        yaw_rad,
+        angles,
         max_range,
         out,
     )

@@ -286,6 +286,21 @@ def search_frontier_paths(
             )
             n_pushed += 1
 
+    candidates = _score_candidates(tmap, best, frontier_at, first_legs, leg_start_angle, l_path, w)
+    return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+
+
+def _score_candidates(
+    tmap: TopometricMap,
+    best: dict[int, tuple[float, _Partial]],
+    frontier_at: dict[int, Frontier],
+    first_legs: dict[int, np.ndarray],
+    leg_start_angle: dict[int, float],
+    l_path: float,
+    w: FrontierCostWeights,
+) -> list[FrontierCandidate]:
+    """The cheapest path found to each frontier, scored with ``C = metric - gain``, cheapest
+    first (ties by path length)."""
     candidates: list[FrontierCandidate] = []
     for node, (metric, path) in best.items():
         f = frontier_at[node]
@@ -310,7 +325,7 @@ def search_frontier_paths(
             )
         )
     candidates.sort(key=lambda c: (c.cost, c.d_m))
-    return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+    return candidates
 
 
 # --- metric helpers -------------------------------------------------------------------------

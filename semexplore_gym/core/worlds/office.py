@@ -119,62 +119,19 @@ def _split_row(xa: int, xb: int, rng: np.random.Generator) -> list[int]:
     return cuts
 
 
-def generate_office(params: OfficeParams, name: str | None = None) -> World:
-    """A procedural office world (deterministic for ``params.seed``).
-
-    The start pose is in the first corridor, facing +x.
-    """
-    rng = np.random.default_rng(params.seed)
-    n = _cells(params.size_m)
+def _carve_rooms(
+    free: np.ndarray,
+    room_rows: list[tuple[int, int, str]],
+    corridors: list[tuple[int, int]],
+    verticals: list[tuple[int, int]],
+    params: OfficeParams,
+    rng: np.random.Generator,
+) -> None:
+    """Split each row of rooms beside a corridor into rooms with doors, in place."""
+    n = free.shape[1]
     t = _WALL_CELLS
-    cw = _cells(params.corridor_width_m)
     dw = _cells(params.door_width_m)
     margin = _cells(_DOOR_MARGIN_M)
-    d_min = _cells(_MIN_ROOM_DEPTH_M)
-    free = np.ones((n, n), dtype=bool)
-
-    n_bands = max(1, n // (2 * d_min + cw + 3 * t))
-    edges = np.round(np.linspace(0, n, n_bands + 1)).astype(int)
-    corridors: list[tuple[int, int]] = []
-    room_rows: list[tuple[int, int, str]] = []  # (y0, y1, side of the corridor: "above"/"below")
-    for i in range(n_bands):
-        lo = edges[i] + (t - t // 2 if i > 0 else 0)
-        hi = edges[i + 1] - (t // 2 if i < n_bands - 1 else 0)
-        room_space = hi - lo - cw - 2 * t
-        jitter = room_space // 10
-        lower = room_space // 2 + int(rng.integers(-jitter, jitter + 1))
-        y0 = lo + lower + t
-        y1 = y0 + cw
-        free[y0 - t : y0, :] = False
-        free[y1 : y1 + t, :] = False
-        if i < n_bands - 1:
-            free[edges[i + 1] - t // 2 : edges[i + 1] + t - t // 2, :] = False
-        corridors.append((y0, y1))
-        room_rows.append((lo, y0 - t, "above"))
-        room_rows.append((y1 + t, hi, "below"))
-
-    verticals: list[tuple[int, int]] = []
-    if n_bands >= 2:
-        room_w = _cells(_MIN_ROOM_WIDTH_M)
-        x0 = int(rng.integers(n // 4, max(n // 4 + 1, 3 * n // 4 - cw)))
-        verticals.append((x0, x0 + cw))
-        if rng.random() < 0.5:
-            # A second vertical corridor near the end farther from the first closes a loop.
-            if x0 > n // 2:
-                x2 = int(rng.integers(room_w + t, 2 * room_w + t))
-            else:
-                x2 = n - cw - int(rng.integers(room_w + t, 2 * room_w + t))
-            if abs(x2 - x0) > cw + 2 * t + room_w:
-                verticals.append((x2, x2 + cw))
-        verticals.sort()
-        ya, yb = corridors[0][0], corridors[-1][1]
-        for vx0, vx1 in verticals:
-            free[ya:yb, vx0 - t : vx0] = False
-            free[ya:yb, vx1 : vx1 + t] = False
-            free[ya:yb, vx0:vx1] = True
-        for cy0, cy1 in corridors:
-            free[cy0:cy1, :] = True
-
     for ry0, ry1, side in room_rows:
         crossed = [v for v in verticals if corridors[0][0] <= ry0 and ry1 <= corridors[-1][1]]
         # Spans of the row between vertical corridors: (x0, x1, left wall col, right wall col),
@@ -221,6 +178,63 @@ def generate_office(params: OfficeParams, name: str | None = None) -> World:
                 ):
                     dy = int(rng.integers(ry0 + margin, ry1 - margin - dw + 1))
                     free[dy : dy + dw, wall_col : wall_col + t] = True
+
+
+def generate_office(params: OfficeParams, name: str | None = None) -> World:
+    """A procedural office world (deterministic for ``params.seed``).
+
+    The start pose is in the first corridor, facing +x.
+    """
+    rng = np.random.default_rng(params.seed)
+    n = _cells(params.size_m)
+    t = _WALL_CELLS
+    cw = _cells(params.corridor_width_m)
+    d_min = _cells(_MIN_ROOM_DEPTH_M)
+    free = np.ones((n, n), dtype=bool)
+
+    n_bands = max(1, n // (2 * d_min + cw + 3 * t))
+    edges = np.round(np.linspace(0, n, n_bands + 1)).astype(int)
+    corridors: list[tuple[int, int]] = []
+    room_rows: list[tuple[int, int, str]] = []  # (y0, y1, side of the corridor: "above"/"below")
+    for i in range(n_bands):
+        lo = edges[i] + (t - t // 2 if i > 0 else 0)
+        hi = edges[i + 1] - (t // 2 if i < n_bands - 1 else 0)
+        room_space = hi - lo - cw - 2 * t
+        jitter = room_space // 10
+        lower = room_space // 2 + int(rng.integers(-jitter, jitter + 1))
+        y0 = lo + lower + t
+        y1 = y0 + cw
+        free[y0 - t : y0, :] = False
+        free[y1 : y1 + t, :] = False
+        if i < n_bands - 1:
+            free[edges[i + 1] - t // 2 : edges[i + 1] + t - t // 2, :] = False
+        corridors.append((y0, y1))
+        room_rows.append((lo, y0 - t, "above"))
+        room_rows.append((y1 + t, hi, "below"))
+
+    verticals: list[tuple[int, int]] = []
+    if n_bands >= 2:
+        room_w = _cells(_MIN_ROOM_WIDTH_M)
+        x0 = int(rng.integers(n // 4, max(n // 4 + 1, 3 * n // 4 - cw)))
+        verticals.append((x0, x0 + cw))
+        if rng.random() < 0.5:
+            # A second vertical corridor near the end farther from the first closes a loop.
+            if x0 > n // 2:
+                x2 = int(rng.integers(room_w + t, 2 * room_w + t))
+            else:
+                x2 = n - cw - int(rng.integers(room_w + t, 2 * room_w + t))
+            if abs(x2 - x0) > cw + 2 * t + room_w:
+                verticals.append((x2, x2 + cw))
+        verticals.sort()
+        ya, yb = corridors[0][0], corridors[-1][1]
+        for vx0, vx1 in verticals:
+            free[ya:yb, vx0 - t : vx0] = False
+            free[ya:yb, vx1 : vx1 + t] = False
+            free[ya:yb, vx0:vx1] = True
+        for cy0, cy1 in corridors:
+            free[cy0:cy1, :] = True
+
+    _carve_rooms(free, room_rows, corridors, verticals, params, rng)
 
     if params.clutter > 0:
         _add_clutter(free, room_rows, params)
