@@ -7,10 +7,11 @@ goals near aborted ones with a :class:`~policies.navigation.GoalBlacklist`.
 :class:`FrontierExplorationPolicy` (``"frontier"``) follows ``frontier_exploration``
 (``explore_server`` + ``BoundedExploreLayer``, indigo; blacklist of the melodic plugin):
 
-* when the current goal has ended (``frequency_hz = 0``, the ``explore_server`` default: it
-  commits to each goal until move_base reports success or abort), or every
-  ``1 / frequency_hz`` (2 Hz in ``global_map.launch``; at that rate the robot tends to flip
-  between frontiers at similar distances, the goal switching users report), it runs the wavefront
+* every ``1 / frequency_hz`` (default 2 Hz, as FE's example launch files set it; the robot
+  then tends to flip between frontiers at similar distances, the goal switching users report),
+  or, with ``frequency_hz = 0`` (``frontier[frequency_hz=0]``, the ``explore_server`` node's
+  own default), only when the current goal has ended (it commits to each goal until move_base
+  reports success or abort), it runs the wavefront
   frontier search (:func:`~semexplore_gym.core.frontiers.detect_frontiers`) **on its explore
   costmap** (``search_on_costmap``): only cells of cost 0 are free, so frontiers hide within
   ``explore_costmap.inflation_radius_m`` (0.15 m) of walls, exactly as FE's search on its
@@ -167,6 +168,8 @@ class _FrontierBaseline(Policy):
         if self.done:
             return self._action(0.0, 0.0)
         v, w = self._drive(grid, pose, scan, stats)
+        # The navigator's counts (plans, recoveries, aborts, ...) travel with the policy's.
+        self.counters.update({f"nav_{k}": n for k, n in self.nav.counters.items()})
         stats.extra = {"nav_status": self.nav.status, "n_frontiers": len(self.frontiers)}
         self.now_s += self.dt_s
         return self._action(v, w)
@@ -218,9 +221,12 @@ class FrontierExplorationParams:
     """ROS ``frontier_exploration`` (indigo explore_server + BoundedExploreLayer).
 
     Attributes:
-        frequency_hz: Frontier search / goal update rate (``frequency``); 0 (the server's
-            default) = wait until each goal ends before choosing the next. Its
-            ``global_map.launch`` uses 2.0.
+        frequency_hz: Frontier search / goal update rate (``frequency``). 2.0, the default,
+            is what FE's example launch files (``global_map.launch``, ``no_global_map.launch``)
+            set, so what users run: every 0.5 s the frontier search runs again and the goal is
+            re-sent if it moved (``goal_aliasing_m``). 0 is the ``explore_server`` node's own
+            default: it waits until each goal ends (reached or aborted) before choosing the
+            next; spell it ``frontier[frequency_hz=0]``.
         goal_aliasing_m: A new travel point is sent only if farther than 0.9 times this from
             the current goal (``goal_aliasing``, the launch sets it to the sensor range, 1.0).
         travel_point: ``"closest"`` (first-contact cell, FE's default), ``"middle"`` (FE's
@@ -238,10 +244,11 @@ class FrontierExplorationParams:
         blacklist_box_m: Travel points within this box half-size of an aborted goal are skipped
             (melodic ``blacklist_box_size`` 0.5).
         no_frontier_retries: Searches without a frontier tolerated before stopping (FE: 5).
-        navigation: The move_base-like navigator.
+        navigation: The move_base-like navigator (with ``local_goal_check``: a goal that
+            turned out to be a wall makes the local planner fail, as ROS's DWA does).
     """
 
-    frequency_hz: float = 0.0
+    frequency_hz: float = 2.0
     goal_aliasing_m: float = 1.0
     travel_point: Literal["closest", "middle", "centroid"] = "closest"
     selection: Literal["euclidean", "bfs_order"] = "euclidean"
@@ -253,7 +260,9 @@ class FrontierExplorationParams:
     check_reachability: bool = False
     blacklist_box_m: float = 0.5
     no_frontier_retries: int = 5
-    navigation: MoveBaseParams = field(default_factory=MoveBaseParams)
+    navigation: MoveBaseParams = field(
+        default_factory=lambda: MoveBaseParams(local_goal_check=True)
+    )
 
     def __post_init__(self) -> None:
         check_positive(

@@ -168,6 +168,10 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             "looks": 0,
             "look_drives": 0,
             "oscillations_blocked": 0,
+            # Instrumentation only (no decision reads them): replans with scored frontiers, and
+            # those where the metric cost alone would have picked another frontier.
+            "scored_replans": 0,
+            "semantic_decisive": 0,
         }
         self._angles: np.ndarray | None = None
         self._time_s = 0.0
@@ -398,6 +402,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         if segmented and self.memory.dropped:
             self._revive_dropped(grid)
         self.candidates = self._scored_candidates(tmap, pose, prm.cost)
+        self._count_semantic_decisive(self.candidates)
         new_plan, clearance = None, None
         if self._retry is not None:
             new_plan, clearance = self._retry_plan(grid, pose)
@@ -420,6 +425,21 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         else:
             self._adopt_plan(new_plan)
         self.on_replanned(self.plan_source)
+
+    def _count_semantic_decisive(self, candidates: list[FrontierCandidate]) -> None:
+        """Count a replan whose cheapest frontier by ``C`` is not cheapest by the metric part.
+
+        The metric part ``d / L_path + w_v v`` is ``C`` with ``w_p = w_I = 0``; both choices are
+        made among the same candidates (the ones Algorithm 1 found with the full cost). A tie
+        on the metric cost counts as agreement. ``semantic_decisive / scored_replans`` is the
+        share of replans in which the semantic gain changed the chosen frontier.
+        """
+        if not candidates:
+            return
+        self.counters["scored_replans"] += 1
+        best_metric = min(c.metric_cost for c in candidates)
+        if candidates[0].metric_cost > best_metric + 1e-9:
+            self.counters["semantic_decisive"] += 1
 
     def _update_topometric_map(self, grid: np.ndarray) -> tuple[TopometricMap, bool]:
         """The topometric map to plan on, and whether it was segmented anew."""

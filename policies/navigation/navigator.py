@@ -13,7 +13,20 @@ costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planne
   runs: rotate in place once round (``recovery_rotation_rad`` at
   ``recovery_angular_speed_radps``; move_base's ``rotate_recovery``), then plan again;
 * after ``max_recoveries`` (2, the two rotations of move_base's default recovery list) the
-  goal is **aborted**.
+  goal is **aborted**;
+* the goal counts as reached within the local planner's ``xy_goal_tolerance`` (TurtleBot3
+  ``dwa_local_planner``: 0.05 m; the planner's own default is 0.10 m);
+* the local planner **fails when its local goal cannot be reached** (``local_goal_check``, on
+  for FE):
+  ROS's DWA scores every trajectory by a distance flood from the local goal (the last point of
+  the global path inside the local window) that does not enter lethal or inscribed cells, so
+  once that point is mapped as (next to) a wall every trajectory is invalid. move_base then
+  replans; a goal in a wall cannot be planned to, so planner patience, the recoveries and the
+  abort follow. Without this rule a goal that turned out to be a wall kept the emulated DWA
+  circling 0.3-0.7 m from it for the rest of the mission (an FE run on maze1 circled for
+  ~1,100 s). move_base's oscillation check does not catch that case (in ROS neither): it
+  measures displacement from the last reset point, and a circle wider than
+  ``oscillation_distance_m`` keeps resetting it.
 
 The oscillation check is a :class:`~policies.navigation.bookkeeping.ProgressWatch`, the same
 progress watch the semantic expert uses for its stuck detection.
@@ -102,6 +115,12 @@ class MoveBaseParams:
             radius of a newly mapped obstacle (move_base only replans when the local planner
             fails, with ``planner_frequency`` 0, so a stale path through a wall first costs an
             oscillation timeout and a recovery).
+        local_goal_check: The local planner fails when every cell round its local goal lies
+            within the robot radius of an obstacle (ROS DWA's goal-distance flood cannot leave
+            it); see the module docstring. On for FE (``frontier``); off here so that the
+            ``nearest`` baseline keeps its pinned behaviour (``nearest[navigation.
+            local_goal_check=true]`` turns it on). The goal tolerance is
+            ``dwa.xy_goal_tolerance_m``.
     """
 
     costmap: CostmapParams = field(default_factory=CostmapParams)
@@ -117,6 +136,7 @@ class MoveBaseParams:
     max_recoveries: int = 2
     stand_still_speed_mps: float = 0.005
     replan_on_blocked_path: bool = False
+    local_goal_check: bool = False
 
     def __post_init__(self) -> None:
         check_positive(
@@ -191,6 +211,7 @@ class Navigator:
             "recoveries": 0,
             "aborts": 0,
             "successes": 0,
+            "unreachable_local_goal": 0,
         }
         self.last_plan_failed = False
         # Set by a policy to force replan_on_blocked_path (FE's check_reachability).
@@ -297,6 +318,11 @@ class Navigator:
         cmd = self.dwa.compute(
             pose, self.velocity, grid, geometry, obstacle_points_m=scan_pts, limits=self.limits
         )
+        unreachable = (
+            prm.local_goal_check
+            and not cmd.goal_reached
+            and self._local_goal_unreachable(pose, grid, geometry)
+        )
         stats.local_planning_ms += (time.perf_counter() - t0) * 1e3
         self.trajectory_m = cmd.trajectory_m
         if cmd.goal_reached:
@@ -307,7 +333,9 @@ class Navigator:
             abs(cmd.v_mps) < prm.stand_still_speed_mps
             and abs(cmd.omega_radps) * self.radius_m < prm.stand_still_speed_mps
         )
-        if not cmd.valid or still:
+        if unreachable:
+            self.counters["unreachable_local_goal"] += 1
+        if not cmd.valid or still or unreachable:
             # Local planner failure: replan next step; recover after controller patience.
             if self._ctrl_fail_since is None:
                 self._ctrl_fail_since = now_s
@@ -332,6 +360,38 @@ class Navigator:
         if len(ahead) == 0:
             return False
         return bool(cells_near_occupied(grid, ahead, self.radius_m, geometry.resolution_m).any())
+
+    def _local_goal_unreachable(
+        self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry
+    ) -> bool:
+        """Whether ROS DWA's goal-distance flood could not leave the local goal's cell.
+
+        The local goal is the last point of the first run of path points (from the robot's
+        progress on) inside the square local window. The flood leaves its cell through any of
+        the 8 neighbours that is neither lethal nor inscribed; cells the robot covers count as
+        passable (ROS's ``within_robot``), so a goal next to the robot never fails here.
+        """
+        points = self.dwa.path_m[self.dwa.progress_index :]
+        if len(points) == 0:
+            return False
+        half = 0.5 * self.dwa.params.local_window_m
+        inside = (np.abs(points[:, 0] - pose[0]) <= half) & (np.abs(points[:, 1] - pose[1]) <= half)
+        if not inside[0]:
+            return False
+        n_in = len(inside) if inside.all() else int(np.argmin(inside))
+        gx, gy = points[n_in - 1]
+        res = geometry.resolution_m
+        if math.hypot(gx - pose[0], gy - pose[1]) <= self.radius_m + 1.5 * res:
+            return False
+        r_a, c_a = geometry.world_to_grid(gx, gy)
+        r, c = int(r_a), int(c_a)
+        rr, cc = np.mgrid[r - 1 : r + 2, c - 1 : c + 2]
+        cells = np.column_stack([rr.ravel(), cc.ravel()])
+        cells = cells[(cells[:, 0] >= 0) & (cells[:, 0] < grid.shape[0])]
+        cells = cells[(cells[:, 1] >= 0) & (cells[:, 1] < grid.shape[1])]
+        if len(cells) == 0:
+            return False
+        return bool(cells_near_occupied(grid, cells, self.radius_m, res).all())
 
     def _plan(self, pose: np.ndarray, grid: np.ndarray, geometry: GridGeometry) -> GridPath | None:
         costmap = inflate_costmap(grid, geometry.resolution_m, self.costmap_params)

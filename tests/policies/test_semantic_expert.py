@@ -318,6 +318,27 @@ def test_expert_explores_the_paper_mazes(world):
     _check_mission(res)
     # The expert plans with the topometric map for most of the mission.
     assert res.policy_counters["semantic_plans"] > res.policy_counters["fallback_plans"]
+    c = res.policy_counters
+    assert 0 <= c["semantic_decisive"] <= c["scored_replans"] and c["scored_replans"] > 0
+
+
+def test_semantic_decisive_counts_replans_where_the_metric_cost_alone_disagrees():
+    from types import SimpleNamespace
+
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+
+    def cands(*metric: float) -> list:
+        return [SimpleNamespace(metric_cost=m) for m in metric]  # cheapest C first
+
+    pol._count_semantic_decisive(cands(1.0, 2.0))  # same choice
+    pol._count_semantic_decisive(cands(2.0, 1.0))  # the semantic gain overturned the metric
+    pol._count_semantic_decisive(cands(1.0, 1.0))  # a metric tie is no disagreement
+    pol._count_semantic_decisive([])  # nothing scored
+    assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (3, 1)
+    pol.act(obs, INFO)  # a real replan with one candidate
+    assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (4, 1)
 
 
 @pytest.mark.slow
