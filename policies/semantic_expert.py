@@ -167,6 +167,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             "revived": 0,
             "looks": 0,
             "look_drives": 0,
+            "goal_timeouts": 0,
             "oscillations_blocked": 0,
             # Instrumentation only (no decision reads them): replans with scored frontiers, and
             # those where the metric cost alone would have picked another frontier.
@@ -175,6 +176,8 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         }
         self._angles: np.ndarray | None = None
         self._time_s = 0.0
+        self._goal_since_s = 0.0
+        self._goal_budget_s = math.inf
         self._plan: _Plan | None = None
         self._next_replan_s = 0.0
         self._last_reason = ""
@@ -593,6 +596,14 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             if old is not None:
                 self.counters["switches"] += 1
                 self.memory.abandon(old.goal_xy_m, self._time_s)
+            # A new goal gets a time budget: a few times the time its path takes at full speed.
+            self._goal_since_s = self._time_s
+            self._goal_budget_s = max(
+                self.params.min_goal_time_s,
+                self.params.goal_time_factor
+                * self._remaining_m(new_plan)
+                / self.limits.max_linear_speed_mps,
+            )
             self._log("goal", f"{new_plan.source} {tuple(round(v, 2) for v in new_plan.goal_xy_m)}")
         if old is None or old.source != new_plan.source:
             self._log(
@@ -663,7 +674,14 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             self._path_watch.update(
                 t, known_cells=self._known_cells, remaining_m=self._remaining_m(self._plan)
             )
-        if stuck or self._path_watch.stalled(t):
+        overdue = self._plan is not None and t - self._goal_since_s > self._goal_budget_s
+        if overdue:
+            # Moving, but not getting there (a limit cycle round clutter, a path that keeps
+            # changing): treat it as a failed approach, so the goal is retried another way.
+            self.counters["goal_timeouts"] += 1
+            self._log("goal_timeout", f"goal={self.goal_xy_m}")
+        if stuck or self._path_watch.stalled(t) or overdue:
+            self._goal_since_s, self._goal_budget_s = t, math.inf
             self._start_recovery()
 
     def _log(self, event: str, detail: str = "") -> None:

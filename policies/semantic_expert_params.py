@@ -160,6 +160,10 @@ class SemanticExpertParams:
         local_min_escape: Lower the repulsion when the field holds the robot still.
         stuck_recovery: Watch progress; back off, retry or drop the goal when stuck.
         reach_blacklist: Drop goals reached ``max_goal_reaches`` times without clearing.
+        goal_time_factor: A goal not reached within this many times its path's length at full
+            speed (at least ``min_goal_time_s``) counts as a failed approach (part of
+            ``stuck_recovery``): the robot may be moving but not getting there.
+        min_goal_time_s: See ``goal_time_factor``.
     """
 
     cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
@@ -208,6 +212,8 @@ class SemanticExpertParams:
     local_min_escape: bool = True
     stuck_recovery: bool = True
     reach_blacklist: bool = True
+    goal_time_factor: float = 4.0
+    min_goal_time_s: float = 90.0
 
     def __post_init__(self) -> None:
         if self.prune_by not in ("opening", "area"):
@@ -237,6 +243,8 @@ class SemanticExpertParams:
             "blacklist_radius_m",
             "revive_window_m",
             "look_min_unknown_depth_m",
+            "goal_time_factor",
+            "min_goal_time_s",
             "look_min_frontier_m",
             "look_seen_radius_m",
             "look_clearance_fraction",
