@@ -234,6 +234,14 @@ def _suite_tasks(
         records.append({"name": suite.name, "version": suite.version, "source": name})
         seeds = seeds_for(suite.runs)
         random_start = suite.random_start and not args.fixed_start
+        repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
+        if not random_start and len(seeds) > 1 and repeated:
+            print(
+                f"warning: suite {suite.name}: fixed start poses: every seed repeats the same "
+                f"mission on {len(repeated)} world(s) without seed=*; the summary will say "
+                "'no variation'",
+                file=sys.stderr,
+            )
         for entry in suite.worlds:
             if entry.world in all_worlds:
                 raise ValueError(

@@ -238,8 +238,8 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     paths: list[Path] = []
 
     # 1. Explored free area over time, mean and min-max band.
-    fig, axes = plt.subplots(1, len(worlds), figsize=(5.2 * len(worlds), 4), squeeze=False)
-    for ax, world in zip(axes[0], worlds, strict=True):
+    fig, panels = _panels(plt, len(worlds), 5.2)
+    for ax, world in zip(panels, worlds, strict=True):
         for policy, rs in groups[world].items():
             traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
             if not traces:
@@ -277,8 +277,8 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
             "global_planning_time.png",
         ),
     ):
-        fig, axes = plt.subplots(1, len(worlds), figsize=(4.2 * len(worlds), 4), squeeze=False)
-        for ax, world in zip(axes[0], worlds, strict=True):
+        fig, panels = _panels(plt, len(worlds), 4.2)
+        for ax, world in zip(panels, worlds, strict=True):
             names = list(groups[world])
             data = [_values(groups[world][p], key) for p in names]
             ax.boxplot(
@@ -302,6 +302,21 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     # 5. Trajectory of the median (by mission time) run of each world and policy.
     paths.append(_trajectory_figure(out, groups, worlds, policies, colours, plt))
     return paths
+
+
+#: Panels per row of the per-world figures (a suite has dozens of worlds).
+PANELS_PER_ROW = 4
+
+
+def _panels(plt: Any, n: int, width_in: float) -> tuple[Any, list[Any]]:
+    """A figure with ``n`` panels, at most :data:`PANELS_PER_ROW` per row; unused ones hidden."""
+    cols = min(n, PANELS_PER_ROW)
+    rows = math.ceil(n / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width_in * cols, 4 * rows), squeeze=False)
+    flat = list(axes.ravel())
+    for ax in flat[n:]:
+        ax.set_visible(False)
+    return fig, flat[:n]
 
 
 def _trajectory_figure(

@@ -263,3 +263,23 @@ def test_bad_suites_fail_at_once(tmp_path, capsys, suite, fragment) -> None:
     assert main(_bench(tmp_path / "b", "--suite", suite)) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and fragment in err[0]
+
+
+def test_many_worlds_plot_in_a_grid(tmp_path) -> None:
+    from PIL import Image
+
+    from semexplore_gym.evaluation.report import write_plots
+
+    worlds = ["maze1", "maze2", *(f"maze:seed={i},size_m=4" for i in range(4))]
+    run_benchmark(
+        expand_tasks(worlds, ["semantic", "nearest"], [0, 1]),
+        tmp_path,
+        progress=False,
+        task_fn=_constant,
+    )
+    text = write_summary(tmp_path).read_text()
+    assert "### paper mazes (2 worlds)" in text and "### maze (4 worlds)" in text
+    assert "## All worlds (6 worlds)" in text
+    paths = {p.name: p for p in write_plots(tmp_path)}
+    with Image.open(paths["explored_area.png"]) as im:
+        assert im.size[0] < im.size[1] * 3  # two rows of at most four panels, not one long row
