@@ -14,6 +14,7 @@ mapping or a YAML file), all merged by :func:`semexplore_gym.core.params.build_p
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -191,32 +192,129 @@ def policy_factories() -> dict[str, Factory]:
     }
 
 
-def strip_label(spec: str) -> str:
-    """``"semantic[tuned]"`` -> ``"semantic"``; a spec without a label is returned stripped."""
+def _bracket(spec: str) -> tuple[str, str | None]:
+    """``"semantic[x]"`` -> ``("semantic", "x")``; a spec without a trailing bracket -> (spec, None)."""
     spec = spec.strip()
     if spec.endswith("]") and "[" in spec:
-        spec = spec[: spec.rindex("[")].strip()
-    return spec
+        i = spec.rindex("[")
+        return spec[:i].strip(), spec[i + 1 : -1].strip()
+    return spec, None
+
+
+def split_specs(text: str) -> list[str]:
+    """Split comma-separated policy specs; commas inside ``[...]`` belong to the spec.
+
+    ``"semantic[cost.w_v=0,cost.w_p=0],nearest"`` -> ``["semantic[cost.w_v=0,cost.w_p=0]",
+    "nearest"]``.
+
+    Raises:
+        ValueError: an unbalanced bracket (the message names the text).
+    """
+    out: list[str] = []
+    depth = 0
+    current = ""
+    for ch in text or "":
+        if ch == "[":
+            depth += 1
+        elif ch == "]":
+            depth -= 1
+            if depth < 0:
+                raise ValueError(f"policy specs {text!r}: unbalanced brackets (']' without '[')")
+        if ch == "," and depth == 0:
+            out.append(current)
+            current = ""
+        else:
+            current += ch
+    if depth != 0:
+        raise ValueError(f"policy specs {text!r}: unbalanced brackets ('[' without ']')")
+    out.append(current)
+    return [s.strip() for s in out if s.strip()]
+
+
+def parse_spec(spec: str) -> tuple[str, str | None, dict[str, Any]]:
+    """Split a policy spec into ``(base spec, label, parameter overrides)``.
+
+    A trailing bracket is either a label or a set of parameter overrides, never both:
+
+    - ``"semantic[tuned]"``: no ``=`` inside, a label that only names the variant in tables;
+    - ``"semantic[cost.w_v=0]"``, ``"semantic[cost.w_v=0;cost.w_p=0]"`` (``;`` or ``,``
+      between items): dotted ``key=value`` overrides of the policy's parameters, applied by
+      :func:`make_policy` on top of its keyword overrides. The table label is the whole spec.
+
+    Raises:
+        ValueError: an empty bracket, a bracket mixing labels and ``key=value`` items, or an
+            item that is not ``key=value``; the message names the spec.
+    """
+    from semexplore_gym.core.params import ConfigError, parse_override
+
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
+    base, inner = _bracket(spec)
+    if inner is None:
+        if "[" in spec or "]" in spec:
+            raise ValueError(
+                f"policy spec {spec!r}: unbalanced brackets; one bracket closes the spec, as in "
+                "'semantic[cost.w_v=0]' or 'semantic[my label]'"
+            )
+        return base, None, {}
+    if not inner:
+        raise ValueError(f"policy spec {spec!r}: empty brackets; give a label or key=value items")
+    if not base:
+        raise ValueError(f"policy spec {spec!r}: no policy name before the bracket")
+    if "=" not in inner:
+        return base, inner, {}
+    items = [t.strip() for t in re.split(r"[;,]", inner)]
+    overrides: dict[str, Any] = {}
+    for item in items:
+        if not item or "=" not in item:
+            raise ValueError(
+                f"policy spec {spec!r}: {item!r} is not key=value; a bracket is either a label "
+                "(no '=') or parameter overrides such as [cost.w_v=0;cost.w_p=0], not both"
+            )
+        try:
+            keys, value = parse_override(item)
+        except ConfigError as e:
+            raise ValueError(f"policy spec {spec!r}: {e}") from None
+        key = ".".join(k.strip() for k in keys)
+        if not all(k.strip() for k in keys):
+            raise ValueError(f"policy spec {spec!r}: {item!r} has an empty key")
+        if key in overrides:
+            raise ValueError(f"policy spec {spec!r}: {key!r} is set twice")
+        overrides[key] = value
+    return base, None, overrides
+
+
+def strip_label(spec: str) -> str:
+    """``"semantic[tuned]"`` or ``"semantic[cost.w_v=0]"`` -> ``"semantic"``."""
+    return _bracket(spec)[0]
 
 
 def make_policy(spec: str, **overrides: Any) -> Policy:
-    """Create a policy from ``spec`` (``"name"`` or ``"name:argument"``).
+    """Create a policy from ``spec`` (``"name"``, ``"name:argument"``, either with a bracket).
 
     A trailing ``[label]`` (``"semantic[tuned]"``) only names a variant in benchmark tables;
-    it is stripped before the policy is built (the variant comes from ``overrides``).
+    a trailing ``[key=value;...]`` (``"semantic[cost.w_v=0]"``) sets parameters, on top of
+    ``overrides`` (see :func:`parse_spec`).
 
     Raises:
-        ValueError: unknown name, a bad argument, or a bad parameter override (``ConfigError``
-            names the dotted key).
+        ValueError: unknown name, a bad argument or bracket, or a bad parameter override
+            (the message names the spec and the dotted key).
     """
     if not isinstance(spec, str) or not spec.strip():
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
-    spec = strip_label(spec)
-    name, _, arg = spec.partition(":")
+    base, _, bracket = parse_spec(spec)
+    name, _, arg = base.partition(":")
     factories = policy_factories()
     if name not in factories:
         raise ValueError(
             f"unknown policy {spec!r}; known: {', '.join(sorted(factories))} "
             "(sb3 as 'sb3:path.zip', your own as 'py:module:Class' or 'py:file.py:Class')"
         )
-    return factories[name](arg, dict(overrides))
+    if not bracket:
+        return factories[name](arg, dict(overrides))
+    # Dotted keys after the keyword layer: build_params lets later keys win.
+    merged = {**overrides, **bracket}
+    try:
+        return factories[name](arg, merged)
+    except ValueError as e:
+        raise ValueError(f"policy spec {spec!r}: {e}") from None

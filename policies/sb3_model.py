@@ -49,6 +49,124 @@ def learner_action(
     return np.clip(action.cpu().numpy().astype(np.float32).reshape(-1), -1.0, 1.0)
 
 
+#: Environment variable that lets :func:`load_policy_entry` unpickle classes outside its
+#: allowlist (a custom feature extractor, say): full pickle, for files you trust only.
+TRUST_ENV_VAR = "SEMEXPLORE_TRUST_MODEL_PICKLE"
+
+
+def _safe_globals() -> list[Any]:
+    """Classes a ``policy.pt`` of an SB3 policy needs, and nothing that runs arbitrary code.
+
+    The constructor arguments saved next to the weights hold gymnasium spaces (numpy arrays
+    and dtypes inside), the activation and optimizer classes, the feature-extractor class and
+    the learning-rate schedule, which SB3 saves as ``getattr(BasePolicy, "_dummy_schedule")``:
+    ``builtins.getattr`` is replaced by :func:`_schedule_getattr`, which resolves only that.
+    """
+    import inspect
+
+    import gymnasium.spaces as gs
+    import numpy as np
+    import torch as th
+    from stable_baselines3.common import policies as sb3_policies
+    from stable_baselines3.common import torch_layers
+
+    out: list[Any] = [
+        gs.Dict,
+        gs.Box,
+        gs.Discrete,
+        gs.MultiDiscrete,
+        gs.MultiBinary,
+        np.ndarray,
+        np.dtype,
+        sb3_policies.BasePolicy,
+        (_schedule_getattr, "builtins.getattr"),
+    ]
+    try:  # numpy >= 2 moved the reconstructor
+        from numpy._core.multiarray import _reconstruct
+    except ImportError:  # pragma: no cover - numpy 1.x
+        from numpy.core.multiarray import _reconstruct  # type: ignore[no-redef]
+    out.append(_reconstruct)
+    # A space that has sampled carries its numpy Generator (rebuilt from a bit-generator state).
+    import numpy.random._pickle as rng_pickle
+    from numpy.random import bit_generator
+
+    out += [
+        getattr(rng_pickle, "__generator_ctor"),
+        getattr(rng_pickle, "__bit_generator_ctor"),
+        np.random.Generator,
+        np.random.SeedSequence,
+        np.random.PCG64,
+        np.random.PCG64DXSM,
+        np.random.MT19937,
+        np.random.Philox,
+        np.random.SFC64,
+    ]
+    unpickle_seq = getattr(bit_generator, "__pyx_unpickle_SeedSequence", None)
+    if unpickle_seq is not None:
+        out.append(unpickle_seq)
+    out += [
+        c
+        for c in vars(np.dtypes).values()
+        if isinstance(c, type) and c.__name__.endswith("DType") and c is not np.dtype
+    ]
+    for module, base in (
+        (th.nn.modules.activation, th.nn.Module),
+        (th.optim, th.optim.Optimizer),
+        (torch_layers, th.nn.Module),
+    ):
+        out += [
+            c
+            for _, c in inspect.getmembers(module, inspect.isclass)
+            if issubclass(c, base) and c.__module__.startswith(("torch.", "stable_baselines3."))
+        ]
+    return out
+
+
+def _schedule_getattr(obj: Any, name: str) -> Any:
+    """``getattr`` as a ``policy.pt`` may use it: only SB3's dummy learning-rate schedule."""
+    from stable_baselines3.common.policies import BasePolicy
+
+    if isinstance(obj, type) and issubclass(obj, BasePolicy) and name == "_dummy_schedule":
+        return getattr(obj, name)
+    raise ValueError(f"policy.pt asks for {getattr(obj, '__name__', obj)!r}.{name}; refused")
+
+
+def load_policy_entry(data: bytes, source: Path, device: str = "cpu") -> Any:
+    """Unpickle a ``policy.pt`` with ``torch.load(weights_only=True)`` and an allowlist.
+
+    The entry holds the policy's constructor arguments as well as its weights, so a plain
+    ``weights_only=True`` load refuses it; the allowlist (:func:`_safe_globals`) admits the
+    spaces, layer, optimizer and extractor classes of SB3 and torch and nothing that can run
+    code. A model whose arguments need another class (a custom extractor) is refused with its
+    name, unless :data:`TRUST_ENV_VAR` is set to 1 (full pickle: for trusted files only).
+    """
+    import pickle
+
+    import torch as th
+
+    try:
+        with th.serialization.safe_globals(_safe_globals()):
+            return th.load(io.BytesIO(data), map_location=device, weights_only=True)
+    except pickle.UnpicklingError as e:
+        if os.environ.get(TRUST_ENV_VAR) == "1":
+            return th.load(io.BytesIO(data), map_location=device, weights_only=False)
+        import re
+
+        found = re.search(
+            r"(?:unsupported|Unsupported global:) GLOBAL ([\w.]+)|but got <class '([\w.]+)'>",
+            str(e),
+        )
+        what = (
+            f"it needs {found.group(1) or found.group(2)}"
+            if found
+            else str(e).strip()[:200] or type(e).__name__
+        )
+        raise ValueError(
+            f"{str(source)!r}: policy.pt holds more than weights and SB3's own classes ({what}); "
+            f"if you trust this file, set {TRUST_ENV_VAR}=1 to load it anyway"
+        ) from None
+
+
 def load_model(path: str | os.PathLike, device: str = "cpu") -> tuple[Any, EgocentricParams]:
     """Load ``(sb3_policy, egocentric_params)`` from a PPO/A2C/SAC zip or a ``save_policy`` zip."""
     p = Path(path)
@@ -63,7 +181,6 @@ def load_model(path: str | os.PathLike, device: str = "cpu") -> tuple[Any, Egoce
         is_algorithm_zip = "data" in names
     params = EgocentricParams.from_dict(meta.get("egocentric"))
     if policy_bytes is not None:
-        import torch as th
         from stable_baselines3.common import policies as sb3_policies
 
         cls = getattr(
@@ -71,7 +188,7 @@ def load_model(path: str | os.PathLike, device: str = "cpu") -> tuple[Any, Egoce
         )
         if cls is None:
             raise ValueError(f"{str(p)!r}: unknown policy class {meta.get('policy_class')!r}")
-        saved = th.load(io.BytesIO(policy_bytes), map_location=device, weights_only=False)
+        saved = load_policy_entry(policy_bytes, p, device)
         policy = cls(**saved["data"])
         policy.load_state_dict(saved["state_dict"])
         policy.to(device)

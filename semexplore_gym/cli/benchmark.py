@@ -1,8 +1,19 @@
 """``semexplore benchmark``: every (world, policy, seed) mission, resumable, with figures and stats.
 
-Example::
+Each seed starts every policy from the same random free pose (``--fixed-start`` keeps the
+world's start pose; then seeds vary a mission only through ``seed=*`` worlds). A policy spec
+may carry a label, ``semantic[tuned]``, or parameter overrides, ``semantic[cost.w_v=0]``
+(items separated by ``;`` or ``,``); tables show the whole spec. Examples::
 
     semexplore benchmark --worlds maze1,maze2 --policies semantic,frontier,nearest --runs 10 --out runs/bench
+    semexplore benchmark --suite mazes,caves --policies 'semantic,semantic[cost.w_p=0],nearest' --out runs/suites
+
+A suite (``configs/suites/NAME.yaml`` or a path to your own YAML) gives the worlds, the runs,
+the start poses and each world's time limit; its summary adds a table per world family and
+one over all worlds.
+
+Model zips (``sb3:``) and ``py:`` specs run code from the file they name, in this process and
+in every worker: use only files from sources you trust.
 """
 
 from __future__ import annotations
@@ -11,10 +22,11 @@ import argparse
 import json
 import shlex
 import sys
+from typing import Any
 
+from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
-from semexplore_gym.cli import describe
 
 
 def _split(text: str) -> list[str]:
@@ -30,6 +42,13 @@ def _split_worlds(text: str) -> list[str]:
         else:
             out.append(part)
     return out
+
+
+def _split_policies(text: str) -> list[str]:
+    """Comma-separated policy specs; commas inside ``[...]`` stay with their spec."""
+    from policies.registry import split_specs
+
+    return split_specs(text)
 
 
 def _check_worlds(worlds: list[str], seed: int) -> None:
@@ -50,6 +69,32 @@ def _check_worlds(worlds: list[str], seed: int) -> None:
             raise ValueError(f"--worlds {world!r}: {e}") from None
 
 
+def _check_policies(policies: list[str]) -> None:
+    """Build every spec with a bracket or a file once, so a typo fails before any mission.
+
+    Raises:
+        ValueError: an unknown policy, a malformed bracket, an unknown parameter, a bad file.
+    """
+    from policies.registry import make_policy, parse_spec, policy_factories
+
+    known = policy_factories()
+    for p in policies:
+        base, _, overrides = parse_spec(p)
+        name = base.partition(":")[0]
+        if name not in known:
+            raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
+        if overrides or name in ("py", "sb3"):
+            try:
+                make_policy(p)
+            except (ValueError, FileNotFoundError) as e:
+                msg = str(e)
+                raise ValueError(
+                    f"--policies: {msg}" if p in msg else f"--policies {p!r}: {msg}"
+                ) from None
+
+
+#: Seeds per (world, policy) when neither --runs nor a suite says.
+DEFAULT_RUNS = 10
 #: Bounds of the benchmark's counts: beyond them a typo, not a plan.
 MAX_RUNS = 100_000
 MAX_WORKERS = 256
@@ -63,9 +108,9 @@ def validate_args(args: argparse.Namespace) -> None:
     """
     from pathlib import Path
 
-    if not (1 <= args.runs <= MAX_RUNS):
+    if args.runs is not None and not (1 <= args.runs <= MAX_RUNS):
         raise ValueError(f"--runs must be in 1..{MAX_RUNS}, got {args.runs}")
-    if not (0 <= args.seed0 <= 2**32 - 1 - args.runs):
+    if not (0 <= args.seed0 <= 2**32 - 1 - (args.runs or 1000)):
         raise ValueError(f"--seed0 must be in 0..2**32-1-runs, got {args.seed0}")
     if not (1 <= args.workers <= MAX_WORKERS):
         raise ValueError(f"--workers must be in 1..{MAX_WORKERS}, got {args.workers}")
@@ -83,25 +128,39 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument(
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument(
         "--worlds",
-        required=True,
         help="comma-separated world spellings; 'maze:seed=*' uses each run's seed",
+    )
+    which.add_argument(
+        "--suite",
+        help="comma-separated suite names (configs/suites: paper, mazes, offices, caves, open) "
+        "or suite YAML paths; each world gets the suite's time limit, runs and start poses",
     )
     p.add_argument(
         "--policies",
         default="semantic,frontier,nearest",
-        help="comma-separated policy specs (default: %(default)s)",
+        help="comma-separated policy specs; 'semantic[cost.w_v=0;cost.w_p=0]' sets parameters, "
+        "'semantic[my label]' only names a variant. sb3:MODEL.zip and py: specs run code from "
+        "the named file: use only files from trusted sources (default: %(default)s)",
     )
     p.add_argument(
-        "--runs", type=int, default=10, help="seeds per (world, policy) (default: %(default)s)"
+        "--runs",
+        type=int,
+        default=None,
+        help="seeds per (world, policy) (default: 10, or the suite's runs)",
     )
     p.add_argument("--seed0", type=int, default=0, help="first seed (default: %(default)s)")
     p.add_argument(
         "--out", required=True, help="output directory; rerunning the same command resumes"
     )
     p.add_argument(
-        "--max-time-s", type=float, default=None, help="stop each mission after this simulated time"
+        "--max-time-s",
+        type=float,
+        default=None,
+        help="stop each mission after this simulated time (with --suite: replaces the suite's "
+        "per-world limits)",
     )
     p.add_argument("--env-config", default=None, help="env config: preset name or YAML path")
     p.add_argument(
@@ -112,10 +171,17 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="KEY=VALUE",
         help="env config override, e.g. lidar.n_beams=180 (repeatable)",
     )
-    p.add_argument(
+    start = p.add_mutually_exclusive_group()
+    start.add_argument(
         "--random-start",
         action="store_true",
-        help="sample each seed's start pose in free space (same for every policy)",
+        help="sample each seed's start pose in free space, the same for every policy (the default)",
+    )
+    start.add_argument(
+        "--fixed-start",
+        action="store_true",
+        help="start every mission at the world's own start pose; seeds then repeat the same "
+        "mission unless the world spelling has seed=*",
     )
     p.add_argument(
         "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
@@ -138,6 +204,72 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _suite_tasks(
+    args: argparse.Namespace, seeds_for: Any
+) -> tuple[list[Any], list[dict[str, Any]], list[str]]:
+    """Tasks of every ``--suite``: each world with the suite's time limit, runs and start poses.
+
+    Returns:
+        (tasks, ``[{"name", "version", "source"}]`` per suite, every world in order).
+    """
+    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.evaluation.harness import expand_tasks
+    from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
+
+    names = _split(args.suite)
+    if not names:
+        raise ValueError("--suite is empty")
+    tasks: list[Any] = []
+    records: list[dict[str, Any]] = []
+    all_worlds: list[str] = []
+    policies = _split_policies(args.policies)
+    for name in names:
+        try:
+            suite = load_suite(name)
+        except FileNotFoundError as e:
+            raise ValueError(f"--suite {short_repr(name)}: {e}") from None
+        if any(r["name"] == suite.name for r in records):
+            raise ValueError(f"--suite lists suite {suite.name!r} twice")
+        records.append({"name": suite.name, "version": suite.version, "source": name})
+        seeds = seeds_for(suite.runs)
+        random_start = suite.random_start and not args.fixed_start
+        repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
+        if not random_start and len(seeds) > 1 and repeated:
+            print(
+                f"warning: suite {suite.name}: fixed start poses: every seed repeats the same "
+                f"mission on {len(repeated)} world(s) without seed=*; the summary will say "
+                "'no variation'",
+                file=sys.stderr,
+            )
+        for entry in suite.worlds:
+            if entry.world in all_worlds:
+                raise ValueError(
+                    f"--suite: world {short_repr(entry.world)} is in two suites; each world must "
+                    "appear once (a repeat would count the same missions twice)"
+                )
+            all_worlds.append(entry.world)
+            try:
+                world = make_world(entry.world.replace("seed=*", f"seed={seeds[0]}"))
+            except (ValueError, FileNotFoundError) as e:
+                raise ValueError(f"--suite {suite.name}: world {entry.world!r}: {e}") from None
+            if args.max_time_s is not None:
+                limit = args.max_time_s
+            else:
+                area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
+                limit = world_time_limit_s(suite, entry, area_m2)
+            # The env's own limit must not cut the mission short; the user's --env-set wins.
+            overrides = [f"episode.random_start={'true' if random_start else 'false'}"]
+            if limit is not None:
+                overrides.append(f"episode.max_time_s={limit!r}")
+            overrides += args.env_overrides
+            env_config = load_env_config(args.env_config, overrides)
+            tasks += expand_tasks(
+                [entry.world], policies, seeds, max_time_s=limit, env_config=env_config
+            )
+    return tasks, records, all_worlds
+
+
 def run(args: argparse.Namespace) -> int:
     from semexplore_gym.evaluation.harness import (
         expand_tasks,
@@ -148,56 +280,73 @@ def run(args: argparse.Namespace) -> int:
     from semexplore_gym.evaluation.report import write_plots, write_summary
 
     validate_args(args)
-    worlds = _split_worlds(args.worlds)
-    policies = _split(args.policies)
-    seeds = parse_seeds(args.runs, args.seed0)
-    for what, items in (("worlds", worlds), ("policies", policies)):
-        if not items:
-            raise ValueError(f"--{what} is empty")
-        dup = next((x for i, x in enumerate(items) if x in items[:i]), None)
-        if dup is not None:
-            raise ValueError(
-                f"--{what} lists {short_repr(dup)} twice; each must appear once "
-                "(a repeat would count the same missions twice)"
-            )
-    _check_worlds(worlds, seeds[0])
-    from policies.registry import policy_factories, strip_label
+    policies = _split_policies(args.policies)
+    if not policies:
+        raise ValueError("--policies is empty")
+    dup = next((x for i, x in enumerate(policies) if x in policies[:i]), None)
+    if dup is not None:
+        raise ValueError(
+            f"--policies lists {short_repr(dup)} twice; each must appear once "
+            "(a repeat would count the same missions twice)"
+        )
+    _check_policies(policies)
+    from pathlib import Path
 
-    known = policy_factories()
-    for p in policies:
-        if strip_label(p).partition(":")[0] not in known:
-            raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
-        if strip_label(p).partition(":")[0] in ("py", "sb3"):
-            # user code and model files: load them once now, so a typo fails before any mission
-            from policies.registry import make_policy
-
-            try:
-                make_policy(p)
-            except (ValueError, FileNotFoundError) as e:
-                raise ValueError(f"--policies {p!r}: {e}") from None
     from semexplore_gym.core.params import to_dict
     from semexplore_gym.envs.config import load_env_config
 
-    overrides = list(args.env_overrides) + (
-        ["episode.random_start=true"] if args.random_start else []
-    )
-    env_config = (
-        load_env_config(args.env_config, overrides) if (args.env_config or overrides) else None
-    )
-    tasks = expand_tasks(worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config)
-    from pathlib import Path
+    suites: list[dict[str, Any]] = []
+    if args.suite is not None:
+        tasks, suites, worlds = _suite_tasks(
+            args, lambda runs: parse_seeds(args.runs or runs, args.seed0)
+        )
+        seeds = sorted({t.seed for t in tasks})
+        env_config_record: Any = "per world (suite)"
+    else:
+        worlds = _split_worlds(args.worlds)
+        seeds = parse_seeds(args.runs or DEFAULT_RUNS, args.seed0)
+        if not worlds:
+            raise ValueError("--worlds is empty")
+        dup = next((x for i, x in enumerate(worlds) if x in worlds[:i]), None)
+        if dup is not None:
+            raise ValueError(
+                f"--worlds lists {short_repr(dup)} twice; each must appear once "
+                "(a repeat would count the same missions twice)"
+            )
+        _check_worlds(worlds, seeds[0])
+        if args.fixed_start and len(seeds) > 1:
+            same = [w for w in worlds if "seed=*" not in w]
+            if same:
+                print(
+                    f"warning: --fixed-start: every seed repeats the same mission on "
+                    f"{', '.join(same)} (no seed=* in the spelling); the summary will say "
+                    "'no variation'",
+                    file=sys.stderr,
+                )
+        # The env's own limit must not cut the mission short; the user's --env-set wins.
+        overrides = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
+        if args.max_time_s is not None:
+            overrides.append(f"episode.max_time_s={args.max_time_s!r}")
+        overrides += args.env_overrides
+        env_config = load_env_config(args.env_config, overrides)
+        env_config_record = to_dict(env_config)
+        tasks = expand_tasks(
+            worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config
+        )
 
     Path(args.out).mkdir(parents=True, exist_ok=True)
     write_manifest(
         args.out,
         {
             "command": " ".join(shlex.quote(a) for a in sys.argv),
+            "suites": suites or None,
             "worlds": worlds,
             "policies": policies,
             "seeds": seeds,
             "max_time_s": args.max_time_s,
+            "fixed_start": bool(args.fixed_start),
             "config": args.env_config,
-            "env_config": to_dict(env_config) if env_config is not None else None,
+            "env_config": env_config_record,
             "workers": args.workers,
             "backend": args.backend,
         },
@@ -209,6 +358,7 @@ def run(args: argparse.Namespace) -> int:
         backend=args.backend,
         ray_address=args.ray_address,
         progress=not args.no_progress,
+        suites=[{"name": r["name"], "version": r["version"]} for r in suites] or None,
     )
     summary = write_summary(args.out)
     plots = [] if args.no_plots else write_plots(args.out)

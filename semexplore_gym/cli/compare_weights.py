@@ -6,9 +6,10 @@
    ``mission_time_s + penalty_s * max(0, target_coverage - coverage)``). The study is kept in
    ``OUT/tuning/study.sqlite`` and every trial in ``OUT/tuning/trials.jsonl``.
 2. Run every weight set on the test worlds x test seeds through the benchmark harness
-   (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` and the ablations
-   of the paper weights ``semantic[paper,w_p=0]``, ``semantic[paper,w_I=0]``,
-   ``semantic[paper,w_p=w_I=0]`` (w_I=0: ``cost.w_i=0``).
+   (``OUT/test/runs.csv``, resumable): ``semantic[paper]``, ``semantic[tuned]`` (labels) and the
+   ablations of the paper weights, spelled as policy specs that ``explore --policy`` and
+   ``benchmark --policies`` run as they are: ``semantic[cost.w_p=0]``, ``semantic[cost.w_i=0]``
+   (w_I = 0), ``semantic[cost.w_p=0;cost.w_i=0]`` (the expert's defaults are the paper's weights).
    ``--agents`` adds learned agents (any policy spec, e.g. a ``SemanticExploreWeights-v0`` PPO
    model that chooses the weights at every decision: ``sb3:runs/pw/model.zip[learned]``) on the
    same test worlds and seeds.
@@ -40,6 +41,9 @@ from semexplore_gym.core.safe_io import short_repr
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
+ABLATE_P = "semantic[cost.w_p=0]"
+ABLATE_I = "semantic[cost.w_i=0]"
+ABLATE_BOTH = "semantic[cost.w_p=0;cost.w_i=0]"
 
 
 def validate_args(args: argparse.Namespace) -> None:
@@ -81,9 +85,10 @@ def weight_sets(tuned: dict[str, float]) -> dict[str, dict[str, float]]:
     return {
         PAPER: dict(PAPER_WEIGHTS),
         TUNED: {**PAPER_WEIGHTS, **tuned},
-        "semantic[paper,w_p=0]": {**PAPER_WEIGHTS, "cost.w_p": 0.0},
-        "semantic[paper,w_I=0]": {**PAPER_WEIGHTS, "cost.w_i": 0.0},
-        "semantic[paper,w_p=w_I=0]": {**PAPER_WEIGHTS, "cost.w_p": 0.0, "cost.w_i": 0.0},
+        # Policy specs, not only labels: each bracket sets what its overrides set.
+        ABLATE_P: {**PAPER_WEIGHTS, "cost.w_p": 0.0},
+        ABLATE_I: {**PAPER_WEIGHTS, "cost.w_i": 0.0},
+        ABLATE_BOTH: {**PAPER_WEIGHTS, "cost.w_p": 0.0, "cost.w_i": 0.0},
     }
 
 
@@ -255,7 +260,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--agents",
         default="",
         help="comma-separated policy specs compared on the test worlds too, e.g. "
-        "'sb3:runs/pw/model.zip[learned weights]'",
+        "'sb3:runs/pw/model.zip[learned weights]'. sb3:MODEL.zip and py: specs run code from "
+        "the named file: use only files from trusted sources",
     )
     p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
     p.add_argument("--env-config", default=None, help="env config: preset name or YAML path")
@@ -311,7 +317,9 @@ def _check_run_args(
         )
     if args.trials < 1:
         raise ValueError(f"--trials must be >= 1, got {args.trials}")
-    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
+    from policies.registry import split_specs
+
+    agents = split_specs(args.agents)
     if agents:
         from policies.registry import make_policy, strip_label
 

@@ -5,6 +5,7 @@ Example::
     semexplore explore --world maze1 --policy semantic --seed 0 --gif maze1.gif
     semexplore explore --world ../shared/maps/turtlebot3/world/map.yaml --json
     semexplore explore --world maze2 --policy-config configs/expert/paper.yaml --policy-set cost.w_v=2
+    semexplore explore --world maze2 --policy 'semantic[cost.w_v=0]'
 """
 
 from __future__ import annotations
@@ -45,7 +46,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--policy",
         default=None,
         help="policy spec: semantic (default), frontier, nearest, random, sb3:MODEL.zip, "
-        "py:FILE.py:CLASS or py:package.module:CLASS (your own Policy)",
+        "py:FILE.py:CLASS or py:package.module:CLASS (your own Policy); a bracket sets "
+        "parameters, 'semantic[cost.w_v=0;cost.w_p=0]' (the spelling benchmark and "
+        "compare-weights use; applied after --policy-set). sb3: and py: specs run code from "
+        "the named file: use only files from trusted sources",
     )
     p.add_argument(
         "--seed", type=int, default=0, help="seed for env.reset and the policy (default: 0)"
@@ -118,8 +122,8 @@ def run(args: argparse.Namespace) -> int:
     from policies.config import load_policy_config
     from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
-    from semexplore_gym.evaluation.rollout import run_mission
     from semexplore_gym.core.safe_io import check_output_file
+    from semexplore_gym.evaluation.rollout import run_mission
     from semexplore_gym.evaluation.warmup import warm_up
 
     if not (0 < args.max_time_s <= 1e7):

@@ -121,6 +121,19 @@ def task_stem(world: str, policy: str, seed: int) -> str:
     return f"{_slug(world)}__{_slug(policy)}__{seed}"
 
 
+def _warm_up_config_key(env_config: Any) -> str:
+    """The env config without its episode section: the warm-up sets its own time limit, so
+    suite worlds that differ only in ``episode.max_time_s`` warm up once."""
+    if env_config is None or isinstance(env_config, str):
+        return repr(env_config)
+    from semexplore_gym.core.params import to_dict
+
+    d = to_dict(env_config)
+    if not isinstance(d, dict):
+        return repr(env_config)
+    return json.dumps({k: v for k, v in d.items() if k != "episode"}, sort_keys=True, default=str)
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
     from policies.registry import make_policy
@@ -131,7 +144,7 @@ def run_task(task: Task) -> dict[str, Any]:
     warm_up(
         lambda: make_policy(task.policy, **task.policy_overrides),
         task.env_config,
-        key=(task.policy, repr(task.env_config), repr(task.policy_overrides)),
+        key=(task.policy, _warm_up_config_key(task.env_config), repr(task.policy_overrides)),
     )
     env = make_mission_env(task.resolved_world, task.env_config)
     try:
@@ -275,43 +288,62 @@ class ResultWriter:
 FINGERPRINT_FILE = "fingerprint.json"
 
 
-def run_fingerprint(tasks: Sequence[Task]) -> dict[str, Any]:
-    """What makes rows comparable beyond (world, policy, seed): the time limit, the env config
-    and each policy's overrides. Stored next to ``runs.csv`` and checked on resume."""
+def _canon(value: Any) -> Any:
+    return json.loads(json.dumps(value, sort_keys=True, default=str))
+
+
+def run_fingerprint(
+    tasks: Sequence[Task], suites: Sequence[dict[str, Any]] | None = None
+) -> dict[str, Any]:
+    """What makes rows comparable beyond (world, policy, seed): the time limit, the env config,
+    each policy's overrides and the suites run. Stored next to ``runs.csv``, checked on resume.
+
+    When every mission shares one time limit and env config they are stored once
+    (``max_time_s``, ``env_config``); a suite's per-world limits go to ``world_settings``.
+    """
     from semexplore_gym.core.params import to_dict
 
-    def canon(value: Any) -> Any:
-        return json.loads(json.dumps(value, sort_keys=True, default=str))
-
-    shared = {
-        json.dumps(
-            canon(
-                {
-                    "max_time_s": t.max_time_s,
-                    "env_config": to_dict(t.env_config) if t.env_config is not None else None,
-                }
-            ),
-            sort_keys=True,
+    per_world: dict[str, Any] = {}
+    for t in tasks:
+        s = _canon(
+            {
+                "max_time_s": t.max_time_s,
+                "env_config": to_dict(t.env_config) if t.env_config is not None else None,
+            }
         )
-        for t in tasks
-    }
-    if len(shared) > 1:
-        raise ValueError("the missions of one benchmark must share max_time_s and env_config")
-    fp: dict[str, Any] = json.loads(next(iter(shared))) if shared else {}
+        if per_world.setdefault(t.world, s) != s:
+            raise ValueError(
+                f"world {short_repr(t.world)} is listed with two time limits or env configs"
+            )
+    shared = {json.dumps(v, sort_keys=True) for v in per_world.values()}
+    fp: dict[str, Any] = {}
+    if len(shared) == 1:
+        fp.update(json.loads(next(iter(shared))))
+    elif shared:
+        fp["world_settings"] = {w: per_world[w] for w in sorted(per_world)}
     overrides: dict[str, Any] = {}
     for t in tasks:
-        o = canon(t.policy_overrides)
+        o = _canon(t.policy_overrides)
         if overrides.setdefault(t.policy, o) != o:
             raise ValueError(f"policy {short_repr(t.policy)} is listed with two sets of overrides")
     fp["policy_overrides"] = {k: overrides[k] for k in sorted(overrides)}
+    if suites:
+        fp["suites"] = [_canon(dict(s)) for s in suites]
     return fp
+
+
+def _settings_of(fp: dict[str, Any], world: str) -> dict[str, Any] | None:
+    """The (max_time_s, env_config) a fingerprint records for ``world``, or None if unknown."""
+    if "world_settings" in fp:
+        return fp["world_settings"].get(world)
+    return {"max_time_s": fp.get("max_time_s"), "env_config": fp.get("env_config")}
 
 
 def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool) -> None:
     """Store ``fingerprint`` in ``out_dir``, or refuse to resume rows made with other settings.
 
-    Adding worlds, seeds or policies to a run is fine; changing ``max_time_s``, the env config
-    or the overrides of a policy that already has rows is not.
+    Adding worlds, seeds or policies to a run is fine; changing ``max_time_s``, the env config,
+    the overrides of a policy that already has rows, or a suite's version is not.
     """
     path = out_dir / FINGERPRINT_FILE
     old: dict[str, Any] | None = None
@@ -321,11 +353,26 @@ def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool
         except (ValueError, OSError):
             old = {}
     if old is not None:
-        changed = [
-            (k, old.get(k), fingerprint.get(k))
-            for k in ("max_time_s", "env_config")
-            if old.get(k) != fingerprint.get(k)
-        ]
+        changed: list[tuple[str, Any, Any]] = []
+        if "world_settings" not in old and "world_settings" not in fingerprint:
+            changed += [
+                (k, old.get(k), fingerprint.get(k))
+                for k in ("max_time_s", "env_config")
+                if old.get(k) != fingerprint.get(k)
+            ]
+        else:
+            worlds = sorted(fingerprint.get("world_settings") or {}) or sorted(
+                old.get("world_settings") or {}
+            )
+            for w in worlds:
+                a, b = _settings_of(old, w), _settings_of(fingerprint, w)
+                if a is None or b is None:
+                    continue
+                changed += [
+                    (f"{k} of {w}", a.get(k), b.get(k))
+                    for k in ("max_time_s", "env_config")
+                    if a.get(k) != b.get(k)
+                ]
         old_over = old.get("policy_overrides") or {}
         new_over = fingerprint["policy_overrides"]
         changed += [
@@ -333,6 +380,11 @@ def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool
             for p in sorted(set(old_over) & set(new_over))
             if old_over[p] != new_over[p]
         ]
+        old_suites = {s.get("name"): s for s in old.get("suites") or []}
+        for s in fingerprint.get("suites") or []:
+            o = old_suites.get(s.get("name"))
+            if o is not None and o != s:
+                changed.append((f"suite {s.get('name')}", o, s))
         if changed:
             detail = ", ".join(
                 f"{k}: {short_repr(a, 60)} -> {short_repr(b, 60)}" for k, a, b in changed
@@ -341,7 +393,16 @@ def check_fingerprint(out_dir: Path, fingerprint: dict[str, Any], has_rows: bool
                 f"{out_dir} holds missions run with different settings ({detail}); "
                 "rerun with the same settings to resume, or use a new --out directory"
             )
-        fingerprint = dict(fingerprint, policy_overrides={**old_over, **new_over})
+        merged = dict(fingerprint, policy_overrides={**old_over, **new_over})
+        if "world_settings" in old and "world_settings" in fingerprint:
+            merged["world_settings"] = {**old["world_settings"], **fingerprint["world_settings"]}
+        if old.get("suites") or fingerprint.get("suites"):
+            names = {
+                s.get("name"): s
+                for s in [*(old.get("suites") or []), *(fingerprint.get("suites") or [])]
+            }
+            merged["suites"] = list(names.values())
+        fingerprint = merged
     path.write_text(json.dumps(fingerprint, indent=2, sort_keys=True))
 
 
@@ -446,6 +507,8 @@ def run_benchmark(
     ray_address: str | None = None,
     progress: bool = True,
     task_fn: Callable[[Task], dict[str, Any]] = run_task,
+    *,
+    suites: Sequence[dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """Run the missions not yet in ``out_dir/runs.csv``; write each as it finishes.
 
@@ -457,6 +520,8 @@ def run_benchmark(
         ray_address: Address of an existing Ray cluster (``"auto"``), or None for a local one.
         progress: Show a progress bar over missions on stderr.
         task_fn: The mission runner (tests substitute a fake one; only the sequential path uses it).
+        suites: ``{"name", "version"}`` of the suites the tasks come from, kept in the run's
+            fingerprint (a suite's version may not change between runs into one directory).
 
     Returns:
         ``{"ran": n, "skipped": n, "failed": [(key, message), ...]}``.
@@ -467,7 +532,7 @@ def run_benchmark(
         raise ValueError(f"workers must be >= 1, got {workers!r}")
     if len({t.key for t in tasks}) != len(tasks):
         raise ValueError("the same (world, policy, seed) mission is listed twice")
-    fingerprint = run_fingerprint(tasks)
+    fingerprint = run_fingerprint(tasks, suites)
     writer = ResultWriter(out_dir)
     try:
         rows = read_runs(writer.csv_path)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import os
 from collections import defaultdict
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -40,12 +41,23 @@ def _values(rows: list[dict[str, Any]], key: str) -> np.ndarray:
     )
 
 
+def _fmt(x: float, med: float) -> str:
+    return f"{x:.3f}" if abs(med) < 10 else f"{x:.1f}"
+
+
+def no_variation(n: int) -> str:
+    """What a cell says instead of a spread or a test when every sample is the same value."""
+    return f"no variation ({n} identical samples)"
+
+
 def _median_iqr(v: np.ndarray) -> str:
     if v.size == 0:
         return "–"
+    if v.size >= 2 and np.all(v == v[0]):
+        # Duplicated missions have no spread: an IQR of zero width would look like a result.
+        return f"{_fmt(float(v[0]), float(v[0]))} — {no_variation(int(v.size))}"
     q1, med, q3 = np.percentile(v, [25, 50, 75])
-    fmt = (lambda x: f"{x:.3f}") if abs(med) < 10 else (lambda x: f"{x:.1f}")
-    return f"{fmt(med)} [{fmt(q1)}–{fmt(q3)}]"
+    return f"{_fmt(med, med)} [{_fmt(q1, med)}–{_fmt(q3, med)}]"
 
 
 def group_runs(rows: list[dict[str, Any]]) -> dict[str, dict[str, list[dict[str, Any]]]]:
@@ -56,10 +68,110 @@ def group_runs(rows: list[dict[str, Any]]) -> dict[str, dict[str, list[dict[str,
     return out
 
 
-def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY) -> Path:
-    """Write ``summary.md``: medians/IQRs, and the reference policy against each other one."""
+def group_by_family(
+    rows: list[dict[str, Any]], family: Callable[[str], str] | None = None
+) -> dict[str, dict[str, list[dict[str, Any]]]]:
+    """``{family: {policy: [rows]}}`` in first-seen order (family: :func:`world_family`)."""
+    from semexplore_gym.evaluation.suites import world_family
+
+    fam = family or world_family
+    out: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        out[fam(r["world"])][r["policy"]].append(r)
+    return out
+
+
+COMPARED_METRICS: tuple[tuple[str, str], ...] = (
+    ("mission_time_s", "mission time"),
+    ("T90_s", "T90"),
+    ("T99_s", "T99"),
+    ("mean_map_generation_ms", "map generation ms"),
+    ("mean_global_planning_ms", "global planning ms"),
+)
+
+
+def _policy_table(by_policy: dict[str, list[dict[str, Any]]]) -> list[str]:
+    header = (
+        "| policy | n | self-stopped | " + " | ".join(label for _, label in SUMMARY_METRICS) + " |"
+    )
+    lines = [header, "|" + "---|" * (3 + len(SUMMARY_METRICS))]
+    for policy, rs in by_policy.items():
+        stopped = sum(1 for r in rs if r["self_stopped"])
+        cells = [_median_iqr(_values(rs, key)) for key, _ in SUMMARY_METRICS]
+        lines.append(f"| {policy} | {len(rs)} | {stopped}/{len(rs)} | " + " | ".join(cells) + " |")
+    lines.append("")
+    return lines
+
+
+def _comparison_table(
+    by_policy: dict[str, list[dict[str, Any]]], reference: str, paired_by: str
+) -> list[str]:
+    """The reference policy against each other one, paired by (world, seed)."""
     from scipy.stats import mannwhitneyu
 
+    if reference not in by_policy or len(by_policy) < 2:
+        return []
+    lines = [
+        f"{reference} vs each other policy, paired by {paired_by}. Ratio = median({reference}) / "
+        "median(other); p = two-sided Mann–Whitney U; wins = missions where "
+        f"{reference} is lower.",
+        "",
+        "| vs | metric | ratio of medians | p (Mann–Whitney U) | wins |",
+        "|---|---|---:|---:|---:|",
+    ]
+
+    def key(r: dict[str, Any]) -> tuple[str, int]:
+        return (r["world"], int(r["seed"]))
+
+    ref_rows = {key(r): r for r in by_policy[reference]}
+    for other, rs in by_policy.items():
+        if other == reference:
+            continue
+        other_rows = {key(r): r for r in rs}
+        pairs = sorted(set(ref_rows) & set(other_rows))
+        for metric, label in COMPARED_METRICS:
+            both = [
+                (ref_rows[k][metric], other_rows[k][metric])
+                for k in pairs
+                if ref_rows[k][metric] is not None and other_rows[k][metric] is not None
+            ]
+            a = np.array([x for x, _ in both], dtype=float)
+            b = np.array([y for _, y in both], dtype=float)
+            if a.size == 0:
+                lines.append(f"| {other} | {label} | – | – | – |")
+                continue
+            ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
+            if a.size >= 2 and np.all(a == a[0]) and np.all(b == b[0]):
+                # Each side one repeated value: a test or a win count over copies means nothing.
+                lines.append(f"| {other} | {label} | {ratio:.2f} | {no_variation(a.size)} | – |")
+                continue
+            p = mannwhitneyu(a, b, alternative="two-sided").pvalue if a.size >= 2 else math.nan
+            wins = int(np.sum(a < b))
+            lines.append(f"| {other} | {label} | {ratio:.2f} | {p:.3g} | {wins}/{a.size} |")
+    lines.append("")
+    return lines
+
+
+def _suite_lines(out: Path) -> list[str]:
+    """Which suites (name, version) the run came from, as recorded in ``benchmark.json``."""
+    import json
+
+    try:
+        manifest = json.loads((out / "benchmark.json").read_text())
+    except (OSError, ValueError):
+        return []
+    suites = manifest.get("suites") if isinstance(manifest, dict) else None
+    if not suites:
+        return []
+    named = ", ".join(
+        f"`{s.get('name')}` v{s.get('version')}" for s in suites if isinstance(s, dict)
+    )
+    return [f"Suites: {named}.", ""]
+
+
+def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY) -> Path:
+    """Write ``summary.md``: per world, per family and over all worlds, medians/IQRs and the
+    reference policy against each other one."""
     out = Path(out_dir)
     rows = read_runs(out / "runs.csv")
     if not rows:
@@ -70,72 +182,31 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         "",
         f"{len(rows)} missions from `{out / 'runs.csv'}`. Cells: median [IQR].",
         "",
+        *_suite_lines(out),
     ]
+    if len(groups) > 1:
+        families = group_by_family(rows)
+        lines += [
+            "## Per family",
+            "",
+            "Every mission of the family's worlds pooled; comparisons paired by (world, seed).",
+            "",
+        ]
+        for fam, by_policy in families.items():
+            worlds = sorted({r["world"] for rs in by_policy.values() for r in rs})
+            lines += [f"### {fam} ({len(worlds)} world{'s' if len(worlds) != 1 else ''})", ""]
+            lines += _policy_table(by_policy)
+            lines += _comparison_table(by_policy, reference, "(world, seed)")
+        everything: dict[str, list[dict[str, Any]]] = defaultdict(list)
+        for r in rows:
+            everything[r["policy"]].append(r)
+        lines += [f"## All worlds ({len(groups)} worlds)", ""]
+        lines += _policy_table(everything)
+        lines += _comparison_table(everything, reference, "(world, seed)")
     for world, by_policy in groups.items():
         lines += [f"## {world}", ""]
-        header = (
-            "| policy | n | self-stopped | "
-            + " | ".join(label for _, label in SUMMARY_METRICS)
-            + " |"
-        )
-        lines += [header, "|" + "---|" * (3 + len(SUMMARY_METRICS))]
-        for policy, rs in by_policy.items():
-            stopped = sum(1 for r in rs if r["self_stopped"])
-            cells = [_median_iqr(_values(rs, key)) for key, _ in SUMMARY_METRICS]
-            lines.append(
-                f"| {policy} | {len(rs)} | {stopped}/{len(rs)} | " + " | ".join(cells) + " |"
-            )
-        lines.append("")
-        if reference in by_policy and len(by_policy) > 1:
-            lines += [
-                f"{reference} vs each other policy, paired by seed. Ratio = median({reference}) / median(other); "
-                "p = two-sided Mann–Whitney U; wins = seeds where "
-                f"{reference} is lower.",
-                "",
-                "| vs | metric | ratio of medians | p (Mann–Whitney U) | wins |",
-                "|---|---|---:|---:|---:|",
-            ]
-            ref_rows = {r["seed"]: r for r in by_policy[reference]}
-            for other, rs in by_policy.items():
-                if other == reference:
-                    continue
-                other_rows = {r["seed"]: r for r in rs}
-                seeds = sorted(set(ref_rows) & set(other_rows))
-                for key, label in (
-                    ("mission_time_s", "mission time"),
-                    ("T90_s", "T90"),
-                    ("T99_s", "T99"),
-                    ("mean_map_generation_ms", "map generation ms"),
-                    ("mean_global_planning_ms", "global planning ms"),
-                ):
-                    a = np.array(
-                        [
-                            ref_rows[s][key]
-                            for s in seeds
-                            if ref_rows[s][key] is not None and other_rows[s][key] is not None
-                        ],
-                        dtype=float,
-                    )
-                    b = np.array(
-                        [
-                            other_rows[s][key]
-                            for s in seeds
-                            if ref_rows[s][key] is not None and other_rows[s][key] is not None
-                        ],
-                        dtype=float,
-                    )
-                    if a.size == 0:
-                        lines.append(f"| {other} | {label} | – | – | – |")
-                        continue
-                    ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
-                    p = (
-                        mannwhitneyu(a, b, alternative="two-sided").pvalue
-                        if a.size >= 2 and not (np.all(a == a[0]) and np.array_equal(a, b))
-                        else float("nan")
-                    )
-                    wins = int(np.sum(a < b))
-                    lines.append(f"| {other} | {label} | {ratio:.2f} | {p:.3g} | {wins}/{a.size} |")
-            lines.append("")
+        lines += _policy_table(by_policy)
+        lines += _comparison_table(by_policy, reference, "seed")
     path = out / "summary.md"
     path.write_text("\n".join(lines))
     return path
@@ -167,8 +238,8 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     paths: list[Path] = []
 
     # 1. Explored free area over time, mean and min-max band.
-    fig, axes = plt.subplots(1, len(worlds), figsize=(5.2 * len(worlds), 4), squeeze=False)
-    for ax, world in zip(axes[0], worlds, strict=True):
+    fig, panels = _panels(plt, len(worlds), 5.2)
+    for ax, world in zip(panels, worlds, strict=True):
         for policy, rs in groups[world].items():
             traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
             if not traces:
@@ -206,8 +277,8 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
             "global_planning_time.png",
         ),
     ):
-        fig, axes = plt.subplots(1, len(worlds), figsize=(4.2 * len(worlds), 4), squeeze=False)
-        for ax, world in zip(axes[0], worlds, strict=True):
+        fig, panels = _panels(plt, len(worlds), 4.2)
+        for ax, world in zip(panels, worlds, strict=True):
             names = list(groups[world])
             data = [_values(groups[world][p], key) for p in names]
             ax.boxplot(
@@ -231,6 +302,21 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     # 5. Trajectory of the median (by mission time) run of each world and policy.
     paths.append(_trajectory_figure(out, groups, worlds, policies, colours, plt))
     return paths
+
+
+#: Panels per row of the per-world figures (a suite has dozens of worlds).
+PANELS_PER_ROW = 4
+
+
+def _panels(plt: Any, n: int, width_in: float) -> tuple[Any, list[Any]]:
+    """A figure with ``n`` panels, at most :data:`PANELS_PER_ROW` per row; unused ones hidden."""
+    cols = min(n, PANELS_PER_ROW)
+    rows = math.ceil(n / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width_in * cols, 4 * rows), squeeze=False)
+    flat = list(axes.ravel())
+    for ax in flat[n:]:
+        ax.set_visible(False)
+    return fig, flat[:n]
 
 
 def _trajectory_figure(

@@ -31,8 +31,8 @@ def _tiny_run(max_time_s: float) -> list[str]:
 
 def test_summarise_medians_completion_and_p_values() -> None:
     rows = _rows(PAPER, [100.0, 110.0, 120.0, 130.0]) + _rows(TUNED, [50.0, 60.0, 70.0, 80.0])
-    rows += _rows("semantic[paper,w_p=0]", [100.0, 110.0, 120.0, 130.0], cov=0.87)
-    table = summarise(rows, [PAPER, TUNED, "semantic[paper,w_p=0]"], 0.97, 600.0)
+    rows += _rows("semantic[cost.w_p=0]", [100.0, 110.0, 120.0, 130.0], cov=0.87)
+    table = summarise(rows, [PAPER, TUNED, "semantic[cost.w_p=0]"], 0.97, 600.0)
     paper, tuned, ablated = table
     assert paper["median_mission_time_s"] == 115.0 and math.isnan(paper["p_value_vs_paper"])
     assert tuned["median_mission_time_s"] == 65.0 and tuned["completed_fraction"] == 1.0
@@ -54,11 +54,25 @@ def test_summarise_medians_completion_and_p_values() -> None:
 def test_weight_sets_ablate_the_paper_terms() -> None:
     sets = weight_sets({"cost.w_v": 1.0})
     assert sets[TUNED] == {"cost.w_v": 1.0, "cost.w_p": 0.2, "cost.w_i": 0.1}
-    assert sets["semantic[paper,w_p=w_I=0]"] == {"cost.w_v": 4.0, "cost.w_p": 0.0, "cost.w_i": 0.0}
+    assert sets["semantic[cost.w_p=0;cost.w_i=0]"] == {
+        "cost.w_v": 4.0,
+        "cost.w_p": 0.0,
+        "cost.w_i": 0.0,
+    }
     assert (
-        sets["semantic[paper,w_I=0]"]["cost.w_i"] == 0.0
-        and sets["semantic[paper,w_I=0]"]["cost.w_p"] == 0.2
+        sets["semantic[cost.w_i=0]"]["cost.w_i"] == 0.0
+        and sets["semantic[cost.w_i=0]"]["cost.w_p"] == 0.2
     )
+
+
+def test_ablation_labels_are_the_specs_that_explore_and_benchmark_run() -> None:
+    from policies.registry import make_policy
+
+    for label, overrides in weight_sets({"cost.w_v": 1.0}).items():
+        built = make_policy(label, **overrides).params
+        if label in (PAPER, TUNED):
+            continue  # labels
+        assert make_policy(label).params == built, label
 
 
 def test_overlapping_train_and_test_seeds_are_rejected(tmp_path: Path) -> None:

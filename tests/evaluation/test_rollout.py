@@ -97,3 +97,47 @@ def test_time_to_coverage():
     assert time_to_coverage(trace, 0.9) == 2.0
     assert time_to_coverage(trace, 0.99) is None
     assert time_to_coverage(trace, 0.1) == 0.0 and not math.isnan(time_to_coverage(trace, 0.5))
+
+
+def test_gif_frames_stream_to_the_file_with_bounded_memory(tmp_path):
+    """A long mission's GIF must not hold every frame: memory stays at about one frame."""
+    import tracemalloc
+
+    from PIL import Image
+
+    from semexplore_gym.evaluation.rollout import GifStreamWriter
+
+    rng = np.random.default_rng(0)
+    frame = (rng.random((240, 320, 3)) * 255).astype(np.uint8)  # 230 kB
+
+    def peak(n: int) -> int:
+        writer = GifStreamWriter(tmp_path / f"{n}.gif", fps=5)
+        tracemalloc.start()
+        for i in range(n):
+            writer.append(np.roll(frame, i, axis=1))
+        writer.close()
+        _, top = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        return top
+
+    small, large = peak(5), peak(60)
+    assert large < 1.5 * small + frame.nbytes  # no growth with the number of frames
+    assert large < 8 * frame.nbytes  # a few frames' worth at most, not 60
+    with Image.open(tmp_path / "60.gif") as im:
+        assert im.n_frames == 60 and im.info["loop"] == 0 and im.info["duration"] == 200
+        im.seek(7)
+        err = np.abs(np.asarray(im.convert("RGB")).astype(int) - np.roll(frame, 7, axis=1))
+        assert err.mean() < 25  # an adaptive 128-colour palette of noise
+    assert not (tmp_path / "60.gif.part").exists()
+
+
+def test_explore_gif_every_0_2_s_through_the_cli(tmp_path, capsys):
+    from PIL import Image
+
+    from semexplore_gym.cli import main
+
+    out = tmp_path / "sub" / "m.gif"
+    argv = ["explore", "--world", "maze1", "--policy", "random", "--max-time-s", "3"]
+    assert main([*argv, "--gif", str(out), "--gif-every-s", "0.2"]) == 0
+    with Image.open(out) as im:
+        assert im.n_frames == 17  # t = 0, 0.2, ..., 3.0 and the final frame
