@@ -51,8 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     import semexplore_gym  # noqa: F401
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from semexplore_gym.evaluation.rollout import STAGES, run_mission
     from semexplore_gym.core.params import merge_overrides
+    from semexplore_gym.evaluation.rollout import STAGES, run_mission
 
     cfg = load_policy_config(args.policy_config)
     kwargs = merge_overrides(None, args.overrides)

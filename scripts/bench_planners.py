@@ -33,6 +33,8 @@ from scipy import ndimage
 
 from semexplore_gym.core.frontiers.detection import detect_frontiers
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 from semexplore_gym.core.planning.grid_search import (
     CostmapParams,
     NavfnParams,
@@ -42,8 +44,6 @@ from semexplore_gym.core.planning.grid_search import (
     navfn_cell_costs,
     plan_path,
 )
-from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
-from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 from semexplore_gym.core.worlds.registry import make_world
 
 #: World used for each map size (the map is padded to exactly that size).

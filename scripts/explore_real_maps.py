@@ -95,8 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     import semexplore_gym  # noqa: F401
     from policies.config import load_policy_config
     from policies.registry import make_policy
-    from semexplore_gym.evaluation.rollout import run_mission
     from semexplore_gym.core.params import merge_overrides
+    from semexplore_gym.evaluation.rollout import run_mission
 
     if not args.maps_dir.is_dir():
         print(f"maps directory not found: {args.maps_dir}", file=sys.stderr)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.grid import FREE, UNKNOWN
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 from semexplore_gym.core.topometric.types import Frontier
 from semexplore_gym.wrappers.frontier_choice import (
     N_CANDIDATE_FEATURES,
@@ -231,8 +231,8 @@ def test_registered_macro_envs_pass_check_env(env_id: str) -> None:
 
 
 def test_observation_vector_shows_the_first_k_and_counts_all() -> None:
-    from semexplore_gym.core.grid import FREE, UNKNOWN
     from semexplore_gym.core.features.macro import observation_size, observation_vector
+    from semexplore_gym.core.grid import FREE, UNKNOWN
 
     params = MacroParams(n_candidates=2, time_scale_s=100.0)
     cands = [_cand((float(i), 0.0), 1.0 + i, float(i)) for i in range(5)]

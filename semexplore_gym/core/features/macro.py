@@ -35,9 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
 N_CANDIDATE_FEATURES = 8
 N_GLOBAL_FEATURES = 4

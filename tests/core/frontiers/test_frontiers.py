@@ -5,7 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from semexplore_gym.core.frontiers.detection import GridFrontier, detect_frontiers, frontier_cell_mask
+from semexplore_gym.core.frontiers.detection import (
+    GridFrontier,
+    detect_frontiers,
+    frontier_cell_mask,
+)
 from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
 
 

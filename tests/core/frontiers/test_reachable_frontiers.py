@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     frontier_groups,
     nearest_reachable_frontier,
 )
+from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
 
 # 0.1 m cells. A room on the left; a wide corridor (5 free cells) to unknown on the right; a
 # narrow slot (1 free cell) at the top leading to unknown as well.

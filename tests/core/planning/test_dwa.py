@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner, scan_points_m
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
+from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner, scan_points_m
 
 DT_S = 0.2
 # Fewer samples than the TurtleBot3 defaults keep the closed-loop tests fast.

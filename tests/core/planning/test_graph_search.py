@@ -8,13 +8,13 @@ import networkx as nx
 import numpy as np
 import pytest
 
+from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     find_frontier_paths,
     project_onto_polyline,
     search_frontier_paths,
 )
-from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.topometric.types import (
     Area,
     AreaType,
