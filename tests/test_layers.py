@@ -60,12 +60,13 @@ LAYERS: list[Layer] = [
     Layer("semexplore_gym/sim", forbid=("gymnasium",)),
     Layer("semexplore_gym/envs"),
     Layer("semexplore_gym/wrappers"),
-    # A policy turns observations into actions: core and observations only.
+    # A policy turns observations into actions: core and observations only. Loading a trained
+    # model may need torch, SB3 and the gymnasium space classes pickled in it (inside functions).
     Layer(
         "policies",
         only=(_CORE,),
-        forbid=("gymnasium", "pymunk"),
-        lazy_only=("torch", "stable_baselines3", "sb3_contrib"),
+        forbid=("pymunk",),
+        lazy_only=("gymnasium", "torch", "stable_baselines3", "sb3_contrib"),
     ),
     Layer("semexplore_gym/macro_envs.py"),
     Layer("semexplore_gym/evaluation"),
