@@ -167,7 +167,7 @@ def run(args: argparse.Namespace) -> int:
     for p in policies:
         if strip_label(p).partition(":")[0] not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
-        if strip_label(p).partition(":")[0] in ("py", "sb3"):
+        if strip_label(p).partition(":")[0] in ("py", "sb3", "pretrained"):
             # user code and model files: load them once now, so a typo fails before any mission
             from policies.registry import make_policy
 
