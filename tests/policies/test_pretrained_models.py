@@ -11,7 +11,7 @@ NAMES = [m.name for m in pretrained_models()]
 
 
 def test_the_dagger_model_and_the_best_agent_ship() -> None:
-    assert {"frontier_choice_maze"} <= set(NAMES)
+    assert {"dagger_maze", "frontier_choice_maze"} <= set(NAMES)
 
 
 @pytest.mark.parametrize("name", NAMES)
