@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -41,3 +42,15 @@ def test_explore_with_an_unknown_pretrained_name_is_a_clear_error(
         "unknown pretrained model pretrained:nope" in err
         and "pretrained:frontier_choice_maze" in err
     )
+
+
+def test_benchmark_runs_pretrained_specs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("stable_baselines3")
+    specs = ",".join(m.spec for m in pretrained_models())
+    argv = ["benchmark", "--worlds", "maze:seed=0,size_m=4", "--policies", specs, "--runs", "1"]
+    argv += ["--max-time-s", "3", "--no-plots", "--no-progress", "--out", str(tmp_path)]
+    assert main(argv) == 0
+    summary = (tmp_path / "summary.md").read_text()
+    assert all(f"| {m.spec} | 1 |" in summary for m in pretrained_models())
