@@ -107,6 +107,16 @@ def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
         ) from None
 
 
+def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
+    """``pretrained:NAME``: a model shipped in :mod:`policies.pretrained` (``semexplore pretrained``)."""
+    from policies.pretrained import get_pretrained
+
+    model = get_pretrained(arg)
+    policy = _sb3(str(model.model_path), overrides)
+    policy.name = model.spec
+    return policy
+
+
 def _python(arg: str, overrides: dict[str, Any]) -> Policy:
     """``py:MODULE:NAME`` or ``py:path/to/file.py:NAME``: a user's own policy.
 
@@ -188,6 +198,7 @@ def policy_factories() -> dict[str, Factory]:
         "nearest": _nearest,
         "random": _random,
         "sb3": _sb3,
+        "pretrained": _pretrained,
         "py": _python,
     }
 

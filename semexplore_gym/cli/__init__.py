@@ -22,6 +22,7 @@ SUBCOMMANDS: dict[str, str] = {
     "train": "train",
     "compare-weights": "compare_weights",
     "maps": "maps",
+    "pretrained": "pretrained",
 }
 
 

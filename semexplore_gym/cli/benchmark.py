@@ -83,7 +83,7 @@ def _check_policies(policies: list[str]) -> None:
         name = base.partition(":")[0]
         if name not in known:
             raise ValueError(f"unknown policy {p!r}; known: {', '.join(sorted(known))}")
-        if overrides or name in ("py", "sb3"):
+        if overrides or name in ("py", "sb3", "pretrained"):
             try:
                 make_policy(p)
             except (ValueError, FileNotFoundError) as e:

@@ -505,7 +505,7 @@ def run_benchmark(
     workers: int = 1,
     backend: str = "process",
     ray_address: str | None = None,
-    progress: bool = True,
+    progress: bool = False,
     task_fn: Callable[[Task], dict[str, Any]] = run_task,
     *,
     suites: Sequence[dict[str, Any]] | None = None,
@@ -518,7 +518,7 @@ def run_benchmark(
         workers: Parallel missions (processes, or Ray CPUs for a local Ray instance).
         backend: ``"process"`` (local processes; 1 worker runs in this process) or ``"ray"``.
         ray_address: Address of an existing Ray cluster (``"auto"``), or None for a local one.
-        progress: Show a progress bar over missions on stderr.
+        progress: Show a progress bar over missions on stderr (off by default; the CLI turns it on).
         task_fn: The mission runner (tests substitute a fake one; only the sequential path uses it).
         suites: ``{"name", "version"}`` of the suites the tasks come from, kept in the run's
             fingerprint (a suite's version may not change between runs into one directory).

@@ -256,7 +256,7 @@ def run_mission(
     policy: Policy,
     seed: int | None,
     max_time_s: float | None = None,
-    progress: bool = True,
+    progress: bool = False,
     gif_path: str | os.PathLike | None = None,
     on_step: Callable[[int, dict[str, Any], dict[str, Any], np.ndarray, Policy], None]
     | None = None,
@@ -273,7 +273,8 @@ def run_mission(
         policy: The policy.
         seed: Seed for ``env.reset`` and ``policy.reset``.
         max_time_s: Stop after this much simulated time (None: only the env's own truncation).
-        progress: Show a tqdm bar on stderr (simulated seconds, coverage).
+        progress: Show a tqdm bar on stderr (simulated seconds, coverage); off by default
+            (the CLI turns it on).
         gif_path: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         on_step: Called after every step as ``on_step(step, obs, info, action, policy)``.
         gif_every_s: Simulated seconds between GIF frames.

@@ -93,12 +93,25 @@ class DaggerSection:
     workers: int = 1
 
 
+#: ``ppo.vec_env`` choices: how the ``n_envs`` learner envs are stepped.
+VEC_ENV_KINDS: tuple[str, ...] = ("auto", "subproc", "dummy")
+
+
 @dataclass(frozen=True)
 class PPOSection:
-    """SB3 PPO settings; ``init_from`` starts from a BC/DAgger model zip (egocentric env only)."""
+    """SB3 PPO settings; ``init_from`` starts from a BC/DAgger model zip (egocentric env only).
+
+    PPO collects from ``n_envs`` envs at once (``n_steps`` each per update). ``vec_env`` picks
+    how: ``"subproc"`` (SB3's ``SubprocVecEnv``: one process per env, so the env steps and the
+    egocentric encoding of 2 envs use both cores of a 2-core machine while the learner runs
+    its forward pass), ``"dummy"`` (``DummyVecEnv``: all envs in this process, no start-up
+    cost; best for one env, for tiny runs, or when the cores are busy anyway) or ``"auto"``
+    (subproc when ``n_envs > 1``, else dummy).
+    """
 
     total_timesteps: int = 20_000
-    n_envs: int = 1
+    n_envs: int = 2
+    vec_env: str = "auto"
     n_steps: int = 512
     batch_size: int = 64
     n_epochs: int = 5
@@ -147,6 +160,14 @@ def check_train_config(cfg: TrainConfig, algo: str) -> None:
     ):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
+    if (
+        isinstance(cfg.ppo.n_envs, bool)
+        or not isinstance(cfg.ppo.n_envs, int)
+        or cfg.ppo.n_envs < 1
+    ):
+        raise ValueError(f"ppo.n_envs must be an integer >= 1, got {cfg.ppo.n_envs!r}")
+    if cfg.ppo.vec_env not in VEC_ENV_KINDS:
+        raise ValueError(f"ppo.vec_env must be one of {VEC_ENV_KINDS}, got {cfg.ppo.vec_env!r}")
     if algo == "maskable_ppo" and not is_macro(cfg):
         raise ValueError(
             f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"

@@ -120,7 +120,7 @@ def dagger_rounds(
 
 
 def train_imitation(
-    cfg: TrainConfig, algo: str, out: Path, log: LogFn, progress: bool = True
+    cfg: TrainConfig, algo: str, out: Path, log: LogFn, progress: bool = False
 ) -> dict[str, Any]:
     """Record, behaviour-clone and (``algo="dagger"``) run DAgger; save ``out/model.zip``.
 
@@ -145,7 +145,8 @@ def train_imitation(
         cfg.expert.holdout_fraction, np.random.default_rng(cfg.seed)
     )
     # PPO's policy object is the learner, so a BC model can be fine-tuned by `train --algo ppo`.
-    model = new_ppo(cfg, make_vec_env(cfg), None)
+    # One env in this process: the vec env only gives the learner its spaces.
+    model = new_ppo(cfg, make_vec_env(cfg, n_envs=1, vec_env="dummy"), None)
     policy = model.policy
     metrics: dict[str, Any] = {
         "dataset_samples": len(data),

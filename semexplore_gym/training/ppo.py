@@ -8,6 +8,7 @@ MLP over that env's own observation, and MaskablePPO uses the env's ``action_mas
 from __future__ import annotations
 
 import time
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -68,14 +69,21 @@ def new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None, algo: s
     )
 
 
-def make_vec_env(cfg: TrainConfig) -> Any:
-    """``ppo.n_envs`` learner envs (episodes capped at ``ppo.max_episode_steps``), seeded."""
+def make_vec_env(cfg: TrainConfig, n_envs: int | None = None, vec_env: str | None = None) -> Any:
+    """``n_envs`` learner envs, seeded, episodes capped at ``ppo.max_episode_steps``, stepped
+    in worker processes or in this one; ``n_envs`` and ``vec_env`` default to ``cfg.ppo``'s."""
     from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
+    n = cfg.ppo.n_envs if n_envs is None else int(n_envs)
+    kind = cfg.ppo.vec_env if vec_env is None else vec_env
+    if kind == "auto":
+        kind = "subproc" if n > 1 else "dummy"
     return sb3_make_vec_env(
-        lambda: make_learner_env(cfg, cfg.ppo.max_episode_steps),
-        n_envs=cfg.ppo.n_envs,
+        partial(make_learner_env, cfg, cfg.ppo.max_episode_steps),
+        n_envs=n,
         seed=cfg.seed,
+        vec_env_cls=SubprocVecEnv if kind == "subproc" else DummyVecEnv,
     )
 
 
@@ -106,7 +114,7 @@ def _load_init_weights(cfg: TrainConfig, model: Any, init_from: str) -> None:
         raise ValueError(f"ppo.init_from model does not match the policy network: {missing}")
 
 
-def train_ppo(cfg: TrainConfig, algo: str, out: Path, progress: bool = True) -> dict[str, Any]:
+def train_ppo(cfg: TrainConfig, algo: str, out: Path, progress: bool = False) -> dict[str, Any]:
     """Train ``algo`` (``ppo`` or ``maskable_ppo``) and save ``out/model.zip``; returns metrics.
 
     SB3's own logger writes TensorBoard logs to ``out/tb/<algo>_N``.

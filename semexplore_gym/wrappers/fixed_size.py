@@ -29,12 +29,12 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from semexplore_gym.core.grid import UNKNOWN
+from semexplore_gym.core.features.map_window import MAP_ANCHORS, map_window, window_origin
 
 if TYPE_CHECKING:
     from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 
-ANCHORS = ("world", "robot")
+ANCHORS = MAP_ANCHORS
 
 
 class FixedSizeMap(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
@@ -71,27 +71,18 @@ class FixedSizeMap(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         self._offset = (0, 0)
 
     def _origin(self, grid_shape: tuple[int, int], pose: np.ndarray) -> tuple[int, int]:
-        half = self.map_size // 2
-        if self.anchor == "world":
-            return (grid_shape[0] // 2 - half, grid_shape[1] // 2 - half)
-        geometry = cast("SemanticExploreEnv", self.env.unwrapped).map_geometry
-        row, col = geometry.world_to_grid(float(pose[0]), float(pose[1]))
-        return (int(row) - half, int(col) - half)
+        robot_rc = None
+        if self.anchor == "robot":
+            geometry = cast("SemanticExploreEnv", self.env.unwrapped).map_geometry
+            row, col = geometry.world_to_grid(float(pose[0]), float(pose[1]))
+            robot_rc = (int(row), int(col))
+        return window_origin(grid_shape, self.map_size, self.anchor, robot_rc)
 
     def observation(self, observation: dict[str, Any]) -> dict[str, Any]:
         grid = observation["map"]
-        h, w = grid.shape
-        r0, c0 = self._origin((h, w), observation["pose"])
-        self._offset = (r0, c0)
-        s = self.map_size
-        image = np.full((1, s, s), UNKNOWN, dtype=np.uint8)
-        # Overlap of the image window [r0, r0 + s) x [c0, c0 + s) with the map.
-        gr0, gr1 = max(r0, 0), min(r0 + s, h)
-        gc0, gc1 = max(c0, 0), min(c0 + s, w)
-        if gr0 < gr1 and gc0 < gc1:
-            image[0, gr0 - r0 : gr1 - r0, gc0 - c0 : gc1 - c0] = grid[gr0:gr1, gc0:gc1]
+        self._offset = self._origin(grid.shape, observation["pose"])
         out = dict(observation)
-        out["map"] = image
+        out["map"] = map_window(grid, self._offset, self.map_size)[None]
         return out
 
     def reset(self, **kwargs: Any) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -1,0 +1,110 @@
+"""Pretrained agents shipped inside the package: ``make_policy("pretrained:NAME")``.
+
+Each model lives in its own folder here, ``<name>/model.zip`` beside the resolved
+``config.yaml`` of the ``semexplore train`` run that produced it (a macro-action agent reads
+its settings from it). ``index.yaml`` describes them: what each was trained on, the command and
+config that reproduce it, and its measured results. ``semexplore pretrained`` lists them, one
+line each starting with the policy spec::
+
+    from policies.registry import make_policy
+    policy = make_policy("pretrained:dagger_maze")
+
+The models need the ``rl`` extra (torch, stable-baselines3, sb3-contrib) to load.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: The folder holding the model folders and the index.
+PRETRAINED_DIR = Path(__file__).resolve().parent
+#: The index of the shipped models.
+INDEX_PATH = PRETRAINED_DIR / "index.yaml"
+#: Largest model file shipped (bytes); a test holds every model to it.
+MAX_MODEL_BYTES = 5 * 1024 * 1024
+
+_FIELDS = ("name", "description", "trained_on", "command", "config", "training_time", "results")
+
+
+@dataclass(frozen=True)
+class PretrainedModel:
+    """One shipped model, as described in ``index.yaml``.
+
+    Attributes:
+        name: Its name: the policy spec is ``pretrained:<name>``.
+        description: What the agent is, in one sentence.
+        trained_on: The worlds and the amount of experience it was trained on.
+        command: The ``semexplore train`` command that reproduces it (from a checkout).
+        config: The training config of that command (a path in the repository).
+        training_time: Wall time of the training run and the machine it ran on.
+        results: Its measured results on unseen worlds, and how they were measured.
+    """
+
+    name: str
+    description: str
+    trained_on: str
+    command: str
+    config: str
+    training_time: str
+    results: str
+
+    @property
+    def spec(self) -> str:
+        """The policy spec that runs it: ``pretrained:<name>``."""
+        return f"pretrained:{self.name}"
+
+    @property
+    def model_path(self) -> Path:
+        """The model zip (its folder also holds the run's ``config.yaml``)."""
+        return PRETRAINED_DIR / self.name / "model.zip"
+
+    def summary_line(self) -> str:
+        """One line: the spec first, then description, training data, command, results."""
+        return (
+            f"{self.spec}  {self.description} Trained on {self.trained_on} "
+            f"(training: {self.training_time}). Reproduce: {self.command} (config {self.config}). "
+            f"Results: {self.results}"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The index fields plus ``spec``, ``model_path`` and ``size_bytes``."""
+        d: dict[str, Any] = {k: getattr(self, k) for k in _FIELDS}
+        size = self.model_path.stat().st_size if self.model_path.is_file() else None
+        return {"spec": self.spec, **d, "model_path": str(self.model_path), "size_bytes": size}
+
+
+def pretrained_models() -> list[PretrainedModel]:
+    """The shipped models, in the index's order.
+
+    Raises:
+        ValueError: the index is malformed (a missing or unknown field).
+    """
+    from semexplore_gym.core.safe_io import load_yaml_file
+
+    data = load_yaml_file(INDEX_PATH, "pretrained model index") or {}
+    entries = data.get("models") if isinstance(data, dict) else None
+    if not isinstance(entries, list):
+        raise ValueError(f"{INDEX_PATH} must hold a 'models' list")
+    models = []
+    for entry in entries:
+        if not isinstance(entry, dict) or set(entry) != set(_FIELDS):
+            keys = sorted(entry) if isinstance(entry, dict) else entry
+            raise ValueError(f"{INDEX_PATH}: each model needs exactly {list(_FIELDS)}, got {keys}")
+        models.append(PretrainedModel(**{k: " ".join(str(entry[k]).split()) for k in _FIELDS}))
+    return models
+
+
+def get_pretrained(name: str) -> PretrainedModel:
+    """The shipped model called ``name``.
+
+    Raises:
+        ValueError: no model has that name (the message lists the names).
+    """
+    models = {m.name: m for m in pretrained_models()}
+    if name not in models:
+        known = ", ".join(f"pretrained:{n}" for n in models) or "(none)"
+        shown = f"pretrained:{name}" if name else "'pretrained' without a name"
+        raise ValueError(f"unknown pretrained model {shown}; shipped: {known}")
+    return models[name]

@@ -1,0 +1,56 @@
+"""``semexplore pretrained``: one line per shipped model, starting with its policy spec."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from policies.pretrained import pretrained_models
+from semexplore_gym.cli import main
+
+
+def test_lists_each_model_on_one_line_starting_with_its_spec(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["pretrained"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    models = pretrained_models()
+    assert len(lines) == len(models) >= 2
+    for line, model in zip(lines, models, strict=True):
+        assert line.startswith(f"pretrained:{model.name} ")
+        for part in ("Trained on", model.command, model.config, "Results:", model.results):
+            assert part in line
+
+
+def test_json_lists_paths_and_sizes(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["pretrained", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["spec"] for r in rows] == [f"pretrained:{m.name}" for m in pretrained_models()]
+    assert all(r["size_bytes"] and r["size_bytes"] <= 5 * 1024 * 1024 for r in rows)
+
+
+def test_explore_with_an_unknown_pretrained_name_is_a_clear_error(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert (
+        main(["explore", "--world", "maze1", "--policy", "pretrained:nope", "--no-progress"]) == 2
+    )
+    err = capsys.readouterr().err
+    assert (
+        "unknown pretrained model pretrained:nope" in err
+        and "pretrained:frontier_choice_maze" in err
+    )
+
+
+def test_benchmark_runs_pretrained_specs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("stable_baselines3")
+    specs = ",".join(m.spec for m in pretrained_models())
+    argv = ["benchmark", "--worlds", "maze:seed=0,size_m=4", "--policies", specs, "--runs", "1"]
+    argv += ["--max-time-s", "3", "--no-plots", "--no-progress", "--out", str(tmp_path)]
+    assert main(argv) == 0
+    summary = (tmp_path / "summary.md").read_text()
+    assert all(f"| {m.spec} | 1 |" in summary for m in pretrained_models())
