@@ -1,6 +1,7 @@
-"""The Python API snippet of ``docs/README_learning_section.md`` runs as written.
+"""The README's Python API snippet (section "The Python API") runs as written.
 
-The test reads the block from the document (the first ``python`` fence), so the two cannot drift.
+The test reads the block from the README (the first ``python`` fence after that heading), so
+the two cannot drift.
 """
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-DOC = Path(__file__).resolve().parents[2] / "docs" / "README_learning_section.md"
+DOC = Path(__file__).resolve().parents[2] / "README.md"
+HEADING = "### The Python API"
 
 
 def python_blocks(markdown: str) -> list[str]:
@@ -24,7 +26,9 @@ def test_api_snippet_runs_as_written(
     capsys: pytest.CaptureFixture[str],
     one_torch_thread: None,
 ) -> None:
-    blocks = python_blocks(DOC.read_text(encoding="utf-8"))
+    text = DOC.read_text(encoding="utf-8")
+    assert HEADING in text, f"no {HEADING!r} section in {DOC}"
+    blocks = python_blocks(text[text.index(HEADING) :])
     assert blocks, f"no python block in {DOC}"
     monkeypatch.chdir(tmp_path)  # the snippet writes expert.npz to the working directory
     exec(compile(blocks[0], str(DOC), "exec"), {"__name__": "__doc_snippet__"})
