@@ -5,11 +5,11 @@ catalogue map from disk; this module knows what the maps are and where they live
 network I/O. Fetching them is ``semexplore maps get NAME`` (:mod:`semexplore_gym.maps`).
 
 Every file has a sha256 and a size. Upstream files are fetched from
-``raw.githubusercontent.com/OWNER/REPO/COMMIT/PATH`` at the commit given (as recorded in the
-collection the checksums were taken from; some commits are abbreviated). Maps whose source
-has no map_server yaml (a bare image plus a scale in a Stage world file) get a sidecar yaml
-written by us; this package generates it from the fields recorded below, since there is nothing upstream to
-download, and is checksummed like the rest.
+``raw.githubusercontent.com/OWNER/REPO/COMMIT/PATH`` at the full commit hash given (checked
+once against each repository: every upstream file exists at its commit with the catalogue's
+sha256). Maps whose source has no map_server yaml (a bare image plus a scale in a Stage world
+file) get a sidecar yaml written by us: this package generates it from the fields recorded
+below, since there is nothing upstream to download, and checksums it like the rest.
 
 Where maps are looked for, in order:
 
@@ -268,7 +268,7 @@ _HOUSEEXPO_PNGS = (
 _ENTRIES: tuple[CatalogueMap, ...] = (
     CatalogueMap(
         "tb3-world", "TurtleBot3 World: Gazebo hexagonal arena with 3x3 pillars (SLAM map)",
-        _TB3[1], _TB3[0], "da785b7", "turtlebot3/world",
+        _TB3[1], _TB3[0], "da785b7201d317e6e2a662e41bb3d3fd50ebd503", "turtlebot3/world",
         (_up("turtlebot3_navigation2/map", "map.pgm",
              "57eaad9291fcf02e068cbcd1874990694838a74a3304755bae1bd7b726c4522f", 147508),
          _up("turtlebot3_navigation2/map", "map.yaml",
@@ -276,7 +276,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "tb3-office", "real office with desks, gmapping on a TurtleBot3 (RPLidar A3)",
-        _TB3[1], _TB3[0], "5315fa67", "turtlebot3/office",
+        _TB3[1], _TB3[0], "5315fa67213f1052af57b8abe35105546cc0dcb8", "turtlebot3/office",
         (_up("maps", "map_office_raw.pgm",
              "32db1e9e5d9f27b5349def932165143d18f4f8cdc741c9e1c67dc34e6b1ad0af", 147508),
          _up("maps", "map_office_raw.yaml",
@@ -284,7 +284,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "nav2-depot", "Nav2 demo depot: small warehouse floor with shelves, 30x15 m",
-        _NAV2[1], _NAV2[0], "a3a97043", "navigation2",
+        _NAV2[1], _NAV2[0], "a3a97043ee93d92fe8d70ec56d183933169beb1c", "navigation2",
         (_up("nav2_bringup/maps", "depot.pgm",
              "71bbac79cfc2f5db89095182bfa86b29d96b07d4ed3b7726e513ed57afffc851", 185443),
          _up("nav2_bringup/maps", "depot.yaml",
@@ -292,7 +292,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "nav2-warehouse", "Nav2 demo warehouse: racks and aisles, 30x50 m at 3 cm",
-        _NAV2[1], _NAV2[0], "a3a97043", "navigation2",
+        _NAV2[1], _NAV2[0], "a3a97043ee93d92fe8d70ec56d183933169beb1c", "navigation2",
         (_up("nav2_bringup/maps", "warehouse.pgm",
              "934ce2ca1feacc2216b68142349c6ebb3e46cc7c76fd80a9c2d2a6fb85ba7ff7", 1684107),
          _up("nav2_bringup/maps", "warehouse.yaml",
@@ -300,7 +300,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "willow-garage", "Willow Garage office building: offices, corridors, 54x59 m (SLAM map)",
-        "BSD", "ros-simulation/stage_ros", "c3abc19b", "stage_ros",
+        "BSD", "ros-simulation/stage_ros", "c3abc19b9e9713fe450597ca33b6f5399d1691ca", "stage_ros",
         (_up("world", "willow-full.pgm",
              "6ca11ef810d13d981dca36fd6592114a1abb4225008ba7affc549243b2cc5d2f", 317018),
          _ours("willow-full.yaml",
@@ -308,7 +308,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "intel-lab", "Intel Research Lab Seattle: ring corridor and small rooms (SLAM benchmark)",
-        _IPA[1], _IPA[0], "f8a1dae4", "ipa_room_segmentation",
+        _IPA[1], _IPA[0], "f8a1dae4a09693f36a84fd92b6f9772d4c6faff1", "ipa_room_segmentation",
         (_up(_IPA_DIR, "intel_map.png",
              "05a2e536c6d9d2fdb72184668372293f96cbdf21f0272116375390805369711f", 99405),
          _ours("intel_map.yaml",
@@ -316,7 +316,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "freiburg79", "Freiburg building 079: corridor with offices, raw SLAM map",
-        _IPA[1], _IPA[0], "f8a1dae4", "ipa_room_segmentation",
+        _IPA[1], _IPA[0], "f8a1dae4a09693f36a84fd92b6f9772d4c6faff1", "ipa_room_segmentation",
         (_up(_IPA_DIR, "freiburg_building79.png",
              "dc8e2abd27d9d1bfeee50207c18825bef19df3ec58c1f8f80cc5bf3d6e576c18", 12448),
          _ours("freiburg_building79.yaml",
@@ -324,7 +324,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "freiburg79-scan", "Freiburg building 079, cleaned into a tidy map with straight walls",
-        _IPA[1], _IPA[0], "f8a1dae4", "ipa_room_segmentation",
+        _IPA[1], _IPA[0], "f8a1dae4a09693f36a84fd92b6f9772d4c6faff1", "ipa_room_segmentation",
         (_up(_IPA_DIR, "Freiburg79_scan.png",
              "fb51360bce67938c2562c1a60a774ab9e1aebc558d734afc0fe453d15774ca02", 4146),
          _ours("Freiburg79_scan.yaml",
@@ -332,7 +332,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "stata-basement", "MIT Stata Center basement corridor loops, 87x66 m (SLAM map)",
-        _F1T[1], _F1T[0], "4fdb9c7e", "f1tenth_gym",
+        _F1T[1], _F1T[0], "4fdb9c7e6fb7c701290f4dc18377d07c1681724f", "f1tenth_gym",
         (_up(_F1T_DIR, "stata_basement.png",
              "b0ea5bed595dc3dd68f7d3c12a8b337c476c66a09fd7bf5c818c25c461b2aa2b", 23608),
          _up(_F1T_DIR, "stata_basement.yaml",
@@ -340,7 +340,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "skirk", "indoor corridors and rooms, 22x30 m (SLAM map)",
-        _F1T[1], _F1T[0], "4fdb9c7e", "f1tenth_gym",
+        _F1T[1], _F1T[0], "4fdb9c7e6fb7c701290f4dc18377d07c1681724f", "f1tenth_gym",
         (_up(_F1T_DIR, "skirk.png",
              "7af605d5487fbd7bbd3d7db286aa240cc0ce5ebfb7c6e144767aad8e2fd02aea", 10705),
          _up(_F1T_DIR, "skirk.yaml",
@@ -348,7 +348,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "brsu-c069", "RoboCup@Home lab C069, H-BRS: two furnished rooms (SLAM map)",
-        "GPL-3.0", "b-it-bots/mas_domestic_robotics", "fac00775", "mas_domestic_robotics/brsu-c069",
+        "GPL-3.0", "b-it-bots/mas_domestic_robotics", "fac00775f00ad11849e7e98bae2e45698c349ca2", "mas_domestic_robotics/brsu-c069",
         (_up("mdr_environments/brsu-c069", "map.pgm",
              "2d9ee74a8c0e146202fe343f0183b3029795c7262f0d9764594fe7823fe4a059", 313400),
          _up("mdr_environments/brsu-c069", "map.yaml",
@@ -356,7 +356,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "stage-cave", "Player/Stage cave: unstructured blobs, no straight walls, 16x16 m",
-        _STAGE[1], _STAGE[0], "281ed731", "stage",
+        _STAGE[1], _STAGE[0], "281ed731ed56b23d0879a2c765d4a20824a6d58a", "stage",
         (_up("worlds/bitmaps", "cave.png",
              "ebe0bd0973e25e40299d3877483574815c1cc4c82e96eadfbb9ef6994aaa7f3f", 3138),
          _ours("cave.yaml",
@@ -364,7 +364,7 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "sfu-campus", "outdoor roads of the SFU campus, 1200x615 m at 1 m (stress test)",
-        _STAGE[1], _STAGE[0], "281ed731", "stage",
+        _STAGE[1], _STAGE[0], "281ed731ed56b23d0879a2c765d4a20824a6d58a", "stage",
         (_up("worlds/bitmaps", "SFU_1200x615.png",
              "d30276e5d31dd42763aee2ab227b96656eea3d6393e14dbaadd936f77d15e1fd", 224435),
          _ours("SFU_1200x615.yaml",
@@ -372,14 +372,14 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
     CatalogueMap(
         "houseexpo-1451", "HouseExpo 7-room house as a vector plan (JSON), 11.3x10.8 m",
-        "MIT", "ExistentialRobotics/erl_geometry", "7d53206a", "houseexpo/json",
+        "MIT", "ExistentialRobotics/erl_geometry", "7d53206acc335ad95e826fe7af3688e4dd594a80", "houseexpo/json",
         (_up("data", "house_expo_room_1451.json",
              "30a679b267df712356e9549f823677a092660da63c4d1ef44051b942b8f595f7", 16655),),
     ),
     *(
         CatalogueMap(
             f"houseexpo-{house_id[:8]}", f"HouseExpo floor plan at 1 cm: {what}",
-            "MIT", "diesistdername/HouseExpo", "c84d5eb8", "houseexpo/png",
+            "MIT", "diesistdername/HouseExpo", "c84d5eb85c4cfb330a2af417a9ab86fb155312f7", "houseexpo/png",
             (_up("png", f"{house_id}.png", png_sha, png_size),
              _ours(f"{house_id}.yaml", yaml_sha, 782)),
         )
