@@ -235,8 +235,10 @@ def test_every_readme_command_runs(
         if any(a.startswith("path/to/") and a.endswith(".yaml") for a in argv):
             skipped.append(" ".join(argv))  # a placeholder for the reader's own suite file
             continue
-        # `map:NAME` worlds come from `maps get ... --from ../shared/maps` earlier in the README.
-        if any("../shared" in a or a.startswith("map:") for a in argv):
+        # `map:NAME` worlds (and `maps path NAME`) need the `maps get ... --from ../shared/maps`
+        # earlier in the README.
+        needs_map = argv[1:3] == ["maps", "path"] or any(a.startswith("map:") for a in argv)
+        if needs_map or any("../shared" in a for a in argv):
             if not SHARED.is_dir():
                 skipped.append(" ".join(argv))
                 continue
