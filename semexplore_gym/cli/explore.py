@@ -45,8 +45,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--policy",
         default=None,
-        help="policy spec: semantic (default), frontier, nearest, random, sb3:MODEL.zip, "
-        "py:FILE.py:CLASS or py:package.module:CLASS (your own Policy); a bracket sets "
+        help="policy spec: semantic (default), semantic-paper (the paper's method alone), "
+        "frontier, nearest, random, pretrained:NAME (see 'semexplore pretrained'), "
+        "sb3:MODEL.zip, py:FILE.py:CLASS or py:package.module:CLASS (your own Policy); a bracket sets "
         "parameters, 'semantic[cost.w_v=0;cost.w_p=0]' (the spelling benchmark and "
         "compare-weights use; applied after --policy-set). sb3: and py: specs run code from "
         "the named file: use only files from trusted sources",

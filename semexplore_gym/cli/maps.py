@@ -27,7 +27,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "sha256. Downloaded maps are used with --world map:NAME.",
     )
     actions = p.add_subparsers(dest="maps_action", metavar="ACTION")
-    actions.add_parser("list", help="one line per map: name, size, licence, source")
+    lst = actions.add_parser("list", help="one line per map: name, size, licence, source")
+    lst.add_argument(
+        "--files",
+        action="store_true",
+        help="also one line per file: its download URL at the pinned commit and its sha256",
+    )
     get = actions.add_parser(
         "get", help="download maps into the cache (or --dir), verifying each file's sha256"
     )
@@ -66,13 +71,16 @@ def _size(n_bytes: int) -> str:
     return f"{n_bytes / 1024:.0f} KB" if n_bytes < 1024 * 1024 else f"{n_bytes / 2**20:.1f} MB"
 
 
-def _list() -> int:
+def _list(files: bool = False) -> int:
     from semexplore_gym.core.worlds.catalogue import CATALOGUE
 
     rows = [(m.name, _size(m.size_bytes), m.licence, m.source) for m in CATALOGUE.values()]
     widths = [max(len(r[i]) for r in rows) for i in range(3)]
-    for name, size, licence, source in rows:
+    for entry, (name, size, licence, source) in zip(CATALOGUE.values(), rows, strict=True):
         print(f"{name:<{widths[0]}}  {size:>{widths[1]}}  {licence:<{widths[2]}}  {source}")
+        for f in entry.files if files else ():
+            where = entry.url(f) or "written by this package (the source has none)"
+            print(f"    {f.filename}  sha256 {f.sha256}  {where}")
     return 0
 
 
@@ -116,7 +124,7 @@ def _path(args: argparse.Namespace) -> int:
 
 def run(args: argparse.Namespace) -> int:
     if args.maps_action == "list":
-        return _list()
+        return _list(args.files)
     if args.maps_action == "get":
         return _get(args)
     if args.maps_action == "path":

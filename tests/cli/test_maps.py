@@ -36,6 +36,19 @@ def test_list_prints_one_line_per_map(capsys) -> None:
     assert "1.6 MB" in warehouse
 
 
+def test_list_files_gives_each_files_pinned_url_and_sha256(capsys) -> None:
+    assert main(["maps", "list", "--files"]) == 0
+    out = capsys.readouterr().out
+    for entry in CATALOGUE.values():
+        for f in entry.files:
+            url = entry.url(f)
+            line = next(x for x in out.splitlines() if f"sha256 {f.sha256}" in x)
+            assert line.strip().startswith(f.filename + " ")
+            assert (url in line) if url else "written by this package" in line
+            if url:
+                assert f"/{entry.commit}/" in url and len(entry.commit) == 40
+
+
 def test_path_without_name_is_the_cache(cache, capsys) -> None:
     assert main(["maps", "path"]) == 0
     assert capsys.readouterr().out.strip() == str(cache)
