@@ -272,6 +272,7 @@ def build_params(
     *layers: Any,
     overrides: Iterable[str] = (),
     presets: Mapping[str, Any] | None = None,
+    renamed: Mapping[str, tuple[str, str]] | None = None,
 ) -> T:
     """Build the frozen parameter dataclass ``cls``: layers merged in order, then overrides.
 
@@ -286,6 +287,8 @@ def build_params(
             by key: mappings merge, any other value replaces.
         overrides: ``"a.b=value"`` strings applied last (the value read as a YAML scalar).
         presets: Named layers (dataclass instances or mappings) that a string may name.
+        renamed: Published keys that were renamed, old dotted path -> (new one, why): using
+            an old key is an error naming the new one and the reason.
 
     Returns:
         The ``cls`` instance; a lone layer that already is one, without overrides, as is.
@@ -300,7 +303,19 @@ def build_params(
     merged: dict[str, Any] = {}
     for layer in given:
         _merge_into(merged, _layer_data(layer, presets))
-    return from_dict(cls, merge_overrides(merged, overrides))
+    merged = merge_overrides(merged, overrides)
+    for old, (new, why) in (renamed or {}).items():
+        node: Any = merged
+        for part in old.split("."):
+            node = node.get(part, _MISSING) if isinstance(node, Mapping) else _MISSING
+        if node is not _MISSING:
+            raise ConfigError(
+                f"config key {old!r} was renamed {new!r} ({why}); use {new}={short_repr(node)}"
+            )
+    return from_dict(cls, merged)
+
+
+_MISSING = object()
 
 
 def load_yaml(path: str | os.PathLike) -> dict[str, Any]:

@@ -119,10 +119,14 @@ class EnvConfig:
                 f"physics.max_substep_travel_m={self.physics.max_substep_travel_m:g}"
             )
 
-#: Config keys renamed since they were published: old dotted path -> new one.
-RENAMED_KEYS: dict[str, str] = {
-    # "new area" read as m^2 newly mapped, but the term is a net change (it can be negative).
-    "reward.new_area_weight": "reward.free_area_change_weight",
+
+#: Config keys renamed since they were published: old dotted path -> (new one, why).
+RENAMED_KEYS: dict[str, tuple[str, str]] = {
+    "reward.new_area_weight": (
+        "reward.free_area_change_weight",
+        "the term is the net change of the map's free area per step, negative when free cells "
+        "are re-marked occupied",
+    ),
 }
 
 
@@ -151,13 +155,6 @@ def load_env_config(
         ConfigError: unknown preset, unknown key (named with its dotted path) or a bad value.
         FileNotFoundError: a config path that does not exist.
     """
-    try:
-        return build_params(EnvConfig, config, overrides=overrides or (), presets=PRESETS)
-    except ConfigError as e:
-        for old, new in RENAMED_KEYS.items():
-            if repr(old) in str(e) or repr(old.split(".")[-1]) in str(e):
-                raise ConfigError(
-                    f"config key {old!r} was renamed {new!r} (the term is the net change of the "
-                    "map's free area per step, negative when free cells are re-marked occupied)"
-                ) from None
-        raise
+    return build_params(
+        EnvConfig, config, overrides=overrides or (), presets=PRESETS, renamed=RENAMED_KEYS
+    )
