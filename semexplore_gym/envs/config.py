@@ -10,7 +10,7 @@ from typing import Any
 
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
-from semexplore_gym.core.params import ConfigError, build_params
+from semexplore_gym.core.params import build_params
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 
