@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from semexplore_gym.evaluation.suites import world_family
+
 #: Per family, the parameter sets that cycle over the sweep's worlds (sizes small to large).
 FAMILIES: dict[str, list[str]] = {
     "maze": [
@@ -68,10 +70,6 @@ def sweep_worlds(families: list[str], per_family: int, seed0: int) -> list[str]:
     return worlds
 
 
-def _family(world: str) -> str:
-    return world.partition(":")[0]
-
-
 def _ok(row: dict[str, Any], ok_coverage: float) -> bool:
     return bool(row["self_stopped"]) and float(row["coverage"]) >= ok_coverage
 
@@ -83,12 +81,12 @@ def summarise(rows: list[dict[str, Any]], ok_coverage: float) -> str:
         "| collisions | median mission time (s) | median coverage |",
         "|---|---|---:|---:|---:|---:|---:|---:|",
     ]
-    keys = sorted({(_family(r["world"]), r["policy"]) for r in rows})
+    keys = sorted({(world_family(r["world"]), r["policy"]) for r in rows})
     for family, policy in [*keys, ("all", None)]:
         sel = [
             r
             for r in rows
-            if (family == "all" or _family(r["world"]) == family)
+            if (family == "all" or world_family(r["world"]) == family)
             and (policy is None or r["policy"] == policy)
         ]
         if not sel:
