@@ -28,20 +28,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from semexplore_gym.core.planning.graph_search import FrontierCostWeights
+from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.evaluation.harness import resolve_world
 from semexplore_gym.evaluation.rollout import make_mission_env
 
-#: The paper's weights (Table I of Fredriksson et al.), as dotted overrides.
+_PAPER_COST = FrontierCostWeights()
+_PAPER_POTENTIAL = PotentialFieldParams()
+#: The paper's weights (Table I of Fredriksson et al.; the dataclass defaults), as dotted
+#: overrides.
 PAPER_WEIGHTS: dict[str, float] = {
-    "cost.w_v": 4.0,
-    "cost.w_p": 0.2,
-    "cost.w_i": 0.1,
+    f"cost.{k}": float(getattr(_PAPER_COST, k)) for k in ("w_v", "w_p", "w_i")
 }
-#: The paper's potential-field parameters, as dotted overrides.
+#: The paper's potential-field parameters (the dataclass defaults), as dotted overrides.
 PAPER_FIELD: dict[str, float] = {
-    "potential_field.f_g": 30.0,
-    "potential_field.f_o": 0.065,
-    "potential_field.f_l": 1.5,
+    f"potential_field.{k}": float(getattr(_PAPER_POTENTIAL, k)) for k in ("f_g", "f_o", "f_l")
 }
 
 Objective = Callable[[dict[str, float]], float]

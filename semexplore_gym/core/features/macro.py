@@ -37,7 +37,7 @@ import numpy as np
 
 from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.params import require_finite
-from semexplore_gym.core.planning.graph_search import FrontierCandidate
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 N_CANDIDATE_FEATURES = 8
 N_GLOBAL_FEATURES = 4
@@ -156,11 +156,13 @@ def observation_size(params: MacroParams) -> int:
     return params.n_candidates * N_CANDIDATE_FEATURES + N_GLOBAL_FEATURES
 
 
-#: Ranges ``(low, paper, high)`` of ``w_v``, ``w_p``, ``w_I`` for :func:`action_to_weights`.
+_PAPER = FrontierCostWeights()
+#: Ranges ``(low, paper, high)`` of ``w_v``, ``w_p``, ``w_I`` for :func:`action_to_weights`
+#: (the middle values are the paper's, the defaults of :class:`FrontierCostWeights`).
 WEIGHT_RANGES: tuple[tuple[float, float, float], ...] = (
-    (0.0, 4.0, 10.0),
-    (0.0, 0.2, 1.0),
-    (0.0, 0.1, 1.0),
+    (0.0, _PAPER.w_v, 10.0),
+    (0.0, _PAPER.w_p, 1.0),
+    (0.0, _PAPER.w_i, 1.0),
 )
 
 
