@@ -49,7 +49,12 @@ CSV_COLUMNS: tuple[str, ...] = (
     "wall_time_s",
     "explored_area_m2",
     "steps",
+    "scored_replans",
+    "semantic_share",
 )
+
+#: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
+OPTIONAL_COLUMNS: frozenset[str] = frozenset({"scored_replans", "semantic_share"})
 
 
 def resolve_world(world: str, seed: int) -> str:
@@ -179,6 +184,7 @@ def run_task(task: Task) -> dict[str, Any]:
         "wall_time_s": res.wall_time_s,
         "explored_area_m2": res.explored_area_m2,
         "steps": res.steps,
+        **semantic_share_cells(res.policy_counters),
     }
     return {
         "row": row,
@@ -187,8 +193,21 @@ def run_task(task: Task) -> dict[str, Any]:
     }
 
 
+def semantic_share_cells(counters: dict[str, int]) -> dict[str, Any]:
+    """The semantic expert's replans with scored frontiers, and the share of them in which the
+    semantic gain changed the chosen frontier (None for policies that do not count them)."""
+    scored = counters.get("scored_replans")
+    if scored is None:
+        return {"scored_replans": None, "semantic_share": None}
+    decisive = counters.get("semantic_decisive", 0)
+    return {
+        "scored_replans": int(scored),
+        "semantic_share": (decisive / scored) if scored > 0 else None,
+    }
+
+
 def _parse_row(raw: dict[str, Any], where: str) -> dict[str, Any]:
-    if None in raw or any(raw.get(k) is None for k in CSV_COLUMNS):
+    if None in raw or any(raw.get(k) is None for k in CSV_COLUMNS if k not in OPTIONAL_COLUMNS):
         raise ValueError(f"{where}: expected {len(CSV_COLUMNS)} cells")
     row: dict[str, Any] = {}
     for k, v in raw.items():
@@ -206,7 +225,9 @@ def _parse_row(raw: dict[str, Any], where: str) -> dict[str, Any]:
             row[k] = None
         else:
             try:
-                row[k] = int(v) if k in ("seed", "collisions", "steps") else float(v)
+                row[k] = (
+                    int(v) if k in ("seed", "collisions", "steps", "scored_replans") else float(v)
+                )
             except ValueError:
                 raise ValueError(f"{where}: {k} is not a number: {short_repr(v)}") from None
     return row

@@ -31,6 +31,7 @@ SUMMARY_METRICS: tuple[tuple[str, str], ...] = (
     ("mean_global_planning_ms", "global planning (ms)"),
     ("wall_time_s", "wall time (s)"),
     ("collisions", "collisions"),
+    ("semantic_share", "semantic share of replans"),
 )
 
 
@@ -113,11 +114,12 @@ def _comparison_table(
         return []
     lines = [
         f"{reference} vs each other policy, paired by {paired_by}. Ratio = median({reference}) / "
-        "median(other); p = two-sided Mann–Whitney U; wins = missions where "
-        f"{reference} is lower.",
+        f"median(other); paired ratio = median over pairs of {reference} / other (worlds of "
+        "different sizes pooled in a family weigh alike); p = two-sided Mann–Whitney U; wins = "
+        f"missions where {reference} is lower.",
         "",
-        "| vs | metric | ratio of medians | p (Mann–Whitney U) | wins |",
-        "|---|---|---:|---:|---:|",
+        "| vs | metric | ratio of medians | paired ratio | p (Mann–Whitney U) | wins |",
+        "|---|---|---:|---:|---:|---:|",
     ]
 
     def key(r: dict[str, Any]) -> tuple[str, int]:
@@ -138,16 +140,22 @@ def _comparison_table(
             a = np.array([x for x, _ in both], dtype=float)
             b = np.array([y for _, y in both], dtype=float)
             if a.size == 0:
-                lines.append(f"| {other} | {label} | – | – | – |")
+                lines.append(f"| {other} | {label} | – | – | – | – |")
                 continue
             ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
+            pos = b > 0
+            paired = f"{np.median(a[pos] / b[pos]):.2f}" if np.any(pos) else "–"
             if a.size >= 2 and np.all(a == a[0]) and np.all(b == b[0]):
                 # Each side one repeated value: a test or a win count over copies means nothing.
-                lines.append(f"| {other} | {label} | {ratio:.2f} | {no_variation(a.size)} | – |")
+                lines.append(
+                    f"| {other} | {label} | {ratio:.2f} | {paired} | {no_variation(a.size)} | – |"
+                )
                 continue
             p = mannwhitneyu(a, b, alternative="two-sided").pvalue if a.size >= 2 else math.nan
             wins = int(np.sum(a < b))
-            lines.append(f"| {other} | {label} | {ratio:.2f} | {p:.3g} | {wins}/{a.size} |")
+            lines.append(
+                f"| {other} | {label} | {ratio:.2f} | {paired} | {p:.3g} | {wins}/{a.size} |"
+            )
     lines.append("")
     return lines
 

@@ -98,12 +98,12 @@ def test_identical_samples_print_no_variation_instead_of_p(tmp_path) -> None:
     )
     text = write_summary(tmp_path).read_text()
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | mission time |"))
-    ratio, p, wins = (c.strip() for c in line.strip("|").split("|")[2:5])
-    assert ratio == "0.67"
+    ratio, paired, p, wins = (c.strip() for c in line.strip("|").split("|")[2:6])
+    assert ratio == "0.67" and paired == "0.67"
     assert p == "no variation (4 identical samples)" and wins == "–"
     # A metric that varies still gets its test.
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | global planning"))
-    assert "no variation" not in line and line.strip("|").split("|")[4].strip() == "0/4"
+    assert "no variation" not in line and line.strip("|").split("|")[5].strip() == "0/4"
     semantic = next(ln for ln in text.splitlines() if ln.startswith("| semantic | 4 |"))
     assert "100.0 — no variation (4 identical samples)" in semantic
 
@@ -135,6 +135,9 @@ def test_bracket_overrides_change_the_mission(tmp_path, capsys) -> None:
     assert np.allclose(a[0], b[0])  # same start
     assert a.shape != b.shape or not np.allclose(a, b)  # another mission
     assert f"| {wv0} | 1 |" in (out / "summary.md").read_text()  # the whole spec is the label
+    # Every expert row carries its replan count and the share the semantic gain decided.
+    for r in rows.values():
+        assert r["scored_replans"] > 0 and 0.0 <= r["semantic_share"] <= 1.0
 
 
 def test_explore_takes_the_same_bracket(capsys) -> None:
@@ -222,6 +225,8 @@ def test_a_user_suite_runs_end_to_end_with_family_tables(tmp_path, capsys) -> No
     ):
         assert heading in summary
     assert "## All worlds (2 worlds)" in summary and "| semantic | 4 |" in summary
+    # Baselines do not score semantics: their share cells stay empty.
+    assert all(r["semantic_share"] is None for r in rows if r["policy"] == "nearest")
     manifest = json.loads((out / "benchmark.json").read_text())
     assert manifest["suites"][0]["name"] == "tiny" and manifest["suites"][0]["version"] == 2
     fingerprint = json.loads((out / "fingerprint.json").read_text())

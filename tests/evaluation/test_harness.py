@@ -92,8 +92,9 @@ def test_summary_compares_reference_with_each_baseline(tmp_path) -> None:
     text = write_summary(tmp_path).read_text()
     assert "## maze1" in text and "| semantic | 6 | 6/6 |" in text
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | mission time |"))
-    ratio, p, wins = (c.strip() for c in line.strip("|").split("|")[2:5])
+    ratio, paired, p, wins = (c.strip() for c in line.strip("|").split("|")[2:6])
     assert float(ratio) < 0.75  # ~110 s vs ~170 s
+    assert float(paired) < 0.75
     assert float(p) < 0.01
     assert wins == "6/6"
 
