@@ -118,12 +118,13 @@ def expand_tasks(
     ]
 
 
-def _slug(text: str) -> str:
+def file_slug(text: str) -> str:
+    """``text`` made safe as part of a file name (at most 120 characters)."""
     return re.sub(r"[^A-Za-z0-9._=-]+", "_", text).strip("_")[:120] or "x"
 
 
 def task_stem(world: str, policy: str, seed: int) -> str:
-    return f"{_slug(world)}__{_slug(policy)}__{seed}"
+    return f"{file_slug(world)}__{file_slug(policy)}__{seed}"
 
 
 def _warm_up_config_key(env_config: Any) -> str:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from semexplore_gym.evaluation.harness import read_runs, task_stem
+from semexplore_gym.evaluation.harness import file_slug, read_runs, task_stem
 
 #: The policy every other one is compared against in ``summary.md``.
 REFERENCE_POLICY = "semantic"
@@ -245,31 +245,28 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     colours = {p: plt.get_cmap("tab10")(i % 10) for i, p in enumerate(policies)}
     paths: list[Path] = []
 
-    # 1. Explored free area over time, mean and min-max band.
+    # 1. Explored free area over time, mean and min-max band: per world, and per family with
+    # one panel per world class (the family's worlds that differ only in their seed).
     fig, panels = _panels(plt, len(worlds), 5.2)
     for ax, world in zip(panels, worlds, strict=True):
-        for policy, rs in groups[world].items():
-            traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
-            if not traces:
-                continue
-            t_end = max(float(t[-1, 0]) for t in traces)
-            grid = np.linspace(0.0, max(t_end, 1e-6), 300)
-            # After a mission ends its area stays at its final value.
-            ys = np.stack([np.interp(grid, t[:, 0], t[:, 2]) for t in traces])
-            ax.plot(
-                grid,
-                ys.mean(axis=0),
-                color=colours[policy],
-                label=f"{policy_label(policy)} (n={len(traces)})",
-            )
-            ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
-        ax.set_title(world_label(world))
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("explored free area (m²)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        _area_curves(ax, out, groups[world], colours, world_label(world))
     fig.tight_layout()
     paths.append(_save(fig, out / "explored_area.png"))
+    families = group_by_family(rows)
+    if len(groups) > 1:
+        for fam, by_policy in families.items():
+            classes: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(
+                lambda: defaultdict(list)
+            )
+            for policy, rs in by_policy.items():
+                for r in rs:
+                    classes[world_class(r["world"])][policy].append(r)
+            fig, panels = _panels(plt, len(classes), 5.2)
+            for ax, (name, by_pol) in zip(panels, classes.items(), strict=True):
+                _area_curves(ax, out, by_pol, colours, world_label(name))
+            fig.suptitle(f"{fam}: explored free area over time (mean, min–max band)")
+            fig.tight_layout()
+            paths.append(_save(fig, out / f"explored_area_{file_slug(fam)}.png"))
 
     # 2-4. Box plots per world: mission time, map-generation time, global-planning time.
     for key, ylabel, name in (
@@ -310,6 +307,44 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     # 5. Trajectory of the median (by mission time) run of each world and policy.
     paths.append(_trajectory_figure(out, groups, worlds, policies, colours, plt))
     return paths
+
+
+def world_class(world: str) -> str:
+    """A world spelling without its seed: the worlds of a suite that differ only in it.
+
+    ``office:seed=300,size_m=12`` becomes ``office:size_m=12``; other spellings are unchanged.
+    """
+    head, sep, args = world.partition(":")
+    if not sep or "/" in world or "\\" in world:
+        return world
+    kept = [a for a in args.split(",") if not a.strip().startswith("seed=")]
+    return f"{head}:{','.join(kept)}" if kept else head
+
+
+def _area_curves(
+    ax: Any, out: Path, by_policy: dict[str, list[dict[str, Any]]], colours: dict, title: str
+) -> None:
+    """Mean explored area over time with a min-max band, one line per policy."""
+    for policy, rs in by_policy.items():
+        traces = [t for t in (_trace(out, r) for r in rs) if t is not None]
+        if not traces:
+            continue
+        t_end = max(float(t[-1, 0]) for t in traces)
+        grid = np.linspace(0.0, max(t_end, 1e-6), 300)
+        # After a mission ends its area stays at its final value.
+        ys = np.stack([np.interp(grid, t[:, 0], t[:, 2]) for t in traces])
+        ax.plot(
+            grid,
+            ys.mean(axis=0),
+            color=colours[policy],
+            label=f"{policy_label(policy)} (n={len(traces)})",
+        )
+        ax.fill_between(grid, ys.min(axis=0), ys.max(axis=0), color=colours[policy], alpha=0.2)
+    ax.set_title(title)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("explored free area (m²)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
 
 
 #: Panels per row of the per-world figures (a suite has dozens of worlds).

@@ -288,3 +288,17 @@ def test_many_worlds_plot_in_a_grid(tmp_path) -> None:
     paths = {p.name: p for p in write_plots(tmp_path)}
     with Image.open(paths["explored_area.png"]) as im:
         assert im.size[0] < im.size[1] * 3  # two rows of at most four panels, not one long row
+    # One exploration-curve figure per family, one panel per world class (seeds pooled).
+    assert {"explored_area_paper_mazes.png", "explored_area_maze.png"} <= set(paths)
+    with Image.open(paths["explored_area_maze.png"]) as im:
+        assert im.size[0] < 800  # the four seed=i,size_m=4 worlds share one panel
+
+
+def test_world_class_drops_only_the_seed() -> None:
+    from semexplore_gym.evaluation.report import world_class
+
+    assert world_class("office:seed=300,size_m=12") == "office:size_m=12"
+    assert world_class("forest:size_m=8,seed=3,density=2") == "forest:size_m=8,density=2"
+    assert world_class("maze:seed=*") == "maze"
+    assert world_class("maze1") == "maze1"
+    assert world_class("/maps/a:b/map.yaml") == "/maps/a:b/map.yaml"
