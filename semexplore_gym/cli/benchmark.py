@@ -135,7 +135,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     which.add_argument(
         "--suite",
-        help="comma-separated suite names (configs/suites: paper, mazes, offices, caves, open) "
+        help="comma-separated suite names (configs/suites: paper, mazes, offices, caves, open, real) "
         "or suite YAML paths; each world gets the suite's time limit, runs and start poses",
     )
     p.add_argument(

@@ -200,10 +200,13 @@ def save_suite(suite: Suite, path: str | os.PathLike) -> Path:
 
 
 def world_family(world: str) -> str:
-    """The family a world belongs to in a summary: ``maze``, ``office``, ..., or the map's file."""
+    """The family a world belongs to in a summary: ``maze``, ``office``, ..., ``real maps`` for
+    catalogue maps (``map:NAME``), or the file name of a map given by path."""
     if world.lower().endswith((".yaml", ".yml", ".json")):
         return Path(world).stem
     name = world.partition(":")[0]
+    if name == "map":
+        return "real maps"
     return "paper mazes" if name in ("maze1", "maze2") else name
 
 

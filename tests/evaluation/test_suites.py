@@ -19,8 +19,32 @@ from semexplore_gym.evaluation.suites import (
 )
 
 
+SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
+
+
 def test_the_shipped_suites_are_there() -> None:
-    assert {"paper", "mazes", "offices", "caves", "open"} <= set(list_suites())
+    assert {"paper", "mazes", "offices", "caves", "open", "real"} <= set(list_suites())
+
+
+def test_the_real_suite_names_catalogue_maps(monkeypatch: pytest.MonkeyPatch) -> None:
+    from semexplore_gym.core.worlds.catalogue import CATALOGUE
+
+    suite = load_suite("real")
+    names = [w.world.removeprefix("map:") for w in suite.worlds]
+    assert all(w.world.startswith("map:") for w in suite.worlds)
+    assert set(names) <= set(CATALOGUE) and len(names) >= 10
+    assert {world_family(w.world) for w in suite.worlds} == {"real maps"}
+    if not SHARED_MAPS.is_dir():
+        pytest.skip(f"shared maps not found at {SHARED_MAPS}")
+    monkeypatch.setenv("SEMEXPLORE_MAPS_DIR", str(SHARED_MAPS))
+    limits = {}
+    for entry in suite.worlds:
+        world = make_world(entry.world)
+        area = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
+        limits[entry.world] = (area, world_time_limit_s(suite, entry, area))
+    # Per-map limits grow with the explorable area (600 s at least).
+    big = max(limits.values())
+    assert big[1] == pytest.approx(6.0 * big[0]) and min(v[1] for v in limits.values()) == 600.0
 
 
 @pytest.mark.parametrize("name", ["paper", "mazes", "offices", "caves", "open"])
