@@ -18,7 +18,6 @@ from semexplore_gym.evaluation.suites import (
     world_time_limit_s,
 )
 
-
 SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
 
 
