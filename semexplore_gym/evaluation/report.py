@@ -160,6 +160,53 @@ def _comparison_table(
     return lines
 
 
+def _overview_table(
+    families: dict[str, dict[str, list[dict[str, Any]]]], reference: str
+) -> list[str]:
+    """One row per (family, policy): medians, and the reference's mission time against it."""
+    from scipy.stats import mannwhitneyu
+
+    lines = [
+        "## Overview",
+        "",
+        f"Medians per family. `{reference} ÷ policy` = median over (world, seed) pairs of "
+        f"{reference}'s mission time divided by the policy's (< 1: {reference} is faster); p = "
+        "two-sided Mann–Whitney U on the paired missions' times.",
+        "",
+        "| family | policy | n | self-stopped | coverage | mission time (s) | T90 (s) | "
+        f"semantic share | {reference} ÷ policy | p |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+
+    def med(rs: list[dict[str, Any]], key: str) -> str:
+        v = _values(rs, key)
+        return _fmt(float(np.median(v)), float(np.median(v))) if v.size else "–"
+
+    for fam, by_policy in families.items():
+        ref = {(r["world"], int(r["seed"])): r for r in by_policy.get(reference, [])}
+        for policy, rs in by_policy.items():
+            ratio, p = "–", "–"
+            if policy != reference and ref:
+                pairs = [
+                    (ref[k]["mission_time_s"], r["mission_time_s"])
+                    for r in rs
+                    if (k := (r["world"], int(r["seed"]))) in ref and r["mission_time_s"]
+                ]
+                if pairs:
+                    a, b = np.array(pairs, dtype=float).T
+                    ratio = f"{np.median(a / b):.2f}"
+                    if a.size >= 2 and not (np.all(a == a[0]) and np.all(b == b[0])):
+                        p = f"{mannwhitneyu(a, b, alternative='two-sided').pvalue:.3g}"
+            stopped = sum(1 for r in rs if r["self_stopped"])
+            lines.append(
+                f"| {fam} | {policy} | {len(rs)} | {stopped}/{len(rs)} | {med(rs, 'coverage')} | "
+                f"{med(rs, 'mission_time_s')} | {med(rs, 'T90_s')} | "
+                f"{med(rs, 'semantic_share')} | {ratio} | {p} |"
+            )
+    lines.append("")
+    return lines
+
+
 def _suite_lines(out: Path) -> list[str]:
     """Which suites (name, version) the run came from, as recorded in ``benchmark.json``."""
     import json
@@ -194,6 +241,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     ]
     if len(groups) > 1:
         families = group_by_family(rows)
+        lines += _overview_table(families, reference)
         lines += [
             "## Per family",
             "",

@@ -302,3 +302,22 @@ def test_world_class_drops_only_the_seed() -> None:
     assert world_class("maze:seed=*") == "maze"
     assert world_class("maze1") == "maze1"
     assert world_class("/maps/a:b/map.yaml") == "/maps/a:b/map.yaml"
+
+
+def test_the_overview_has_one_row_per_family_and_policy(tmp_path) -> None:
+    worlds = ["maze1", *(f"maze:seed={i},size_m=4" for i in range(3))]
+    run_benchmark(
+        expand_tasks(worlds, ["semantic", "frontier"], [0, 1, 2, 3]),
+        tmp_path,
+        progress=False,
+        task_fn=_constant,
+    )
+    text = write_summary(tmp_path).read_text()
+    overview = text.split("## Overview")[1].split("## Per family")[0]
+    rows = [
+        ln for ln in overview.splitlines() if ln.startswith("| paper") or ln.startswith("| maze")
+    ]
+    assert len(rows) == 4  # 2 families x 2 policies
+    frontier_maze = next(r for r in rows if r.startswith("| maze | frontier |"))
+    cells = [c.strip() for c in frontier_maze.strip("|").split("|")]
+    assert cells[2] == "12" and cells[8] == "0.67"  # 3 worlds x 4 seeds; 100 s / 150 s
