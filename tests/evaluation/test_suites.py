@@ -43,7 +43,8 @@ def test_the_real_suite_names_catalogue_maps(monkeypatch: pytest.MonkeyPatch) ->
         limits[entry.world] = (area, world_time_limit_s(suite, entry, area))
     # Per-map limits grow with the explorable area (600 s at least).
     big = max(limits.values())
-    assert big[1] == pytest.approx(6.0 * big[0]) and min(v[1] for v in limits.values()) == 600.0
+    assert big[1] == pytest.approx(suite.time_per_m2_s * big[0])
+    assert min(v[1] for v in limits.values()) == suite.min_time_s == 600.0
 
 
 @pytest.mark.parametrize("name", ["paper", "mazes", "offices", "caves", "open"])
