@@ -52,6 +52,7 @@ from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     search_frontier_paths,
 )
+from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
@@ -194,7 +195,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         self._last_cmd: PotentialFieldCommand | None = None
         self._still_s = 0.0
         self._escape_until_s = -1.0
-        self._known_cells = int(np.count_nonzero(np.asarray(obs["map"]) != UNKNOWN))
+        self._known_cells = known_cell_count(obs["map"])
         prm = self.params
         self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
         # Stuck: the robot stayed near one point while the map hardly grew ...
@@ -227,7 +228,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         scan = np.asarray(obs["scan"], dtype=np.float64)
         if self._angles is None or len(self._angles) != len(scan):
             self._angles = beam_angles_rad(len(scan))
-        self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
+        self._known_cells = known_cell_count(grid)
         self._trail.add((int(pose[0] // TRAIL_CELL_M), int(pose[1] // TRAIL_CELL_M)))
 
         if self._backoff.active(self._time_s):
