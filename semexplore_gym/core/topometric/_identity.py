@@ -68,7 +68,7 @@ def _match_by_overlap(
     pr, pc = previous.geometry.world_to_grid(skeleton_xy_m[:, 0], skeleton_xy_m[:, 1])
     inside = previous.geometry.contains(pr, pc)
     prev_id = np.full(skeleton_region.size, -1, dtype=np.int64)
-    prev_id[inside] = previous.area_ids[pr[inside], pc[inside]]
+    prev_id[inside] = previous.area_ids_at(pr[inside], pc[inside])
     ok = prev_id >= 0
     if ok.any():
         base = int(prev_id.max()) + 1

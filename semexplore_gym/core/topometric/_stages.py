@@ -40,12 +40,12 @@ from semexplore_gym.core.topometric.kernels.regions import (
     build_regions,
     grow_regions,
     region_centres,
-    scatter_labels,
+    window_labels,
 )
 from semexplore_gym.core.topometric.kernels.skeleton import thin
 from semexplore_gym.core.topometric.kernels.skeleton_graph import skeleton_graph
 from semexplore_gym.core.topometric.params import SegmentationParams
-from semexplore_gym.core.topometric.types import AreaType, TopometricMap
+from semexplore_gym.core.topometric.types import AreaRasterCrop, AreaType, TopometricMap
 
 if TYPE_CHECKING:
     from semexplore_gym.core.topometric.segmentation import _Scratch
@@ -427,10 +427,12 @@ class _Segmenter:
         frontiers = frontier_records(fronts, fronts_len, ids_l, openings)
         n_inter = int(np.count_nonzero(prov_type == int(AreaType.INTERSECTION)))
         l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
-        area_raster = np.empty(self.g.shape, dtype=np.int32)
-        scatter_labels(
-            area_raster, self.lab, ids[:n_reg].astype(np.int32), self.W, self.r0, self.c0
-        )
+        # Only the work grid's window is labelled: the full raster is built if someone reads it.
+        H0, W0 = self.g.shape
+        ra, rb = max(0, -self.r0), min(self.H, H0 - self.r0)
+        ca, cb = max(0, -self.c0), min(self.W, W0 - self.c0)
+        window = window_labels(self.lab, ids[:n_reg].astype(np.int32), self.W, ra, rb, ca, cb)
+        area_raster = AreaRasterCrop(self.g.shape, self.r0 + ra, self.c0 + ca, window)
         self._lap("assemble")
         extras = self._extras(next_id)
         return TopometricMap(
