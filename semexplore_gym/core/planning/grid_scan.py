@@ -31,7 +31,7 @@ _EVEN = 0x00FF00FF00FF00FF
 
 
 @njit(cache=True, boundscheck=False)
-def _byte_sum(acc: uint64) -> int:  # pragma: no cover - numba
+def _byte_sum(acc):  # type: ignore[no-untyped-def]  # pragma: no cover - numba
     """Sum of the eight byte lanes of ``acc``."""
     even = uint64(_EVEN)
     s = (acc & even) + ((acc >> uint64(8)) & even)

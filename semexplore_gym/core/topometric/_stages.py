@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -437,7 +437,7 @@ class _Segmenter:
         extras = self._extras(next_id)
         return TopometricMap(
             geometry=self.g,
-            area_ids=area_raster,
+            area_ids=cast(np.ndarray, area_raster),  # the field accepts the window too
             areas=areas,
             openings=openings,
             frontiers=frontiers,

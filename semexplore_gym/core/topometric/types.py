@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -212,7 +212,11 @@ class TopometricMap:
     """
 
     geometry: GridGeometry
-    area_ids: np.ndarray = _AreaIdsField()  # type: ignore[assignment]
+    if TYPE_CHECKING:
+        area_ids: np.ndarray
+    else:
+        # the descriptor stores an array or an AreaRasterCrop and always returns the array
+        area_ids: np.ndarray = _AreaIdsField()
     areas: dict[int, Area]
     openings: list[Opening]
     frontiers: list[Frontier]
