@@ -41,39 +41,51 @@ def _byte_sum(acc):  # type: ignore[no-untyped-def]  # pragma: no cover - numba
 
 
 @njit(cache=True, boundscheck=False)
-def _unknown_in_words(words: np.ndarray) -> int:  # pragma: no cover - numba
-    """Bytes equal to UNKNOWN (128) in ``words`` ``(n_blocks, _BLOCK_WORDS)``."""
+def _unknown_cells(flat):  # type: ignore[no-untyped-def]  # pragma: no cover - numba
+    """Bytes of the uint8 array ``flat`` equal to UNKNOWN (128)."""
     low7 = uint64(_LOW7)
     high = uint64(_HIGH)
     seven = uint64(7)
+    n = flat.size
+    n_blocks = n // (8 * _BLOCK_WORDS)
+    if flat.ctypes.data % 8:
+        n_blocks = 0  # not word-aligned: bytes only
+    head = n_blocks * _BLOCK_WORDS * 8
+    words = flat[:head].view(np.uint64)
     n_unknown = 0
-    for b in range(words.shape[0]):
-        row = words[b]
+    for b in range(n_blocks):
         acc = uint64(0)  # one counter per byte lane
-        for k in range(row.size):
-            y = row[k] ^ high
+        for k in range(b * _BLOCK_WORDS, (b + 1) * _BLOCK_WORDS):
+            y = words[k] ^ high
             # high bit of each byte set where that byte of y is non-zero (exact: no carries)
             nz_y = (((y & low7) + low7) | y) & high
             acc += ((~nz_y) & high) >> seven
         n_unknown += _byte_sum(acc)
+    for k in range(head, n):
+        n_unknown += flat[k] == 128
     return n_unknown
 
 
 @njit(cache=True, boundscheck=False)
-def _word_stats(words: np.ndarray) -> tuple[int, bool]:  # pragma: no cover - numba
-    """:func:`_unknown_in_words`, and whether a byte is none of OCCUPIED (0) / UNKNOWN (128) /
+def _grid_stats(flat):  # type: ignore[no-untyped-def]  # pragma: no cover - numba
+    """:func:`_unknown_cells`, and whether a byte is none of OCCUPIED (0) / UNKNOWN (128) /
     FREE (255)."""
     low7 = uint64(_LOW7)
     high = uint64(_HIGH)
     seven = uint64(7)
+    n = flat.size
+    n_blocks = n // (8 * _BLOCK_WORDS)
+    if flat.ctypes.data % 8:
+        n_blocks = 0
+    head = n_blocks * _BLOCK_WORDS * 8
+    words = flat[:head].view(np.uint64)
     n_unknown = 0
     bad = uint64(0)
-    for b in range(words.shape[0]):
-        row = words[b]
+    for b in range(n_blocks):
         acc = uint64(0)
         block_bad = uint64(0)
-        for k in range(row.size):
-            x = row[k]
+        for k in range(b * _BLOCK_WORDS, (b + 1) * _BLOCK_WORDS):
+            x = words[k]
             y = x ^ high
             nz_y = (((y & low7) + low7) | y) & high  # byte != 128
             nz_x = (((x & low7) + low7) | x) & high  # byte != 0
@@ -83,16 +95,12 @@ def _word_stats(words: np.ndarray) -> tuple[int, bool]:  # pragma: no cover - nu
             block_bad |= nz_x & nz_y & nz_nx
         bad |= block_bad
         n_unknown += _byte_sum(acc)
-    return n_unknown, bad != 0
-
-
-def _split_words(flat: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
-    """``flat`` as whole blocks of aligned 64-bit words (None if there are none) and the rest."""
-    n_blocks = flat.size // (8 * _BLOCK_WORDS)
-    if not n_blocks or flat.ctypes.data % 8:
-        return None, flat
-    head = n_blocks * _BLOCK_WORDS * 8
-    return flat[:head].view(np.uint64).reshape(n_blocks, _BLOCK_WORDS), flat[head:]
+    ok = bad == 0
+    for k in range(head, n):
+        v = flat[k]
+        n_unknown += v == 128
+        ok = ok and (v == 0 or v == 128 or v == 255)
+    return n_unknown, ok
 
 
 def encoded_grid_stats(grid: np.ndarray) -> tuple[int, bool]:
@@ -108,22 +116,16 @@ def encoded_grid_stats(grid: np.ndarray) -> tuple[int, bool]:
     flat = np.ravel(grid)
     if flat.dtype != np.uint8:
         raise TypeError(f"grid must have dtype uint8, got {flat.dtype}")
-    words, tail = _split_words(flat)
-    n_unknown, bad = _word_stats(words) if words is not None else (0, False)
-    if tail.size:
-        n_unknown += int(np.count_nonzero(tail == UNKNOWN))
-        bad = bad or not bool(((tail == UNKNOWN) | (tail == 0) | (tail == 255)).all())
-    return int(n_unknown), not bad
+    n_unknown, ok = _grid_stats(flat)
+    return int(n_unknown), bool(ok)
 
 
 def known_cell_count(grid: np.ndarray) -> int:
     """``grid.size - np.count_nonzero(grid == UNKNOWN)``: one fast pass for a uint8 grid."""
-    flat = np.ravel(np.asarray(grid))
+    flat = np.ravel(grid)
     if flat.dtype != np.uint8:
         return int(flat.size - np.count_nonzero(flat == UNKNOWN))
-    words, tail = _split_words(flat)
-    n_unknown = _unknown_in_words(words) if words is not None else 0
-    return int(flat.size - n_unknown - np.count_nonzero(tail == UNKNOWN))
+    return int(flat.size - _unknown_cells(flat))
 
 
 def checked_encoded_grid(grid: npt.ArrayLike, name: str = "grid") -> np.ndarray:
@@ -132,6 +134,6 @@ def checked_encoded_grid(grid: npt.ArrayLike, name: str = "grid") -> np.ndarray:
     Returns ``grid`` as a uint8 array; raises what ``validate_encoded_grid`` raises.
     """
     a = np.asarray(grid)
-    if a.ndim == 2 and a.dtype == np.uint8 and a.size and encoded_grid_stats(a)[1]:
+    if a.ndim == 2 and a.dtype == np.uint8 and a.size and _grid_stats(np.ravel(a))[1]:
         return a
     return validate_encoded_grid(a, name)
