@@ -296,8 +296,12 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
 
     def _unknown_near(self, grid: np.ndarray, xy: tuple[float, float], radius_m: float) -> bool:
         g = self.geometry
-        r0, c0 = (int(v) for v in g.world_to_grid(xy[0] - radius_m, xy[1] - radius_m))
-        r1, c1 = (int(v) for v in g.world_to_grid(xy[0] + radius_m, xy[1] + radius_m))
+        # g.world_to_grid's arithmetic on scalars (called every step: no arrays)
+        ox, oy, res = g.origin_x_m, g.origin_y_m, g.resolution_m
+        c0 = math.floor((float(xy[0] - radius_m) - ox) / res)
+        r0 = math.floor((float(xy[1] - radius_m) - oy) / res)
+        c1 = math.floor((float(xy[0] + radius_m) - ox) / res)
+        r1 = math.floor((float(xy[1] + radius_m) - oy) / res)
         if r0 < 0 or c0 < 0 or r1 >= g.height or c1 >= g.width:
             return True  # the map's edge: beyond it is unknown
         return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())

@@ -302,11 +302,13 @@ def _score_candidates(
     """The cheapest path found to each frontier, scored with ``C = metric - gain``, cheapest
     first (ties by path length)."""
     candidates: list[FrontierCandidate] = []
+    # oriented edge polylines, shared by the candidates' paths (read only)
+    polylines: dict[tuple[int, int], np.ndarray] = {}
     for node, (metric, path) in best.items():
         f = frontier_at[node]
         p_l, n_open, n_fp = semantic_terms(tmap, f)
         gain = w.w_p * p_l + w.w_i * (n_open + n_fp)
-        poly = _assemble(tmap, path, first_legs[path.nodes[0]], f.midpoint_m)
+        poly = _assemble(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
         candidates.append(
             FrontierCandidate(
                 frontier=f,
@@ -438,10 +440,10 @@ def _first_legs(
     best: dict[int, tuple[float, np.ndarray]] = {}
 
     def offer(node: int, dist: float, q: np.ndarray, rest: np.ndarray) -> None:
-        poly = _dedupe(np.vstack([r, q, rest]))
         length = dist + _polyline_length(np.vstack([q, rest]))
         if node not in best or length < best[node][0]:
-            best[node] = (length, poly)
+            # the polyline only for the best offer so far
+            best[node] = (length, _dedupe(np.vstack([r, q, rest])))
 
     for k, e in enumerate(tmap.edges):
         if e.area_id != area_id:
@@ -465,10 +467,22 @@ def _first_legs(
 
 
 def _assemble(
-    tmap: TopometricMap, path: _Partial, first_leg: np.ndarray, goal_xy: tuple[float, float]
+    tmap: TopometricMap,
+    path: _Partial,
+    first_leg: np.ndarray,
+    goal_xy: tuple[float, float],
+    polylines: dict[tuple[int, int], np.ndarray] | None = None,
 ) -> np.ndarray:
+    """The candidate's polyline: first leg, the edges' paths, the goal. ``polylines`` caches
+    :func:`_edge_polyline` by ``(edge, from_node)`` across calls."""
     parts = [first_leg]
     for j, k in enumerate(path.edges):
-        parts.append(_edge_polyline(tmap, k, path.nodes[j]))
+        key = (k, path.nodes[j])
+        poly = polylines.get(key) if polylines is not None else None
+        if poly is None:
+            poly = _edge_polyline(tmap, k, path.nodes[j])
+            if polylines is not None:
+                polylines[key] = poly
+        parts.append(poly)
     parts.append(np.asarray([goal_xy], dtype=np.float64))
     return _dedupe(np.concatenate(parts, axis=0))
