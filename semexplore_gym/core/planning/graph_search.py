@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import numpy as np
 
@@ -132,8 +132,9 @@ class SearchStats:
     n_pruned: int
 
 
-@dataclass(frozen=True)
-class _Partial:
+class _Partial(NamedTuple):
+    """A path of the search (a named tuple: the search builds thousands)."""
+
     nodes: tuple[int, ...]
     edges: tuple[int, ...]
     cost: float
@@ -224,15 +225,20 @@ def search_frontier_paths(
         if f.width_m >= min_frontier_width_m:
             frontier_at[f.opening_id] = f
 
-    adjacency: dict[int, list[tuple[int, int]]] = {}
+    # Edges of the robot's area are never followed (paths do not re-enter it): left out here.
+    adjacency: dict[int, list[tuple[int, int, float]]] = {}
     for k, e in enumerate(tmap.edges):
-        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k))
-        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k))
+        if e.area_id == robot_area:
+            continue
+        d_m = float(e.length_m)
+        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k, d_m))
+        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k, d_m))
+    by_opening = prune_by == "opening"
 
-    def slot(node: int, via_edge: int | None) -> tuple[str, int]:
-        # Which A_cost entry a path ending at `node` competes for.
-        if prune_by == "opening":
-            return ("o", node)
+    def slot(node: int, via_edge: int | None) -> int | tuple[str, int]:
+        # Which A_cost entry a path ending at `node` competes for (by opening: the node).
+        if by_opening:
+            return node
         here = tmap.edges[via_edge].area_id if via_edge is not None else robot_area
         ids = tmap.openings[node].area_ids if 0 <= node < len(tmap.openings) else (here,)
         beyond = [a for a in ids if a >= 0 and a != here]
@@ -240,7 +246,7 @@ def search_frontier_paths(
         return ("a", beyond[0]) if beyond else ("o", node)
 
     first_legs = _first_legs(tmap, robot_area, (rx, ry))
-    a_cost: dict[tuple[str, int], float] = {}
+    a_cost: dict[int | tuple[str, int], float] = {}
     search_list: list[_Partial] = []
     n_pushed = n_popped = n_pruned = 0
     leg_start_angle: dict[int, float] = {}
@@ -263,7 +269,8 @@ def search_frontier_paths(
         path = search_list.pop()
         n_popped += 1
         last = path.nodes[-1]
-        if a_cost.get(slot(last, path.edges[-1] if path.edges else None), math.inf) < path.cost:
+        at = last if by_opening else slot(last, path.edges[-1] if path.edges else None)
+        if a_cost.get(at, math.inf) < path.cost:
             # Reached more cheaply since it was pushed: the A_cost condition, applied at pop.
             n_pruned += 1
             continue
@@ -271,12 +278,11 @@ def search_frontier_paths(
             prev = best.get(last)
             if prev is None or path.cost < prev[0]:
                 best[last] = (path.cost, path)
-        for nbr, k in adjacency.get(last, ()):
-            if nbr in path.nodes or tmap.edges[k].area_id == robot_area:
+        for nbr, k, d_m in adjacency.get(last, ()):
+            if nbr in path.nodes:
                 continue
-            d_m = float(tmap.edges[k].length_m)
             new_cost = path.cost + d_m / l_path
-            key = slot(nbr, k)
+            key = nbr if by_opening else slot(nbr, k)
             if a_cost.get(key, math.inf) <= new_cost:
                 n_pruned += 1
                 continue

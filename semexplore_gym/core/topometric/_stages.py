@@ -472,14 +472,36 @@ class _Segmenter:
         prev = self.previous
         sk_region = np.zeros(0, np.int64)
         sk_xy = np.zeros((0, 2))
+        sk_cells = None
         if prev is not None and prev.areas and self.n_reg:
             sel = self.px[self.lab[self.px] >= 0]
             if sel.size:
                 sk_region = self.lab[sel].astype(np.int64)
-                sk_xy = self._cells_xy(sel)
+                if self._same_frame(prev.geometry):
+                    # the cell centres' world points fall in the same cells of the same grid
+                    r, c = np.divmod(np.asarray(sel, dtype=np.int64), self.W)
+                    sk_cells = (r + self.r0, c + self.c0)
+                else:
+                    sk_xy = self._cells_xy(sel)
         return match_area_ids(
-            prev, self.n_reg, n_prov, centre_xy, sk_region, sk_xy, self.p.match_radius_m
+            prev,
+            self.n_reg,
+            n_prov,
+            centre_xy,
+            sk_region,
+            sk_xy,
+            self.p.match_radius_m,
+            skeleton_cells=sk_cells,
         )
+
+    def _same_frame(self, other: GridGeometry) -> bool:
+        """``other`` is this grid's frame, with coordinates small enough (< 2^40 cells from the
+        world origin) that a cell centre's world point maps back to its own cell exactly."""
+        g = self.g
+        if other != g:
+            return False
+        extent = (abs(g.origin_x_m) + abs(g.origin_y_m)) / g.resolution_m + g.height + g.width
+        return extent < 2.0**40
 
     def _cells_xy(self, cells: np.ndarray) -> np.ndarray:
         """Work-grid flat cell indices to world (x, y) metres of the cell centres, (n, 2)."""
