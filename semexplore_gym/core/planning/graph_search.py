@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
 
 import numpy as np
 
@@ -78,6 +78,42 @@ class FrontierCostWeights:
             )
 
 
+class _PathParts:
+    """A candidate's polyline as the pieces :func:`_assemble` joins (built when first read: a
+    replan scores tens of frontiers and drives to one)."""
+
+    __slots__ = ("parts",)
+
+    def __init__(self, parts: list[np.ndarray]) -> None:
+        self.parts = parts
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"parts": self.parts}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.parts = state["parts"]
+
+    def build(self) -> np.ndarray:
+        return _dedupe(np.concatenate(self.parts, axis=0))
+
+
+class _PathField:
+    """Data descriptor of ``FrontierCandidate.path_m``: stores an array or :class:`_PathParts`,
+    returns the array (joined once, on first read)."""
+
+    def __get__(self, obj: Any, objtype: Any = None) -> np.ndarray:
+        if obj is None:
+            raise AttributeError("path_m")  # no default value for the dataclass field
+        v = obj.__dict__["_path_m"]
+        if isinstance(v, _PathParts):
+            v = v.build()
+            obj.__dict__["_path_m"] = v
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__["_path_m"] = value
+
+
 @dataclass(frozen=True)
 class FrontierCandidate:
     """The cheapest path found to one frontier, with every term of its cost.
@@ -100,7 +136,10 @@ class FrontierCandidate:
 
     frontier: Frontier
     goal_xy_m: tuple[float, float]
-    path_m: np.ndarray
+    if TYPE_CHECKING:
+        path_m: np.ndarray
+    else:
+        path_m: np.ndarray = _PathField()
     opening_ids: tuple[int, ...]
     d_m: float
     v_rad: float
@@ -314,12 +353,12 @@ def _score_candidates(
         f = frontier_at[node]
         p_l, n_open, n_fp = semantic_terms(tmap, f)
         gain = w.w_p * p_l + w.w_i * (n_open + n_fp)
-        poly = _assemble(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
+        poly = _path_parts(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
         candidates.append(
             FrontierCandidate(
                 frontier=f,
                 goal_xy_m=(float(f.midpoint_m[0]), float(f.midpoint_m[1])),
-                path_m=poly,
+                path_m=cast(np.ndarray, poly),  # joined when first read
                 opening_ids=path.nodes,
                 d_m=path.length_m,
                 v_rad=leg_start_angle[path.nodes[0]],
@@ -481,6 +520,17 @@ def _assemble(
 ) -> np.ndarray:
     """The candidate's polyline: first leg, the edges' paths, the goal. ``polylines`` caches
     :func:`_edge_polyline` by ``(edge, from_node)`` across calls."""
+    return _path_parts(tmap, path, first_leg, goal_xy, polylines).build()
+
+
+def _path_parts(
+    tmap: TopometricMap,
+    path: _Partial,
+    first_leg: np.ndarray,
+    goal_xy: tuple[float, float],
+    polylines: dict[tuple[int, int], np.ndarray] | None = None,
+) -> _PathParts:
+    """The pieces of :func:`_assemble`'s polyline, not yet joined."""
     parts = [first_leg]
     for j, k in enumerate(path.edges):
         key = (k, path.nodes[j])
@@ -491,4 +541,4 @@ def _assemble(
                 polylines[key] = poly
         parts.append(poly)
     parts.append(np.asarray([goal_xy], dtype=np.float64))
-    return _dedupe(np.concatenate(parts, axis=0))
+    return _PathParts(parts)
