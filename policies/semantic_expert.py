@@ -52,6 +52,7 @@ from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     search_frontier_paths,
 )
+from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
@@ -194,7 +195,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         self._last_cmd: PotentialFieldCommand | None = None
         self._still_s = 0.0
         self._escape_until_s = -1.0
-        self._known_cells = int(np.count_nonzero(np.asarray(obs["map"]) != UNKNOWN))
+        self._known_cells = known_cell_count(obs["map"])
         prm = self.params
         self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
         # Stuck: the robot stayed near one point while the map hardly grew ...
@@ -227,7 +228,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         scan = np.asarray(obs["scan"], dtype=np.float64)
         if self._angles is None or len(self._angles) != len(scan):
             self._angles = beam_angles_rad(len(scan))
-        self._known_cells = int(grid.size - np.count_nonzero(grid == UNKNOWN))
+        self._known_cells = known_cell_count(grid)
         self._trail.add((int(pose[0] // TRAIL_CELL_M), int(pose[1] // TRAIL_CELL_M)))
 
         if self._backoff.active(self._time_s):
@@ -295,8 +296,12 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
 
     def _unknown_near(self, grid: np.ndarray, xy: tuple[float, float], radius_m: float) -> bool:
         g = self.geometry
-        r0, c0 = (int(v) for v in g.world_to_grid(xy[0] - radius_m, xy[1] - radius_m))
-        r1, c1 = (int(v) for v in g.world_to_grid(xy[0] + radius_m, xy[1] + radius_m))
+        # g.world_to_grid's arithmetic on scalars (called every step: no arrays)
+        ox, oy, res = g.origin_x_m, g.origin_y_m, g.resolution_m
+        c0 = math.floor((float(xy[0] - radius_m) - ox) / res)
+        r0 = math.floor((float(xy[1] - radius_m) - oy) / res)
+        c1 = math.floor((float(xy[0] + radius_m) - ox) / res)
+        r1 = math.floor((float(xy[1] + radius_m) - oy) / res)
         if r0 < 0 or c0 < 0 or r1 >= g.height or c1 >= g.width:
             return True  # the map's edge: beyond it is unknown
         return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())

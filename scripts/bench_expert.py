@@ -4,11 +4,14 @@ A warm-up mission (numba compilation, caches) runs first and is not timed. Then 
 mission runs the full loop (env stepping, segmentation, Algorithm 1, potential field) and the
 script prints the speed-up over simulated time, by wall clock and by the process's CPU time
 (the same on an idle machine; CPU time is not inflated by other load), and where the wall time
-went. The acceptance target is a maze1 mission at >= 100x simulated time.
+went. The acceptance target is a maze1 mission at >= 100x simulated time. ``--seg-stages``
+adds the map generation's own split: the mean time per segmentation of each stage of
+:class:`~semexplore_gym.core.topometric.TopometricSegmenter` (its ``stage_ms``).
 
 Usage::
 
     python scripts/bench_expert.py [--world maze1] [--seeds 0 1 2] [--policy-set KEY=VALUE] [--json]
+        [--seg-stages]
 """
 
 from __future__ import annotations
@@ -44,6 +47,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--json", action="store_true", help="print one JSON object per mission instead of the table"
     )
+    ap.add_argument(
+        "--seg-stages",
+        action="store_true",
+        help="also print the mean time per segmentation of each segmentation stage",
+    )
     args = ap.parse_args(argv)
 
     import gymnasium as gym
@@ -52,7 +60,23 @@ def main(argv: list[str] | None = None) -> int:
     from policies.config import load_policy_config
     from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
+    from semexplore_gym.core.topometric import TopometricSegmenter
     from semexplore_gym.evaluation.rollout import STAGES, run_mission
+
+    class StageRecorder(TopometricSegmenter):
+        """The expert's segmenter, adding up each call's ``stage_ms``."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.calls = 0
+            self.stage_ms: dict[str, float] = {}
+
+        def __call__(self, *a, **k):  # type: ignore[no-untyped-def]
+            tmap = super().__call__(*a, **k)
+            self.calls += 1
+            for name, ms in tmap.extras.get("stage_ms", {}).items():
+                self.stage_ms[name] = self.stage_ms.get(name, 0.0) + ms
+            return tmap
 
     cfg = load_policy_config(args.policy_config)
     kwargs = merge_overrides(None, args.overrides)
@@ -75,9 +99,13 @@ def main(argv: list[str] | None = None) -> int:
         )
     rows = []
     for seed in args.seeds:
+        recorder = StageRecorder() if args.seg_stages else None
+        policy = make_policy("semantic", **dict(kwargs))
+        if recorder is not None:
+            policy = type(policy)(params=policy.params, segmenter=recorder)
         res = run_mission(
             env,
-            make_policy("semantic", **dict(kwargs)),
+            policy,
             seed=seed,
             max_time_s=args.max_time_s,
             progress=False,
@@ -107,6 +135,13 @@ def main(argv: list[str] | None = None) -> int:
             print(
                 f"  {k:16s} {v:8.3f} {1e3 * v / max(1, res.steps):8.3f} {100 * v / total if total else 0:5.1f}%"
             )
+        if recorder is not None and recorder.calls:
+            seg_total = sum(recorder.stage_ms.values())
+            print(f"  segmentation stages over {recorder.calls} calls (ms per call):")
+            for name, ms in recorder.stage_ms.items():
+                print(
+                    f"    {name:14s} {ms / recorder.calls:7.3f} {100 * ms / seg_total if seg_total else 0:5.1f}%"
+                )
     env.close()
     if not args.json and len(rows) > 1:
         sp = np.array([r.speedup for r in rows])

@@ -35,7 +35,8 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry, validate_encoded_grid
+from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
 __all__ = ["GridFrontier", "detect_frontiers", "frontier_cell_mask"]
 
@@ -90,7 +91,7 @@ def frontier_cell_mask(
 
     Useful for drawing and for tests; :func:`detect_frontiers` adds reachability and grouping.
     """
-    a = validate_encoded_grid(grid)
+    a = checked_encoded_grid(grid)
     conv = _convention_code(cell_convention)
     target = a == (UNKNOWN if conv == 0 else FREE)
     other = a == (FREE if conv == 0 else UNKNOWN)
@@ -128,7 +129,7 @@ def detect_frontiers(
         ValueError: Bad grid values or shape, ``min_frontier_cells < 1``, unknown convention or
             a robot outside the grid.
     """
-    a = validate_encoded_grid(grid)
+    a = checked_encoded_grid(grid)
     if a.shape != geometry.shape:
         raise ValueError(f"grid shape {a.shape} does not match geometry shape {geometry.shape}")
     if int(min_frontier_cells) < 1:

@@ -27,7 +27,8 @@ from numba import njit
 from scipy import ndimage
 
 from semexplore_gym.core.frontiers.detection import frontier_cell_mask
-from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
 
 @dataclass(frozen=True)
@@ -51,7 +52,7 @@ class ReachableFrontier:
 
 def clearance_field_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
     """Distance in metres from every cell centre to the nearest OCCUPIED cell centre (inf if none)."""
-    g = validate_encoded_grid(grid)
+    g = checked_encoded_grid(grid)
     occupied = g == OCCUPIED
     if not occupied.any():
         return np.full(g.shape, np.inf)
@@ -137,7 +138,7 @@ def nearest_reachable_frontier(
     Raises:
         ValueError: on a malformed grid, a shape mismatch or negative distances.
     """
-    g = validate_encoded_grid(grid)
+    g = checked_encoded_grid(grid)
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     for name, value in (
@@ -199,7 +200,7 @@ def grid_path_to(
 ) -> np.ndarray | None:
     """Path over usable cells (see the module docstring) from ``start_xy_m`` to a usable cell
     within ``goal_radius_m`` of ``goal_xy_m``; ``(K, 2)`` world polyline, or None if unreachable."""
-    g = validate_encoded_grid(grid)
+    g = checked_encoded_grid(grid)
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     res = geometry.resolution_m

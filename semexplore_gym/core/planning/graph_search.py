@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
 
 import numpy as np
 
@@ -78,6 +78,42 @@ class FrontierCostWeights:
             )
 
 
+class _PathParts:
+    """A candidate's polyline as the pieces :func:`_assemble` joins (built when first read: a
+    replan scores tens of frontiers and drives to one)."""
+
+    __slots__ = ("parts",)
+
+    def __init__(self, parts: list[np.ndarray]) -> None:
+        self.parts = parts
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"parts": self.parts}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.parts = state["parts"]
+
+    def build(self) -> np.ndarray:
+        return _dedupe(np.concatenate(self.parts, axis=0))
+
+
+class _PathField:
+    """Data descriptor of ``FrontierCandidate.path_m``: stores an array or :class:`_PathParts`,
+    returns the array (joined once, on first read)."""
+
+    def __get__(self, obj: Any, objtype: Any = None) -> np.ndarray:
+        if obj is None:
+            raise AttributeError("path_m")  # no default value for the dataclass field
+        v = obj.__dict__["_path_m"]
+        if isinstance(v, _PathParts):
+            v = v.build()
+            obj.__dict__["_path_m"] = v
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__["_path_m"] = value
+
+
 @dataclass(frozen=True)
 class FrontierCandidate:
     """The cheapest path found to one frontier, with every term of its cost.
@@ -100,7 +136,10 @@ class FrontierCandidate:
 
     frontier: Frontier
     goal_xy_m: tuple[float, float]
-    path_m: np.ndarray
+    if TYPE_CHECKING:
+        path_m: np.ndarray
+    else:
+        path_m: np.ndarray = _PathField()
     opening_ids: tuple[int, ...]
     d_m: float
     v_rad: float
@@ -132,8 +171,9 @@ class SearchStats:
     n_pruned: int
 
 
-@dataclass(frozen=True)
-class _Partial:
+class _Partial(NamedTuple):
+    """A path of the search (a named tuple: the search builds thousands)."""
+
     nodes: tuple[int, ...]
     edges: tuple[int, ...]
     cost: float
@@ -224,15 +264,20 @@ def search_frontier_paths(
         if f.width_m >= min_frontier_width_m:
             frontier_at[f.opening_id] = f
 
-    adjacency: dict[int, list[tuple[int, int]]] = {}
+    # Edges of the robot's area are never followed (paths do not re-enter it): left out here.
+    adjacency: dict[int, list[tuple[int, int, float]]] = {}
     for k, e in enumerate(tmap.edges):
-        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k))
-        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k))
+        if e.area_id == robot_area:
+            continue
+        d_m = float(e.length_m)
+        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k, d_m))
+        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k, d_m))
+    by_opening = prune_by == "opening"
 
-    def slot(node: int, via_edge: int | None) -> tuple[str, int]:
-        # Which A_cost entry a path ending at `node` competes for.
-        if prune_by == "opening":
-            return ("o", node)
+    def slot(node: int, via_edge: int | None) -> int | tuple[str, int]:
+        # Which A_cost entry a path ending at `node` competes for (by opening: the node).
+        if by_opening:
+            return node
         here = tmap.edges[via_edge].area_id if via_edge is not None else robot_area
         ids = tmap.openings[node].area_ids if 0 <= node < len(tmap.openings) else (here,)
         beyond = [a for a in ids if a >= 0 and a != here]
@@ -240,7 +285,7 @@ def search_frontier_paths(
         return ("a", beyond[0]) if beyond else ("o", node)
 
     first_legs = _first_legs(tmap, robot_area, (rx, ry))
-    a_cost: dict[tuple[str, int], float] = {}
+    a_cost: dict[int | tuple[str, int], float] = {}
     search_list: list[_Partial] = []
     n_pushed = n_popped = n_pruned = 0
     leg_start_angle: dict[int, float] = {}
@@ -263,7 +308,8 @@ def search_frontier_paths(
         path = search_list.pop()
         n_popped += 1
         last = path.nodes[-1]
-        if a_cost.get(slot(last, path.edges[-1] if path.edges else None), math.inf) < path.cost:
+        at = last if by_opening else slot(last, path.edges[-1] if path.edges else None)
+        if a_cost.get(at, math.inf) < path.cost:
             # Reached more cheaply since it was pushed: the A_cost condition, applied at pop.
             n_pruned += 1
             continue
@@ -271,12 +317,11 @@ def search_frontier_paths(
             prev = best.get(last)
             if prev is None or path.cost < prev[0]:
                 best[last] = (path.cost, path)
-        for nbr, k in adjacency.get(last, ()):
-            if nbr in path.nodes or tmap.edges[k].area_id == robot_area:
+        for nbr, k, d_m in adjacency.get(last, ()):
+            if nbr in path.nodes:
                 continue
-            d_m = float(tmap.edges[k].length_m)
             new_cost = path.cost + d_m / l_path
-            key = slot(nbr, k)
+            key = nbr if by_opening else slot(nbr, k)
             if a_cost.get(key, math.inf) <= new_cost:
                 n_pruned += 1
                 continue
@@ -302,16 +347,18 @@ def _score_candidates(
     """The cheapest path found to each frontier, scored with ``C = metric - gain``, cheapest
     first (ties by path length)."""
     candidates: list[FrontierCandidate] = []
+    # oriented edge polylines, shared by the candidates' paths (read only)
+    polylines: dict[tuple[int, int], np.ndarray] = {}
     for node, (metric, path) in best.items():
         f = frontier_at[node]
         p_l, n_open, n_fp = semantic_terms(tmap, f)
         gain = w.w_p * p_l + w.w_i * (n_open + n_fp)
-        poly = _assemble(tmap, path, first_legs[path.nodes[0]], f.midpoint_m)
+        poly = _path_parts(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
         candidates.append(
             FrontierCandidate(
                 frontier=f,
                 goal_xy_m=(float(f.midpoint_m[0]), float(f.midpoint_m[1])),
-                path_m=poly,
+                path_m=cast(np.ndarray, poly),  # joined when first read
                 opening_ids=path.nodes,
                 d_m=path.length_m,
                 v_rad=leg_start_angle[path.nodes[0]],
@@ -438,10 +485,10 @@ def _first_legs(
     best: dict[int, tuple[float, np.ndarray]] = {}
 
     def offer(node: int, dist: float, q: np.ndarray, rest: np.ndarray) -> None:
-        poly = _dedupe(np.vstack([r, q, rest]))
         length = dist + _polyline_length(np.vstack([q, rest]))
         if node not in best or length < best[node][0]:
-            best[node] = (length, poly)
+            # the polyline only for the best offer so far
+            best[node] = (length, _dedupe(np.vstack([r, q, rest])))
 
     for k, e in enumerate(tmap.edges):
         if e.area_id != area_id:
@@ -465,10 +512,33 @@ def _first_legs(
 
 
 def _assemble(
-    tmap: TopometricMap, path: _Partial, first_leg: np.ndarray, goal_xy: tuple[float, float]
+    tmap: TopometricMap,
+    path: _Partial,
+    first_leg: np.ndarray,
+    goal_xy: tuple[float, float],
+    polylines: dict[tuple[int, int], np.ndarray] | None = None,
 ) -> np.ndarray:
+    """The candidate's polyline: first leg, the edges' paths, the goal. ``polylines`` caches
+    :func:`_edge_polyline` by ``(edge, from_node)`` across calls."""
+    return _path_parts(tmap, path, first_leg, goal_xy, polylines).build()
+
+
+def _path_parts(
+    tmap: TopometricMap,
+    path: _Partial,
+    first_leg: np.ndarray,
+    goal_xy: tuple[float, float],
+    polylines: dict[tuple[int, int], np.ndarray] | None = None,
+) -> _PathParts:
+    """The pieces of :func:`_assemble`'s polyline, not yet joined."""
     parts = [first_leg]
     for j, k in enumerate(path.edges):
-        parts.append(_edge_polyline(tmap, k, path.nodes[j]))
+        key = (k, path.nodes[j])
+        poly = polylines.get(key) if polylines is not None else None
+        if poly is None:
+            poly = _edge_polyline(tmap, k, path.nodes[j])
+            if polylines is not None:
+                polylines[key] = poly
+        parts.append(poly)
     parts.append(np.asarray([goal_xy], dtype=np.float64))
-    return _dedupe(np.concatenate(parts, axis=0))
+    return _PathParts(parts)

@@ -39,7 +39,8 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
+from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
 __all__ = [
     "FREE_COST",
@@ -175,7 +176,7 @@ def inflate_costmap(
     Returns:
         ``(H, W)`` uint8 costmap; see the module docstring for the values.
     """
-    a = validate_encoded_grid(grid)
+    a = checked_encoded_grid(grid)
     if not (math.isfinite(resolution_m) and resolution_m > 0):
         raise ValueError(f"resolution_m must be a positive number, got {resolution_m!r}")
     # Distances matter only out to the inflation radius (beyond it the cost is 0), so stamp a

@@ -14,7 +14,8 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry, validate_encoded_grid
+from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
 
 def segment_is_clear(
@@ -43,7 +44,7 @@ def segment_is_clear(
         ValueError: on a malformed grid, a grid whose shape differs from ``geometry``, or a
             negative / non-finite clearance.
     """
-    g = validate_encoded_grid(grid)
+    g = checked_encoded_grid(grid)
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     if not (np.isfinite(clearance_m) and clearance_m >= 0.0):

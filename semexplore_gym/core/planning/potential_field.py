@@ -181,6 +181,21 @@ def beam_angles_rad(n_beams: int) -> np.ndarray:
     return np.arange(int(n_beams), dtype=np.float64) * (2.0 * math.pi / int(n_beams))
 
 
+#: ``(cos, sin)`` of :func:`beam_angles_rad` by beam count, computed once (only the numba
+#: kernels of this module read them).
+_BEAM_TRIG: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _beam_trig(n_beams: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.cos`` and ``np.sin`` of ``beam_angles_rad(n_beams)``, cached (every control step
+    needs them for the same scan size)."""
+    trig = _BEAM_TRIG.get(n_beams)
+    if trig is None:
+        angles = beam_angles_rad(n_beams)
+        trig = _BEAM_TRIG[n_beams] = (np.cos(angles), np.sin(angles))
+    return trig
+
+
 def valid_beams(scan_m: np.ndarray, max_range_m: float) -> np.ndarray:
     """Mask of beams that saw an obstacle: range > 0 (0 = invalid) and below the maximum range."""
     return (scan_m > 0.0) & (scan_m < max_range_m) & np.isfinite(scan_m)
@@ -390,8 +405,7 @@ def potential_field_command(
         raise ValueError(f"pose must be finite, got {pose!r}")
 
     n = len(scan)
-    angles = beam_angles_rad(n)
-    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    cos_a, sin_a = _beam_trig(n)
     l_min = float(_min_valid(scan, limits.max_range_m))
     lookahead = min(max(p.f_l * l_min, p.min_lookahead_m), p.max_lookahead_m)
     gi, visible = select_lookahead(

@@ -29,6 +29,7 @@ def match_area_ids(
     skeleton_region: np.ndarray,
     skeleton_xy_m: np.ndarray,
     match_radius_m: float,
+    skeleton_cells: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, int]:
     """Final ids of the provisional areas, and the next fresh id.
 
@@ -42,13 +43,15 @@ def match_area_ids(
             match by overlap).
         skeleton_xy_m: ``(n, 2)`` world position of those pixels, metres.
         match_radius_m: Largest distance at which a zero-area frontier pathway keeps its id.
+        skeleton_cells: ``(rows, cols)`` of those pixels in ``previous``'s grid, if the caller
+            has them (then ``skeleton_xy_m`` is not read): the cells ``skeleton_xy_m`` falls in.
     """
     next_id = next_area_id(previous)
     if previous is None:
         return np.arange(next_id, next_id + n_prov, dtype=np.int64), next_id + n_prov
     ids = np.full(n_prov, -1, dtype=np.int64)
     if previous.areas:
-        used = _match_by_overlap(previous, ids, skeleton_region, skeleton_xy_m)
+        used = _match_by_overlap(previous, ids, skeleton_region, skeleton_xy_m, skeleton_cells)
         _match_zero_area(previous, ids, used, n_reg, n_prov, centre_xy, match_radius_m)
     fresh = np.flatnonzero(ids < 0)
     ids[fresh] = next_id + np.arange(fresh.size)
@@ -60,15 +63,19 @@ def _match_by_overlap(
     ids: np.ndarray,
     skeleton_region: np.ndarray,
     skeleton_xy_m: np.ndarray,
+    skeleton_cells: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> set[int]:
     """Give regions the id of the previous area under most of their skeleton (in place)."""
     used: set[int] = set()
     if not skeleton_region.size:
         return used
-    pr, pc = previous.geometry.world_to_grid(skeleton_xy_m[:, 0], skeleton_xy_m[:, 1])
+    if skeleton_cells is not None:
+        pr, pc = skeleton_cells
+    else:
+        pr, pc = previous.geometry.world_to_grid(skeleton_xy_m[:, 0], skeleton_xy_m[:, 1])
     inside = previous.geometry.contains(pr, pc)
     prev_id = np.full(skeleton_region.size, -1, dtype=np.int64)
-    prev_id[inside] = previous.area_ids[pr[inside], pc[inside]]
+    prev_id[inside] = previous.area_ids_at(pr[inside], pc[inside])
     ok = prev_id >= 0
     if ok.any():
         base = int(prev_id.max()) + 1

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -40,12 +40,12 @@ from semexplore_gym.core.topometric.kernels.regions import (
     build_regions,
     grow_regions,
     region_centres,
-    scatter_labels,
+    window_labels,
 )
 from semexplore_gym.core.topometric.kernels.skeleton import thin
 from semexplore_gym.core.topometric.kernels.skeleton_graph import skeleton_graph
 from semexplore_gym.core.topometric.params import SegmentationParams
-from semexplore_gym.core.topometric.types import AreaType, TopometricMap
+from semexplore_gym.core.topometric.types import AreaRasterCrop, AreaType, TopometricMap
 
 if TYPE_CHECKING:
     from semexplore_gym.core.topometric.segmentation import _Scratch
@@ -427,15 +427,17 @@ class _Segmenter:
         frontiers = frontier_records(fronts, fronts_len, ids_l, openings)
         n_inter = int(np.count_nonzero(prov_type == int(AreaType.INTERSECTION)))
         l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
-        area_raster = np.empty(self.g.shape, dtype=np.int32)
-        scatter_labels(
-            area_raster, self.lab, ids[:n_reg].astype(np.int32), self.W, self.r0, self.c0
-        )
+        # Only the work grid's window is labelled: the full raster is built if someone reads it.
+        H0, W0 = self.g.shape
+        ra, rb = max(0, -self.r0), min(self.H, H0 - self.r0)
+        ca, cb = max(0, -self.c0), min(self.W, W0 - self.c0)
+        window = window_labels(self.lab, ids[:n_reg].astype(np.int32), self.W, ra, rb, ca, cb)
+        area_raster = AreaRasterCrop(self.g.shape, self.r0 + ra, self.c0 + ca, window)
         self._lap("assemble")
         extras = self._extras(next_id)
         return TopometricMap(
             geometry=self.g,
-            area_ids=area_raster,
+            area_ids=cast(np.ndarray, area_raster),  # the field accepts the window too
             areas=areas,
             openings=openings,
             frontiers=frontiers,
@@ -470,14 +472,36 @@ class _Segmenter:
         prev = self.previous
         sk_region = np.zeros(0, np.int64)
         sk_xy = np.zeros((0, 2))
+        sk_cells = None
         if prev is not None and prev.areas and self.n_reg:
             sel = self.px[self.lab[self.px] >= 0]
             if sel.size:
                 sk_region = self.lab[sel].astype(np.int64)
-                sk_xy = self._cells_xy(sel)
+                if self._same_frame(prev.geometry):
+                    # the cell centres' world points fall in the same cells of the same grid
+                    r, c = np.divmod(np.asarray(sel, dtype=np.int64), self.W)
+                    sk_cells = (r + self.r0, c + self.c0)
+                else:
+                    sk_xy = self._cells_xy(sel)
         return match_area_ids(
-            prev, self.n_reg, n_prov, centre_xy, sk_region, sk_xy, self.p.match_radius_m
+            prev,
+            self.n_reg,
+            n_prov,
+            centre_xy,
+            sk_region,
+            sk_xy,
+            self.p.match_radius_m,
+            skeleton_cells=sk_cells,
         )
+
+    def _same_frame(self, other: GridGeometry) -> bool:
+        """``other`` is this grid's frame, with coordinates small enough (< 2^40 cells from the
+        world origin) that a cell centre's world point maps back to its own cell exactly."""
+        g = self.g
+        if other != g:
+            return False
+        extent = (abs(g.origin_x_m) + abs(g.origin_y_m)) / g.resolution_m + g.height + g.width
+        return extent < 2.0**40
 
     def _cells_xy(self, cells: np.ndarray) -> np.ndarray:
         """Work-grid flat cell indices to world (x, y) metres of the cell centres, (n, 2)."""

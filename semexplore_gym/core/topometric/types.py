@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -117,6 +117,78 @@ class GraphEdge(NamedTuple):
     path_m: np.ndarray
 
 
+class AreaRasterCrop:
+    """The area raster of a :class:`TopometricMap` held as its labelled window.
+
+    A large map is mostly unknown while it is explored (Willow Garage: 1.3 M cells, of which
+    the free cells' bounding box covers 1-13 % in a 300 s mission). The segmentation hands its
+    map this window; the full ``(H, W)`` raster (-1 outside the window) is only built when
+    ``TopometricMap.area_ids`` is read, and point look-ups read the window directly.
+
+    Attributes:
+        shape: ``(H, W)`` of the full raster.
+        r0: Row of the window's first row in the full raster (>= 0).
+        c0: Column of the window's first column (>= 0).
+        ids: ``(h, w)`` int32 area ids of the window, -1 where no area.
+    """
+
+    __slots__ = ("shape", "r0", "c0", "ids")
+
+    def __init__(self, shape: tuple[int, int], r0: int, c0: int, ids: np.ndarray) -> None:
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.r0 = int(r0)
+        self.c0 = int(c0)
+        self.ids = ids
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in self.__slots__}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        for k, v in state.items():
+            setattr(self, k, v)
+
+    def full(self) -> np.ndarray:
+        """The ``(H, W)`` int32 raster."""
+        out = np.full(self.shape, -1, dtype=np.int32)
+        h, w = self.ids.shape
+        out[self.r0 : self.r0 + h, self.c0 : self.c0 + w] = self.ids
+        return out
+
+    def at(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Ids at cells inside the full raster (int64 row / column arrays), -1 off the window."""
+        h, w = self.ids.shape
+        r = np.asarray(rows) - self.r0
+        c = np.asarray(cols) - self.c0
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        out = np.full(r.shape, -1, dtype=np.int32)
+        out[inside] = self.ids[r[inside], c[inside]]
+        return out
+
+    def labelled_cells(self) -> np.ndarray:
+        """``np.argwhere(full() >= 0)`` (the same cells, in the same row-major order)."""
+        cells = np.argwhere(self.ids >= 0)
+        cells[:, 0] += self.r0
+        cells[:, 1] += self.c0
+        return cells
+
+
+class _AreaIdsField:
+    """Data descriptor of ``TopometricMap.area_ids``: stores an array or an
+    :class:`AreaRasterCrop`, and returns the full raster (built once, on first read)."""
+
+    def __get__(self, obj: Any, objtype: Any = None) -> np.ndarray:
+        if obj is None:
+            raise AttributeError("area_ids")  # no default value for the dataclass field
+        v = obj.__dict__["_area_ids"]
+        if isinstance(v, AreaRasterCrop):
+            v = v.full()
+            obj.__dict__["_area_ids"] = v
+        return v
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__["_area_ids"] = value
+
+
 @dataclass(frozen=True)
 class TopometricMap:
     """A semantic topometric map of an explored occupancy grid.
@@ -125,7 +197,8 @@ class TopometricMap:
         geometry: The grid frame the map was computed on.
         area_ids: ``(H, W)`` int32 raster, the area id of every reachable free cell, -1 elsewhere
             (cells of occupied specks and unknown holes that the noise filter turned free count
-            as free).
+            as free). The segmentation passes an :class:`AreaRasterCrop`; the full raster is
+            built when this attribute is first read (:meth:`area_ids_at` reads the window).
         areas: Areas by id.
         openings: Openings, ``openings[i].id == i``.
         frontiers: One per frontier opening (one per frontier pathway, two for a lone corridor
@@ -139,7 +212,11 @@ class TopometricMap:
     """
 
     geometry: GridGeometry
-    area_ids: np.ndarray
+    if TYPE_CHECKING:
+        area_ids: np.ndarray
+    else:
+        # the descriptor stores an array or an AreaRasterCrop and always returns the array
+        area_ids: np.ndarray = _AreaIdsField()
     areas: dict[int, Area]
     openings: list[Opening]
     frontiers: list[Frontier]
@@ -169,19 +246,30 @@ class TopometricMap:
                     n += 1
         return n
 
+    def area_ids_at(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``area_ids[rows, cols]`` for cells inside the raster, without building the full
+        raster when the map holds only its labelled window."""
+        v = self.__dict__["_area_ids"]
+        if isinstance(v, AreaRasterCrop):
+            return v.at(rows, cols)
+        return np.asarray(v[rows, cols])
+
     def area_at(self, x_m: float, y_m: float) -> int:
         """Id of the area containing a point, or of the nearest area cell; -1 if the map has none."""
         g = self.geometry
         row, col = g.world_to_grid(x_m, y_m)
         r, c = int(row), int(col)
-        if 0 <= r < g.height and 0 <= c < g.width and self.area_ids[r, c] >= 0:
-            return int(self.area_ids[r, c])
-        cells = np.argwhere(self.area_ids >= 0)
+        if 0 <= r < g.height and 0 <= c < g.width:
+            here = int(self.area_ids_at(np.array([r]), np.array([c]))[0])
+            if here >= 0:
+                return here
+        v = self.__dict__["_area_ids"]
+        cells = v.labelled_cells() if isinstance(v, AreaRasterCrop) else np.argwhere(v >= 0)
         if len(cells) == 0:
             return -1
         d2 = (cells[:, 0] - r) ** 2 + (cells[:, 1] - c) ** 2
         rr, cc = cells[int(np.argmin(d2))]
-        return int(self.area_ids[rr, cc])
+        return int(self.area_ids_at(np.array([rr]), np.array([cc]))[0])
 
     def area_type_raster(self) -> np.ndarray:
         """``(H, W)`` int16 raster of :class:`AreaType` values (-1 where no area): the env overlay."""

@@ -377,3 +377,22 @@ def test_projection_onto_polyline():
     dist, q, i, s = project_onto_polyline(poly, (2.5, 1.0))
     assert (dist, i, s) == pytest.approx((0.5, 1, 3.0))
     np.testing.assert_allclose(q, [2.0, 1.0])
+
+
+def test_candidate_paths_are_joined_when_read_and_survive_pickling():
+    import pickle
+
+    from semexplore_gym.core.planning.graph_search import _PathParts
+
+    tmap = build_map(OPENINGS, AREAS, l_path_m=4.0)
+    cands, _ = search_frontier_paths(tmap, (0.0, 0.0), math.pi, FrontierCostWeights())
+    assert cands and all(isinstance(c.__dict__["_path_m"], _PathParts) for c in cands)
+    copies = pickle.loads(pickle.dumps(cands))  # still unjoined
+    for c, d in zip(cands, copies, strict=True):
+        assert c.path_m is c.path_m  # joined once
+        assert np.array_equal(d.path_m, c.path_m)
+        assert np.allclose(c.path_m[0], (0.0, 0.0)) and np.allclose(c.path_m[-1], c.goal_xy_m)
+    west = next(c for c in copies if c.frontier.opening_id == 7)
+    np.testing.assert_allclose(
+        west.path_m, [[0, 0], [-1, 0], [-3, 0], [-4, 0], [-4, 1], [-4, 5]], atol=1e-9
+    )

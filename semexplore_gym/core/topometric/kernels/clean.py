@@ -8,17 +8,86 @@ and collects the free cells next to unknown space (the frontier candidates of st
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, uint64
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 
+_LOW7 = 0x7F7F7F7F7F7F7F7F
+_HIGH = 0x8080808080808080
 
-@njit(cache=True, error_model="numpy")
+
+@njit(cache=True, error_model="numpy", boundscheck=False)
 def scan_grid(enc: np.ndarray) -> tuple[int, int, int, int, int]:
     """One pass: index of the first value outside the encoding (-1 if none) and the free bbox.
 
     Returns ``(bad_flat_index, rmin, rmax, cmin, cmax)``; ``rmin == -1`` when there is no free cell.
+
+    Each row is read eight cells at a time (64-bit words, bytes tested with word arithmetic:
+    a large map is mostly unknown, and this pass reads all of it); the few cells of a row
+    outside whole words, and grids whose data are not word-aligned, are read cell by cell
+    (:func:`scan_grid_cells`, the same result).
     """
+    H, W = enc.shape
+    flat = enc.ravel()
+    if flat.ctypes.data % 8 or W < 16:
+        return scan_grid_cells(enc)
+    words = flat[: (flat.size // 8) * 8].view(np.uint64)
+    low7 = uint64(_LOW7)
+    high = uint64(_HIGH)
+    rmin = -1
+    rmax = -1
+    cmin = W
+    cmax = -1
+    for r in range(H):
+        s = r * W
+        e = s + W
+        a = (s + 7) // 8
+        b = e // 8
+        free_w = uint64(0)
+        bad_w = uint64(0)
+        for k in range(a, b):
+            x = words[k]
+            nx = ~x
+            y = x ^ high
+            # high bit of each byte set where that byte is non-zero (exact: no carries)
+            nz_nx = (((nx & low7) + low7) | nx) & high  # byte != FREE (255)
+            nz_x = (((x & low7) + low7) | x) & high  # byte != OCCUPIED (0)
+            nz_y = (((y & low7) + low7) | y) & high  # byte != UNKNOWN (128)
+            free_w |= (~nz_nx) & high
+            bad_w |= nz_x & nz_y & nz_nx
+        n_free = free_w != 0
+        n_bad = bad_w != 0
+        for k in range(s, 8 * a):
+            v = flat[k]
+            n_free |= v == FREE
+            n_bad |= (v != FREE) & (v != UNKNOWN) & (v != OCCUPIED)
+        for k in range(8 * b, e):
+            v = flat[k]
+            n_free |= v == FREE
+            n_bad |= (v != FREE) & (v != UNKNOWN) & (v != OCCUPIED)
+        if n_bad:
+            for c in range(W):
+                v = flat[s + c]
+                if v != FREE and v != UNKNOWN and v != OCCUPIED:
+                    return s + c, -1, -1, -1, -1
+        if n_free:
+            if rmin < 0:
+                rmin = r
+            rmax = r
+            c = 0
+            while flat[s + c] != FREE:
+                c += 1
+            cmin = min(cmin, c)
+            c = W - 1
+            while flat[s + c] != FREE:
+                c -= 1
+            cmax = max(cmax, c)
+    return -1, rmin, rmax, cmin, cmax
+
+
+@njit(cache=True, error_model="numpy")
+def scan_grid_cells(enc: np.ndarray) -> tuple[int, int, int, int, int]:
+    """:func:`scan_grid` read cell by cell (any layout)."""
     H, W = enc.shape
     rmin = -1
     rmax = -1

@@ -4,7 +4,7 @@
 pieces) and labels its pixels; :func:`region_centres` picks each region's centre;
 :func:`grow_regions` grows the regions from the skeleton over ``C`` and then over the rest of
 free space within the cover depth, never across an opening chord, and builds one shortest-path
-tree per region. :func:`scatter_labels` writes the final area ids into the full-size raster.
+tree per region. :func:`window_labels` writes the final area ids of the work grid's window of the map.
 """
 
 from __future__ import annotations
@@ -417,24 +417,15 @@ def grow_regions(
 
 
 @njit(cache=True, error_model="numpy")
-def scatter_labels(out, lab, lut, W, r0, c0):
-    """Fill ``out`` (contents undefined on entry): ``out[r + r0, c + c0] = lut[lab[r * W + c]]``
-    for labelled work-grid cells, -1 everywhere else (one pass over ``out``)."""
-    H0, W0 = out.shape
-    Hw = lab.size // W
-    ra = max(0, -r0)
-    rb = min(Hw, H0 - r0)
-    ca = max(0, -c0)
-    cb = min(W, W0 - c0)
-    for ro in range(H0):
-        orow = out[ro]
-        r = ro - r0
-        if r < ra or r >= rb:
-            orow[:] = -1
-            continue
-        orow[: ca + c0] = -1
-        orow[cb + c0 :] = -1
-        base = r * W - c0
-        for co in range(ca + c0, cb + c0):
-            g = lab[base + co]
-            orow[co] = lut[g] if g >= 0 else -1
+def window_labels(lab, lut, W, ra, rb, ca, cb):
+    """Final area ids of the work-grid window rows ``ra:rb``, columns ``ca:cb``:
+    ``lut[lab[r * W + c]]`` for labelled cells, -1 elsewhere, as an ``(rb - ra, cb - ca)`` int32
+    array (the part of the map's raster that is not all -1)."""
+    out = np.empty((max(rb - ra, 0), max(cb - ca, 0)), dtype=np.int32)
+    for r in range(ra, rb):
+        orow = out[r - ra]
+        base = r * W
+        for c in range(ca, cb):
+            g = lab[base + c]
+            orow[c - ca] = lut[g] if g >= 0 else -1
+    return out
