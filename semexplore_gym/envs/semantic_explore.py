@@ -370,7 +370,7 @@ class SemanticExploreEnv(gym.Env):
         }
         reward = float(sum(terms.values()))
         info = self._info(terms, self._static_every_step)
-        terminated = bool(info["coverage"] >= cfg.episode.coverage_goal)
+        terminated = bool(self.grid.n_free_in_mask / self._n_reachable >= cfg.episode.coverage_goal)
         truncated = bool(self.sim_time_s >= cfg.episode.max_time_s - 1e-9)
         if self.render_mode == "human":
             self.render()
