@@ -26,7 +26,7 @@ inter-process messaging; on a busy 2-core machine it is slower than a plain loop
 from __future__ import annotations
 
 from copy import deepcopy
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from gymnasium import spaces
@@ -189,7 +189,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
         for key in keys:
             buf = batch[key]
             for i, obs in enumerate(self._env_obs):
-                buf[i] = obs[key]
+                buf[i] = cast(dict, obs)[key]
         if self.copy:
             return {key: batch[key].copy() for key in keys}
         return batch
