@@ -14,6 +14,13 @@ replayed to time each stage on the poses the robot really visited:
 * rest: the step minus the stages (action checks, odometry, observation, reward, info);
 * pymunk reference: ``Space.segment_query_first`` per beam at the recorded poses.
 
+``--no-stages`` only times the step loop, but round-robin: each repeat steps every world (and
+every ``--map-observation`` variant, e.g. ``copy window``) once in turn, and the table gives the
+median wall and CPU time per step and the median ratio to the first row within each repeat::
+
+    python scripts/bench_env.py --no-stages --world maze1 intel_lab willow \
+        --map-observation copy window --steps 2000 --repeats 7
+
 Prints a markdown table (median over ``--repeats``) and the peak memory per env instance. Not
 a test: the numbers depend on the machine. Run it against two checkouts alternately to compare
 (``PYTHONPATH=<checkout> python scripts/bench_env.py``); the script only uses APIs both have.
@@ -178,7 +185,10 @@ def bench_world(
 ) -> dict[str, float]:
     env = _make(world, **(env_kwargs or {}))
     actions = _actions(n_steps, 0)
-    run_steps(env, actions[: min(300, n_steps)])  # warm-up: numba caches, allocator
+    warm = actions[: min(300, n_steps)]
+    _dt, warm_p, _est, warm_s = run_steps(env, warm)  # warm-up: numba caches, allocator
+    if stages:  # the stage kernels too (their first call loads or compiles them)
+        time_stages(env, warm, warm_p, warm_s)
     rows: dict[str, list[float]] = {}
     for _ in range(repeats):
         dt, true_p, _est_p, scans = run_steps(env, actions)
