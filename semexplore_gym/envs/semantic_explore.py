@@ -177,10 +177,10 @@ class SemanticExploreEnv(gym.Env):
     every ``info`` key of every env and stacks the observations at each step (on maze1 about
     0.7x a plain loop over the same envs); :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv`
     returns the same results with less of that work, and ``static_info="reset"`` leaves fewer
-    keys to merge (together about 0.85x). ``AsyncVectorEnv`` runs each env in its own process:
-    it pays off only with a free core per worker, and more so the longer a step (large maps),
-    since every step also pays inter-process messaging; on a busy 2-core machine it is slower
-    than a plain loop.
+    keys to merge (together 0.8-0.9x with 4 envs). ``AsyncVectorEnv`` runs each env in its own
+    process: it pays off only with a free core per worker, and more so the longer a step (large
+    maps), since every step also pays inter-process messaging; on a busy 2-core machine it is
+    2-3x slower than a plain loop (0.3-0.45x, maze1 and Willow Garage).
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
