@@ -14,6 +14,13 @@ replayed to time each stage on the poses the robot really visited:
 * rest: the step minus the stages (action checks, odometry, observation, reward, info);
 * pymunk reference: ``Space.segment_query_first`` per beam at the recorded poses.
 
+``--no-stages`` only times the step loop, but round-robin: each repeat steps every world (and
+every ``--map-observation`` variant, e.g. ``copy window``) once in turn, and the table gives the
+median wall and CPU time per step and the median ratio to the first row within each repeat::
+
+    python scripts/bench_env.py --no-stages --world maze1 intel_lab willow \
+        --map-observation copy window --steps 2000 --repeats 7
+
 Prints a markdown table (median over ``--repeats``) and the peak memory per env instance. Not
 a test: the numbers depend on the machine. Run it against two checkouts alternately to compare
 (``PYTHONPATH=<checkout> python scripts/bench_env.py``); the script only uses APIs both have.
@@ -49,13 +56,13 @@ def _rss_mb() -> float:
     return float("nan")
 
 
-def _make(world: str) -> Any:
+def _make(world: str, **env_kwargs: Any) -> Any:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401
 
     cfg = {"episode": {"max_time_s": 1e7, "coverage_goal": 1.0}}
-    return gym.make("SemanticExplore-v0", world=world, config=cfg).unwrapped
+    return gym.make("SemanticExplore-v0", world=world, config=cfg, **env_kwargs).unwrapped
 
 
 def _actions(n: int, seed: int) -> np.ndarray:
@@ -169,11 +176,19 @@ def pymunk_reference(env: Any, true_p: list, n_scans: int) -> float:
 
 
 def bench_world(
-    world: str, n_steps: int, repeats: int, pymunk_scans: int, stages: bool = True
+    world: str,
+    n_steps: int,
+    repeats: int,
+    pymunk_scans: int,
+    stages: bool = True,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> dict[str, float]:
-    env = _make(world)
+    env = _make(world, **(env_kwargs or {}))
     actions = _actions(n_steps, 0)
-    run_steps(env, actions[: min(300, n_steps)])  # warm-up: numba caches, allocator
+    warm = actions[: min(300, n_steps)]
+    _dt, warm_p, _est, warm_s = run_steps(env, warm)  # warm-up: numba caches, allocator
+    if stages:  # the stage kernels too (their first call loads or compiles them)
+        time_stages(env, warm, warm_p, warm_s)
     rows: dict[str, list[float]] = {}
     for _ in range(repeats):
         dt, true_p, _est_p, scans = run_steps(env, actions)
@@ -191,6 +206,47 @@ def bench_world(
     med["n_segments"] = float(env.world.n_segments)
     med["map_cells"] = float(env.map_geometry.height * env.map_geometry.width)
     return med
+
+
+def round_robin(
+    variants: list[tuple[str, str, dict[str, Any], str | None]], n_steps: int, repeats: int
+) -> str:
+    """Time the step loop of each variant in turn, ``repeats`` times; a markdown table.
+
+    Each repeat times every variant once (round-robin), so load drifts hit all alike. The
+    ratios are taken within each repeat against the first variant, then the median is quoted.
+    CPU time (``time.process_time``) is less disturbed by other jobs than wall time.
+    """
+    actions = _actions(n_steps, 0)
+    envs = []
+    for _label, world, kw, mo in variants:
+        env = _make(world, **kw, **({"map_observation": mo} if mo else {}))
+        run_steps(env, actions[: min(300, n_steps)])  # warm-up: numba caches, allocator
+        envs.append(env)
+    wall: list[list[float]] = [[] for _ in envs]
+    cpu: list[list[float]] = [[] for _ in envs]
+    for _ in range(repeats):
+        for k, env in enumerate(envs):
+            env.reset(seed=0)
+            t0, c0 = time.perf_counter(), time.process_time()
+            for a in actions:
+                env.step(a)
+            wall[k].append(time.perf_counter() - t0)
+            cpu[k].append(time.process_time() - c0)
+    lines = [
+        f"Step loop, {n_steps} steps, {repeats} round-robin repeats (medians; ratio to the first row)\n",
+        "| world | steps/s (wall) | us/step (wall) | us/step (CPU) | x first (wall) | x first (CPU) |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    w0, c0_ = np.array(wall[0]), np.array(cpu[0])
+    for (label, *_), w, c in zip(variants, wall, cpu, strict=True):
+        wa, ca = np.array(w), np.array(c)
+        lines.append(
+            f"| {label} | {n_steps / float(np.median(wa)):,.0f} "
+            f"| {float(np.median(wa)) / n_steps * 1e6:.1f} | {float(np.median(ca)) / n_steps * 1e6:.1f} "
+            f"| {float(np.median(w0 / wa)):.2f} | {float(np.median(c0_ / ca)):.2f} |"
+        )
+    return "\n".join(lines)
 
 
 def bench_memory(world: str, n_envs: int) -> float:
@@ -220,16 +276,31 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--no-stages", action="store_true", help="only the step loop (one line per world)"
     )
+    p.add_argument(
+        "--map-observation",
+        nargs="+",
+        default=None,
+        help="env option map_observation (copy, window); several values are timed side by side",
+    )
+    p.add_argument("--static-info", default=None, help="env option static_info (every_step, reset)")
     args = p.parse_args(argv)
+    kw: dict[str, Any] = {}
+    if args.static_info is not None:
+        kw["static_info"] = args.static_info
     if args.no_stages:
-        for w in args.world:
-            m = bench_world(
-                _world_spec(w, args.maps_dir), args.steps, args.repeats, 0, stages=False
-            )
-            print(f"{w}: {m['steps_per_s']:.0f} steps/s ({m['step']:.1f} us per step)")
+        variants = [
+            (f"{w}" + (f" [{mo}]" if mo else ""), _world_spec(w, args.maps_dir), kw, mo)
+            for w in args.world
+            for mo in (args.map_observation or [None])
+        ]
+        print(round_robin(variants, args.steps, args.repeats))
         return 0
+    if args.map_observation:
+        kw["map_observation"] = args.map_observation[0]
     res = {
-        w: bench_world(_world_spec(w, args.maps_dir), args.steps, args.repeats, args.pymunk_scans)
+        w: bench_world(
+            _world_spec(w, args.maps_dir), args.steps, args.repeats, args.pymunk_scans, True, kw
+        )
         for w in args.world
     }
     print(

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pymunk
+from pymunk._chipmunk import ffi as _ffi
 from pymunk._chipmunk import lib as _cp
 
 from semexplore_gym.core.params import require_finite
@@ -166,6 +167,7 @@ class RobotSim:
         shape.collision_type = ROBOT_COLLISION_TYPE
         shape.filter = pymunk.ShapeFilter(categories=0b10)
         self._wall_filter = pymunk.ShapeFilter(mask=0b01)
+        self._query_info = _ffi.new("cpPointQueryInfo *")  # scratch for the near-wall query
         control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
         pivot.max_bias = 0.0
@@ -233,25 +235,33 @@ class RobotSim:
         rp = self.robot_params
         n = self._substeps_for(dt_s)
         reach = rp.radius_m + rp.max_linear_speed_mps * dt_s + 0.01
-        near = self.space.point_query_nearest(self.body.position, reach, self._wall_filter)
-        if near is None and self._touching == 0:
+        # Space.point_query_nearest without its Python result objects: any wall within reach?
+        body_p = self.body._body
+        near = _cp.cpSpacePointQueryNearest(
+            self.space._space,
+            _cp.cpBodyGetPosition(body_p),
+            reach,
+            self._wall_filter,
+            self._query_info,
+        )
+        if near == _ffi.NULL and self._touching == 0:
             self._drive_free(linear_mps, angular_radps, dt_s)
             self.in_contact = False
             return False
         h = dt_s / n
         self._began = False
-        body, control = self.body, self.control
         # The pivot and gear joints have no positional bias: only the control body's velocities
         # matter; keeping it on the robot avoids a large lever arm in the pivot constraint.
-        control.position = body.position
-        control.angular_velocity = angular_radps
+        control_p = self.control._body
+        _cp.cpBodySetPosition(control_p, _cp.cpBodyGetPosition(body_p))  # control.position = ...
+        _cp.cpBodySetAngularVelocity(control_p, angular_radps)
         space = self.space
         if space._bodies_to_check:  # pymunk checks new bodies' masses once, in Space.step
             space.step(0.0)
         # The substeps call Chipmunk through pymunk's own binding: the same C calls as
         # ``body.angle``, ``control.velocity = ...`` and ``space.step(h)``, without their Python
         # wrappers (nothing is added or removed and no post-step callback is registered here).
-        body_p, control_p, space_p = body._body, control._body, space._space
+        space_p = space._space
         get_angle, set_velocity, cp_step = (
             _cp.cpBodyGetAngle,
             _cp.cpBodySetVelocity,
@@ -283,8 +293,11 @@ class RobotSim:
         return self._substeps
 
     def _drive_free(self, v: float, w: float, dt_s: float) -> None:
-        x, y = self.body.position
-        yaw = self.body.angle
+        # The C calls behind body.position, body.angle, ... = and reindex_shapes_for_body.
+        b = self.body._body
+        p = _cp.cpBodyGetPosition(b)
+        x, y = p.x, p.y
+        yaw = _cp.cpBodyGetAngle(b)
         if abs(w) > 1e-9:
             yaw2 = yaw + w * dt_s
             x += v / w * (math.sin(yaw2) - math.sin(yaw))
@@ -293,12 +306,11 @@ class RobotSim:
             yaw2 = yaw
             x += v * dt_s * math.cos(yaw)
             y += v * dt_s * math.sin(yaw)
-        body = self.body
-        body.position = (x, y)
-        body.angle = yaw2
-        body.velocity = (v * math.cos(yaw2), v * math.sin(yaw2))
-        body.angular_velocity = w
-        self.space.reindex_shapes_for_body(body)
+        _cp.cpBodySetPosition(b, (x, y))
+        _cp.cpBodySetAngle(b, yaw2)
+        _cp.cpBodySetVelocity(b, (v * math.cos(yaw2), v * math.sin(yaw2)))
+        _cp.cpBodySetAngularVelocity(b, w)
+        _cp.cpSpaceReindexShapesForBody(self.space._space, b)
 
     # Pymunk objects hold C pointers: pickle the inputs and rebuild.
     def __getstate__(self) -> dict:

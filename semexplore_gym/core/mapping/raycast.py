@@ -39,6 +39,11 @@ _MAX_BUCKETS = 1 << 20
 _N_ANGLE_BINS = 360
 # Below this many candidate segments, binning costs more than it saves.
 _MIN_CANDIDATES_FOR_BINS = 8
+# Pseudo-angle padding of each candidate's bins. A ray that _first_hit counts as crossing a
+# segment lies in the segment's angular extent up to the rounding of the cross products and
+# pseudo-angles (about 1e-15); this pad is a million times that. (It was a whole bin, 1 degree:
+# tiny raster segments then sat in 3-4 bins instead of 1-2; the scans are bit-identical.)
+_BIN_PAD = 1e-9
 
 
 class SegmentIndex:
@@ -428,7 +433,7 @@ def cast_dirs(
         return
 
     # Angular bins: each candidate goes into every bin its angular extent touches, padded by
-    # one bin on each side, so a ray needs only the candidates of its own bin. Bins are
+    # _BIN_PAD on each side, so a ray needs only the candidates of its own bin. Bins are
     # uniform in the cheap "diamond" pseudo-angle, which is monotonic in the true angle.
     nb = _N_ANGLE_BINS
     w = 4.0 / nb
@@ -447,8 +452,8 @@ def cast_dirs(
             span = pa - pb
         if span < 0.0:
             span += 4.0
-        b0 = int(s / w) - 1
-        cnt = int((s + span) / w) + 2 - b0
+        b0 = int(math.floor((s - _BIN_PAD) / w))
+        cnt = int((s + span + _BIN_PAD) / w) + 1 - b0
         if cnt >= nb:
             b0 = 0
             cnt = nb

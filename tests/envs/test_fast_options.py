@@ -1,0 +1,163 @@
+"""The speed options of ``SemanticExplore-v0`` (issue #17), both off by default:
+
+``map_observation="window"`` (a window of the map around the robot) and ``static_info="reset"`` (static ``info``
+entries only at reset). They change only how observations and ``info`` are handed out: the same
+seeds and actions give the same maps, scans, poses and rewards as the default env.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import semexplore_gym  # noqa: F401
+from semexplore_gym.core.grid import UNKNOWN
+from semexplore_gym.wrappers import FixedSizeMap
+
+STATIC = ("map_geometry", "robot", "lidar", "dt_s")
+
+
+def _actions(n: int) -> np.ndarray:
+    return np.random.default_rng(5).uniform(-1, 1, size=(n, 2)).astype(np.float32)
+
+
+def test_reset_info_option_gives_the_default_trajectory_and_dynamic_info() -> None:
+    ref = gym.make("SemanticExplore-v0", world="maze1")
+    fast = gym.make("SemanticExplore-v0", world="maze1", static_info="reset")
+    o_ref, i_ref = ref.reset(seed=4)
+    o_fast, i_fast = fast.reset(seed=4)
+    assert i_fast == i_ref  # reset info keeps the static entries
+    assert np.array_equal(o_fast["map"], o_ref["map"])
+    for a in _actions(200):
+        o_ref, r_ref, term_ref, trunc_ref, i_ref = ref.step(a)
+        o_fast, r_fast, term_fast, trunc_fast, i_fast = fast.step(a)
+        for k in ("map", "pose", "scan"):
+            assert np.array_equal(o_fast[k], o_ref[k]), k
+        assert (r_fast, term_fast, trunc_fast) == (r_ref, term_ref, trunc_ref)
+        assert i_fast == {k: v for k, v in i_ref.items() if k not in STATIC}
+    ref.close()
+    fast.close()
+
+
+def test_copy_stays_the_default_and_bad_options_fail() -> None:
+    env = gym.make("SemanticExplore-v0", world="maze1")
+    obs0, info0 = env.reset(seed=0)
+    obs1, *_, info1 = env.step(np.zeros(2, np.float32))
+    assert obs1["map"] is not obs0["map"] and obs1["map"].flags.writeable
+    assert all(k in info1 for k in STATIC)
+    env.close()
+    with pytest.raises(ValueError, match="map_observation"):
+        gym.make("SemanticExplore-v0", world="maze1", map_observation="view")
+    with pytest.raises(ValueError, match="static_info"):
+        gym.make("SemanticExplore-v0", world="maze1", static_info="never")
+    for bad in (4, 5000, 16.0, True):
+        with pytest.raises(ValueError, match="map_window_cells"):
+            gym.make("SemanticExplore-v0", world="maze1", map_window_cells=bad)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"map_observation": "window", "map_window_cells": 48},
+        {"static_info": "reset"},
+    ],
+)
+def test_gymnasium_check_env_passes_with_the_options(kwargs: dict) -> None:
+    env = gym.make("SemanticExplore-v0", world="maze1", **kwargs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", category=UserWarning)
+        check_env(env.unwrapped)
+    env.close()
+
+
+def _window_matches(win: np.ndarray, offset: np.ndarray, full: np.ndarray) -> bool:
+    r0, c0 = int(offset[0]), int(offset[1])
+    s = win.shape[0]
+    h, w = full.shape
+    rows = slice(max(r0, 0), min(r0 + s, h))
+    cols = slice(max(c0, 0), min(c0 + s, w))
+    inside = np.zeros(win.shape, bool)
+    inside[rows.start - r0 : rows.stop - r0, cols.start - c0 : cols.stop - c0] = True
+    return bool(
+        np.array_equal(win[inside], full[rows, cols].ravel()) and np.all(win[~inside] == UNKNOWN)
+    )
+
+
+def test_window_observation_is_the_part_of_the_full_map_around_the_robot() -> None:
+    full = gym.make("SemanticExplore-v0", world="maze1")
+    win = gym.make(
+        "SemanticExplore-v0", world="maze1", map_observation="window", map_window_cells=100
+    )
+    ref = FixedSizeMap(gym.make("SemanticExplore-v0", world="maze1"), map_size=100, anchor="robot")
+    space = win.observation_space
+    assert space["map"].shape == (100, 100) and space["map_offset_cells"].dtype == np.int32
+    o_full, _ = full.reset(seed=2)
+    o_win, _ = win.reset(seed=2)
+    o_ref, _ = ref.reset(seed=2)
+    g = full.unwrapped.map_geometry
+    offsets = set()
+    for a in [np.zeros(2, np.float32), *_actions(150)]:
+        if a.any():
+            o_full, r_full, *_ = full.step(a)
+            o_win, r_win, *_ = win.step(a)
+            o_ref, *_, i_ref = ref.step(a)
+            assert r_win == r_full
+        assert space.contains(o_win) and o_win["map"].shape == (100, 100)
+        assert np.array_equal(o_win["pose"], o_full["pose"])
+        assert np.array_equal(o_win["scan"], o_full["scan"])
+        assert _window_matches(o_win["map"], o_win["map_offset_cells"], o_full["map"])
+        row, col = (int(v[()]) for v in g.world_to_grid(o_win["pose"][0], o_win["pose"][1]))
+        assert tuple(o_win["map_offset_cells"]) == (row - 50, col - 50)
+        assert np.array_equal(o_win["map"], o_ref["map"][0])
+        offsets.add(tuple(o_win["map_offset_cells"]))
+    assert len(offsets) > 1  # the window follows the robot
+    # Near the border the window is padded with UNKNOWN (maze1's map is 164 cells wide).
+    assert any(min(o) < 0 for o in offsets) or any(max(o) + 100 > 164 for o in offsets)
+    for e in (full, win, ref):
+        e.close()
+
+
+def test_window_option_in_a_vector_env() -> None:
+    fn = lambda: gym.make(  # noqa: E731
+        "SemanticExplore-v0", world="maze1", map_observation="window", map_window_cells=64
+    )
+    venv = gym.vector.SyncVectorEnv([fn] * 3)
+    try:
+        obs, _ = venv.reset(seed=0)
+        assert obs["map"].shape == (3, 64, 64) and obs["map_offset_cells"].shape == (3, 2)
+        for a in _actions(30).reshape(10, 3, 2)[:, :, :]:
+            obs, *_ = venv.step(a)
+        for i, env in enumerate(venv.envs):
+            assert _window_matches(
+                obs["map"][i], obs["map_offset_cells"][i], env.unwrapped.grid.encoded
+            )
+    finally:
+        venv.close()
+
+
+@pytest.mark.parametrize("copy", [True, False])
+def test_vector_envs_over_reset_info_batch_the_same_data(copy: bool) -> None:
+    def fn(**kw):
+        return lambda: gym.make("SemanticExplore-v0", world="maze1", **kw)
+
+    ref_v = gym.vector.SyncVectorEnv([fn()] * 2)
+    fast_v = gym.vector.SyncVectorEnv([fn(static_info="reset")] * 2, copy=copy)
+    try:
+        ref_v.reset(seed=1)
+        _, vinfo0 = fast_v.reset(seed=1)
+        assert vinfo0["lidar"].shape == (2,)  # reset info: static entries present
+        for a in _actions(40).reshape(20, 2, 2):
+            o_ref, r_ref, _, _, i_ref = ref_v.step(a)
+            o_fast, r_fast, _, _, i_fast = fast_v.step(a)
+            assert np.array_equal(o_fast["map"], o_ref["map"]) and o_fast["map"].shape[0] == 2
+            assert np.array_equal(o_fast["scan"], o_ref["scan"])
+            assert np.array_equal(r_fast, r_ref)
+            assert np.array_equal(i_fast["coverage"], i_ref["coverage"])
+            assert "lidar" not in i_fast and "map_geometry" not in i_fast
+    finally:
+        ref_v.close()
+        fast_v.close()
