@@ -164,18 +164,20 @@ def _overview_table(
     families: dict[str, dict[str, list[dict[str, Any]]]], reference: str
 ) -> list[str]:
     """One row per (family, policy): medians, and the reference's mission time against it."""
-    from scipy.stats import mannwhitneyu
+    from scipy.stats import mannwhitneyu, wilcoxon
 
     lines = [
         "## Overview",
         "",
         f"Medians per family. `{reference} ÷ policy` = median over (world, seed) pairs of "
-        f"{reference}'s mission time divided by the policy's (< 1: {reference} is faster); p = "
-        "two-sided Mann–Whitney U on the paired missions' times.",
+        f"{reference}'s mission time divided by the policy's (< 1: {reference} is faster); p MW = "
+        "two-sided Mann–Whitney U on the paired missions' times; p W = two-sided Wilcoxon "
+        "signed-rank test on the pairs' log ratios (the paired test: a family pools worlds of "
+        "very different sizes).",
         "",
         "| family | policy | n | self-stopped | coverage | mission time (s) | T90 (s) | "
-        f"semantic share | {reference} ÷ policy | p |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        f"semantic share | {reference} ÷ policy | p MW | p W |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
 
     def med(rs: list[dict[str, Any]], key: str) -> str:
@@ -185,7 +187,7 @@ def _overview_table(
     for fam, by_policy in families.items():
         ref = {(r["world"], int(r["seed"])): r for r in by_policy.get(reference, [])}
         for policy, rs in by_policy.items():
-            ratio, p = "–", "–"
+            ratio, p, pw = "–", "–", "–"
             if policy != reference and ref:
                 pairs = [
                     (ref[k]["mission_time_s"], r["mission_time_s"])
@@ -197,11 +199,14 @@ def _overview_table(
                     ratio = f"{np.median(a / b):.2f}"
                     if a.size >= 2 and not (np.all(a == a[0]) and np.all(b == b[0])):
                         p = f"{mannwhitneyu(a, b, alternative='two-sided').pvalue:.3g}"
+                    log_ratio = np.log(a / b)
+                    if a.size >= 2 and np.any(log_ratio != 0):
+                        pw = f"{wilcoxon(log_ratio, alternative='two-sided').pvalue:.3g}"
             stopped = sum(1 for r in rs if r["self_stopped"])
             lines.append(
                 f"| {fam} | {policy} | {len(rs)} | {stopped}/{len(rs)} | {med(rs, 'coverage')} | "
                 f"{med(rs, 'mission_time_s')} | {med(rs, 'T90_s')} | "
-                f"{med(rs, 'semantic_share')} | {ratio} | {p} |"
+                f"{med(rs, 'semantic_share')} | {ratio} | {p} | {pw} |"
             )
     lines.append("")
     return lines

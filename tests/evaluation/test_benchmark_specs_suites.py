@@ -321,3 +321,5 @@ def test_the_overview_has_one_row_per_family_and_policy(tmp_path) -> None:
     frontier_maze = next(r for r in rows if r.startswith("| maze | frontier |"))
     cells = [c.strip() for c in frontier_maze.strip("|").split("|")]
     assert cells[2] == "12" and cells[8] == "0.67"  # 3 worlds x 4 seeds; 100 s / 150 s
+    # Twelve equal, negative log ratios: the paired signed-rank test rejects equality.
+    assert float(cells[10]) < 0.001
