@@ -306,14 +306,14 @@ def write_plots(out_dir: str | os.PathLike) -> list[Path]:
     fig.tight_layout()
     paths.append(_save(fig, out / "explored_area.png"))
     families = group_by_family(rows)
-    if len(groups) > 1:
-        for fam, by_policy in families.items():
-            classes: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(
-                lambda: defaultdict(list)
-            )
-            for policy, rs in by_policy.items():
-                for r in rs:
-                    classes[world_class(r["world"])][policy].append(r)
+    for fam, by_policy in families.items():
+        classes: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(lambda: defaultdict(list))
+        for policy, rs in by_policy.items():
+            for r in rs:
+                classes[world_class(r["world"])][policy].append(r)
+        n_worlds = len({r["world"] for rs in by_policy.values() for r in rs})
+        # A lone family whose worlds pool nothing would repeat explored_area.png.
+        if len(families) > 1 or len(classes) < n_worlds:
             fig, panels = _panels(plt, len(classes), 5.2)
             for ax, (name, by_pol) in zip(panels, classes.items(), strict=True):
                 _area_curves(ax, out, by_pol, colours, world_label(name))
