@@ -1,7 +1,8 @@
 """Build any policy from a short spec string: ``make_policy("semantic", **overrides)``.
 
 Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
-every addition of ours off), ``"frontier"`` (ROS frontier_exploration
+every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
+value, :mod:`policies.frontier_value`), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
 agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
@@ -46,6 +47,18 @@ def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
         raise ValueError(f"policy 'semantic-paper' takes no argument, got 'semantic-paper:{arg}'")
     params = build_params(SemanticExpertParams, PAPER_PURE, base, overrides)
     return SemanticExpertPolicy(params, segmenter=segmenter)
+
+
+def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
+    """The expert choosing frontiers by a learned value (:mod:`policies.frontier_value`)."""
+    from policies.frontier_value import FrontierValueParams, FrontierValuePolicy
+
+    segmenter = overrides.pop("segmenter", None)
+    base = overrides.pop("params", None)
+    if arg:
+        raise ValueError(f"policy 'frontier-value' takes no argument, got 'frontier-value:{arg}'")
+    params = build_params(FrontierValueParams, base, overrides)
+    return FrontierValuePolicy(params, segmenter=segmenter)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
@@ -112,7 +125,11 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.pretrained import get_pretrained
 
     model = get_pretrained(arg)
-    policy = _sb3(str(model.model_path), overrides)
+    if model.model_path.suffix == ".yaml":
+        # A learned frontier value: its weights on top of the expert (no torch needed).
+        policy = _frontier_value("", {"params": model.model_path, **overrides})
+    else:
+        policy = _sb3(str(model.model_path), overrides)
     policy.name = model.spec
     return policy
 
@@ -194,6 +211,7 @@ def policy_factories() -> dict[str, Factory]:
     return {
         "semantic": _semantic,
         "semantic-paper": _semantic_paper,
+        "frontier-value": _frontier_value,
         "frontier": _frontier,
         "nearest": _nearest,
         "random": _random,

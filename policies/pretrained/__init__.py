@@ -1,15 +1,17 @@
 """Pretrained agents shipped inside the package: ``make_policy("pretrained:NAME")``.
 
-Each model lives in its own folder here, ``<name>/model.zip`` beside the resolved
-``config.yaml`` of the ``semexplore train`` run that produced it (a macro-action agent reads
-its settings from it). ``index.yaml`` describes them: what each was trained on, the command and
+Each model lives in its own folder here, ``<name>/model.zip`` (an SB3 model) or
+``<name>/model.yaml`` (the weights of a learned frontier value, :mod:`policies.frontier_value`)
+beside the resolved ``config.yaml`` of the ``semexplore train`` run that produced it (a
+macro-action agent reads its settings from it). ``index.yaml`` describes them: what each was trained on, the command and
 config that reproduce it, and its measured results. ``semexplore pretrained`` lists them, one
 line each starting with the policy spec::
 
     from policies.registry import make_policy
     policy = make_policy("pretrained:dagger_maze")
 
-The models need the ``rl`` extra (torch, stable-baselines3, sb3-contrib) to load.
+The SB3 models need the ``rl`` extra (torch, stable-baselines3, sb3-contrib) to load; a
+``model.yaml`` needs nothing beyond the package.
 """
 
 from __future__ import annotations
@@ -57,8 +59,13 @@ class PretrainedModel:
 
     @property
     def model_path(self) -> Path:
-        """The model zip (its folder also holds the run's ``config.yaml``)."""
-        return PRETRAINED_DIR / self.name / "model.zip"
+        """The model file: ``model.zip`` (an SB3 model; its folder also holds the run's
+        ``config.yaml``), or ``model.yaml`` (the parameters of a learned frontier value,
+        :mod:`policies.frontier_value`) when the folder has no zip."""
+        folder = PRETRAINED_DIR / self.name
+        if not (folder / "model.zip").is_file() and (folder / "model.yaml").is_file():
+            return folder / "model.yaml"
+        return folder / "model.zip"
 
     def summary_line(self) -> str:
         """One line: the spec first, then description, training data, command, results."""

@@ -1,4 +1,4 @@
-"""``semexplore train --algo bc|dagger|ppo --train-config FILE --out DIR``: train a learning agent.
+"""``semexplore train --algo bc|dagger|ppo|frontier_value --train-config FILE --out DIR``: train an agent.
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
@@ -9,6 +9,9 @@ observation instead (``env.macro`` holds its ``MacroParams`` fields, ``env.exper
 the driving expert's parameters). Every run directory gets ``model.zip``, the resolved
 ``config.yaml``, ``args.json`` (arguments and command line), TensorBoard logs (CSV when
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
+``frontier_value`` fits a learned frontier value for the expert
+(:mod:`semexplore_gym.training.frontier_value`, no torch needed) and writes ``model.yaml``,
+``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
 
 This module parses the arguments and writes the run directory; the configuration
 (:mod:`semexplore_gym.training.config`) and the runs (:mod:`semexplore_gym.training.imitation`,
@@ -30,7 +33,7 @@ import yaml
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.params import ConfigError, to_dict
 
-ALGOS = ("bc", "dagger", "ppo", "maskable_ppo")
+ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -46,7 +49,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--algo",
         required=True,
         choices=ALGOS,
-        help="bc, dagger, ppo or maskable_ppo (macro-action envs)",
+        help="bc, dagger, ppo, maskable_ppo (macro-action envs) or frontier_value (a learned "
+        "frontier value for the expert, fitted by a cross-entropy method over missions)",
     )
     p.add_argument("--train-config", default=None, help="agent config YAML (configs/agents/*.yml)")
     p.add_argument("--out", required=True, help="run directory (created)")
@@ -77,6 +81,8 @@ def _command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.algo == "frontier_value":
+        return _run_frontier_value(args)
     try:
         import stable_baselines3  # noqa: F401
         import torch
@@ -103,6 +109,27 @@ def run(args: argparse.Namespace) -> int:
     metrics["model"] = str(out / "model.zip")
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print(json.dumps({k: v for k, v in metrics.items() if k != "dagger_rounds"}, default=float))
+    return 0
+
+
+def _run_frontier_value(args: argparse.Namespace) -> int:
+    """``--algo frontier_value``: no torch; missions only (:mod:`~semexplore_gym.training.frontier_value`)."""
+    from semexplore_gym.training.frontier_value import (
+        load_frontier_value_config,
+        train_frontier_value,
+    )
+
+    try:
+        cfg = load_frontier_value_config(args.train_config, args.overrides)
+    except ConfigError as e:
+        raise ValueError(str(e)) from e
+    out = Path(args.out)
+    _write_run_record(out, cfg, args)
+    t0 = time.perf_counter()
+    final = train_frontier_value(cfg, out, log=lambda line: print(line, flush=True))
+    metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
+    print(json.dumps(metrics, default=float))
     return 0
 
 
