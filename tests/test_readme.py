@@ -140,6 +140,15 @@ TINY_PPO = [
     "ppo.n_epochs=1",
 ]
 
+TINY_FRONTIER_VALUE = [
+    "generations=1",
+    "population=2",
+    "elite=1",
+    "worlds_per_generation=1",
+    "max_time_s=5",
+    "workers=1",
+]
+
 
 def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
     """The same command with a test-sized budget (flags substituted or appended)."""
@@ -167,7 +176,11 @@ def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
         config = argv[argv.index("--train-config") + 1] if "--train-config" in argv else ""
         if "frontier_choice" in config or "planner_weights" in config:
             return [*argv, *(a for a in tiny_macro if a != "--no-progress")]
-        sets = {"bc": TINY_IMITATION, "dagger": TINY_IMITATION + TINY_DAGGER}.get(algo, TINY_PPO)
+        sets = {
+            "bc": TINY_IMITATION,
+            "dagger": TINY_IMITATION + TINY_DAGGER,
+            "frontier_value": TINY_FRONTIER_VALUE,
+        }.get(algo, TINY_PPO)
         return [*argv, *(t for s in sets for t in (SET, s))]
     return argv
 
