@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
 import numpy as np
 
 from semexplore_gym.core.grid import wrap_angle_rad
+from semexplore_gym.core.lazy import LazyField
 from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
 
@@ -97,23 +98,6 @@ class _PathParts:
         return _dedupe(np.concatenate(self.parts, axis=0))
 
 
-class _PathField:
-    """Data descriptor of ``FrontierCandidate.path_m``: stores an array or :class:`_PathParts`,
-    returns the array (joined once, on first read)."""
-
-    def __get__(self, obj: Any, objtype: Any = None) -> np.ndarray:
-        if obj is None:
-            raise AttributeError("path_m")  # no default value for the dataclass field
-        v = obj.__dict__["_path_m"]
-        if isinstance(v, _PathParts):
-            v = v.build()
-            obj.__dict__["_path_m"] = v
-        return v
-
-    def __set__(self, obj: Any, value: Any) -> None:
-        obj.__dict__["_path_m"] = value
-
-
 @dataclass(frozen=True)
 class FrontierCandidate:
     """The cheapest path found to one frontier, with every term of its cost.
@@ -139,7 +123,7 @@ class FrontierCandidate:
     if TYPE_CHECKING:
         path_m: np.ndarray
     else:
-        path_m: np.ndarray = _PathField()
+        path_m: np.ndarray = LazyField(_PathParts, _PathParts.build)
     opening_ids: tuple[int, ...]
     d_m: float
     v_rad: float

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.lazy import LazyField
 
 
 class AreaType(IntEnum):
@@ -172,23 +173,6 @@ class AreaRasterCrop:
         return cells
 
 
-class _AreaIdsField:
-    """Data descriptor of ``TopometricMap.area_ids``: stores an array or an
-    :class:`AreaRasterCrop`, and returns the full raster (built once, on first read)."""
-
-    def __get__(self, obj: Any, objtype: Any = None) -> np.ndarray:
-        if obj is None:
-            raise AttributeError("area_ids")  # no default value for the dataclass field
-        v = obj.__dict__["_area_ids"]
-        if isinstance(v, AreaRasterCrop):
-            v = v.full()
-            obj.__dict__["_area_ids"] = v
-        return v
-
-    def __set__(self, obj: Any, value: Any) -> None:
-        obj.__dict__["_area_ids"] = value
-
-
 @dataclass(frozen=True)
 class TopometricMap:
     """A semantic topometric map of an explored occupancy grid.
@@ -216,7 +200,7 @@ class TopometricMap:
         area_ids: np.ndarray
     else:
         # the descriptor stores an array or an AreaRasterCrop and always returns the array
-        area_ids: np.ndarray = _AreaIdsField()
+        area_ids: np.ndarray = LazyField(AreaRasterCrop, AreaRasterCrop.full)
     areas: dict[int, Area]
     openings: list[Opening]
     frontiers: list[Frontier]
