@@ -25,15 +25,28 @@ from semexplore_gym.core.params import build_params
 Factory = Callable[[str, dict[str, Any]], Policy]
 
 
-def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-
+def _expert_like(
+    name: str, arg: str, overrides: dict[str, Any], policy_cls: Any, *layers: Any
+) -> Policy:
+    """A semantic-expert-family policy: ``policy_cls(params, segmenter=...)`` with its params
+    built from ``layers``, the caller's ``params`` and the overrides."""
     segmenter = overrides.pop("segmenter", None)
     base = overrides.pop("params", None)
     if arg:
-        raise ValueError(f"policy 'semantic' takes no argument, got 'semantic:{arg}'")
-    params = build_params(SemanticExpertParams, base, overrides)
-    return SemanticExpertPolicy(params, segmenter=segmenter)
+        raise ValueError(f"policy {name!r} takes no argument, got '{name}:{arg}'")
+    return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter)
+
+
+def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
+    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+
+    return _expert_like(
+        "semantic",
+        arg,
+        overrides,
+        SemanticExpertPolicy,
+        SemanticExpertParams,
+    )
 
 
 def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -41,24 +54,27 @@ def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
     from policies.semantic_expert_params import PAPER_PURE
 
-    segmenter = overrides.pop("segmenter", None)
-    base = overrides.pop("params", None)
-    if arg:
-        raise ValueError(f"policy 'semantic-paper' takes no argument, got 'semantic-paper:{arg}'")
-    params = build_params(SemanticExpertParams, PAPER_PURE, base, overrides)
-    return SemanticExpertPolicy(params, segmenter=segmenter)
+    return _expert_like(
+        "semantic-paper",
+        arg,
+        overrides,
+        SemanticExpertPolicy,
+        SemanticExpertParams,
+        PAPER_PURE,
+    )
 
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
     """The expert choosing frontiers by a learned value (:mod:`policies.frontier_value`)."""
     from policies.frontier_value import FrontierValueParams, FrontierValuePolicy
 
-    segmenter = overrides.pop("segmenter", None)
-    base = overrides.pop("params", None)
-    if arg:
-        raise ValueError(f"policy 'frontier-value' takes no argument, got 'frontier-value:{arg}'")
-    params = build_params(FrontierValueParams, base, overrides)
-    return FrontierValuePolicy(params, segmenter=segmenter)
+    return _expert_like(
+        "frontier-value",
+        arg,
+        overrides,
+        FrontierValuePolicy,
+        FrontierValueParams,
+    )
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:

@@ -270,6 +270,16 @@ def _suite_tasks(
     return tasks, records, all_worlds
 
 
+def _refuse_repeats(flag: str, items: list[str]) -> None:
+    """A ValueError naming the first item ``flag`` lists twice."""
+    dup = next((x for i, x in enumerate(items) if x in items[:i]), None)
+    if dup is not None:
+        raise ValueError(
+            f"{flag} lists {short_repr(dup)} twice; each must appear once "
+            "(a repeat would count the same missions twice)"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     from semexplore_gym.evaluation.harness import (
         expand_tasks,
@@ -283,12 +293,7 @@ def run(args: argparse.Namespace) -> int:
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")
-    dup = next((x for i, x in enumerate(policies) if x in policies[:i]), None)
-    if dup is not None:
-        raise ValueError(
-            f"--policies lists {short_repr(dup)} twice; each must appear once "
-            "(a repeat would count the same missions twice)"
-        )
+    _refuse_repeats("--policies", policies)
     _check_policies(policies)
     from pathlib import Path
 
@@ -307,12 +312,7 @@ def run(args: argparse.Namespace) -> int:
         seeds = parse_seeds(args.runs or DEFAULT_RUNS, args.seed0)
         if not worlds:
             raise ValueError("--worlds is empty")
-        dup = next((x for i, x in enumerate(worlds) if x in worlds[:i]), None)
-        if dup is not None:
-            raise ValueError(
-                f"--worlds lists {short_repr(dup)} twice; each must appear once "
-                "(a repeat would count the same missions twice)"
-            )
+        _refuse_repeats("--worlds", worlds)
         _check_worlds(worlds, seeds[0])
         if args.fixed_start and len(seeds) > 1:
             same = [w for w in worlds if "seed=*" not in w]
