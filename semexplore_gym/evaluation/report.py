@@ -151,10 +151,13 @@ def _comparison_table(
                     f"| {other} | {label} | {ratio:.2f} | {paired} | {no_variation(a.size)} | – |"
                 )
                 continue
-            p = mannwhitneyu(a, b, alternative="two-sided").pvalue if a.size >= 2 else math.nan
             wins = int(np.sum(a < b))
+            if a.size < 2:  # one pair: no test
+                p_cell = "– (1 pair)"
+            else:
+                p_cell = f"{mannwhitneyu(a, b, alternative='two-sided').pvalue:.3g}"
             lines.append(
-                f"| {other} | {label} | {ratio:.2f} | {paired} | {p:.3g} | {wins}/{a.size} |"
+                f"| {other} | {label} | {ratio:.2f} | {paired} | {p_cell} | {wins}/{a.size} |"
             )
     lines.append("")
     return lines

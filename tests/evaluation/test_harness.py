@@ -125,3 +125,13 @@ def test_csv_with_other_columns_is_refused(tmp_path) -> None:
         run_benchmark(
             expand_tasks(["maze1"], ["semantic"], [0]), tmp_path, progress=False, task_fn=_fake
         )
+
+
+def test_summary_with_one_pair_prints_no_p_value(tmp_path) -> None:
+    tasks = expand_tasks(["maze1"], ["semantic", "frontier"], [0])
+    run_benchmark(tasks, tmp_path, progress=False, task_fn=_fake)
+    text = write_summary(tmp_path).read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | mission time |"))
+    p = line.strip("|").split("|")[4].strip()
+    assert p == "– (1 pair)"
+    assert "nan" not in text
