@@ -40,13 +40,7 @@ def _expert_like(
 def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 
-    return _expert_like(
-        "semantic",
-        arg,
-        overrides,
-        SemanticExpertPolicy,
-        SemanticExpertParams,
-    )
+    return _expert_like("semantic", arg, overrides, SemanticExpertPolicy, SemanticExpertParams)
 
 
 def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -54,27 +48,15 @@ def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
     from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
     from policies.semantic_expert_params import PAPER_PURE
 
-    return _expert_like(
-        "semantic-paper",
-        arg,
-        overrides,
-        SemanticExpertPolicy,
-        SemanticExpertParams,
-        PAPER_PURE,
-    )
+    layers = (SemanticExpertParams, PAPER_PURE)
+    return _expert_like("semantic-paper", arg, overrides, SemanticExpertPolicy, *layers)
 
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
     """The expert choosing frontiers by a learned value (:mod:`policies.frontier_value`)."""
     from policies.frontier_value import FrontierValueParams, FrontierValuePolicy
 
-    return _expert_like(
-        "frontier-value",
-        arg,
-        overrides,
-        FrontierValuePolicy,
-        FrontierValueParams,
-    )
+    return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
