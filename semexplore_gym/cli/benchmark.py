@@ -207,67 +207,18 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _suite_tasks(
     args: argparse.Namespace, seeds_for: Any
 ) -> tuple[list[Any], list[dict[str, Any]], list[str]]:
-    """Tasks of every ``--suite``: each world with the suite's time limit, runs and start poses.
+    """Tasks of every ``--suite`` (see :func:`~semexplore_gym.evaluation.suites.suite_tasks`)."""
+    from semexplore_gym.evaluation.suites import suite_tasks
 
-    Returns:
-        (tasks, ``[{"name", "version", "source"}]`` per suite, every world in order).
-    """
-    from semexplore_gym.core.worlds import make_world
-    from semexplore_gym.envs.config import load_env_config
-    from semexplore_gym.evaluation.harness import expand_tasks
-    from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
-
-    names = _split(args.suite)
-    if not names:
-        raise ValueError("--suite is empty")
-    tasks: list[Any] = []
-    records: list[dict[str, Any]] = []
-    all_worlds: list[str] = []
-    policies = _split_policies(args.policies)
-    for name in names:
-        try:
-            suite = load_suite(name)
-        except FileNotFoundError as e:
-            raise ValueError(f"--suite {short_repr(name)}: {e}") from None
-        if any(r["name"] == suite.name for r in records):
-            raise ValueError(f"--suite lists suite {suite.name!r} twice")
-        records.append({"name": suite.name, "version": suite.version, "source": name})
-        seeds = seeds_for(suite.runs)
-        random_start = suite.random_start and not args.fixed_start
-        repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
-        if not random_start and len(seeds) > 1 and repeated:
-            print(
-                f"warning: suite {suite.name}: fixed start poses: every seed repeats the same "
-                f"mission on {len(repeated)} world(s) without seed=*; the summary will say "
-                "'no variation'",
-                file=sys.stderr,
-            )
-        for entry in suite.worlds:
-            if entry.world in all_worlds:
-                raise ValueError(
-                    f"--suite: world {short_repr(entry.world)} is in two suites; each world must "
-                    "appear once (a repeat would count the same missions twice)"
-                )
-            all_worlds.append(entry.world)
-            try:
-                world = make_world(entry.world.replace("seed=*", f"seed={seeds[0]}"))
-            except (ValueError, FileNotFoundError) as e:
-                raise ValueError(f"--suite {suite.name}: world {entry.world!r}: {e}") from None
-            if args.max_time_s is not None:
-                limit = args.max_time_s
-            else:
-                area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
-                limit = world_time_limit_s(suite, entry, area_m2)
-            # The env's own limit must not cut the mission short; the user's --env-set wins.
-            overrides = [f"episode.random_start={'true' if random_start else 'false'}"]
-            if limit is not None:
-                overrides.append(f"episode.max_time_s={limit!r}")
-            overrides += args.env_overrides
-            env_config = load_env_config(args.env_config, overrides)
-            tasks += expand_tasks(
-                [entry.world], policies, seeds, max_time_s=limit, env_config=env_config
-            )
-    return tasks, records, all_worlds
+    return suite_tasks(
+        _split(args.suite),
+        _split_policies(args.policies),
+        seeds_for,
+        max_time_s=args.max_time_s,
+        fixed_start=args.fixed_start,
+        env_config=args.env_config,
+        env_overrides=args.env_overrides,
+    )
 
 
 def _refuse_repeats(flag: str, items: list[str]) -> None:

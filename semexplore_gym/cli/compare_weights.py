@@ -18,7 +18,11 @@
    ``OUT/mission_times.png`` (box plot per weight set). ``OUT/weights.json`` has every set.
 
 Test seeds start at ``--test-seed0`` (default 1000) so ``seed=*`` procedural test worlds are
-disjoint from the training ones. Example::
+disjoint from the training ones. ``--test-suite mazes,offices,caves`` tests on benchmark suites
+instead (``configs/suites``): each world with its suite's time limit, runs and start seeds, as
+``semexplore benchmark --suite`` runs them (so the paper row repeats that run's ``semantic``
+missions). ``OUT/test/summary.md`` compares every set with the paper's per family, paired by
+(world, seed). Example::
 
     semexplore compare-weights --train-worlds 'maze:seed=*,size_m=4' \\
         --test-worlds 'maze:seed=*,size_m=4' --trials 20 --runs 5 --max-time-s 120 --out runs/cw
@@ -32,12 +36,20 @@ import json
 import math
 import shlex
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
+
+#: Defaults of --runs, --test-seed0 and --max-time-s with --test-worlds.
+DEFAULT_TEST_RUNS = 5
+DEFAULT_TEST_SEED0 = 1000
+DEFAULT_MAX_TIME_S = 300.0
+#: First test seed with --test-suite: the one ``semexplore benchmark --suite`` starts from.
+SUITE_SEED0 = 0
 
 PAPER = "semantic[paper]"
 TUNED = "semantic[tuned]"
@@ -53,15 +65,20 @@ def validate_args(args: argparse.Namespace) -> None:
         ValueError: naming the argument and its value.
     """
     checks = (
-        ("--max-time-s", args.max_time_s, 0 < args.max_time_s <= 1e7),
+        ("--max-time-s", args.max_time_s, args.max_time_s is None or 0 < args.max_time_s <= 1e7),
+        (
+            "--train-max-time-s",
+            args.train_max_time_s,
+            args.train_max_time_s is None or 0 < args.train_max_time_s <= 1e7,
+        ),
         ("--target-coverage", args.target_coverage, 0.0 < args.target_coverage <= 1.0),
         ("--penalty-s", args.penalty_s, math.isfinite(args.penalty_s) and args.penalty_s >= 0),
         ("--trials", args.trials, 1 <= args.trials <= 100_000),
-        ("--runs", args.runs, 1 <= args.runs <= 100_000),
+        ("--runs", args.runs, args.runs is None or 1 <= args.runs <= 100_000),
         ("--train-runs", args.train_runs, 1 <= args.train_runs <= 100_000),
         ("--workers", args.workers, 1 <= args.workers <= 256),
         ("--train-seed0", args.train_seed0, 0 <= args.train_seed0 <= 2**31),
-        ("--test-seed0", args.test_seed0, 0 <= args.test_seed0 <= 2**31),
+        ("--test-seed0", args.test_seed0, args.test_seed0 is None or 0 <= args.test_seed0 <= 2**31),
         ("--seed", args.seed, 0 <= args.seed <= 2**32 - 1),
     )
     for flag, value, ok in checks:
@@ -180,6 +197,8 @@ def write_table(
         ),
         *(f"- `{spec}`: learned agent (policy spec)" for spec in agents or []),
         "",
+        "Per family, each set against the paper's paired by (world, seed): `test/summary.md`.",
+        "",
     ]
     md_path = out / "compare.md"
     md_path.write_text("\n".join(lines))
@@ -220,26 +239,48 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         required=True,
         help="comma-separated training worlds ('maze:seed=*,size_m=4')",
     )
-    p.add_argument("--test-worlds", required=True, help="comma-separated test worlds")
+    test = p.add_mutually_exclusive_group(required=True)
+    test.add_argument("--test-worlds", help="comma-separated test worlds")
+    test.add_argument(
+        "--test-suite",
+        help="comma-separated benchmark suites to test on instead (configs/suites: mazes, "
+        "offices, caves, ...; or suite YAML paths), with each suite's worlds, time limits and "
+        "start seeds",
+    )
     p.add_argument("--out", required=True, help="output directory; rerunning resumes")
     p.add_argument("--trials", type=int, default=20, help="Optuna trials (default: %(default)s)")
     p.add_argument(
         "--train-runs", type=int, default=2, help="seeds per training world (default: %(default)s)"
     )
     p.add_argument(
-        "--runs", type=int, default=5, help="seeds per test world (default: %(default)s)"
+        "--runs",
+        type=int,
+        default=None,
+        help=f"seeds per test world (default: {DEFAULT_TEST_RUNS}; with --test-suite the suite's runs)",
     )
     p.add_argument(
         "--train-seed0", type=int, default=0, help="first training seed (default: %(default)s)"
     )
     p.add_argument(
-        "--test-seed0", type=int, default=1000, help="first test seed (default: %(default)s)"
+        "--test-seed0",
+        type=int,
+        default=None,
+        help=f"first test seed (default: {DEFAULT_TEST_SEED0}; with --test-suite {SUITE_SEED0}, "
+        "the seeds semexplore benchmark --suite uses)",
     )
     p.add_argument(
         "--max-time-s",
         type=float,
-        default=300.0,
-        help="simulated time limit per mission (default: %(default)s)",
+        default=None,
+        help=f"simulated time limit per mission (default: {DEFAULT_MAX_TIME_S:g}; with "
+        "--test-suite it replaces the suites' own limits only when given)",
+    )
+    p.add_argument(
+        "--train-max-time-s",
+        type=float,
+        default=None,
+        help="time limit of the tuning missions (default: --max-time-s, or "
+        f"{DEFAULT_MAX_TIME_S:g})",
     )
     p.add_argument(
         "--target-coverage",
@@ -278,45 +319,33 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def _check_run_args(
     args: argparse.Namespace,
-) -> tuple[list[str], list[str], list[int], list[int], list[str]]:
+) -> tuple[list[str], list[int], list[Any], list[str]]:
     """Everything is checked before the tuning starts: a typo must not cost an Optuna run.
 
     Returns:
-        ``(train_worlds, test_worlds, train_seeds, test_seeds, agents)``.
+        ``(train_worlds, train_seeds, test_tasks, agents)``: the test tasks of every weight set
+        and agent, without the weight sets' overrides (known after the tuning).
     """
-    from semexplore_gym.evaluation.harness import parse_seeds
+    from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
 
     validate_args(args)
     train_worlds = _split_worlds(args.train_worlds)
-    test_worlds = _split_worlds(args.test_worlds)
-    if not train_worlds or not test_worlds:
-        raise ValueError("--train-worlds and --test-worlds must each name at least one world")
+    if not train_worlds:
+        raise ValueError("--train-worlds must name at least one world")
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
-    test_seeds = parse_seeds(args.runs, args.test_seed0)
     from semexplore_gym.cli.benchmark import _check_worlds
 
-    for flag, worlds, seeds in (
-        ("--train-worlds", train_worlds, train_seeds),
-        ("--test-worlds", test_worlds, test_seeds),
-    ):
-        dup = next((w for i, w in enumerate(worlds) if w in worlds[:i]), None)
-        if dup is not None:
-            raise ValueError(f"{flag} lists {short_repr(dup)} twice")
-        try:
-            _check_worlds(worlds, seeds[0])
-        except (ValueError, FileNotFoundError) as e:
-            raise ValueError(f"{flag}: {e}") from None
+    dup = next((w for i, w in enumerate(train_worlds) if w in train_worlds[:i]), None)
+    if dup is not None:
+        raise ValueError(f"--train-worlds lists {short_repr(dup)} twice")
+    try:
+        _check_worlds(train_worlds, train_seeds[0])
+    except (ValueError, FileNotFoundError) as e:
+        raise ValueError(f"--train-worlds: {e}") from None
     if args.env_config is not None:
         from semexplore_gym.envs.config import load_env_config
 
         load_env_config(args.env_config)
-    overlap = set(train_seeds) & set(test_seeds)
-    if overlap and set(train_worlds) & set(test_worlds):
-        raise ValueError(
-            f"training and test (world, seed) pairs overlap on seeds {sorted(overlap)}; change --test-seed0"
-        )
-    if args.trials < 1:
-        raise ValueError(f"--trials must be >= 1, got {args.trials}")
     from policies.registry import split_specs
 
     agents = split_specs(args.agents)
@@ -333,16 +362,58 @@ def _check_run_args(
                 make_policy(spec)  # a bad path or spec fails now, not after the tuning
             except (ValueError, FileNotFoundError) as e:
                 raise ValueError(f"--agents {spec!r}: {e}") from None
-    return train_worlds, test_worlds, train_seeds, test_seeds, agents
+    labels = [*weight_sets({}), *agents]
+    if args.test_suite is not None:
+        from semexplore_gym.cli.benchmark import _split
+        from semexplore_gym.evaluation.suites import suite_tasks
+
+        seed0 = SUITE_SEED0 if args.test_seed0 is None else args.test_seed0
+        tasks, _records, test_worlds = suite_tasks(
+            _split(args.test_suite),
+            labels,
+            lambda runs: parse_seeds(args.runs or runs, seed0),
+            max_time_s=args.max_time_s,
+            env_config=args.env_config,
+            flag="--test-suite",
+        )
+    else:
+        test_worlds = _split_worlds(args.test_worlds)
+        if not test_worlds:
+            raise ValueError("--test-worlds must name at least one world")
+        seed0 = DEFAULT_TEST_SEED0 if args.test_seed0 is None else args.test_seed0
+        test_seeds = parse_seeds(args.runs or DEFAULT_TEST_RUNS, seed0)
+        dup = next((w for i, w in enumerate(test_worlds) if w in test_worlds[:i]), None)
+        if dup is not None:
+            raise ValueError(f"--test-worlds lists {short_repr(dup)} twice")
+        try:
+            _check_worlds(test_worlds, test_seeds[0])
+        except (ValueError, FileNotFoundError) as e:
+            raise ValueError(f"--test-worlds: {e}") from None
+        limit = DEFAULT_MAX_TIME_S if args.max_time_s is None else args.max_time_s
+        tasks = expand_tasks(
+            test_worlds, labels, test_seeds, max_time_s=limit, env_config=args.env_config
+        )
+    overlap = set(train_seeds) & {t.seed for t in tasks}
+    if overlap and set(train_worlds) & set(test_worlds):
+        raise ValueError(
+            f"training and test (world, seed) pairs overlap on seeds {sorted(overlap)}; change --test-seed0"
+        )
+    if args.trials < 1:
+        raise ValueError(f"--trials must be >= 1, got {args.trials}")
+    return train_worlds, train_seeds, tasks, agents
+
+
+def _train_limit_s(args: argparse.Namespace) -> float:
+    """The tuning missions' time limit: --train-max-time-s, else --max-time-s, else the default."""
+    for value in (args.train_max_time_s, args.max_time_s):
+        if value is not None:
+            return float(value)
+    return DEFAULT_MAX_TIME_S
 
 
 def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import (
-        expand_tasks,
-        read_runs,
-        run_benchmark,
-        write_manifest,
-    )
+    from semexplore_gym.evaluation.harness import read_runs, run_benchmark, write_manifest
+    from semexplore_gym.evaluation.report import write_summary
     from semexplore_gym.training.weight_tuning import (
         PAPER_FIELD,
         PAPER_WEIGHTS,
@@ -351,7 +422,7 @@ def run(args: argparse.Namespace) -> int:
         tune_weights,
     )
 
-    train_worlds, test_worlds, train_seeds, test_seeds, agents = _check_run_args(args)
+    train_worlds, train_seeds, test_tasks, agents = _check_run_args(args)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_manifest(
@@ -367,7 +438,7 @@ def run(args: argparse.Namespace) -> int:
     objective = mission_objective(
         train_worlds,
         train_seeds,
-        args.max_time_s,
+        _train_limit_s(args),
         args.target_coverage,
         args.penalty_s,
         env_config=args.env_config,
@@ -393,22 +464,10 @@ def run(args: argparse.Namespace) -> int:
         json.dumps({"sets": sets, "best_train_value": result.best_value}, indent=2)
     )
 
-    tasks = []
-    for label, ws in sets.items():
-        tasks += expand_tasks(
-            test_worlds,
-            [label],
-            test_seeds,
-            max_time_s=args.max_time_s,
-            env_config=args.env_config,
-            policy_overrides=ws,
-        )
-    if agents:
-        tasks += expand_tasks(
-            test_worlds, agents, test_seeds, max_time_s=args.max_time_s, env_config=args.env_config
-        )
+    tasks = [replace(t, policy_overrides=dict(sets.get(t.policy, {}))) for t in test_tasks]
     res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
     rows = read_runs(out / "test" / "runs.csv")
+    summary = write_summary(out / "test", reference=PAPER)
     labels = [*sets, *agents]
     table = summarise(rows, labels, args.target_coverage, args.penalty_s)
     csv_path, md_path = write_table(out, table, sets, agents)
@@ -422,6 +481,7 @@ def run(args: argparse.Namespace) -> int:
                 "table": str(md_path),
                 "csv": str(csv_path),
                 "plot": str(plot),
+                "per_family": str(summary),
                 "failed": len(res["failed"]),
             }
         )

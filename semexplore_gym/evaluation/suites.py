@@ -20,6 +20,8 @@ family of a world (its spelling before ``:``, or the file name of a map) groups 
 from __future__ import annotations
 
 import os
+import sys
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -219,3 +221,90 @@ def world_time_limit_s(suite: Suite, entry: SuiteWorld, free_area_m2: float | No
     if suite.time_per_m2_s is not None and free_area_m2 is not None:
         return max(suite.min_time_s, suite.time_per_m2_s * free_area_m2)
     return None
+
+
+def suite_tasks(
+    names: Sequence[str],
+    policies: Sequence[str],
+    seeds_for: Callable[[int], list[int]],
+    *,
+    max_time_s: float | None = None,
+    fixed_start: bool = False,
+    env_config: Any = None,
+    env_overrides: Sequence[str] = (),
+    flag: str = "--suite",
+) -> tuple[list[Any], list[dict[str, Any]], list[str]]:
+    """The benchmark tasks of the suites ``names``: every world with its suite's time limit,
+    runs and start poses, for every policy.
+
+    Args:
+        names: suite names (``configs/suites``) or YAML paths.
+        policies: policy specs.
+        seeds_for: the seeds to run, given a suite's ``runs``.
+        max_time_s: replaces every suite's time limits when given.
+        fixed_start: start every mission at the world's fixed pose (warns when seeds repeat).
+        env_config: env config preset or YAML the suite's overrides apply to.
+        env_overrides: ``SECTION.KEY=VALUE`` env overrides (win over the suite's).
+        flag: the command-line flag named in errors.
+
+    Returns:
+        (tasks, ``[{"name", "version", "source"}]`` per suite, every world in order).
+
+    Raises:
+        ValueError: an unknown or repeated suite, a world in two suites, a world that cannot
+            be built; each message names ``flag`` and the value.
+    """
+    from semexplore_gym.core.safe_io import short_repr
+    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.evaluation.harness import expand_tasks
+
+    if not names:
+        raise ValueError(f"{flag} is empty")
+    tasks: list[Any] = []
+    records: list[dict[str, Any]] = []
+    all_worlds: list[str] = []
+    for name in names:
+        try:
+            suite = load_suite(name)
+        except FileNotFoundError as e:
+            raise ValueError(f"{flag} {short_repr(name)}: {e}") from None
+        if any(r["name"] == suite.name for r in records):
+            raise ValueError(f"{flag} lists suite {suite.name!r} twice")
+        records.append({"name": suite.name, "version": suite.version, "source": str(name)})
+        seeds = seeds_for(suite.runs)
+        random_start = suite.random_start and not fixed_start
+        repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
+        if not random_start and len(seeds) > 1 and repeated:
+            print(
+                f"warning: suite {suite.name}: fixed start poses: every seed repeats the same "
+                f"mission on {len(repeated)} world(s) without seed=*; the summary will say "
+                "'no variation'",
+                file=sys.stderr,
+            )
+        for entry in suite.worlds:
+            if entry.world in all_worlds:
+                raise ValueError(
+                    f"{flag}: world {short_repr(entry.world)} is in two suites; each world must "
+                    "appear once (a repeat would count the same missions twice)"
+                )
+            all_worlds.append(entry.world)
+            try:
+                world = make_world(entry.world.replace("seed=*", f"seed={seeds[0]}"))
+            except (ValueError, FileNotFoundError) as e:
+                raise ValueError(f"{flag} {suite.name}: world {entry.world!r}: {e}") from None
+            if max_time_s is not None:
+                limit: float | None = max_time_s
+            else:
+                area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
+                limit = world_time_limit_s(suite, entry, area_m2)
+            # The env's own limit must not cut the mission short; the user's overrides win.
+            overrides = [f"episode.random_start={'true' if random_start else 'false'}"]
+            if limit is not None:
+                overrides.append(f"episode.max_time_s={limit!r}")
+            overrides += list(env_overrides)
+            config = load_env_config(env_config, overrides)
+            tasks += expand_tasks(
+                [entry.world], policies, seeds, max_time_s=limit, env_config=config
+            )
+    return tasks, records, all_worlds

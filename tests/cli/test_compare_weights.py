@@ -122,3 +122,80 @@ def test_agents_join_the_test_table_and_bad_agents_fail_early(tmp_path: Path) ->
     assert main([*argv, "--agents", "sb3:no/such/model.zip", "--out", str(bad)]) == 2
     assert not (bad / "tuning").exists()  # rejected before any tuning trial
     assert main([*argv, "--agents", "semantic[x]", "--out", str(bad)]) == 2
+
+
+TINY_SUITE = """\
+name: tiny
+version: 1
+runs: 2
+random_start: true
+time_per_m2_s: 1.0
+min_time_s: 12
+worlds:
+  - maze:seed=1,size_m=4
+  - {world: 'cave:seed=2,size_m=6', max_time_s: 6}
+"""
+
+
+def test_compare_weights_tests_on_a_suite_as_benchmark_runs_it(tmp_path: Path, capsys) -> None:
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(TINY_SUITE)
+    out = tmp_path / "cw"
+    argv = [
+        "compare-weights", "--train-worlds", "maze:seed=*,size_m=4", "--test-suite", str(suite),
+        "--trials", "1", "--train-runs", "1", "--train-max-time-s", "5", "--out", str(out),
+    ]  # fmt: skip
+    assert main(argv) == 0  # progress bars on, as users run it
+    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    rows = list(csv.DictReader((out / "test" / "runs.csv").open()))
+    # Every set on both worlds with the suite's runs (2) and start seeds (0, 1), not 1000+.
+    assert len(rows) == 2 * 2 * len(weight_sets({}))
+    assert {r["seed"] for r in rows} == {"0", "1"}
+    times = {(r["world"], r["policy"]): float(r["mission_time_s"]) for r in rows}
+    assert max(t for (w, _), t in times.items() if w.startswith("cave")) <= 6.0 + 1e-6
+    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
+
+    maze = make_world("maze:seed=1,size_m=4")
+    area_m2 = float(maze.free_mask.sum()) * maze.free_geometry.resolution_m**2
+    limit = world_time_limit_s(load_suite(suite), load_suite(suite).worlds[0], area_m2)
+    assert limit > 12.0  # the area rule, above the suite's minimum and the tuning's 5 s
+    step_s = 0.2  # the env's control step: the step that crosses the limit ends the mission
+    assert limit < max(t for (w, _), t in times.items() if w.startswith("maze")) <= limit + step_s
+    # Tuning ran at its own limit (5 s), not the suite's.
+    trial = json.loads((out / "tuning" / "trials.jsonl").read_text().splitlines()[0])
+    assert trial["value"] <= 5.0 + 600.0
+    summary = Path(report["per_family"]).read_text()
+    assert "### maze (1 world)" in summary and "### cave (1 world)" in summary
+    assert "semantic[paper]" in summary and "test/summary.md" in (out / "compare.md").read_text()
+
+    # The paper row is the same missions `benchmark --suite` runs with the default expert.
+    bench = tmp_path / "bench"
+    assert main(["benchmark", "--suite", str(suite), "--policies", "semantic", "--out",
+                 str(bench), "--no-plots", "--no-progress"]) == 0  # fmt: skip
+    ref = {
+        (r["world"], r["seed"]): (r["mission_time_s"], r["coverage"], r["path_length_m"])
+        for r in csv.DictReader((bench / "runs.csv").open())
+    }
+    paper = {
+        (r["world"], r["seed"]): (r["mission_time_s"], r["coverage"], r["path_length_m"])
+        for r in rows
+        if r["policy"] == PAPER
+    }
+    assert paper == ref
+
+
+def test_test_suite_and_test_worlds_exclude_each_other(tmp_path: Path, capsys) -> None:
+    base = ["compare-weights", "--train-worlds", "maze:seed=*,size_m=4", "--out", str(tmp_path)]
+    for argv in ([*base, "--test-suite", "caves", "--test-worlds", "maze1"], base):
+        with pytest.raises(SystemExit) as exc:  # argparse's usage error
+            main(argv)
+        assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "not allowed with argument" in err and "--test-worlds --test-suite" in err.replace(
+        "/", " "
+    )
+    assert main([*base, "--test-suite", "no_such_suite", "--trials", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--test-suite" in err[0] and "no_such_suite" in err[0]
+    assert not (tmp_path / "tuning").exists()  # rejected before any tuning trial
