@@ -102,15 +102,15 @@ class PPOSection:
     """SB3 PPO settings; ``init_from`` starts from a BC/DAgger model zip (egocentric env only).
 
     PPO collects from ``n_envs`` envs at once (``n_steps`` each per update). ``vec_env`` picks
-    how: ``"subproc"`` (SB3's ``SubprocVecEnv``: one process per env, so the env steps and the
-    egocentric encoding of 2 envs use both cores of a 2-core machine while the learner runs
-    its forward pass), ``"dummy"`` (``DummyVecEnv``: all envs in this process, no start-up
-    cost; best for one env, for tiny runs, or when the cores are busy anyway) or ``"auto"``
-    (subproc when ``n_envs > 1``, else dummy).
+    how: ``"subproc"`` (SB3's ``SubprocVecEnv``: one process per env, which pays off with a
+    free core per env), ``"dummy"`` (``DummyVecEnv``: all envs in this process, no start-up
+    cost or messaging; the policy's forward pass is batched over them) or ``"auto"`` (subproc
+    when the machine has more cores than ``n_envs``, else dummy). On a 2-core machine 4 envs
+    in this process collect the most (``scripts/bench_ppo_collection.py``).
     """
 
     total_timesteps: int = 20_000
-    n_envs: int = 2
+    n_envs: int = 4
     vec_env: str = "auto"
     n_steps: int = 512
     batch_size: int = 64
