@@ -317,6 +317,23 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:
+    """The worlds ``flag`` lists, each once and each buildable (``seed=*`` with ``seed``)."""
+    from semexplore_gym.cli.benchmark import _check_worlds
+
+    worlds = _split_worlds(text)
+    if not worlds:
+        raise ValueError(f"{flag} must name at least one world")
+    dup = next((w for i, w in enumerate(worlds) if w in worlds[:i]), None)
+    if dup is not None:
+        raise ValueError(f"{flag} lists {short_repr(dup)} twice")
+    try:
+        _check_worlds(worlds, seed)
+    except (ValueError, FileNotFoundError) as e:
+        raise ValueError(f"{flag}: {e}") from None
+    return worlds
+
+
 def _check_run_args(
     args: argparse.Namespace,
 ) -> tuple[list[str], list[int], list[Any], list[str]]:
@@ -329,19 +346,8 @@ def _check_run_args(
     from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
 
     validate_args(args)
-    train_worlds = _split_worlds(args.train_worlds)
-    if not train_worlds:
-        raise ValueError("--train-worlds must name at least one world")
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
-    from semexplore_gym.cli.benchmark import _check_worlds
-
-    dup = next((w for i, w in enumerate(train_worlds) if w in train_worlds[:i]), None)
-    if dup is not None:
-        raise ValueError(f"--train-worlds lists {short_repr(dup)} twice")
-    try:
-        _check_worlds(train_worlds, train_seeds[0])
-    except (ValueError, FileNotFoundError) as e:
-        raise ValueError(f"--train-worlds: {e}") from None
+    train_worlds = _checked_worlds("--train-worlds", args.train_worlds, train_seeds[0])
     if args.env_config is not None:
         from semexplore_gym.envs.config import load_env_config
 
@@ -377,18 +383,9 @@ def _check_run_args(
             flag="--test-suite",
         )
     else:
-        test_worlds = _split_worlds(args.test_worlds)
-        if not test_worlds:
-            raise ValueError("--test-worlds must name at least one world")
         seed0 = DEFAULT_TEST_SEED0 if args.test_seed0 is None else args.test_seed0
         test_seeds = parse_seeds(args.runs or DEFAULT_TEST_RUNS, seed0)
-        dup = next((w for i, w in enumerate(test_worlds) if w in test_worlds[:i]), None)
-        if dup is not None:
-            raise ValueError(f"--test-worlds lists {short_repr(dup)} twice")
-        try:
-            _check_worlds(test_worlds, test_seeds[0])
-        except (ValueError, FileNotFoundError) as e:
-            raise ValueError(f"--test-worlds: {e}") from None
+        test_worlds = _checked_worlds("--test-worlds", args.test_worlds, test_seeds[0])
         limit = DEFAULT_MAX_TIME_S if args.max_time_s is None else args.max_time_s
         tasks = expand_tasks(
             test_worlds, labels, test_seeds, max_time_s=limit, env_config=args.env_config

@@ -124,22 +124,22 @@ def test_agents_join_the_test_table_and_bad_agents_fail_early(tmp_path: Path) ->
     assert main([*argv, "--agents", "semantic[x]", "--out", str(bad)]) == 2
 
 
-TINY_SUITE = """\
-name: tiny
-version: 1
-runs: 2
-random_start: true
-time_per_m2_s: 1.0
-min_time_s: 12
-worlds:
-  - maze:seed=1,size_m=4
-  - {world: 'cave:seed=2,size_m=6', max_time_s: 6}
-"""
+#: A two-world suite: the maze's limit follows the area rule, the cave has its own.
+TINY_SUITE = {
+    "name": "tiny",
+    "version": 1,
+    "runs": 2,
+    "random_start": True,
+    "time_per_m2_s": 1.0,
+    "min_time_s": 12,
+    "worlds": ["maze:seed=1,size_m=4", {"world": "cave:seed=2,size_m=6", "max_time_s": 6}],
+}
 
 
 def test_compare_weights_tests_on_a_suite_as_benchmark_runs_it(tmp_path: Path, capsys) -> None:
-    suite = tmp_path / "tiny.yaml"
-    suite.write_text(TINY_SUITE)
+    from semexplore_gym.evaluation.suites import save_suite, suite_from_dict
+
+    suite = save_suite(suite_from_dict(TINY_SUITE), tmp_path / "tiny.yaml")
     out = tmp_path / "cw"
     argv = [
         "compare-weights", "--train-worlds", "maze:seed=*,size_m=4", "--test-suite", str(suite),
