@@ -319,14 +319,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:
     """The worlds ``flag`` lists, each once and each buildable (``seed=*`` with ``seed``)."""
-    from semexplore_gym.cli.benchmark import _check_worlds
+    from semexplore_gym.cli.benchmark import _check_worlds, _refuse_repeats
 
     worlds = _split_worlds(text)
     if not worlds:
         raise ValueError(f"{flag} must name at least one world")
-    dup = next((w for i, w in enumerate(worlds) if w in worlds[:i]), None)
-    if dup is not None:
-        raise ValueError(f"{flag} lists {short_repr(dup)} twice")
+    _refuse_repeats(flag, worlds)
     try:
         _check_worlds(worlds, seed)
     except (ValueError, FileNotFoundError) as e:
@@ -336,12 +334,13 @@ def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:
 
 def _check_run_args(
     args: argparse.Namespace,
-) -> tuple[list[str], list[int], list[Any], list[str]]:
+) -> tuple[list[str], list[int], list[Any], list[str], list[dict[str, Any]]]:
     """Everything is checked before the tuning starts: a typo must not cost an Optuna run.
 
     Returns:
-        ``(train_worlds, train_seeds, test_tasks, agents)``: the test tasks of every weight set
-        and agent, without the weight sets' overrides (known after the tuning).
+        ``(train_worlds, train_seeds, test_tasks, agents, suites)``: the test tasks of every
+        weight set and agent, without the weight sets' overrides (known after the tuning), and
+        the name and version of each ``--test-suite`` (empty with ``--test-worlds``).
     """
     from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
 
@@ -374,7 +373,7 @@ def _check_run_args(
         from semexplore_gym.evaluation.suites import suite_tasks
 
         seed0 = SUITE_SEED0 if args.test_seed0 is None else args.test_seed0
-        tasks, _records, test_worlds = suite_tasks(
+        tasks, suites, test_worlds = suite_tasks(
             _split(args.test_suite),
             labels,
             lambda runs: parse_seeds(args.runs or runs, seed0),
@@ -383,6 +382,7 @@ def _check_run_args(
             flag="--test-suite",
         )
     else:
+        suites = []
         seed0 = DEFAULT_TEST_SEED0 if args.test_seed0 is None else args.test_seed0
         test_seeds = parse_seeds(args.runs or DEFAULT_TEST_RUNS, seed0)
         test_worlds = _checked_worlds("--test-worlds", args.test_worlds, test_seeds[0])
@@ -395,9 +395,7 @@ def _check_run_args(
         raise ValueError(
             f"training and test (world, seed) pairs overlap on seeds {sorted(overlap)}; change --test-seed0"
         )
-    if args.trials < 1:
-        raise ValueError(f"--trials must be >= 1, got {args.trials}")
-    return train_worlds, train_seeds, tasks, agents
+    return train_worlds, train_seeds, tasks, agents, suites
 
 
 def _train_limit_s(args: argparse.Namespace) -> float:
@@ -419,7 +417,7 @@ def run(args: argparse.Namespace) -> int:
         tune_weights,
     )
 
-    train_worlds, train_seeds, test_tasks, agents = _check_run_args(args)
+    train_worlds, train_seeds, test_tasks, agents, suites = _check_run_args(args)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_manifest(
@@ -462,6 +460,9 @@ def run(args: argparse.Namespace) -> int:
     )
 
     tasks = [replace(t, policy_overrides=dict(sets.get(t.policy, {}))) for t in test_tasks]
+    # OUT/test is a benchmark directory: its manifest names the suites for its summary.
+    (out / "test").mkdir(exist_ok=True)
+    write_manifest(out / "test", {"suites": suites or None, "weight_sets": sets})
     res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
     rows = read_runs(out / "test" / "runs.csv")
     summary = write_summary(out / "test", reference=PAPER)

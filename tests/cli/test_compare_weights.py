@@ -167,6 +167,7 @@ def test_compare_weights_tests_on_a_suite_as_benchmark_runs_it(tmp_path: Path, c
     assert trial["value"] <= 5.0 + 600.0
     summary = Path(report["per_family"]).read_text()
     assert "### maze (1 world)" in summary and "### cave (1 world)" in summary
+    assert "Suites: `tiny` v1." in summary
     assert "semantic[paper]" in summary and "test/summary.md" in (out / "compare.md").read_text()
 
     # The paper row is the same missions `benchmark --suite` runs with the default expert.
