@@ -168,6 +168,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             "revived": 0,
             "looks": 0,
             "look_drives": 0,
+            "pocket_escapes": 0,
             "goal_timeouts": 0,
             "oscillations_blocked": 0,
             # Instrumentation only (no decision reads them): replans with scored frontiers, and
@@ -422,6 +423,8 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             new_plan = self._committed_fallback_plan(grid, pose, clearance)
             if new_plan is None:
                 new_plan = self._nearest_fallback_plan(grid, pose, clearance)
+            if new_plan is None and prm.pocket_escape:
+                new_plan = self._pocket_escape_plan(grid, pose, clearance)
         stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
 
         if new_plan is None and prm.grid_fallback and prm.look_at_narrow_frontiers:
@@ -558,23 +561,30 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
     ) -> _Plan | None:
         """The nearest frontier a grid search with the robot's clearance reaches (or None)."""
-        prm = self.params
-        res_m = self.geometry.resolution_m
         found = nearest_reachable_frontier(
             grid,
             self.geometry,
             pose[:2],
             self.clearance_m,
-            min_frontier_cells=max(1, math.ceil(prm.fallback_min_frontier_m / res_m - 1e-9)),
-            min_unknown_depth_cells=prm.fallback_min_unknown_depth_m / res_m,
-            reach_m=prm.fallback_reach_m,
-            excluded_xy_m=self.memory.active_points(),
-            excluded_radius_m=prm.blacklist_radius_m + prm.fallback_reach_m,
             clearance_field=clearance,
+            **self._fallback_search_kwargs(),
         )
         if found is None:
             return None
+        res_m = self.geometry.resolution_m
         return _Plan("fallback", found.goal_xy_m, resample_polyline(found.path_m, res_m), None)
+
+    def _fallback_search_kwargs(self) -> dict[str, Any]:
+        """Which frontiers the grid check counts (the same for its every search)."""
+        prm = self.params
+        res_m = self.geometry.resolution_m
+        return {
+            "min_frontier_cells": max(1, math.ceil(prm.fallback_min_frontier_m / res_m - 1e-9)),
+            "min_unknown_depth_cells": prm.fallback_min_unknown_depth_m / res_m,
+            "reach_m": prm.fallback_reach_m,
+            "excluded_xy_m": self.memory.active_points(),
+            "excluded_radius_m": prm.blacklist_radius_m + prm.fallback_reach_m,
+        }
 
     def _give_up_plan(self) -> None:
         """No frontier from either source: wait a step, stop after ``stop_confirmations``."""

@@ -64,6 +64,13 @@ What the paper leaves open, and how the expert handles it (parameters in
 * **The stop rule**: the mission stops only when the grid fallback (a clearance-aware grid
   search, the final check) finds no frontier the robot's disc can reach, besides dropped goals;
   the stop reason names the rule and counts what was dropped and why.
+* **Pocket escape** (``pocket_escape``, ``pocket_max_share``, ``pocket_clearance_margin_m``):
+  the potential field may park the robot closer to a wall than the planner's clearance, in a
+  spot cut off from the rest of the usable map by a gap narrower than that clearance. The grid
+  check then searches only that pocket and finds nothing. When the robot's region holds less
+  than ``pocket_max_share`` of the usable cells, the robot leaves it over cells with the
+  clearance of its radius plus ``pocket_clearance_margin_m`` (half the usual margin), and the
+  check runs again, with the full clearance, from the nearest region that is not a pocket.
 * **A closer look at narrow frontiers** (``look_at_narrow_frontiers``, ``look_reach_m``,
   ``look_min_unknown_depth_m``): frontiers too narrow for the robot at first sight are not
   discarded: before stopping, the robot drives to a standable point within ``look_reach_m`` of
@@ -140,6 +147,13 @@ class SemanticExpertParams:
         revive_window_m: Radius round a dropped goal watched for map changes.
         revive_min_changed_cells: Changed cells in that window that bring a dropped goal back.
         max_revivals: How often one place may come back.
+        pocket_escape: When the grid check finds nothing from a pocket of the usable map,
+            leave the pocket and check again from outside (see above; part of
+            ``grid_fallback``).
+        pocket_max_share: The robot's region is a pocket when it holds less than this share
+            of the usable cells.
+        pocket_clearance_margin_m: The way out of a pocket keeps the robot radius plus this
+            from walls.
         look_at_narrow_frontiers: Drive close to frontiers too narrow to reach, to look again
             (an extension of the grid fallback's final check: needs ``grid_fallback``).
         look_reach_m: The look point lies within this distance of the frontier.
@@ -198,6 +212,9 @@ class SemanticExpertParams:
     revive_window_m: float = 0.75
     revive_min_changed_cells: int = 40
     max_revivals: int = 2
+    pocket_escape: bool = True
+    pocket_max_share: float = 0.1
+    pocket_clearance_margin_m: float = 0.025
     look_at_narrow_frontiers: bool = True
     look_reach_m: float = 1.0
     look_min_unknown_depth_m: float = 0.3
@@ -250,8 +267,12 @@ class SemanticExpertParams:
             "look_clearance_fraction",
             "look_reach_m",
             "oscillation_window_s",
+            "pocket_clearance_margin_m",
+            "pocket_max_share",
         )
         require_finite(self, nonneg, positive=False)
+        if self.pocket_max_share > 1.0:
+            raise ValueError(f"pocket_max_share must be in [0, 1], got {self.pocket_max_share!r}")
         if not 0.0 <= self.backoff_speed_fraction <= 1.0:
             raise ValueError(
                 f"backoff_speed_fraction must be in [0, 1], got {self.backoff_speed_fraction!r}"
@@ -280,6 +301,7 @@ PAPER_PURE: dict[str, object] = {
     "resegment_min_new_m2": 0.0,
     "stop_confirmations": 1,
     "grid_fallback": False,
+    "pocket_escape": False,
     "look_at_narrow_frontiers": False,
     "oscillation_guard": False,
     "entry_detour": False,

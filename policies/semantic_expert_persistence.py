@@ -20,6 +20,7 @@ from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
+    pocket_exit_path,
 )
 from semexplore_gym.core.planning.potential_field import resample_polyline
 
@@ -43,6 +44,7 @@ class GoalPersistence:
     params: Any
     geometry: Any
     clearance_m: float
+    limits: Any
     counters: dict[str, int]
     memory: FrontierMemory
     blacklist: Any
@@ -55,6 +57,7 @@ class GoalPersistence:
 
         def _log(self, event: str, detail: str = "") -> None: ...
         def request_replan(self) -> None: ...
+        def _fallback_search_kwargs(self) -> dict[str, Any]: ...
         def _unknown_near(
             self, grid: np.ndarray, xy: tuple[float, float], radius_m: float
         ) -> bool: ...
@@ -207,6 +210,57 @@ class GoalPersistence:
             self.counters["looks"] += 1
             self._drop(grid, found.frontier_xy_m, "looked")
         return None
+
+    def _pocket_escape_plan(
+        self, grid: np.ndarray, pose: tuple[float, float, float], clearance: np.ndarray
+    ) -> _Plan | None:
+        """The grid check found nothing: if the robot stands in a pocket, check from outside it.
+
+        The potential field may leave the robot nearer a wall than the planner's clearance, in a
+        spot that a gap narrower than the clearance cuts off from the rest of the usable map;
+        the check, which starts where the robot stands, then sees only that pocket. The robot
+        fits where it stands, so it leaves over cells with the clearance of its radius plus
+        ``pocket_clearance_margin_m`` to the nearest region that is not a pocket, and the check
+        runs again from there with the full clearance (see
+        :mod:`policies.semantic_expert_params`). The plan is both legs; none when the check
+        from outside finds nothing either.
+        """
+        prm = self.params
+        thin_m = self.limits.radius_m + prm.pocket_clearance_margin_m
+        exit_path = pocket_exit_path(
+            grid,
+            self.geometry,
+            pose[:2],
+            self.clearance_m,
+            min(thin_m, self.clearance_m),
+            prm.pocket_max_share,
+            clearance_field=clearance,
+        )
+        if exit_path is None:
+            return None
+        outside = (float(exit_path[-1, 0]), float(exit_path[-1, 1]))
+        found = nearest_reachable_frontier(
+            grid,
+            self.geometry,
+            outside,
+            self.clearance_m,
+            clearance_field=clearance,
+            **self._fallback_search_kwargs(),
+        )
+        if found is None:
+            return None
+        from policies.semantic_expert import _Plan
+
+        self.counters["pocket_escapes"] += 1
+        self._log(
+            "pocket",
+            f"out at {tuple(round(v, 2) for v in outside)}, then to the frontier at "
+            f"{tuple(round(v, 2) for v in found.frontier_xy_m)}",
+        )
+        path = np.vstack([exit_path, found.path_m[1:]])
+        return _Plan(
+            "fallback", found.goal_xy_m, resample_polyline(path, self.geometry.resolution_m), None
+        )
 
     def _standable_prefix(self, path_m: np.ndarray, clearance: np.ndarray) -> np.ndarray:
         """The part of ``path_m`` from its start on which the robot's own clearance holds."""

@@ -16,7 +16,7 @@ from policies.navigation.frontier_memory import FrontierMemory
 from policies.registry import make_policy
 from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 from policies.semantic_expert_params import PAPER_PURE
-from semexplore_gym.core.frontiers.reachable import clearance_field_m
+from semexplore_gym.core.frontiers.reachable import clearance_field_m, pocket_exit_path
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.params import build_params
 from semexplore_gym.core.worlds.build import world_from_free_mask
@@ -157,6 +157,65 @@ def test_a_failed_goal_is_retried_by_other_approaches_before_it_is_dropped() -> 
     assert pol.done and f"failed {prm.max_goal_attempts} approaches" in pol.stop_reason
 
 
+def _pocket_and_room() -> np.ndarray:
+    """A pocket (x 0.2-0.8 m) joined to a room (x 1.5-3.55 m, unknown beyond) by a passage
+    whose middle row is 0.15 m from its walls: passable for the robot (radius 0.105 m), but
+    narrower than the planner's clearance (0.155 m)."""
+    g = np.full(GEOM.shape, OCCUPIED, dtype=np.uint8)
+    g[24:36, 4:16] = FREE  # the pocket
+    g[28:33, 16:30] = FREE  # the passage: walls at rows 27 and 33
+    g[4:56, 30:71] = FREE  # the room
+    g[4:56, 71:96] = UNKNOWN  # unexplored: the room's frontier at x = 3.5 m
+    return g
+
+
+def test_the_grid_check_leads_out_of_a_pocket_instead_of_stopping() -> None:
+    grid = _pocket_and_room()
+    in_pocket = _obs(grid, 0.525, 1.525)
+    way_out = pocket_exit_path(grid, GEOM, (0.525, 1.525), 0.155, 0.13, 0.1)
+    assert way_out is not None and 1.5 <= way_out[-1][0] <= 1.6  # the room's first usable cell
+    assert pocket_exit_path(grid, GEOM, (0.525, 1.525), 0.155, 0.155, 0.1) is None  # too thin
+    assert pocket_exit_path(grid, GEOM, (2.5, 1.5), 0.155, 0.13, 0.1) is None  # not a pocket
+    pol = SemanticExpertPolicy(segmenter=_empty_tmap)
+    pol.reset(in_pocket, INFO, seed=0)
+    pol.act(in_pocket, INFO)
+    assert pol.plan_source == "fallback" and not pol.done
+    assert pol.counters["pocket_escapes"] == 1
+    assert pol.goal_xy_m[0] > 3.3  # at the room's frontier
+    assert any(e == "pocket" for _t, e, _d in pol.events)
+    # Without the escape the check sees only the pocket: no fallback goal (a look, then a stop).
+    off = SemanticExpertPolicy(SemanticExpertParams(pocket_escape=False), segmenter=_empty_tmap)
+    off.reset(in_pocket, INFO, seed=0)
+    for _ in range(20):
+        off.act(in_pocket, INFO)
+        assert off.plan_source != "fallback"
+        if off.done:
+            break
+    assert off.done and "grid check: none reachable" in off.stop_reason
+    # From the room itself nothing changes: the usual check finds the frontier.
+    in_room = _obs(grid, 2.0, 1.5)
+    pol2 = SemanticExpertPolicy(segmenter=_empty_tmap)
+    pol2.reset(in_room, INFO, seed=0)
+    pol2.act(in_room, INFO)
+    assert pol2.plan_source == "fallback" and pol2.counters["pocket_escapes"] == 0
+    # A pocket with no frontier beyond its passage: the escape finds nothing, the mission ends.
+    sealed = grid.copy()
+    sealed[sealed == UNKNOWN] = OCCUPIED
+    done = _obs(sealed, 0.525, 1.525)
+    pol3 = SemanticExpertPolicy(segmenter=_empty_tmap)
+    pol3.reset(done, INFO, seed=0)
+    for _ in range(5):
+        pol3.act(done, INFO)
+    assert pol3.done and pol3.counters["pocket_escapes"] == 0
+
+
+def test_pocket_parameters_are_checked() -> None:
+    with pytest.raises(ValueError, match="pocket_max_share"):
+        SemanticExpertParams(pocket_max_share=1.5)
+    with pytest.raises(ValueError, match="pocket_clearance_margin_m"):
+        SemanticExpertParams(pocket_clearance_margin_m=-0.01)
+
+
 def test_frontier_memory_drops_revives_and_caps_revivals() -> None:
     grid = _two_rooms(0.6)
     mem = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3)
@@ -204,8 +263,8 @@ def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
     assert pol.params == from_yaml
     assert pol.params.cost == SemanticExpertParams().cost  # the paper's weights
     flags = (
-        "grid_fallback look_at_narrow_frontiers oscillation_guard entry_detour goal_commitment "
-        "local_min_escape stuck_recovery reach_blacklist"
+        "grid_fallback pocket_escape look_at_narrow_frontiers oscillation_guard entry_detour "
+        "goal_commitment local_min_escape stuck_recovery reach_blacklist"
     ).split()
     assert not any(getattr(pol.params, f) for f in flags)
     assert all(getattr(SemanticExpertParams(), f) for f in flags)  # the robust default

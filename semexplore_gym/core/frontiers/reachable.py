@@ -13,6 +13,9 @@ cost) usable cell within ``reach_m`` of a kept frontier cell, found by an 8-conn
 search from the robot. A step costs its length times ``1 + wall_cost * max(0, 1 - d / d_pref)``
 with ``d`` the cell's distance to the nearest wall and ``d_pref = clearance_m + prefer_extra_m``,
 so paths keep to the middle of corridors instead of hugging the usable region's edge.
+
+:func:`pocket_exit_path` finds the way out when the robot stands in a pocket of the usable
+cells (a spot the robot fits in, cut off from the rest by a gap narrower than the clearance).
 """
 
 from __future__ import annotations
@@ -251,14 +254,70 @@ def _step_cost(
     return np.where(usable, cost, np.inf)
 
 
-def _search_path(
-    g: np.ndarray,
+def pocket_exit_path(
+    grid: npt.ArrayLike,
     geometry: GridGeometry,
-    usable: np.ndarray,
-    cost: np.ndarray,
-    goal_mask: np.ndarray,
     start_xy_m: tuple[float, float],
+    clearance_m: float,
+    exit_clearance_m: float,
+    max_share: float,
+    clearance_field: np.ndarray | None = None,
 ) -> np.ndarray | None:
+    """The way out of a pocket of the usable map, over cells with a thinner clearance.
+
+    A search from ``start_xy_m`` starts at the robot's cell, or the nearest usable cell within
+    0.5 m, and steps between side neighbours (diagonal steps need both side cells usable, so
+    they connect nothing more). The region it starts in is a pocket when it holds less than
+    ``max_share`` of the cells usable with ``clearance_m`` (or when no start cell is found): a
+    spot narrower than ``clearance_m`` cuts it off from the rest. The path then leads, over FREE
+    cells at least ``exit_clearance_m`` from walls, to the nearest usable cell of a region that
+    is not a pocket.
+
+    Returns:
+        ``(K, 2)`` polyline from ``start_xy_m`` to that cell's centre, or None when the start
+        is not in a pocket or no way out exists.
+
+    Raises:
+        ValueError: on a malformed grid, a shape mismatch, negative clearances, an exit
+            clearance above ``clearance_m`` or a share outside [0, 1].
+    """
+    g = checked_encoded_grid(grid)
+    if g.shape != geometry.shape:
+        raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
+    if not (math.isfinite(exit_clearance_m) and 0.0 <= exit_clearance_m <= clearance_m):
+        raise ValueError(
+            f"need 0 <= exit_clearance_m <= clearance_m, got {exit_clearance_m!r}, {clearance_m!r}"
+        )
+    if not (math.isfinite(max_share) and 0.0 <= max_share <= 1.0):
+        raise ValueError(f"max_share must be in [0, 1], got {max_share!r}")
+    dist = (
+        clearance_field
+        if clearance_field is not None
+        else clearance_field_m(g, geometry.resolution_m)
+    )
+    usable = (g == FREE) & (dist >= clearance_m - 1e-9)
+    n_usable = int(np.count_nonzero(usable))
+    if n_usable == 0:
+        return None
+    labels, _n = ndimage.label(usable)
+    sizes = np.bincount(labels.ravel())
+    sizes[0] = 0
+    start = _start_cell(g, geometry, usable, start_xy_m)
+    own = int(labels[start]) if start is not None else 0
+    big = sizes >= max_share * n_usable
+    big[0] = False
+    if own and big[own]:
+        return None
+    big[own] = False
+    wide = (g == FREE) & (dist >= exit_clearance_m - 1e-9)
+    cost = _step_cost(dist, wide, exit_clearance_m, 4.0, 0.15)
+    return _search_path(g, geometry, wide, cost, big[labels], start_xy_m)
+
+
+def _start_cell(
+    g: np.ndarray, geometry: GridGeometry, usable: np.ndarray, start_xy_m: tuple[float, float]
+) -> tuple[int, int] | None:
+    """The search's start: the robot's cell when usable, else the nearest usable within 0.5 m."""
     h, w = g.shape
     sr, sc = (int(v) for v in geometry.world_to_grid(start_xy_m[0], start_xy_m[1]))
     if not (0 <= sr < h and 0 <= sc < w):
@@ -270,6 +329,22 @@ def _search_path(
         if found[0] < 0:
             return None
         sr, sc = found
+    return sr, sc
+
+
+def _search_path(
+    g: np.ndarray,
+    geometry: GridGeometry,
+    usable: np.ndarray,
+    cost: np.ndarray,
+    goal_mask: np.ndarray,
+    start_xy_m: tuple[float, float],
+) -> np.ndarray | None:
+    w = g.shape[1]
+    start = _start_cell(g, geometry, usable, start_xy_m)
+    if start is None:
+        return None
+    sr, sc = start
     goal, parent = _dijkstra(cost, goal_mask, sr, sc)
     if goal < 0:
         return None

@@ -9,6 +9,7 @@ from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     frontier_groups,
     nearest_reachable_frontier,
+    pocket_exit_path,
 )
 from semexplore_gym.core.grid import GridGeometry, parse_ascii_grid
 
@@ -137,3 +138,37 @@ def test_thin_unknown_pockets_can_be_ignored():
         is None
     )
     assert nearest_reachable_frontier(grid, geom, (0.25, 0.25), 0.05, 1, 0.2) is not None
+
+
+# 0.1 m cells: a 3 x 3 nook whose only way out is a one-cell slot into the room on the right.
+NOOK = """
+###########
+#...#.....#
+#.........#
+#...#.....#
+###########
+"""
+
+
+def test_pocket_exit_path_leads_out_of_a_pocket_only():
+    grid = parse_ascii_grid(NOOK)
+    geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
+    # With 0.12 m only cells without a wall beside them are usable, and the slot (walls above
+    # and below) is not: the nook keeps 2 of the 6 usable cells, the room 4 (its middle row).
+    path = pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.1, 0.5)
+    assert path is not None
+    np.testing.assert_allclose(path[0], (0.25, 0.25))
+    np.testing.assert_allclose(path[-1], (0.55, 0.25))  # the room's nearest usable cell
+    assert pocket_exit_path(grid, geom, (0.75, 0.25), 0.12, 0.1, 0.5) is None  # not a pocket
+    assert pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.1, 0.3) is None  # 1/3 >= 0.3
+    # No way out over cells as clear as the pocket's own: the slot needs the thinner clearance.
+    assert pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.12, 0.5) is None
+    # No usable cell within 0.5 m of the start counts as a pocket of its own.
+    far = pocket_exit_path(grid, geom, (0.15, 0.15), 0.12, 0.0, 0.5)
+    assert far is not None and far[-1][0] > 0.5
+    with pytest.raises(ValueError, match="exit_clearance_m"):
+        pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.2, 0.5)
+    with pytest.raises(ValueError, match="max_share"):
+        pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.1, 1.5)
+    with pytest.raises(ValueError, match="shape"):
+        pocket_exit_path(grid[:, :5], geom, (0.25, 0.25), 0.12, 0.1, 0.5)
