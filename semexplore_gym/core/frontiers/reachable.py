@@ -33,6 +33,10 @@ from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
+#: Defaults of the searches' step cost (see the module docstring).
+WALL_COST = 4.0
+PREFER_EXTRA_M = 0.15
+
 
 @dataclass(frozen=True)
 class ReachableFrontier:
@@ -113,8 +117,8 @@ def nearest_reachable_frontier(
     excluded_xy_m: Sequence[tuple[float, float]] = (),
     excluded_radius_m: float = 0.5,
     clearance_field: np.ndarray | None = None,
-    wall_cost: float = 4.0,
-    prefer_extra_m: float = 0.15,
+    wall_cost: float = WALL_COST,
+    prefer_extra_m: float = PREFER_EXTRA_M,
 ) -> ReachableFrontier | None:
     """Search from the robot to the nearest usable cell next to a frontier.
 
@@ -165,7 +169,7 @@ def nearest_reachable_frontier(
         if not labels.any():
             return None
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
-    usable = (g == FREE) & (dist >= clearance_m - 1e-9)
+    usable = _usable(g, dist, clearance_m)
     near = _dilate(labels > 0, reach_m / res) if reach_m > 0 else labels > 0
     goal_mask = usable & near
 
@@ -198,8 +202,8 @@ def grid_path_to(
     clearance_m: float,
     goal_radius_m: float = 0.15,
     clearance_field: np.ndarray | None = None,
-    wall_cost: float = 4.0,
-    prefer_extra_m: float = 0.15,
+    wall_cost: float = WALL_COST,
+    prefer_extra_m: float = PREFER_EXTRA_M,
 ) -> np.ndarray | None:
     """Path over usable cells (see the module docstring) from ``start_xy_m`` to a usable cell
     within ``goal_radius_m`` of ``goal_xy_m``; ``(K, 2)`` world polyline, or None if unreachable."""
@@ -208,7 +212,7 @@ def grid_path_to(
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     res = geometry.resolution_m
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
-    usable = (g == FREE) & (dist >= clearance_m - 1e-9)
+    usable = _usable(g, dist, clearance_m)
     h, w = g.shape
     gr, gc = (int(v) for v in geometry.world_to_grid(goal_xy_m[0], goal_xy_m[1]))
     rad = int(math.ceil(goal_radius_m / res))
@@ -227,6 +231,11 @@ def grid_path_to(
         return None
     cost = _step_cost(dist, usable, clearance_m, wall_cost, prefer_extra_m)
     return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
+
+
+def _usable(g: np.ndarray, dist: np.ndarray, clearance_m: float) -> np.ndarray:
+    """FREE cells at least ``clearance_m`` from every OCCUPIED cell (to rounding)."""
+    return (g == FREE) & (dist >= clearance_m - 1e-9)
 
 
 def _step_cost(
@@ -295,7 +304,7 @@ def pocket_exit_path(
         if clearance_field is not None
         else clearance_field_m(g, geometry.resolution_m)
     )
-    usable = (g == FREE) & (dist >= clearance_m - 1e-9)
+    usable = _usable(g, dist, clearance_m)
     n_usable = int(np.count_nonzero(usable))
     if n_usable == 0:
         return None
@@ -309,8 +318,8 @@ def pocket_exit_path(
     if own and big[own]:
         return None
     big[own] = False
-    wide = (g == FREE) & (dist >= exit_clearance_m - 1e-9)
-    cost = _step_cost(dist, wide, exit_clearance_m, 4.0, 0.15)
+    wide = _usable(g, dist, exit_clearance_m)
+    cost = _step_cost(dist, wide, exit_clearance_m, WALL_COST, PREFER_EXTRA_M)
     return _search_path(g, geometry, wide, cost, big[labels], start_xy_m)
 
 
