@@ -30,6 +30,7 @@ from numba import njit
 from scipy import ndimage
 
 from semexplore_gym.core.frontiers.detection import frontier_cell_mask
+from semexplore_gym.core.frontiers.wall_distance import wall_distance_m
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
@@ -59,11 +60,11 @@ class ReachableFrontier:
 
 def clearance_field_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
     """Distance in metres from every cell centre to the nearest OCCUPIED cell centre (inf if none)."""
-    g = checked_encoded_grid(grid)
-    occupied = g == OCCUPIED
-    if not occupied.any():
+    g = np.ascontiguousarray(checked_encoded_grid(grid))
+    if not (g == OCCUPIED).any():
         return np.full(g.shape, np.inf)
-    return ndimage.distance_transform_edt(~occupied) * float(resolution_m)
+    # The same floats as ndimage.distance_transform_edt(g != OCCUPIED) * resolution_m.
+    return wall_distance_m(g, float(resolution_m))
 
 
 def frontier_groups(
@@ -255,12 +256,34 @@ def _step_cost(
             f"wall_cost and prefer_extra_m must be finite and >= 0, got {wall_cost!r}, {prefer_extra_m!r}"
         )
     pref = clearance_m + prefer_extra_m
-    if pref > 0.0 and wall_cost > 0.0:
-        penalty = np.clip(1.0 - np.minimum(dist, 1e9) / pref, 0.0, 1.0)
-        cost = 1.0 + wall_cost * penalty
-    else:
-        cost = np.ones(dist.shape)
-    return np.where(usable, cost, np.inf)
+    cost = np.empty(dist.shape)
+    _step_cost_kernel(
+        np.ascontiguousarray(dist, dtype=np.float64),
+        np.ascontiguousarray(usable, dtype=np.bool_),
+        float(pref),
+        float(wall_cost),
+        cost,
+    )
+    return cost
+
+
+@njit(cache=True)
+def _step_cost_kernel(dist, usable, pref, wall_cost, out):  # pragma: no cover - numba
+    """``out`` = ``1 + wall_cost * clip(1 - min(dist, 1e9) / pref, 0, 1)`` on usable cells, inf
+    elsewhere (1 when ``pref`` or ``wall_cost`` is 0): numpy's expression, one pass, same floats."""
+    d = dist.ravel()
+    u = usable.ravel()
+    o = out.ravel()
+    weigh = pref > 0.0 and wall_cost > 0.0
+    for i in range(d.shape[0]):
+        if not u[i]:
+            o[i] = np.inf
+        elif weigh:
+            p = 1.0 - min(d[i], 1e9) / pref
+            p = min(max(p, 0.0), 1.0)
+            o[i] = 1.0 + wall_cost * p
+        else:
+            o[i] = 1.0
 
 
 def pocket_exit_path(

@@ -48,6 +48,7 @@ import numpy as np
 from semexplore_gym.core.grid import wrap_angle_rad
 from semexplore_gym.core.lazy import LazyField
 from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.planning.graph_search_kernels import first_leg_offers, search_by_opening
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
 
 
@@ -248,14 +249,6 @@ def search_frontier_paths(
         if f.width_m >= min_frontier_width_m:
             frontier_at[f.opening_id] = f
 
-    # Edges of the robot's area are never followed (paths do not re-enter it): left out here.
-    adjacency: dict[int, list[tuple[int, int, float]]] = {}
-    for k, e in enumerate(tmap.edges):
-        if e.area_id == robot_area:
-            continue
-        d_m = float(e.length_m)
-        adjacency.setdefault(e.opening_a, []).append((e.opening_b, k, d_m))
-        adjacency.setdefault(e.opening_b, []).append((e.opening_a, k, d_m))
     by_opening = prune_by == "opening"
 
     def slot(node: int, via_edge: int | None) -> int | tuple[str, int]:
@@ -287,12 +280,127 @@ def search_frontier_paths(
         n_pushed += 1
     n_seeds = n_pushed
 
+    if by_opening:
+        best, counts = _search_by_opening(
+            tmap, robot_area, frontier_at, a_cost, search_list, l_path
+        )
+    else:
+        best, counts = _search_by_area(
+            tmap, robot_area, frontier_at, a_cost, search_list, l_path, slot
+        )
+    n_pushed += counts[0]
+    n_popped += counts[1]
+    n_pruned += counts[2]
+
+    candidates = _score_candidates(tmap, best, frontier_at, first_legs, leg_start_angle, l_path, w)
+    return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+
+
+def _edge_lists(
+    tmap: TopometricMap, robot_area: int
+) -> tuple[list[int], list[int], list[int], list[float]]:
+    """The map's edges as directed ``(from, to, edge, length)`` lists, both ways round, in edge
+    order. Edges of the robot's area are never followed (paths do not re-enter it): left out."""
+    src: list[int] = []
+    dst: list[int] = []
+    idx: list[int] = []
+    len_m: list[float] = []
+    for k, e in enumerate(tmap.edges):
+        if e.area_id == robot_area:
+            continue
+        d_m = float(e.length_m)
+        src += (e.opening_a, e.opening_b)
+        dst += (e.opening_b, e.opening_a)
+        idx += (k, k)
+        len_m += (d_m, d_m)
+    return src, dst, idx, len_m
+
+
+def _search_by_opening(
+    tmap: TopometricMap,
+    robot_area: int,
+    frontier_at: dict[int, Frontier],
+    a_cost: dict[Any, float],
+    seeds: list[_Partial],
+    l_path: float,
+) -> tuple[dict[int, tuple[float, _Partial]], tuple[int, int, int]]:
+    """The search loop with one ``A_cost`` slot per opening, compiled
+    (:func:`~semexplore_gym.core.planning.graph_search_kernels.search_by_opening`).
+
+    Returns the cheapest path to each frontier reached (in the order they were first reached)
+    and the pushes, pops and prunings after the seeds.
+    """
+    src, dst, idx, len_m = _edge_lists(tmap, robot_area)
+    seed_ids = [p.nodes[0] for p in seeds]
+    ids = sorted({*src, *seed_ids, *frontier_at})
+    dense = {node: i for i, node in enumerate(ids)}
+    n = len(ids)
+    src_d = np.fromiter((dense[v] for v in src), np.int64, len(src))
+    # A stable sort by source keeps each node's neighbours in the order they were appended.
+    by_src = np.argsort(src_d, kind="stable")
+    adj_ptr = np.zeros(n + 1, np.int64)
+    np.cumsum(np.bincount(src_d, minlength=n), out=adj_ptr[1:])
+    adj_node = np.fromiter((dense[v] for v in dst), np.int64, len(dst))[by_src]
+    adj_edge = np.asarray(idx, np.int64)[by_src]
+    adj_len = np.asarray(len_m, np.float64)[by_src]
+    is_frontier = np.zeros(n, np.bool_)
+    is_frontier[[dense[v] for v in frontier_at]] = True
+    costs = np.full(n, np.inf)
+    for node, c in a_cost.items():
+        costs[dense[node]] = c
+    order, best_rec, rec_node, rec_edge, rec_parent, rec_cost, rec_len, n_pushed, n_popped, n_pruned = (
+        search_by_opening(
+            adj_ptr, adj_node, adj_edge, adj_len, is_frontier, costs,
+            np.asarray([dense[v] for v in seed_ids], np.int64),
+            np.asarray([p.cost for p in seeds], np.float64),
+            np.asarray([p.length_m for p in seeds], np.float64),
+            float(l_path),
+        )
+    )  # fmt: skip
+    rec_node_l, rec_edge_l, rec_parent_l = rec_node.tolist(), rec_edge.tolist(), rec_parent.tolist()
+    best: dict[int, tuple[float, _Partial]] = {}
+    for d in order.tolist():
+        r = int(best_rec[d])
+        nodes: list[int] = []
+        edges: list[int] = []
+        q = r
+        while q >= 0:
+            nodes.append(ids[rec_node_l[q]])
+            if rec_edge_l[q] >= 0:
+                edges.append(rec_edge_l[q])
+            q = rec_parent_l[q]
+        cost = float(rec_cost[r])
+        best[ids[d]] = (
+            cost,
+            _Partial(tuple(nodes[::-1]), tuple(edges[::-1]), cost, float(rec_len[r])),
+        )
+    return best, (int(n_pushed) - len(seeds), int(n_popped), int(n_pruned))
+
+
+def _search_by_area(
+    tmap: TopometricMap,
+    robot_area: int,
+    frontier_at: dict[int, Frontier],
+    a_cost: dict[Any, float],
+    search_list: list[_Partial],
+    l_path: float,
+    slot: Any,
+) -> tuple[dict[int, tuple[float, _Partial]], tuple[int, int, int]]:
+    """The search loop with one ``A_cost`` slot per area (the paper's pseudocode), in Python.
+
+    Returns the cheapest path to each frontier reached and the pushes, pops and prunings after
+    the seeds.
+    """
+    adjacency: dict[int, list[tuple[int, int, float]]] = {}
+    for a, b, k, d_m in zip(*_edge_lists(tmap, robot_area), strict=True):
+        adjacency.setdefault(a, []).append((b, k, d_m))
+    n_pushed = n_popped = n_pruned = 0
     best: dict[int, tuple[float, _Partial]] = {}
     while search_list:
         path = search_list.pop()
         n_popped += 1
         last = path.nodes[-1]
-        at = last if by_opening else slot(last, path.edges[-1] if path.edges else None)
+        at = slot(last, path.edges[-1] if path.edges else None)
         if a_cost.get(at, math.inf) < path.cost:
             # Reached more cheaply since it was pushed: the A_cost condition, applied at pop.
             n_pruned += 1
@@ -305,7 +413,7 @@ def search_frontier_paths(
             if nbr in path.nodes:
                 continue
             new_cost = path.cost + d_m / l_path
-            key = nbr if by_opening else slot(nbr, k)
+            key = slot(nbr, k)
             if a_cost.get(key, math.inf) <= new_cost:
                 n_pruned += 1
                 continue
@@ -314,9 +422,7 @@ def search_frontier_paths(
                 _Partial(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m)
             )
             n_pushed += 1
-
-    candidates = _score_candidates(tmap, best, frontier_at, first_legs, leg_start_angle, l_path, w)
-    return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+    return best, (n_pushed, n_popped, n_pruned)
 
 
 def _score_candidates(
@@ -462,37 +568,53 @@ def _first_legs(
     """Polylines from the robot to every opening of its area, along the area's own paths.
 
     The robot joins the nearest point of each path of its area in a straight line, then follows
-    that path to the opening. Openings no path reaches are joined in a straight line.
+    that path to the opening. Openings no path reaches are joined in a straight line. The
+    projections and lengths of the area's edge paths come from one compiled call
+    (:func:`~semexplore_gym.core.planning.graph_search_kernels.first_leg_offers`, the same values as
+    :func:`project_onto_polyline` and ``_polyline_length``); each opening's polyline is built
+    once, for the shortest offer (the first of equals).
     """
     area = tmap.areas[area_id]
     r = np.asarray(robot_xy, dtype=np.float64)
-    best: dict[int, tuple[float, np.ndarray]] = {}
+    # node -> (length, nearest point q, the rest of the way after q)
+    best: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
 
-    def offer(node: int, dist: float, q: np.ndarray, rest: np.ndarray) -> None:
-        length = dist + _polyline_length(np.vstack([q, rest]))
+    def offer(node: int, length: float, q: np.ndarray, rest: np.ndarray) -> None:
         if node not in best or length < best[node][0]:
-            # the polyline only for the best offer so far
-            best[node] = (length, _dedupe(np.vstack([r, q, rest])))
+            best[node] = (length, q, rest)
 
-    for k, e in enumerate(tmap.edges):
-        if e.area_id != area_id:
-            continue
-        poly = _edge_polyline(tmap, k, e.opening_a)
-        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
-        offer(e.opening_a, dist, q, poly[: i + 1][::-1])
-        offer(e.opening_b, dist, q, poly[i + 1 :])
+    edges = [(k, e) for k, e in enumerate(tmap.edges) if e.area_id == area_id]
+    if edges:
+        polys = [_edge_polyline(tmap, k, e.opening_a) for k, e in edges]
+        sizes = [len(p) for p in polys]
+        if min(sizes) == 0:
+            raise ValueError(f"an edge of area {area_id} has an empty path")
+        starts = np.zeros(len(polys) + 1, dtype=np.int64)
+        np.cumsum(sizes, out=starts[1:])
+        seg_idx = np.empty(len(polys), dtype=np.int64)
+        q_xy = np.empty((len(polys), 2))
+        lengths = np.empty((len(polys), 2))
+        first_leg_offers(
+            np.concatenate(polys), starts, float(r[0]), float(r[1]), seg_idx, q_xy, lengths
+        )
+        for (_k, e), poly, i, q, (back_m, on_m) in zip(
+            edges, polys, seg_idx.tolist(), q_xy, lengths.tolist(), strict=True
+        ):
+            offer(e.opening_a, back_m, q, poly[: i + 1][::-1])
+            offer(e.opening_b, on_m, q, poly[i + 1 :])
     for oid, path in area.paths_m.items():
         if oid in best or oid not in area.opening_ids:
             continue
         # Single-opening areas (dead ends) have no edges; their path starts at the opening.
         poly = _oriented(path, tmap.openings[oid].midpoint_m, tuple(np.asarray(path)[-1]))
         dist, q, i, _ = project_onto_polyline(poly, robot_xy)
-        offer(oid, dist, q, poly[: i + 1][::-1])
+        rest = poly[: i + 1][::-1]
+        offer(oid, dist + _polyline_length(np.vstack([q, rest])), q, rest)
     for oid in area.opening_ids:
         if oid not in best and 0 <= oid < len(tmap.openings):
             m = np.asarray(tmap.openings[oid].midpoint_m, dtype=np.float64)
-            offer(oid, float(np.hypot(*(m - r))), m, np.empty((0, 2)))
-    return {node: poly for node, (_, poly) in best.items()}
+            offer(oid, float(np.hypot(*(m - r))) + 0.0, m, np.empty((0, 2)))
+    return {node: _dedupe(np.vstack([r, q, rest])) for node, (_, q, rest) in best.items()}
 
 
 def _assemble(

@@ -172,3 +172,28 @@ def test_pocket_exit_path_leads_out_of_a_pocket_only():
         pocket_exit_path(grid, geom, (0.25, 0.25), 0.12, 0.1, 1.5)
     with pytest.raises(ValueError, match="shape"):
         pocket_exit_path(grid[:, :5], geom, (0.25, 0.25), 0.12, 0.1, 0.5)
+
+
+def test_step_cost_is_the_numpy_expression_bit_for_bit() -> None:
+    from semexplore_gym.core.frontiers.reachable import _step_cost
+
+    rng = np.random.default_rng(0)
+    for k in range(60):
+        h, w = (int(v) for v in rng.integers(1, 80, size=2))
+        dist = rng.random((h, w)) * float(rng.choice([0.3, 3.0]))
+        dist[rng.random((h, w)) < 0.05] = np.inf
+        if k % 2:
+            dist = np.round(dist * 20) / 20  # on the grid's 5 cm steps: ties at the clip ends
+        usable = rng.random((h, w)) < 0.7
+        clearance_m, wall_cost, extra_m = (
+            float(rng.choice(v)) for v in ([0, 0.155], [0, 4.0], [0, 0.15])
+        )
+        pref = clearance_m + extra_m
+        if pref > 0 and wall_cost > 0:
+            want = 1.0 + wall_cost * np.clip(1.0 - np.minimum(dist, 1e9) / pref, 0.0, 1.0)
+        else:
+            want = np.ones(dist.shape)
+        want = np.where(usable, want, np.inf)
+        np.testing.assert_array_equal(
+            _step_cost(dist, usable, clearance_m, wall_cost, extra_m), want
+        )

@@ -1,0 +1,114 @@
+"""The compiled first-leg kernels give the numpy forms' floats, to the bit."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.graph_search import (
+    _dedupe,
+    _edge_polyline,
+    _first_legs,
+    _oriented,
+    _polyline_length,
+    project_onto_polyline,
+)
+from semexplore_gym.core.planning.graph_search_kernels import first_leg_offers, pairwise_sum
+from semexplore_gym.core.topometric.segmentation import segment_map
+
+
+def test_pairwise_sum_is_numpys_sum() -> None:
+    rng = np.random.default_rng(1)
+    for n in [*range(0, 300), 1000, 1023, 4099, 20000]:
+        x = rng.random(n) * float(rng.choice([1e-3, 1.0, 1e3]))
+        assert pairwise_sum(x, 0, n) == x.sum()
+        if n:
+            lo = int(rng.integers(0, n))
+            assert pairwise_sum(x, lo, n - lo) == x[lo:].sum()
+
+
+def _random_polyline(rng: np.random.Generator) -> np.ndarray:
+    n = int(rng.integers(1, 30))
+    pts = np.cumsum(rng.normal(size=(n, 2)) * float(rng.choice([0.05, 1.0])), axis=0)
+    if n > 2 and rng.random() < 0.3:
+        pts[1] = pts[0]  # a zero-length segment
+    if rng.random() < 0.3:
+        pts = np.round(pts * 20) / 20  # on a 5 cm lattice: ties between segments
+    return pts
+
+
+def test_first_leg_offers_match_the_numpy_projection_and_lengths() -> None:
+    rng = np.random.default_rng(2)
+    for _ in range(300):
+        polys = [_random_polyline(rng) for _ in range(int(rng.integers(1, 8)))]
+        robot = (float(rng.normal()), float(rng.normal()))
+        if rng.random() < 0.2:
+            robot = tuple(float(v) for v in polys[0][len(polys[0]) // 2])  # on a vertex
+        starts = np.concatenate(([0], np.cumsum([len(p) for p in polys]))).astype(np.int64)
+        seg_idx = np.empty(len(polys), np.int64)
+        q_xy = np.empty((len(polys), 2))
+        lengths = np.empty((len(polys), 2))
+        first_leg_offers(np.concatenate(polys), starts, *robot, seg_idx, q_xy, lengths)
+        for e, poly in enumerate(polys):
+            dist, q, i, _ = project_onto_polyline(poly, robot)
+            assert seg_idx[e] == i and q_xy[e, 0] == q[0] and q_xy[e, 1] == q[1]
+            assert lengths[e, 0] == dist + _polyline_length(np.vstack([q, poly[: i + 1][::-1]]))
+            assert lengths[e, 1] == dist + _polyline_length(np.vstack([q, poly[i + 1 :]]))
+
+
+def _first_legs_numpy(tmap, area_id, robot_xy):
+    """The numpy form of ``_first_legs`` (one projection and two lengths per path)."""
+    area = tmap.areas[area_id]
+    r = np.asarray(robot_xy, dtype=np.float64)
+    best: dict[int, tuple[float, np.ndarray]] = {}
+
+    def offer(node, dist, q, rest):
+        length = dist + _polyline_length(np.vstack([q, rest]))
+        if node not in best or length < best[node][0]:
+            best[node] = (length, _dedupe(np.vstack([r, q, rest])))
+
+    for k, e in enumerate(tmap.edges):
+        if e.area_id != area_id:
+            continue
+        poly = _edge_polyline(tmap, k, e.opening_a)
+        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
+        offer(e.opening_a, dist, q, poly[: i + 1][::-1])
+        offer(e.opening_b, dist, q, poly[i + 1 :])
+    for oid, path in area.paths_m.items():
+        if oid in best or oid not in area.opening_ids:
+            continue
+        poly = _oriented(path, tmap.openings[oid].midpoint_m, tuple(np.asarray(path)[-1]))
+        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
+        offer(oid, dist, q, poly[: i + 1][::-1])
+    for oid in area.opening_ids:
+        if oid not in best and 0 <= oid < len(tmap.openings):
+            m = np.asarray(tmap.openings[oid].midpoint_m, dtype=np.float64)
+            offer(oid, float(np.hypot(*(m - r))), m, np.empty((0, 2)))
+    return {node: poly for node, (_, poly) in best.items()}
+
+
+def test_first_legs_on_a_segmented_map_match_the_numpy_form() -> None:
+    # A half-explored building: rooms off a corridor, a junction, unknown space beyond.
+    grid = np.full((160, 200), UNKNOWN, np.uint8)
+    grid[20:140, 10:150] = FREE
+    grid[20, 10:150] = grid[139, 10:150] = OCCUPIED
+    grid[20:140, 10] = OCCUPIED
+    for c in (50, 90):
+        grid[20:70, c] = OCCUPIED
+        grid[90:140, c] = OCCUPIED
+    grid[70, 10:45] = grid[90, 10:45] = OCCUPIED
+    grid[70, 55:85] = grid[90, 95:150] = OCCUPIED
+    geometry = GridGeometry(0.05, 0.0, 0.0, *grid.shape)
+    tmap = segment_map(grid, geometry, 0.155)
+    assert len(tmap.areas) >= 3 and len(tmap.edges) >= 3
+    rng = np.random.default_rng(3)
+    n_legs = 0
+    for area_id in tmap.areas:
+        for _ in range(20):
+            robot = (float(rng.uniform(0.5, 7.5)), float(rng.uniform(1.0, 7.0)))
+            got, want = _first_legs(tmap, area_id, robot), _first_legs_numpy(tmap, area_id, robot)
+            assert list(got) == list(want)
+            for node, poly in want.items():
+                np.testing.assert_array_equal(got[node], poly)
+            n_legs += len(want)
+    assert n_legs > 50
