@@ -24,6 +24,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from scipy import stats
+
 CSV_COLUMNS: tuple[str, ...] = (
     "world",
     "seed",
@@ -205,6 +208,40 @@ def mean_ratios(rows: Sequence[dict[str, Any]], expert: str = "semantic") -> dic
     return {p: sum(v) / len(v) for p, v in acc.items()}
 
 
+def summary_lines(rows: Sequence[dict[str, Any]], expert: str = "semantic") -> list[str]:
+    """Per model: mean, median and share of worlds at >= 0.8 of the expert's coverage; per pair
+    of models, the paired comparison of their ratios over the worlds both ran (median
+    difference, wins, Wilcoxon signed-rank p)."""
+    by: dict[str, dict[tuple[str, int], float]] = {}
+    for r in rows:
+        if r["policy"] != expert:
+            by.setdefault(r["policy"], {})[(r["world"], int(r["seed"]))] = float(r["ratio"])
+    lines = []
+    for policy, ratios in by.items():
+        v = np.array(list(ratios.values()))
+        lines.append(
+            f"{policy}: mean ratio {v.mean():.3f}, median {np.median(v):.3f}, "
+            f">= 0.8 on {int((v >= 0.8).sum())}/{len(v)} worlds"
+        )
+    names = list(by)
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            keys = sorted(set(by[a]) & set(by[b]))
+            if len(keys) < 2:
+                continue
+            d = np.array([by[a][k] - by[b][k] for k in keys])
+            try:
+                p = float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else 1.0
+            except ValueError:
+                p = 1.0
+            lines.append(
+                f"{a} - {b}: median difference {np.median(d):+.3f} over {len(keys)} worlds, "
+                f"{a} ahead on {int((d > 0).sum())}, behind on {int((d < 0).sum())}, "
+                f"Wilcoxon p = {p:.3g}"
+            )
+    return lines
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--models", nargs="+", required=True, help="model zips (or policy specs)")
@@ -247,6 +284,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     print()
     for policy, ratio in mean_ratios(rows, args.expert).items():
         print(f"mean ratio {policy}: {ratio:.3f}")
+    for line in summary_lines(rows, args.expert):
+        print(line)
     return 0
 
 

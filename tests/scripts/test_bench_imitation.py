@@ -116,3 +116,16 @@ def test_real_missions_with_a_tiny_budget(tmp_path: Path, capsys: pytest.Capture
     assert 0.0 < float(rows[1]["coverage"]) <= 1.0
     text = capsys.readouterr().out
     assert "| maze:size_m=5,seed=* | 100 | 3.0 |" in text and "mean ratio" in text
+
+
+def test_summary_per_model_and_paired_comparison() -> None:
+    bench = _bench()
+    rows = [{"world": "m", "seed": s, "policy": "semantic", "ratio": 1.0} for s in range(12)]
+    rows += [{"world": "m", "seed": s, "policy": "a", "ratio": 0.5 + 0.04 * s} for s in range(12)]
+    rows += [{"world": "m", "seed": s, "policy": "b", "ratio": 0.4 + 0.04 * s} for s in range(12)]
+    lines = bench.summary_lines(rows)
+    assert lines[0].startswith("a: mean ratio 0.720, median 0.720, >= 0.8 on 4/12")
+    assert lines[1].startswith("b: mean ratio 0.620")
+    # a beats b on all 12 worlds by 0.1: a small p; b against itself would be p = 1.
+    assert "a - b: median difference +0.100 over 12 worlds, a ahead on 12, behind on 0" in lines[2]
+    assert float(lines[2].rsplit("p = ", 1)[1]) < 0.001
