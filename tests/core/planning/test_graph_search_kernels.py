@@ -112,3 +112,46 @@ def test_first_legs_on_a_segmented_map_match_the_numpy_form() -> None:
                 np.testing.assert_array_equal(got[node], poly)
             n_legs += len(want)
     assert n_legs > 50
+
+
+def test_compiled_search_equals_the_python_loop_on_a_large_graph() -> None:
+    """Algorithm 1's loop with one A_cost slot per opening, compiled, against the Python loop
+    (``_search_by_area`` with the identity slot is that loop): same paths, same order, same
+    counts, on lattices big enough to outgrow the kernel's first buffers."""
+    from types import SimpleNamespace
+
+    from semexplore_gym.core.planning.graph_search import (
+        _Partial,
+        _search_by_area,
+        _search_by_opening,
+    )
+    from semexplore_gym.core.topometric.types import GraphEdge
+
+    rng = np.random.default_rng(4)
+    for n in (3, 7, 10):
+        edges = []
+        for r in range(n):
+            for c in range(n):
+                for dr, dc in ((0, 1), (1, 0), (1, 1)):
+                    if r + dr < n and c + dc < n and rng.random() < 0.8:
+                        length = float(rng.choice([1.0, 1.5, rng.uniform(0.5, 3.0)]))
+                        poly = np.zeros((2, 2))
+                        edges.append(
+                            GraphEdge(
+                                r * n + c, (r + dr) * n + c + dc, len(edges) + 1, length, poly
+                            )
+                        )
+        tmap = SimpleNamespace(edges=edges)
+        frontier_at = {int(v): object() for v in rng.choice(n * n, size=n, replace=False)}
+        seeds = [
+            _Partial((int(v),), (), float(rng.uniform(0, 2)), float(rng.uniform(0, 1)))
+            for v in rng.choice(n * n, size=3, replace=False)
+        ]
+        a_cost = {p.nodes[0]: p.cost for p in seeds}
+        got, got_counts = _search_by_opening(tmap, 0, frontier_at, dict(a_cost), list(seeds), 2.5)
+        want, want_counts = _search_by_area(
+            tmap, 0, frontier_at, dict(a_cost), list(seeds), 2.5, lambda v, _e: v
+        )
+        assert list(got) == list(want) and got == want and got_counts == want_counts
+        if n == 10:
+            assert got_counts[0] > 200  # pushes beyond the first record buffers
