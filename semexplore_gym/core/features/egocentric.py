@@ -87,7 +87,7 @@ class EgocentricParams:
         pool_map: Min-pool the map to the crop resolution first (blocks of ``f x f`` map cells,
             ``f = crop_resolution_m / map resolution``, which must be a whole number; cells
             beyond the map read UNKNOWN), then search the frontier field, stamp the trail and
-            sample each crop cell once on that coarser grid. About 3x cheaper than sampling
+            sample each crop cell once on that coarser grid. About 2.5x cheaper than sampling
             ``f x f`` points of the rotated full-resolution map per crop cell (False), and a
             slightly different image: a crop cell is the minimum over the axis-aligned block its
             centre falls in. Models record the setting; the default (False) is what models
