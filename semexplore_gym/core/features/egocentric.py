@@ -500,14 +500,17 @@ class EgocentricEncoder:
     ) -> np.ndarray:
         """Heading-up crop ``(crop, crop)`` uint8 of ``grid`` around pose (x, y, yaw).
 
-        Samples outside the map read as ``fill``.
+        Samples outside the map read as ``fill``. With ``pool_map`` the crop samples the
+        pooled map, as :meth:`encode` does.
         """
-        g = self.geometry
-        if grid.shape != g.shape:
-            raise ValueError(f"map has shape {grid.shape} but the encoder was built for {g.shape}")
+        if grid.shape != self.geometry.shape:
+            raise ValueError(
+                f"map has shape {grid.shape} but the encoder was built for {self.geometry.shape}"
+            )
+        grid, g = self._sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
         out = np.empty((self.params.crop_cells, self.params.crop_cells), dtype=np.uint8)
         _crop_kernel(
-            np.ascontiguousarray(grid, dtype=np.uint8),
+            grid,
             (x_m - g.origin_x_m) / g.resolution_m,
             (y_m - g.origin_y_m) / g.resolution_m,
             math.cos(yaw_rad),
@@ -518,6 +521,14 @@ class EgocentricEncoder:
             np.uint8(fill),
         )
         return out
+
+    def _sampled_grid(self, grid: np.ndarray) -> tuple[np.ndarray, GridGeometry]:
+        """The grid the crops and the frontier field read, and its geometry: ``grid`` itself,
+        or (``pool_map``) its min-pooled blocks in a buffer reused by every call."""
+        if self._pool == 1:
+            return grid, self.geometry
+        _min_pool(grid, self._pool, self._pooled)
+        return self._pooled, self._sampled
 
     def pool_scan(self, scan: np.ndarray) -> np.ndarray:
         """Min-pool the scan into ``n_scan_bins`` bins, normalised to [0, 1] by max range."""
@@ -533,8 +544,10 @@ class EgocentricEncoder:
         return np.clip(pooled / np.float32(self.max_range_m), 0.0, 1.0).astype(np.float32)
 
     def frontier_distance_image(self, grid: np.ndarray, x_m: float, y_m: float) -> np.ndarray:
-        """``(H, W)`` uint8 map-frame ``frontier_distance`` layer (relative to the robot's cell)."""
-        p, g = self.params, self.geometry
+        """``(H, W)`` uint8 map-frame ``frontier_distance`` layer (relative to the robot's cell);
+        with ``pool_map``, of the pooled map (the grid :meth:`encode` searches)."""
+        p = self.params
+        grid, g = self._sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
         dist = frontier_distance_m(grid, g.resolution_m, p.frontier_clearance_m)
         row, col = (int(v) for v in g.world_to_grid(x_m, y_m))
         return relative_distance_image(dist, row, col, p.distance_scale_per_m)
@@ -562,10 +575,7 @@ class EgocentricEncoder:
             raise ValueError(
                 f"scan has shape {scan.shape} but the encoder expects ({self.n_beams},)"
             )
-        if self._pool > 1:
-            _min_pool(grid, self._pool, self._pooled)
-            grid = self._pooled
-            g = self._sampled
+        grid, g = self._sampled_grid(grid)
         if self._ch_fd >= 0:
             if self._field is None:
                 self._field = FrontierDistanceField(

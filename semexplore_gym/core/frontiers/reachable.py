@@ -60,11 +60,8 @@ class ReachableFrontier:
 
 def clearance_field_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
     """Distance in metres from every cell centre to the nearest OCCUPIED cell centre (inf if none)."""
-    g = np.ascontiguousarray(checked_encoded_grid(grid))
-    if not (g == OCCUPIED).any():
-        return np.full(g.shape, np.inf)
     # The same floats as ndimage.distance_transform_edt(g != OCCUPIED) * resolution_m.
-    return wall_distance_m(g, float(resolution_m))
+    return wall_distance_m(np.ascontiguousarray(checked_encoded_grid(grid)), float(resolution_m))
 
 
 def frontier_groups(

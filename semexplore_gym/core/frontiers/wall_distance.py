@@ -68,6 +68,9 @@ def _row_pass(g, resolution_m, out):  # pragma: no cover - numba
             f[k] = fq
             z[k] = s
             z[k + 1] = 1e300
+        if k < 0:  # no occupied cell in any column: none anywhere
+            out[r, :] = np.inf
+            continue
         k = 0
         for q in range(w):
             while z[k + 1] < q:
@@ -80,9 +83,9 @@ def _row_pass(g, resolution_m, out):  # pragma: no cover - numba
 def wall_distance_m(occupied_grid: np.ndarray, resolution_m: float) -> np.ndarray:
     """``(H, W)`` float64 distance in metres from every cell centre to the nearest OCCUPIED one.
 
-    ``occupied_grid`` is a C-contiguous uint8 encoded grid holding at least one OCCUPIED cell
-    (the caller checks both); equal to ``ndimage.distance_transform_edt(grid != OCCUPIED) *
-    resolution_m``.
+    ``occupied_grid`` is a C-contiguous uint8 encoded grid (the caller checks it). Equal to
+    ``ndimage.distance_transform_edt(grid != OCCUPIED) * resolution_m``; inf everywhere when
+    the grid has no OCCUPIED cell.
     """
     g = np.empty(occupied_grid.shape, np.int32)
     _column_pass(occupied_grid, g)

@@ -40,6 +40,7 @@ The accumulated search cost is the metric part of ``C`` in the same normalised u
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
 
@@ -384,7 +385,7 @@ def _search_by_area(
     a_cost: dict[Any, float],
     search_list: list[_Partial],
     l_path: float,
-    slot: Any,
+    slot: Callable[[int, int | None], Any],
 ) -> tuple[dict[int, tuple[float, _Partial]], tuple[int, int, int]]:
     """The search loop with one ``A_cost`` slot per area (the paper's pseudocode), in Python.
 

@@ -56,13 +56,22 @@ def test_pool_map_is_the_plain_encoder_on_the_pooled_map() -> None:
     rng = np.random.default_rng(2)
     pooled = np.empty(coarse.shape, np.uint8)
     n_fd_levels = set()
-    for _ in range(120):
+    for step in range(120):
         _min_pool(obs["map"], f, pooled)
         got = pooled_enc.encode(obs)
         want = plain_enc.encode({**obs, "map": pooled})
         for key in ("image", "scan", "features"):
             np.testing.assert_array_equal(got[key], want[key])
         n_fd_levels.update(np.unique(got["image"][1]).tolist())
+        if step % 30 == 0:  # now and then: the public helpers read the same grid
+            x, y, yaw = (float(v) for v in obs["pose"])
+            np.testing.assert_array_equal(
+                pooled_enc.crop(obs["map"], x, y, yaw), plain_enc.crop(pooled, x, y, yaw)
+            )
+            np.testing.assert_array_equal(
+                pooled_enc.frontier_distance_image(obs["map"], x, y),
+                plain_enc.frontier_distance_image(pooled, x, y),
+            )
         obs, *_ = env.step(np.array([rng.uniform(0.3, 1.0), rng.uniform(-1, 1)], np.float32))
     env.close()
     assert len(n_fd_levels) > 10  # the frontier channel carried a real field, not a constant

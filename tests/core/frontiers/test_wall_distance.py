@@ -58,3 +58,4 @@ def test_map_like_grid_and_clearance_field() -> None:
     # A non-contiguous view reads the same; no wall at all is inf everywhere.
     np.testing.assert_array_equal(clearance_field_m(grid.T, 0.1), _scipy(grid.T, 0.1))
     assert np.isinf(clearance_field_m(np.full((5, 6), FREE, np.uint8), 0.05)).all()
+    assert np.isinf(wall_distance_m(np.full((4, 3), UNKNOWN, np.uint8), 0.05)).all()
