@@ -100,6 +100,7 @@ class _FrontierBaseline(Policy):
     """
 
     params_type: type[Any]
+    reads_map_in_step_only = True  # tested: missions identical with a copied or a shared map
 
     def __init__(self, params: Any = None, **overrides: Any) -> None:
         super().__init__()

@@ -115,6 +115,7 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
     """
 
     name = "semantic"
+    reads_map_in_step_only = True  # tested: missions identical with a copied or a shared map
 
     def __init__(
         self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None

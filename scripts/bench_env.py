@@ -15,11 +15,11 @@ replayed to time each stage on the poses the robot really visited:
 * pymunk reference: ``Space.segment_query_first`` per beam at the recorded poses.
 
 ``--no-stages`` only times the step loop, but round-robin: each repeat steps every world (and
-every ``--map-observation`` variant, e.g. ``copy window``) once in turn, and the table gives the
+every ``--map-observation`` variant, e.g. ``copy window shared``) once in turn, and the table gives the
 median wall and CPU time per step and the median ratio to the first row within each repeat::
 
     python scripts/bench_env.py --no-stages --world maze1 intel_lab willow \
-        --map-observation copy window --steps 2000 --repeats 7
+        --map-observation copy window shared --steps 2000 --repeats 7
 
 Prints a markdown table (median over ``--repeats``) and the peak memory per env instance. Not
 a test: the numbers depend on the machine. Run it against two checkouts alternately to compare
@@ -280,7 +280,7 @@ def main(argv: list[str] | None = None) -> int:
         "--map-observation",
         nargs="+",
         default=None,
-        help="env option map_observation (copy, window); several values are timed side by side",
+        help="env option map_observation (copy, window, shared); several values are timed side by side",
     )
     p.add_argument("--static-info", default=None, help="env option static_info (every_step, reset)")
     args = p.parse_args(argv)

@@ -11,7 +11,7 @@ adds the map generation's own split: the mean time per segmentation of each stag
 Usage::
 
     python scripts/bench_expert.py [--world maze1] [--seeds 0 1 2] [--policy-set KEY=VALUE] [--json]
-        [--seg-stages]
+        [--seg-stages] [--map-observation shared]
 """
 
 from __future__ import annotations
@@ -43,6 +43,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--max-time-s", type=float, default=1200.0, help="simulated time limit (default: 1200)"
     )
+    ap.add_argument(
+        "--map-observation",
+        default="auto",
+        choices=["auto", "copy", "shared"],
+        help="env option map_observation: a fresh map copy per step or a read-only live view; "
+        "auto (default) gives the expert the live view, as semexplore explore/benchmark do "
+        "(its missions are the same either way)",
+    )
     ap.add_argument("--no-warmup", action="store_true", help="skip the untimed warm-up mission")
     ap.add_argument(
         "--json", action="store_true", help="print one JSON object per mission instead of the table"
@@ -61,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
     from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.core.topometric import TopometricSegmenter
-    from semexplore_gym.evaluation.rollout import STAGES, run_mission
+    from semexplore_gym.evaluation.rollout import STAGES, map_observation_for, run_mission
 
     class StageRecorder(TopometricSegmenter):
         """The expert's segmenter, adding up each call's ``stage_ms``."""
@@ -82,11 +90,18 @@ def main(argv: list[str] | None = None) -> int:
     kwargs = merge_overrides(None, args.overrides)
     if cfg.params:
         kwargs["params"] = cfg.params
+    if args.map_observation == "auto":
+        env_kwargs = map_observation_for(make_policy("semantic", **dict(kwargs)))
+    elif args.map_observation == "shared":
+        env_kwargs = {"map_observation": "shared", "disable_env_checker": True}
+    else:
+        env_kwargs = {"map_observation": "copy"}
     env = gym.make(
         "SemanticExplore-v0",
         world=args.world,
         config=cfg.env,
         overrides=[f"episode.max_time_s={args.max_time_s!r}"],
+        **env_kwargs,
     )
     if not args.no_warmup:
         run_mission(

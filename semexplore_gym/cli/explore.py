@@ -124,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
     from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.core.safe_io import check_output_file
-    from semexplore_gym.evaluation.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
 
     if not (0 < args.max_time_s <= 1e7):
@@ -154,6 +154,7 @@ def run(args: argparse.Namespace) -> int:
         config=env_config,
         overrides=env_overrides,
         render_mode="rgb_array" if args.gif else None,
+        **map_observation_for(policy),
     )
     # Kernels compiled or loaded before the clocks start (and before the progress bar).
     warm_up(lambda: make_policy(spec, **policy_kwargs), env_config, args.env_overrides)

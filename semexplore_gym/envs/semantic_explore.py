@@ -29,8 +29,9 @@ from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
 
 PROCEDURAL_FAMILIES = ("maze", "office", "cave")
-#: ``map_observation`` options: a fresh copy of the whole map, or of a window around the robot.
-MAP_OBSERVATIONS = ("copy", "window")
+#: ``map_observation`` options: a fresh copy of the whole map, a fresh window around the robot,
+#: or a read-only live view of the env's map.
+MAP_OBSERVATIONS = ("copy", "window", "shared")
 #: ``static_info`` options: the static ``info`` entries in every step's ``info``, or at reset only.
 STATIC_INFO_MODES = ("every_step", "reset")
 
@@ -138,9 +139,13 @@ class SemanticExploreEnv(gym.Env):
       beyond the map read UNKNOWN) and adds ``obs["map_offset_cells"]``, int32 ``(row, col)``
       of the window's first cell in the full map: ``obs["map"][r, c] == full_map[r + row,
       c + col]`` where that cell exists (the same window as ``FixedSizeMap(env,
-      map_window_cells, anchor="robot")``, without copying the whole map first). (A live,
-      uncopied view of the map is not offered: gymnasium's ``check_env`` requires new
-      observation data at every call.)
+      map_window_cells, anchor="robot")``, without copying the whole map first).
+      ``"shared"`` gives a read-only live view of the env's own map instead of a copy: no copy
+      at all, but the array changes in place at every step of the episode (a new episode maps
+      into a new array, so the last episode's view keeps its final map). For code that reads
+      the map within the step it gets it, as the scripted policies do (the semantic expert's
+      missions are bit-identical either way, tested); ``np.array(obs["map"])`` keeps a
+      snapshot. Writing into it raises ``ValueError``.
     - ``map_window_cells``: side of the ``"window"`` map in cells (8 to 4096; default 160, 8 m
       at 0.05 m per cell, which holds a 3.5 m LiDAR's reach).
     - ``static_info``: ``"every_step"`` (default) puts the static entries (``map_geometry``,
@@ -166,14 +171,14 @@ class SemanticExploreEnv(gym.Env):
       keys and values; mutating them raises ``TypeError`` (take ``dict(...)`` for a copy).
       In gymnasium vector envs each is collected as an object array of mappings rather than
       a dict of per-field arrays.
-    - v0, issue #17: the ``map_observation`` (``"window"``) and ``static_info``
+    - v0, issue #17: the ``map_observation`` (``"window"``, ``"shared"``) and ``static_info``
       (``"reset"``) options, off by default (the default observations and ``info`` are unchanged).
 
     ## Speed
     ``python scripts/bench_env.py`` times the step stage by stage; ``scripts/bench_vector_env.py``
     compares vector envs with a plain loop. On big real maps the default observation copies the
     whole map every step; ``map_observation="window"`` copies only the window around the robot
-    (Willow Garage: about 1.9x the steps/s of ``"copy"``). gymnasium's ``SyncVectorEnv`` merges
+    and ``"shared"`` copies nothing (Willow Garage: about 2x the steps/s of ``"copy"``). gymnasium's ``SyncVectorEnv`` merges
     every ``info`` key of every env and stacks the observations at each step (on maze1 about
     0.7x a plain loop over the same envs); :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv`
     returns the same results with less of that work, and ``static_info="reset"`` leaves fewer
@@ -414,7 +419,9 @@ class SemanticExploreEnv(gym.Env):
         if self.map_observation == "window":
             return self._window_obs(pose)
         return {
-            "map": self.grid.encoded_copy(),
+            "map": self.grid.encoded
+            if self.map_observation == "shared"
+            else self.grid.encoded_copy(),
             "pose": pose,
             "scan": self._scan,
         }

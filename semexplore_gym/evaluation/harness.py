@@ -143,7 +143,11 @@ def _warm_up_config_key(env_config: Any) -> str:
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
     from policies.registry import make_policy
-    from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
+    from semexplore_gym.evaluation.rollout import (
+        make_mission_env,
+        map_observation_for,
+        run_mission,
+    )
     from semexplore_gym.evaluation.warmup import warm_up
 
     # Kernels compiled or loaded before the mission's clocks start.
@@ -152,9 +156,9 @@ def run_task(task: Task) -> dict[str, Any]:
         task.env_config,
         key=(task.policy, _warm_up_config_key(task.env_config), repr(task.policy_overrides)),
     )
-    env = make_mission_env(task.resolved_world, task.env_config)
+    policy = make_policy(task.policy, **task.policy_overrides)
+    env = make_mission_env(task.resolved_world, task.env_config, **map_observation_for(policy))
     try:
-        policy = make_policy(task.policy, **task.policy_overrides)
         # Missions end when the policy stops itself (or at the time limit), not at the env's
         # coverage goal: mission time is each method's own exploration time; T90/T99 compare
         # all methods on the same coverage levels.

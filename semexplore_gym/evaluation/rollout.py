@@ -137,6 +137,20 @@ def make_mission_env(world: str, env_config: Any = None, **kwargs: Any) -> Any:
     return gym.make("SemanticExplore-v0", world=world, config=env_config, **kwargs)
 
 
+def map_observation_for(policy: Any) -> dict[str, Any]:
+    """``gym.make`` arguments for a mission env that suit ``policy``.
+
+    A policy whose ``reads_map_in_step_only`` is True (the scripted ones) gets the env's
+    read-only live map (``map_observation="shared"``): no per-step copy of the whole map, the
+    same missions. The passive env checker is off for it, since its only complaint would be
+    that point (successive observations share the map). Any other policy gets the default
+    fresh copy per step.
+    """
+    if getattr(policy, "reads_map_in_step_only", False):
+        return {"map_observation": "shared", "disable_env_checker": True}
+    return {}
+
+
 def time_to_coverage(trace: list[tuple[float, float, float]], level: float) -> float | None:
     """First simulated time at which the coverage in ``trace`` reached ``level`` (None if never)."""
     for t, c, _ in trace:

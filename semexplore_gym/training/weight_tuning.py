@@ -18,7 +18,6 @@ rerun with the same paths resumes (it runs only the missing trials).
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import os
@@ -155,13 +154,15 @@ def evaluate_weights(
         ``MissionResult.summary()`` dicts, world-major.
     """
     from policies.registry import make_policy
-    from semexplore_gym.evaluation.rollout import run_mission
+    from policies.semantic_expert import SemanticExpertPolicy
+    from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
 
     if not worlds:
         raise ValueError("no worlds given")
     if not seeds:
         raise ValueError("no seeds given")
-    make_env = env_factory or functools.partial(make_mission_env, env_config=env_config)
+    env_kwargs = map_observation_for(SemanticExpertPolicy)
+    make_env = env_factory or (lambda w: make_mission_env(w, env_config, **env_kwargs))
     out = []
     for world in worlds:
         for seed in seeds:

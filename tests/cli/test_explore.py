@@ -72,3 +72,27 @@ def test_explore_rejects_bad_keys_and_files(tmp_path, capsys):
     assert explore("--policy-config", str(top), "--max-time-s", "1") == 2
     assert "robot" in capsys.readouterr().err
     assert explore("--policy-config", str(tmp_path / "missing.yaml")) == 2
+
+
+@pytest.mark.parametrize(("policy", "want"), [("semantic", "shared"), ("random", "copy")])
+def test_explore_gives_the_shared_map_to_policies_that_declare_it(
+    policy, want, monkeypatch, capsys
+):
+    # The semantic expert reads the map only within a step: explore hands it the env's live
+    # map (no per-step copy); the random policy does not declare it and gets copies. Run with
+    # the progress bar, as users do.
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    made: list[str] = []
+    init = SemanticExploreEnv.__init__
+
+    def spy(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        made.append(self.map_observation)
+
+    monkeypatch.setattr(SemanticExploreEnv, "__init__", spy)
+    args = ["explore", "--world", "maze1", "--policy", policy, "--max-time-s", "20", "--json"]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert out["mission_time_s"] > 0
+    assert made[0] == want  # the mission env (a warm-up env may follow)

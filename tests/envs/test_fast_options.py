@@ -1,6 +1,7 @@
-"""The speed options of ``SemanticExplore-v0`` (issue #17), both off by default:
+"""The speed options of ``SemanticExplore-v0`` (issue #17), all off by default:
 
-``map_observation="window"`` (a window of the map around the robot) and ``static_info="reset"`` (static ``info``
+``map_observation="window"`` (a window of the map around the robot), ``map_observation="shared"``
+(a read-only live view of the env's map) and ``static_info="reset"`` (static ``info``
 entries only at reset). They change only how observations and ``info`` are handed out: the same
 seeds and actions give the same maps, scans, poses and rewards as the default env.
 """
@@ -161,3 +162,35 @@ def test_vector_envs_over_reset_info_batch_the_same_data(copy: bool) -> None:
     finally:
         ref_v.close()
         fast_v.close()
+
+
+def test_shared_map_is_a_read_only_live_view_of_the_default_map() -> None:
+    ref = gym.make("SemanticExplore-v0", world="maze1")
+    shared = gym.make("SemanticExplore-v0", world="maze1", map_observation="shared")
+    o_ref, _ = ref.reset(seed=2)
+    o_sh, _ = shared.reset(seed=2)
+    first = o_sh["map"]
+    assert not first.flags.writeable and first.dtype == np.uint8
+    with pytest.raises(ValueError, match="read-only"):
+        first[0, 0] = 0
+    assert shared.observation_space["map"].shape == first.shape
+    for a in _actions(120):
+        o_ref, r_ref, *_ = ref.step(a)
+        o_sh, r_sh, *_ = shared.step(a)
+        assert np.array_equal(o_sh["map"], o_ref["map"])
+        assert np.array_equal(o_sh["scan"], o_ref["scan"]) and r_sh == r_ref
+        assert np.array_equal(o_sh["pose"], o_ref["pose"])
+    # Live: the reset observation's map is the current map, not the map at reset.
+    assert np.shares_memory(first, o_sh["map"]) and np.array_equal(first, o_ref["map"])
+    final = np.array(o_sh["map"])
+    # A new episode maps into a new array: the last episode's view keeps its final map.
+    o_new, _ = shared.reset(seed=3)
+    assert not np.shares_memory(first, o_new["map"])
+    assert np.array_equal(first, final)
+    ref.close()
+    shared.close()
+
+
+def test_shared_map_option_is_named_in_the_error() -> None:
+    with pytest.raises(ValueError, match="shared"):
+        gym.make("SemanticExplore-v0", world="maze1", map_observation="live")
