@@ -10,7 +10,13 @@ rewards, flags, ``info`` arrays and ``_key`` masks, same autoreset behaviour) bu
 * merges the ``info`` of all envs key by key at the end of the step, building each key's
   array and mask in one call when every env has the key;
 * writes ``Dict``-of-``Box`` observations into the batch buffers directly, and copies them
-  with one ``ndarray.copy`` per key when ``copy=True`` (instead of ``deepcopy``).
+  with one ``ndarray.copy`` per key when ``copy=True`` (instead of ``deepcopy``);
+* steps ``SemanticExplore-v0`` envs directly when nothing but ``gym.make``'s own wrappers
+  (``OrderEnforcing``, ``PassiveEnvChecker``, which only check the first calls) wraps them
+  and their observation is the whole map: after those first checks, each step advances the
+  env itself, writes its observation into the batch row (no per-env observation dict or map
+  copy) and its ``info`` numbers into one array per key. Steps in which an env resets, and
+  ``AutoresetMode.SAME_STEP``, take the general path.
 
 Other observation spaces fall back to gymnasium's ``concatenate``/``deepcopy``. Use it like
 ``SyncVectorEnv``::
@@ -28,12 +34,47 @@ from __future__ import annotations
 from copy import deepcopy
 from typing import Any, cast
 
+import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from gymnasium.vector.utils import concatenate, iterate
+from gymnasium.wrappers import OrderEnforcing, PassiveEnvChecker
+
+from semexplore_gym.envs.semantic_explore import INFO_NUMBERS, SemanticExploreEnv
 
 _SCALAR_TYPES = (int, float, bool)
+#: The number types of ``INFO_NUMBERS`` (``collisions`` counts, the rest are floats).
+_INFO_TYPES = tuple(int if k == "collisions" else float for k in INFO_NUMBERS)
+
+
+def _direct_target(env: Any) -> tuple[SemanticExploreEnv, list[Any]] | None:
+    """``(SemanticExploreEnv, wrappers)`` when stepping the env itself can stand in for
+    ``env.step``: only gymnasium's ``OrderEnforcing`` and ``PassiveEnvChecker`` (what
+    ``gym.make`` adds) wrap it, and its observation is the whole map (``"copy"``/``"shared"``)
+    without human rendering. Otherwise None."""
+    wrappers = []
+    while isinstance(env, gym.Wrapper):
+        if type(env) not in (OrderEnforcing, PassiveEnvChecker):
+            return None
+        wrappers.append(env)
+        env = env.env
+    if type(env) is not SemanticExploreEnv:  # a subclass may step differently
+        return None
+    if env.map_observation not in ("copy", "shared") or env.render_mode == "human":
+        return None
+    return env, wrappers
+
+
+def _wrappers_done(wrappers: list[Any]) -> bool:
+    """Whether the wrappers now only pass ``step`` through (checks done, env reset)."""
+    for w in wrappers:
+        if isinstance(w, PassiveEnvChecker):
+            if not (w.checked_step and w.checked_data_reuse):
+                return False
+        elif not w._has_reset:
+            return False
+    return True
 
 
 class FastSyncVectorEnv(SyncVectorEnv):
@@ -50,6 +91,25 @@ class FastSyncVectorEnv(SyncVectorEnv):
             isinstance(s, spaces.Box) for s in space.spaces.values()
         ):
             self._box_keys = tuple(space.spaces)
+        # The direct path: every env a SemanticExploreEnv under gym.make's two wrappers, the
+        # batch a dict of map, pose and scan, all with static_info alike. It starts once the
+        # wrappers are done with their first-step checks (see _direct_step).
+        targets = [_direct_target(env) for env in self.envs]
+        self._direct: list[SemanticExploreEnv] | None = None
+        self._direct_wrappers: list[list[Any]] = []
+        if (
+            all(t is not None for t in targets)
+            and self._box_keys is not None
+            and set(self._box_keys) == {"map", "pose", "scan"}
+            and len({t[0].static_info for t in targets if t is not None}) == 1
+        ):
+            self._direct_candidates = [t[0] for t in targets if t is not None]
+            self._direct_wrappers = [t[1] for t in targets if t is not None]
+        else:
+            self._direct_candidates = []
+        self._static_merged: dict[str, Any] | None = None
+        self._info_layout: list[tuple[str, type]] | None = None
+        self._env_obs_stale = False
 
     def _merge_infos(self, entries: list[tuple[int, dict[str, Any]]]) -> dict[str, Any]:
         """gymnasium's merge of ``(env index, info)`` pairs, one key at a time (same arrays)."""
@@ -133,8 +193,15 @@ class FastSyncVectorEnv(SyncVectorEnv):
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
         """Step every env; the same results as ``SyncVectorEnv.step``."""
-        entries: list[tuple[int, dict[str, Any]]] = []
         mode = self.autoreset_mode
+        if (
+            self._direct_candidates
+            and mode != AutoresetMode.SAME_STEP
+            and not self._autoreset_envs.any()
+            and (self._direct is not None or self._direct_ready())
+        ):
+            return self._direct_step(actions)
+        entries: list[tuple[int, dict[str, Any]]] = []
         for i, (action, env) in enumerate(
             zip(iterate(self.action_space, actions), self.envs, strict=True)
         ):
@@ -177,6 +244,93 @@ class FastSyncVectorEnv(SyncVectorEnv):
             np.copy(self._truncations),
             self._merge_infos(entries),
         )
+
+    def _direct_ready(self) -> bool:
+        if not all(_wrappers_done(ws) for ws in self._direct_wrappers):
+            return False
+        self._direct = self._direct_candidates
+        return True
+
+    def _direct_step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
+        """A step without autoresets over envs stepped directly (what their wrappers' ``step``
+        would do once their checks are done): observations written into the batch, the
+        ``info`` numbers into one array per key. The same results as the general path."""
+        envs = cast(list[SemanticExploreEnv], self._direct)
+        self._env_obs_stale = True
+        batch = cast(dict, self._observations)
+        rewards, terms_done, truncs = self._rewards, self._terminations, self._truncations
+        rows = []
+        all_terms = []
+        # A batch of actions as an array: its rows (what iterate() yields for a Box space).
+        plain = type(actions) is np.ndarray and actions.shape == self.action_space.shape
+        for i, (action, env) in enumerate(
+            zip(actions if plain else iterate(self.action_space, actions), envs, strict=True)
+        ):
+            rewards[i], terms_done[i], truncs[i], terms = env._advance(action)
+            env._obs_into(batch, i)
+            rows.append((*env._info_values(), *terms.values()))
+            all_terms.append(terms)
+        self._autoreset_envs = np.logical_or(terms_done, truncs)
+        obs = {key: batch[key].copy() for key in batch} if self.copy else batch
+        if self._info_layout is None:
+            self._info_layout = self._direct_layout(envs, rows, all_terms)
+        if self._info_layout:
+            info = self._direct_info(envs[0]._static_every_step, rows)
+        else:  # numbers of unusual types: gymnasium's own merge rules
+            static = envs[0]._static_every_step
+            pairs = zip(envs, all_terms, strict=True)
+            info = self._merge_infos(
+                [(i, env._info(t, static)) for i, (env, t) in enumerate(pairs)]
+            )
+        return obs, np.copy(rewards), np.copy(terms_done), np.copy(truncs), info
+
+    def _direct_layout(
+        self,
+        envs: list[SemanticExploreEnv],
+        rows: list[tuple[Any, ...]],
+        all_terms: list[dict[str, float]],
+    ) -> list[tuple[str, type]]:
+        """The keys and number types of a direct step's ``info`` (checked once: the config
+        fixes them), or ``[]`` when it is not the usual one (then every step merges as
+        gymnasium does)."""
+        keys = [*INFO_NUMBERS, *all_terms[0]]
+        types = [*_INFO_TYPES, *(float for _ in all_terms[0])]
+        usual = all(
+            list(map(type, row)) == types and list(terms) == keys[len(INFO_NUMBERS) :]
+            for row, terms in zip(rows, all_terms, strict=True)
+        )
+        if usual and envs[0]._static_every_step:
+            self._static_merged = self._merge_same_keys([env._static_info for env in envs])
+            usual = self._static_merged is not None
+        return list(zip(keys, types, strict=True)) if usual else []
+
+    def _direct_info(self, static: bool, rows: list[tuple[Any, ...]]) -> dict[str, Any]:
+        """gymnasium's merged ``info`` of a direct step from each env's numbers (usual types)."""
+        layout = cast(list, self._info_layout)
+        out: dict[str, Any] = {}
+        if static:
+            out = {k: v.copy() for k, v in cast(dict, self._static_merged).items()}
+        # Each key's array (and mask) is a row of one fresh block: contiguous, its own values.
+        block = np.array(rows, dtype=np.float64).T.copy()
+        masks = np.ones((len(layout) + 1, self.num_envs), dtype=np.bool_)
+        n_info = len(INFO_NUMBERS)
+        nested: dict[str, Any] = {}
+        for k, (key, typ) in enumerate(layout):
+            d = out if k < n_info else nested
+            d[key] = block[k] if typ is float else block[k].astype(typ)
+            d["_" + key] = masks[k]
+        out["reward_terms"] = nested
+        out["_reward_terms"] = masks[-1]
+        return out
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        """``SyncVectorEnv.reset``; after direct steps, first brings each env's last
+        observation up to date (a partial reset batches the others' as they are)."""
+        if self._env_obs_stale:
+            for i, env in enumerate(cast(list[SemanticExploreEnv], self._direct)):
+                cast(list, self._env_obs)[i] = env._obs()
+            self._env_obs_stale = False
+        return super().reset(**kwargs)
 
     def _batch_observations(self) -> Any:
         keys = self._box_keys

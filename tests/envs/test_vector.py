@@ -10,6 +10,7 @@ import pytest
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 import semexplore_gym  # noqa: F401
+from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 from semexplore_gym.envs.vector import FastSyncVectorEnv
 
 
@@ -38,8 +39,11 @@ def _fn(**kw: Any):
     [
         (AutoresetMode.NEXT_STEP, True, {}),
         (AutoresetMode.NEXT_STEP, False, {"static_info": "reset"}),
+        (AutoresetMode.NEXT_STEP, True, {"static_info": "reset", "map_observation": "shared"}),
         (AutoresetMode.SAME_STEP, True, {"map_observation": "window", "map_window_cells": 32}),
+        (AutoresetMode.SAME_STEP, False, {}),
         (AutoresetMode.DISABLED, False, {}),
+        (AutoresetMode.DISABLED, True, {"static_info": "reset"}),
     ],
 )
 def test_fast_sync_vector_env_matches_sync_vector_env(mode, copy, kw) -> None:
@@ -63,6 +67,10 @@ def test_fast_sync_vector_env_matches_sync_vector_env(mode, copy, kw) -> None:
         assert n_done >= 3  # the episodes ended and restarted along the way
         if copy:  # each step's batch is its own copy
             assert not np.array_equal(kept[0]["scan"], kept[-1]["scan"])
+        # Whole-map observations under gym.make's wrappers are stepped directly (the general
+        # path only when an env resets, or for same-step autoresets and windows).
+        direct = mode != AutoresetMode.SAME_STEP and kw.get("map_observation") != "window"
+        assert (fast._direct is not None) == direct
     finally:
         fast.close()
         ref.close()
@@ -76,3 +84,75 @@ def test_fast_sync_vector_env_rejects_wrong_action_count() -> None:
             fast.step(np.zeros((3, 2), np.float32))
     finally:
         fast.close()
+
+
+def test_direct_steps_fall_back_to_the_general_merge_for_unusual_info_values(monkeypatch) -> None:
+    # A number of an unusual type (here an int coverage) takes gymnasium's own merge rules.
+    fast = FastSyncVectorEnv([_fn()] * 2)
+    ref = SyncVectorEnv([_fn()] * 2)
+    real = SemanticExploreEnv._info_values
+
+    def int_coverage(self):
+        return (int(self.sim_time_s * 10), *real(self)[1:])
+
+    monkeypatch.setattr(SemanticExploreEnv, "_info_values", int_coverage)
+    rng = np.random.default_rng(0)
+    try:
+        assert _same(fast.reset(seed=1), ref.reset(seed=1))
+        for _ in range(6):
+            a = rng.uniform(-1, 1, size=(2, 2)).astype(np.float32)
+            got, want = fast.step(a), ref.step(a)
+            assert all(_same(g, w) for g, w in zip(got, want, strict=True))
+            assert got[4]["coverage"].dtype == np.int64
+        assert fast._direct is not None
+    finally:
+        fast.close()
+        ref.close()
+
+
+def test_other_wrappers_keep_the_general_path() -> None:
+    def fn():
+        return gym.wrappers.RecordEpisodeStatistics(gym.make("SemanticExplore-v0", world="maze1"))
+
+    fast = FastSyncVectorEnv([fn] * 2)
+    try:
+        fast.reset(seed=0)
+        for _ in range(3):
+            fast.step(np.zeros((2, 2), np.float32))
+        assert fast._direct is None and not fast._direct_candidates
+    finally:
+        fast.close()
+
+
+@pytest.mark.parametrize("copy", [True, False])
+def test_partial_resets_after_direct_steps_batch_the_current_observations(copy) -> None:
+    # Episodes of different lengths end at different steps; a partial reset batches the other
+    # envs' latest observations, which direct steps wrote only into the batch.
+    def fn(max_time_s: float):
+        cfg = {"episode": {"max_time_s": max_time_s}}
+        return lambda: gym.make("SemanticExplore-v0", world="maze1", config=cfg)
+
+    fns = [fn(2.0), fn(3.0), fn(5.0)]
+    for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.DISABLED):
+        fast = FastSyncVectorEnv(fns, copy=copy, autoreset_mode=mode)
+        ref = SyncVectorEnv(fns, copy=copy, autoreset_mode=mode)
+        rng = np.random.default_rng(1)
+        try:
+            assert _same(fast.reset(seed=2), ref.reset(seed=2))
+            partial = 0
+            for _ in range(40):
+                a = rng.uniform(-1, 1, size=(3, 2)).astype(np.float32)
+                got, want = fast.step(a), ref.step(a)
+                assert all(_same(g, w) for g, w in zip(got, want, strict=True))
+                done = got[2] | got[3]
+                if mode == AutoresetMode.DISABLED and done.any():
+                    partial += int(not done.all())
+                    assert _same(
+                        fast.reset(options={"reset_mask": done}),
+                        ref.reset(options={"reset_mask": done}),
+                    )
+            assert fast._direct is not None
+            assert mode == AutoresetMode.NEXT_STEP or partial >= 2
+        finally:
+            fast.close()
+            ref.close()
