@@ -108,8 +108,9 @@ class FastSyncVectorEnv(SyncVectorEnv):
         else:
             self._direct_candidates = []
         self._static_merged: dict[str, Any] | None = None
-        self._info_layout: list[tuple[str, type]] | None = None
+        self._info_layout: list[tuple[str, str, type]] | None = None
         self._env_obs_stale = False
+        self._no_pending_reset = False  # no direct step before the first reset
 
     def _merge_infos(self, entries: list[tuple[int, dict[str, Any]]]) -> dict[str, Any]:
         """gymnasium's merge of ``(env index, info)`` pairs, one key at a time (same arrays)."""
@@ -195,9 +196,9 @@ class FastSyncVectorEnv(SyncVectorEnv):
         """Step every env; the same results as ``SyncVectorEnv.step``."""
         mode = self.autoreset_mode
         if (
-            self._direct_candidates
+            self._no_pending_reset
+            and self._direct_candidates
             and mode != AutoresetMode.SAME_STEP
-            and not self._autoreset_envs.any()
             and (self._direct is not None or self._direct_ready())
         ):
             return self._direct_step(actions)
@@ -237,6 +238,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
             entries.append((i, env_info))
         obs = self._batch_observations()
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
+        self._no_pending_reset = not self._autoreset_envs.any()
         return (
             obs,
             np.copy(self._rewards),
@@ -261,16 +263,21 @@ class FastSyncVectorEnv(SyncVectorEnv):
         rewards, terms_done, truncs = self._rewards, self._terminations, self._truncations
         rows = []
         all_terms = []
+        done = False
         # A batch of actions as an array: its rows (what iterate() yields for a Box space).
         plain = type(actions) is np.ndarray and actions.shape == self.action_space.shape
         for i, (action, env) in enumerate(
             zip(actions if plain else iterate(self.action_space, actions), envs, strict=True)
         ):
-            rewards[i], terms_done[i], truncs[i], terms = env._advance(action)
+            rewards[i], term, trunc, terms = env._advance(action)
+            terms_done[i] = term
+            truncs[i] = trunc
+            done = done or term or trunc
             env._obs_into(batch, i)
             rows.append((*env._info_values(), *terms.values()))
             all_terms.append(terms)
         self._autoreset_envs = np.logical_or(terms_done, truncs)
+        self._no_pending_reset = not done
         obs = {key: batch[key].copy() for key in batch} if self.copy else batch
         if self._info_layout is None:
             self._info_layout = self._direct_layout(envs, rows, all_terms)
@@ -289,8 +296,8 @@ class FastSyncVectorEnv(SyncVectorEnv):
         envs: list[SemanticExploreEnv],
         rows: list[tuple[Any, ...]],
         all_terms: list[dict[str, float]],
-    ) -> list[tuple[str, type]]:
-        """The keys and number types of a direct step's ``info`` (checked once: the config
+    ) -> list[tuple[str, str, type]]:
+        """The keys, mask keys and number types of a direct step's ``info`` (checked once: the config
         fixes them), or ``[]`` when it is not the usual one (then every step merges as
         gymnasium does)."""
         keys = [*INFO_NUMBERS, *all_terms[0]]
@@ -302,7 +309,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
         if usual and envs[0]._static_every_step:
             self._static_merged = self._merge_same_keys([env._static_info for env in envs])
             usual = self._static_merged is not None
-        return list(zip(keys, types, strict=True)) if usual else []
+        return [(k, "_" + k, t) for k, t in zip(keys, types, strict=True)] if usual else []
 
     def _direct_info(self, static: bool, rows: list[tuple[Any, ...]]) -> dict[str, Any]:
         """gymnasium's merged ``info`` of a direct step from each env's numbers (usual types)."""
@@ -315,10 +322,10 @@ class FastSyncVectorEnv(SyncVectorEnv):
         masks = np.ones((len(layout) + 1, self.num_envs), dtype=np.bool_)
         n_info = len(INFO_NUMBERS)
         nested: dict[str, Any] = {}
-        for k, (key, typ) in enumerate(layout):
+        for k, (key, mask_key, typ) in enumerate(layout):
             d = out if k < n_info else nested
             d[key] = block[k] if typ is float else block[k].astype(typ)
-            d["_" + key] = masks[k]
+            d[mask_key] = masks[k]
         out["reward_terms"] = nested
         out["_reward_terms"] = masks[-1]
         return out
@@ -330,7 +337,9 @@ class FastSyncVectorEnv(SyncVectorEnv):
             for i, env in enumerate(cast(list[SemanticExploreEnv], self._direct)):
                 cast(list, self._env_obs)[i] = env._obs()
             self._env_obs_stale = False
-        return super().reset(**kwargs)
+        out = super().reset(**kwargs)
+        self._no_pending_reset = not self._autoreset_envs.any()
+        return out
 
     def _batch_observations(self) -> Any:
         keys = self._box_keys
