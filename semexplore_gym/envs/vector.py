@@ -297,9 +297,9 @@ class FastSyncVectorEnv(SyncVectorEnv):
         rows: list[tuple[Any, ...]],
         all_terms: list[dict[str, float]],
     ) -> list[tuple[str, str, type]]:
-        """The keys, mask keys and number types of a direct step's ``info`` (checked once: the config
-        fixes them), or ``[]`` when it is not the usual one (then every step merges as
-        gymnasium does)."""
+        """The keys, mask keys and number types of a direct step's ``info`` (checked once:
+        the config fixes them), or ``[]`` when they are not the usual ones (then every step
+        merges as gymnasium does)."""
         keys = [*INFO_NUMBERS, *all_terms[0]]
         types = [*_INFO_TYPES, *(float for _ in all_terms[0])]
         usual = all(
