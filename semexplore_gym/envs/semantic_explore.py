@@ -423,7 +423,8 @@ class SemanticExploreEnv(gym.Env):
         return self.lidar.sense_and_map(true_pose, self._est_pose, self.grid, self.np_random)
 
     def _obs(self) -> dict[str, np.ndarray]:
-        pose = np.array(self._pose_values(), dtype=np.float32)
+        x, y, yaw = self._est_pose
+        pose = np.array([x, y, wrap_angle_rad(yaw)], dtype=np.float32)
         if self.map_observation == "window":
             return self._window_obs(pose)
         return {
@@ -462,7 +463,14 @@ class SemanticExploreEnv(gym.Env):
     def _info(self, terms: dict[str, float], static: bool) -> dict[str, Any]:
         # The static entries are shared read-only mappings; the top level is a fresh dict.
         info = self._static_info.copy() if static else {}
-        info.update(zip(INFO_NUMBERS, self._info_values(), strict=True))
+        # The keys of INFO_NUMBERS, in its order (a test checks they match).
+        (
+            info["coverage"],
+            info["explored_area_m2"],
+            info["collisions"],
+            info["sim_time_s"],
+            info["path_length_m"],
+        ) = self._info_values()
         info["reward_terms"] = terms
         return info
 
