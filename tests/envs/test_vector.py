@@ -124,6 +124,24 @@ def test_other_wrappers_keep_the_general_path() -> None:
         fast.close()
 
 
+def _step_both(fast, ref, rng, n_steps: int, *, reset_done: bool = False) -> tuple[int, int]:
+    """Step both vector envs with the same random actions and compare every result; with
+    ``reset_done``, reset the envs that ended (partial resets). Returns (episodes ended,
+    partial resets)."""
+    n_done = partial = 0
+    for _ in range(n_steps):
+        a = rng.uniform(-1, 1, size=(fast.num_envs, 2)).astype(np.float32)
+        got, want = fast.step(a), ref.step(a)
+        assert all(_same(g, w) for g, w in zip(got, want, strict=True))
+        done = got[2] | got[3]
+        n_done += int(done.sum())
+        if reset_done and done.any():
+            partial += int(not done.all())
+            options = {"reset_mask": done}
+            assert _same(fast.reset(options=dict(options)), ref.reset(options=dict(options)))
+    return n_done, partial
+
+
 @pytest.mark.parametrize("copy", [True, False])
 def test_partial_resets_after_direct_steps_batch_the_current_observations(copy) -> None:
     # Episodes of different lengths end at different steps; a partial reset batches the other
@@ -136,23 +154,12 @@ def test_partial_resets_after_direct_steps_batch_the_current_observations(copy) 
     for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.DISABLED):
         fast = FastSyncVectorEnv(fns, copy=copy, autoreset_mode=mode)
         ref = SyncVectorEnv(fns, copy=copy, autoreset_mode=mode)
-        rng = np.random.default_rng(1)
         try:
             assert _same(fast.reset(seed=2), ref.reset(seed=2))
-            partial = 0
-            for _ in range(40):
-                a = rng.uniform(-1, 1, size=(3, 2)).astype(np.float32)
-                got, want = fast.step(a), ref.step(a)
-                assert all(_same(g, w) for g, w in zip(got, want, strict=True))
-                done = got[2] | got[3]
-                if mode == AutoresetMode.DISABLED and done.any():
-                    partial += int(not done.all())
-                    assert _same(
-                        fast.reset(options={"reset_mask": done}),
-                        ref.reset(options={"reset_mask": done}),
-                    )
+            disabled = mode == AutoresetMode.DISABLED
+            _, partial = _step_both(fast, ref, np.random.default_rng(1), 40, reset_done=disabled)
             assert fast._direct is not None
-            assert mode == AutoresetMode.NEXT_STEP or partial >= 2
+            assert not disabled or partial >= 2
         finally:
             fast.close()
             ref.close()
@@ -165,15 +172,9 @@ def test_direct_steps_match_over_worlds_drawn_at_every_reset() -> None:
         return gym.make("SemanticExplore-v0", world="cave:size_m=5", config=cfg)
 
     fast, ref = FastSyncVectorEnv([fn] * 3), SyncVectorEnv([fn] * 3)
-    rng = np.random.default_rng(2)
     try:
         assert _same(fast.reset(seed=9), ref.reset(seed=9))
-        n_done = 0
-        for _ in range(40):
-            a = rng.uniform(-1, 1, size=(3, 2)).astype(np.float32)
-            got, want = fast.step(a), ref.step(a)
-            assert all(_same(g, w) for g, w in zip(got, want, strict=True))
-            n_done += int((got[2] | got[3]).sum())
+        n_done, _ = _step_both(fast, ref, np.random.default_rng(2), 40)
         assert n_done >= 6 and fast._direct is not None
     finally:
         fast.close()
