@@ -55,31 +55,22 @@ def _walk(env: Any, n_steps: int, keep: bool) -> tuple[float, list[dict[str, np.
     return t_step / n_steps * 1e6, raws, info
 
 
-def _field_timer(params: Any, geometry: Any) -> Any:
-    """A function timing the frontier field over observations the way the encoder builds it
+def _field_timer(encoder: Any) -> Any:
+    """A function timing the frontier field over observations the way ``encoder`` builds it
     (with ``pool_map``: pooling the map, then the field on the pooled grid)."""
     from semexplore_gym.core.frontiers import distance
 
+    params, geometry = encoder.params, encoder.geometry
     res, clear = geometry.resolution_m, params.frontier_clearance_m
-    pool = round(params.crop_resolution_m / res) if getattr(params, "pool_map", False) else 1
     if hasattr(distance, "FrontierDistanceField"):  # kept between calls, skipped if unchanged
+        # The grid the encoder searches (checkouts before pool_map: the map itself).
+        sample = getattr(encoder, "sampled_grid", lambda grid: (grid, geometry))
 
         def run(raws: list[dict[str, np.ndarray]]) -> tuple[float, int]:
-            if pool > 1:
-                from semexplore_gym.core.features.egocentric import _min_pool
-
-                shape = (-(-geometry.height // pool), -(-geometry.width // pool))
-                pooled = np.empty(shape, np.uint8)
-                field = distance.FrontierDistanceField(shape, res * pool, clear)
-                t0 = time.perf_counter()
-                n = 0
-                for raw in raws:
-                    _min_pool(raw["map"], pool, pooled)
-                    n += bool(field.update(pooled))
-                return time.perf_counter() - t0, n
-            field = distance.FrontierDistanceField(geometry.shape, res, clear)
+            g = sample(raws[0]["map"])[1]
+            field = distance.FrontierDistanceField(g.shape, g.resolution_m, clear)
             t0 = time.perf_counter()
-            n = sum(bool(field.update(raw["map"])) for raw in raws)
+            n = sum(bool(field.update(sample(raw["map"])[0])) for raw in raws)
             return time.perf_counter() - t0, n
 
     else:  # the first encoder: recomputed, then mapped to grey levels, at every call
@@ -113,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     encoders = [EgocentricEncoder.from_info(EgocentricParams(**kw), info) for _, kw in SETTINGS]
     for enc in encoders:
         enc.encode(raws[0])  # numba compile / cache load outside the timing
-    field_run = _field_timer(encoders[0].params, encoders[0].geometry)
+    field_run = _field_timer(encoders[0])
     field_run(raws[:2])
     n = len(raws)
     t_enc = np.zeros((len(encoders), args.repeats))

@@ -507,7 +507,7 @@ class EgocentricEncoder:
             raise ValueError(
                 f"map has shape {grid.shape} but the encoder was built for {self.geometry.shape}"
             )
-        grid, g = self._sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
+        grid, g = self.sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
         out = np.empty((self.params.crop_cells, self.params.crop_cells), dtype=np.uint8)
         _crop_kernel(
             grid,
@@ -522,9 +522,10 @@ class EgocentricEncoder:
         )
         return out
 
-    def _sampled_grid(self, grid: np.ndarray) -> tuple[np.ndarray, GridGeometry]:
-        """The grid the crops and the frontier field read, and its geometry: ``grid`` itself,
-        or (``pool_map``) its min-pooled blocks in a buffer reused by every call."""
+    def sampled_grid(self, grid: np.ndarray) -> tuple[np.ndarray, GridGeometry]:
+        """The grid the crops and the frontier field read, and its geometry: ``grid`` (a
+        contiguous uint8 map of the encoder's shape) itself, or (``pool_map``) its min-pooled
+        blocks, in a buffer the next call overwrites."""
         if self._pool == 1:
             return grid, self.geometry
         _min_pool(grid, self._pool, self._pooled)
@@ -547,7 +548,7 @@ class EgocentricEncoder:
         """``(H, W)`` uint8 map-frame ``frontier_distance`` layer (relative to the robot's cell);
         with ``pool_map``, of the pooled map (the grid :meth:`encode` searches)."""
         p = self.params
-        grid, g = self._sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
+        grid, g = self.sampled_grid(np.ascontiguousarray(grid, dtype=np.uint8))
         dist = frontier_distance_m(grid, g.resolution_m, p.frontier_clearance_m)
         row, col = (int(v) for v in g.world_to_grid(x_m, y_m))
         return relative_distance_image(dist, row, col, p.distance_scale_per_m)
@@ -575,7 +576,7 @@ class EgocentricEncoder:
             raise ValueError(
                 f"scan has shape {scan.shape} but the encoder expects ({self.n_beams},)"
             )
-        grid, g = self._sampled_grid(grid)
+        grid, g = self.sampled_grid(grid)
         if self._ch_fd >= 0:
             if self._field is None:
                 self._field = FrontierDistanceField(
