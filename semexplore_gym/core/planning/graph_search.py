@@ -614,7 +614,7 @@ def _first_legs(
     for oid in area.opening_ids:
         if oid not in best and 0 <= oid < len(tmap.openings):
             m = np.asarray(tmap.openings[oid].midpoint_m, dtype=np.float64)
-            offer(oid, float(np.hypot(*(m - r))) + 0.0, m, np.empty((0, 2)))
+            offer(oid, float(np.hypot(*(m - r))), m, np.empty((0, 2)))
     return {node: _dedupe(np.vstack([r, q, rest])) for node, (_, q, rest) in best.items()}
 
 
