@@ -280,9 +280,15 @@ def main(argv: list[str] | None = None) -> int:
         "--map-observation",
         nargs="+",
         default=None,
-        help="env option map_observation (copy, window, shared); several values are timed side by side",
+        choices=["copy", "window", "shared"],
+        help="env option map_observation; several values are timed side by side",
     )
-    p.add_argument("--static-info", default=None, help="env option static_info (every_step, reset)")
+    p.add_argument(
+        "--static-info",
+        default=None,
+        choices=["every_step", "reset"],
+        help="env option static_info",
+    )
     args = p.parse_args(argv)
     kw: dict[str, Any] = {}
     if args.static_info is not None:

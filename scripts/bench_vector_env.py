@@ -93,7 +93,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeats", type=int, default=3, help="round-robin repeats (median reported)")
     p.add_argument("--no-async", action="store_true", help="skip AsyncVectorEnv")
     p.add_argument(
-        "--map-observation", default=None, help="env option map_observation (copy, window, shared)"
+        "--map-observation",
+        default=None,
+        choices=["copy", "window", "shared"],
+        help="env option map_observation",
     )
     p.add_argument(
         "--fast-info",
