@@ -256,70 +256,86 @@ class FastSyncVectorEnv(SyncVectorEnv):
     def _direct_step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
         """A step without autoresets over envs stepped directly (what their wrappers' ``step``
         would do once their checks are done): observations written into the batch, the
-        ``info`` numbers into one array per key. The same results as the general path."""
+        ``info`` numbers into one array per key. The same results as the general path.
+
+        Rewards and flags go straight into fresh arrays (gymnasium's step copies its buffers
+        ``_rewards``, ``_terminations``, ``_truncations`` to return them; only its general
+        path writes them, before reading them in the same step)."""
         envs = cast(list[SemanticExploreEnv], self._direct)
         self._env_obs_stale = True
         batch = cast(dict, self._observations)
-        rewards, terms_done, truncs = self._rewards, self._terminations, self._truncations
-        rows = []
+        rewards: list[float] = []
+        values: list[Any] = []  # each env's info numbers and reward terms, env after env
         all_terms = []
-        done = False
+        ended: list[tuple[int, bool, bool]] = []
         # A batch of actions as an array: its rows (what iterate() yields for a Box space).
         plain = type(actions) is np.ndarray and actions.shape == self.action_space.shape
         for i, (action, env) in enumerate(
             zip(actions if plain else iterate(self.action_space, actions), envs, strict=True)
         ):
-            rewards[i], term, trunc, terms = env._advance(action)
-            terms_done[i] = term
-            truncs[i] = trunc
-            done = done or term or trunc
+            reward, term, trunc, terms = env._advance(action)
+            rewards.append(reward)
+            if term or trunc:
+                ended.append((i, term, trunc))
             env._obs_into(batch, i)
-            rows.append((*env._info_values(), *terms.values()))
+            values += env._info_values()
+            values += terms.values()
             all_terms.append(terms)
-        self._autoreset_envs = np.logical_or(terms_done, truncs)
-        self._no_pending_reset = not done
+        n = self.num_envs
+        terminations = np.zeros(n, dtype=np.bool_)
+        truncations = np.zeros(n, dtype=np.bool_)
+        for i, term, trunc in ended:
+            terminations[i] = term
+            truncations[i] = trunc
+        # Its own array: a partial reset clears entries of it in place.
+        self._autoreset_envs = terminations | truncations if ended else np.zeros(n, np.bool_)
+        self._no_pending_reset = not ended
         obs = {key: batch[key].copy() for key in batch} if self.copy else batch
         if self._info_layout is None:
-            self._info_layout = self._direct_layout(envs, rows, all_terms)
+            self._info_layout = self._direct_layout(envs, values, all_terms)
         if self._info_layout:
-            info = self._direct_info(envs[0]._static_every_step, rows)
+            info = self._direct_info(envs[0]._static_every_step, values)
         else:  # numbers of unusual types: gymnasium's own merge rules
             static = envs[0]._static_every_step
             pairs = zip(envs, all_terms, strict=True)
             info = self._merge_infos(
                 [(i, env._info(t, static)) for i, (env, t) in enumerate(pairs)]
             )
-        return obs, np.copy(rewards), np.copy(terms_done), np.copy(truncs), info
+        return obs, np.array(rewards, dtype=np.float64), terminations, truncations, info
 
     def _direct_layout(
         self,
         envs: list[SemanticExploreEnv],
-        rows: list[tuple[Any, ...]],
+        values: list[Any],
         all_terms: list[dict[str, float]],
     ) -> list[tuple[str, str, type]]:
         """The keys, mask keys and number types of a direct step's ``info`` (checked once:
         the config fixes them), or ``[]`` when they are not the usual ones (then every step
-        merges as gymnasium does)."""
+        merges as gymnasium does). ``values`` holds each env's numbers, env after env."""
         keys = [*INFO_NUMBERS, *all_terms[0]]
         types = [*_INFO_TYPES, *(float for _ in all_terms[0])]
-        usual = all(
-            list(map(type, row)) == types and list(terms) == keys[len(INFO_NUMBERS) :]
-            for row, terms in zip(rows, all_terms, strict=True)
+        width = len(keys)
+        usual = len(values) == width * len(envs) and all(
+            list(map(type, values[i * width : (i + 1) * width])) == types
+            and list(terms) == keys[len(INFO_NUMBERS) :]
+            for i, terms in enumerate(all_terms)
         )
         if usual and envs[0]._static_every_step:
             self._static_merged = self._merge_same_keys([env._static_info for env in envs])
             usual = self._static_merged is not None
         return [(k, "_" + k, t) for k, t in zip(keys, types, strict=True)] if usual else []
 
-    def _direct_info(self, static: bool, rows: list[tuple[Any, ...]]) -> dict[str, Any]:
-        """gymnasium's merged ``info`` of a direct step from each env's numbers (usual types)."""
+    def _direct_info(self, static: bool, values: list[Any]) -> dict[str, Any]:
+        """gymnasium's merged ``info`` of a direct step from each env's numbers (usual types,
+        env after env in ``values``)."""
         layout = cast(list, self._info_layout)
+        n = self.num_envs
         out: dict[str, Any] = {}
         if static:
             out = {k: v.copy() for k, v in cast(dict, self._static_merged).items()}
         # Each key's array (and mask) is a row of one fresh block: contiguous, its own values.
-        block = np.array(rows, dtype=np.float64).T.copy()
-        masks = np.ones((len(layout) + 1, self.num_envs), dtype=np.bool_)
+        block = np.array(values, dtype=np.float64).reshape(n, len(layout)).T.copy()
+        masks = np.ones((len(layout) + 1, n), dtype=np.bool_)
         n_info = len(INFO_NUMBERS)
         nested: dict[str, Any] = {}
         for k, (key, mask_key, typ) in enumerate(layout):
