@@ -439,11 +439,13 @@ class SemanticExploreEnv(gym.Env):
         x, y, yaw = self._est_pose
         return x, y, wrap_angle_rad(yaw)
 
-    def _obs_into(self, batch: dict[str, np.ndarray], i: int) -> None:
-        """Write what :meth:`_obs` returns into row ``i`` of ``batch`` (the same values; for
+    def _obs_into(self, batch: dict[str, np.ndarray], i: int, map_row: np.ndarray) -> None:
+        """Put what :meth:`_obs` returns into row ``i`` of ``batch`` (the same values; for
         ``map_observation`` ``"copy"`` and ``"shared"``): the vector env's batch, no fresh
-        arrays."""
-        batch["map"][i] = self.grid._encoded
+        arrays. ``map_row`` is ``batch["map"][i]`` (the same view object every step): the
+        map is not copied there each step, the grid keeps its cells in it from the first
+        call on (:meth:`OccupancyGrid.keep_encoded_in`)."""
+        self.grid.keep_encoded_in(map_row)
         batch["pose"][i] = self._pose_values()
         batch["scan"][i] = self._scan
 

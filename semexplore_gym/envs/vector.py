@@ -14,8 +14,11 @@ rewards, flags, ``info`` arrays and ``_key`` masks, same autoreset behaviour) bu
 * steps ``SemanticExplore-v0`` envs directly when nothing but ``gym.make``'s own wrappers
   (``OrderEnforcing``, ``PassiveEnvChecker``, which only check the first calls) wraps them
   and their observation is the whole map: after those first checks, each step advances the
-  env itself, writes its observation into the batch row (no per-env observation dict or map
-  copy) and its ``info`` numbers into one array per key. Steps in which an env resets, and
+  env itself, writes its pose and scan into the batch row (no per-env observation dict) and
+  its ``info`` numbers into one array per key. The map is not copied at all: each env's grid
+  keeps its cells in the env's row of the batch (``OccupancyGrid.keep_encoded_in``), so with
+  ``copy=False`` the returned batch's ``map`` is read-only (writing into it would change the
+  envs' maps; ``copy=True`` returns copies, as usual). Steps in which an env resets, and
   ``AutoresetMode.SAME_STEP``, take the general path.
 
 Other observation spaces fall back to gymnasium's ``concatenate``/``deepcopy``. Use it like
@@ -111,6 +114,10 @@ class FastSyncVectorEnv(SyncVectorEnv):
         self._info_layout: list[tuple[str, str, type]] | None = None
         self._env_obs_stale = False
         self._no_pending_reset = False  # no direct step before the first reset
+        # Direct steps keep each env's map in its batch row (see _map_rows_of_batch).
+        self._map_rows: list[np.ndarray] = []
+        self._map_batch: np.ndarray | None = None
+        self._read_only_batch: dict[str, np.ndarray] = {}
 
     def _merge_infos(self, entries: list[tuple[int, dict[str, Any]]]) -> dict[str, Any]:
         """gymnasium's merge of ``(env index, info)`` pairs, one key at a time (same arrays)."""
@@ -236,7 +243,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
             else:
                 raise ValueError(f"Unexpected autoreset mode, {mode}")
             entries.append((i, env_info))
-        obs = self._batch_observations()
+        obs = self._returned(self._batch_observations())
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
         self._no_pending_reset = not self._autoreset_envs.any()
         return (
@@ -264,6 +271,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
         envs = cast(list[SemanticExploreEnv], self._direct)
         self._env_obs_stale = True
         batch = cast(dict, self._observations)
+        map_rows = self._map_rows_of_batch(batch)
         rewards: list[float] = []
         values: list[Any] = []  # each env's info numbers and reward terms, env after env
         all_terms = []
@@ -277,7 +285,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
             rewards.append(reward)
             if term or trunc:
                 ended.append((i, term, trunc))
-            env._obs_into(batch, i)
+            env._obs_into(batch, i, map_rows[i])
             values += env._info_values()
             values += terms.values()
             all_terms.append(terms)
@@ -290,7 +298,7 @@ class FastSyncVectorEnv(SyncVectorEnv):
         # Its own array: a partial reset clears entries of it in place.
         self._autoreset_envs = terminations | truncations if ended else np.zeros(n, np.bool_)
         self._no_pending_reset = not ended
-        obs = {key: batch[key].copy() for key in batch} if self.copy else batch
+        obs = {key: batch[key].copy() for key in batch} if self.copy else self._read_only_batch
         if self._info_layout is None:
             self._info_layout = self._direct_layout(envs, values, all_terms)
         if self._info_layout:
@@ -346,6 +354,29 @@ class FastSyncVectorEnv(SyncVectorEnv):
         out["_reward_terms"] = masks[-1]
         return out
 
+    def _map_rows_of_batch(self, batch: dict[str, np.ndarray]) -> list[np.ndarray]:
+        """The batch's map rows, one view object per env (the same objects every step).
+
+        Direct steps hand each env its row and the env's grid keeps its cells there, so the
+        map is never copied into the batch. With ``copy=False`` the batch is then returned
+        with a read-only map (writing into it would change the envs' maps)."""
+        maps = batch["map"]
+        if maps is not self._map_batch:
+            self._map_batch = maps
+            self._map_rows = list(maps)
+            read_only = maps.view()
+            read_only.flags.writeable = False
+            self._read_only_batch = {**batch, "map": read_only}
+        return self._map_rows
+
+    def _returned(self, obs: Any) -> Any:
+        """What a step or reset returns: with ``copy=False``, once direct steps have put
+        the envs' maps into the batch, the batch with its read-only map."""
+        if obs is self._observations and self._map_batch is not None:
+            if self._map_batch is cast(dict, obs)["map"]:
+                return self._read_only_batch
+        return obs
+
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
         """``SyncVectorEnv.reset``; after direct steps, first brings each env's last
         observation up to date (a partial reset batches the others' as they are)."""
@@ -353,9 +384,9 @@ class FastSyncVectorEnv(SyncVectorEnv):
             for i, env in enumerate(cast(list[SemanticExploreEnv], self._direct)):
                 cast(list, self._env_obs)[i] = env._obs()
             self._env_obs_stale = False
-        out = super().reset(**kwargs)
+        obs, info = super().reset(**kwargs)
         self._no_pending_reset = not self._autoreset_envs.any()
-        return out
+        return self._returned(obs), info
 
     def _batch_observations(self) -> Any:
         keys = self._box_keys

@@ -179,3 +179,39 @@ def test_direct_steps_match_over_worlds_drawn_at_every_reset() -> None:
     finally:
         fast.close()
         ref.close()
+
+
+@pytest.mark.parametrize("copy", [True, False])
+def test_direct_steps_keep_each_env_map_in_its_batch_row(copy) -> None:
+    # The envs' grids keep their cells in the batch rows, so no map is copied per step;
+    # copy=True still hands out frozen copies, copy=False a read-only batch.
+    fast = FastSyncVectorEnv([_fn(static_info="reset")] * 2, copy=copy)
+    ref = SyncVectorEnv([_fn(static_info="reset")] * 2, copy=copy)
+    rng = np.random.default_rng(4)
+    try:
+        fast.reset(seed=1)
+        ref.reset(seed=1)
+        kept_fast, kept_ref = [], []
+        for _ in range(12):
+            a = rng.uniform(0, 1, size=(2, 2)).astype(np.float32)
+            got, want = fast.step(a)[0], ref.step(a)[0]
+            kept_fast.append(got["map"])
+            kept_ref.append(want["map"].copy())
+        assert fast._direct is not None
+        grids = [env.unwrapped.grid for env in fast.envs]
+        batch_maps = fast._observations["map"]
+        for i, grid in enumerate(grids):
+            assert np.shares_memory(grid.encoded, batch_maps[i])
+            np.testing.assert_array_equal(got["map"][i], grid.encoded)
+        if copy:  # every step's copy is frozen at that step's maps
+            assert all(_same(f, r) for f, r in zip(kept_fast, kept_ref, strict=True))
+            assert not np.array_equal(kept_fast[0], kept_fast[-1])
+        else:
+            with pytest.raises(ValueError, match="read-only"):
+                got["map"][0, 0, 0] = 0
+            obs, _ = fast.reset(seed=2)
+            with pytest.raises(ValueError, match="read-only"):
+                obs["map"][1] = 0
+    finally:
+        fast.close()
+        ref.close()

@@ -214,6 +214,32 @@ class OccupancyGrid:
         """A fresh copy of the encoded grid (safe to hand out as an observation)."""
         return self._encoded.copy()
 
+    def keep_encoded_in(self, buffer: np.ndarray) -> None:
+        """Keep the encoded grid in ``buffer`` from now on (a vector env's batch row).
+
+        ``buffer`` gets the current cells and every later update is written there; the
+        previous array no longer changes. A no-op when ``buffer`` already holds the grid.
+
+        Raises:
+            ValueError: unless ``buffer`` is a writable C-contiguous uint8 array of the grid's shape.
+        """
+        if buffer is self._encoded:
+            return
+        if not (
+            isinstance(buffer, np.ndarray)
+            and buffer.dtype == np.uint8
+            and buffer.shape == self._encoded.shape
+            and buffer.flags.c_contiguous
+            and buffer.flags.writeable
+        ):
+            raise ValueError(
+                "buffer must be a writable C-contiguous uint8 array of shape "
+                f"{self._encoded.shape}, got {type(buffer).__name__} of dtype "
+                f"{getattr(buffer, 'dtype', None)} and shape {getattr(buffer, 'shape', None)}"
+            )
+        buffer[...] = self._encoded
+        self._encoded = buffer
+
     def integrate_scan(
         self,
         x_m: float,

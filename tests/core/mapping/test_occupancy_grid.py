@@ -305,3 +305,42 @@ def test_bad_construction_raises() -> None:
 def test_mapping_params_validation_names_the_field(field: str, value: float) -> None:
     with pytest.raises(ValueError, match=field):
         MappingParams(**{field: value})
+
+
+def test_keep_encoded_in_moves_the_map_into_a_buffer() -> None:
+    og = unit_grid()
+    og.integrate_scan(0.5, 2.5, 0.0, [0.0], [4.2], 10.0)
+    before = og.encoded  # a live view of the grid's array so far
+    rows = np.zeros((2, 5, 8), dtype=np.uint8)
+    og.keep_encoded_in(rows[1])
+    np.testing.assert_array_equal(rows[1], before)  # the current cells, copied once
+    og.keep_encoded_in(rows[1])  # already there: nothing happens
+    og.integrate_scan(0.5, 0.5, 0.0, [0.0], [3.2], 10.0)
+    # Later updates land in the buffer only; the old array stays as it was.
+    ref = unit_grid()
+    ref.integrate_scan(0.5, 2.5, 0.0, [0.0], [4.2], 10.0)
+    frozen = ref.encoded.copy()
+    ref.integrate_scan(0.5, 0.5, 0.0, [0.0], [3.2], 10.0)
+    np.testing.assert_array_equal(rows[1], ref.encoded)
+    np.testing.assert_array_equal(og.encoded, ref.encoded)
+    np.testing.assert_array_equal(before, frozen)
+    assert not rows[0].any() and og.n_free_cells == ref.n_free_cells
+
+
+@pytest.mark.parametrize(
+    "buffer",
+    [
+        np.zeros((5, 9), dtype=np.uint8),
+        np.zeros((5, 8), dtype=np.int16),
+        np.zeros((8, 5), dtype=np.uint8).T,
+        [[0] * 8] * 5,
+    ],
+)
+def test_keep_encoded_in_refuses_other_buffers(buffer) -> None:
+    og = unit_grid()
+    with pytest.raises(ValueError, match=r"writable C-contiguous uint8 array of shape \(5, 8\)"):
+        og.keep_encoded_in(buffer)
+    ro = np.zeros((5, 8), dtype=np.uint8)
+    ro.flags.writeable = False
+    with pytest.raises(ValueError, match="got ndarray of dtype uint8 and shape"):
+        og.keep_encoded_in(ro)
