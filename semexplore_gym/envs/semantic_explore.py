@@ -184,8 +184,9 @@ class SemanticExploreEnv(gym.Env):
     gymnasium's ``SyncVectorEnv`` merges every ``info`` key of every env and stacks the
     observations at each step (on maze1 about 0.7x a plain loop over the same envs);
     :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv` returns the same results, stepping
-    these envs directly into its batch (0.92x, and 0.94-0.95x with ``static_info="reset"``
-    and ``copy=False``, with 4 envs). ``AsyncVectorEnv`` runs each env in its own
+    these envs directly into its batch, their maps kept in its rows (0.93-0.94x, 0.95-0.96x
+    with ``copy=False``, 0.97-0.98x with ``static_info="reset"`` as well, with 4 envs).
+    ``AsyncVectorEnv`` runs each env in its own
     process: it pays off only with a free core per worker, and more so the longer a step (large
     maps), since every step also pays inter-process messaging; on a busy 2-core machine it is
     2-3x slower than a plain loop (0.3-0.45x, maze1 and Willow Garage).
