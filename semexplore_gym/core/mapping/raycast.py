@@ -37,8 +37,6 @@ _MAX_CELL_M = 1.0
 _MAX_BUCKETS = 1 << 20
 # Angular bins per scan; about one per beam of a 360-beam LiDAR.
 _N_ANGLE_BINS = 360
-# Slots per angular bin (a bin with more candidates makes the bins one packed list instead).
-_BIN_SLOTS = 64
 # Below this many candidate segments, binning costs more than it saves.
 _MIN_CANDIDATES_FOR_BINS = 8
 # Pseudo-angle padding of each candidate's bins. A ray that _first_hit counts as crossing a
@@ -437,16 +435,11 @@ def cast_dirs(
     # Angular bins: each candidate goes into every bin its angular extent touches, padded by
     # _BIN_PAD on each side, so a ray needs only the candidates of its own bin. Bins are
     # uniform in the cheap "diamond" pseudo-angle, which is monotonic in the true angle.
-    # Each bin has _BIN_SLOTS slots, filled in one pass; when a bin overflows (dense raster
-    # walls), the bins are rebuilt as one packed list. A ray takes the minimum over the same
-    # candidates either way (only their order differs), so the scan is the same.
     nb = _N_ANGLE_BINS
     w = 4.0 / nb
     first = np.empty(m, dtype=np.int64)
     nspan = np.empty(m, dtype=np.int64)
-    counts = np.zeros(nb, dtype=np.int64)
-    items = np.empty(nb * _BIN_SLOTS, dtype=np.int32)
-    fits = True
+    counts = np.zeros(nb + 1, dtype=np.int64)
     for q in range(m):
         pa = _pseudo_angle(cax[q], cay[q])
         pb = _pseudo_angle(cbx[q], cby[q])
@@ -470,41 +463,22 @@ def cast_dirs(
         nspan[q] = cnt
         # bins b0 .. b0 + cnt - 1, wrapping past nb (no modulo in the hot loop)
         for b in range(b0, min(b0 + cnt, nb)):
-            c = counts[b]
-            if c < _BIN_SLOTS:
-                items[b * _BIN_SLOTS + c] = q
-            else:
-                fits = False
-            counts[b] = c + 1
+            counts[b + 1] += 1
         for b in range(0, b0 + cnt - nb):
-            c = counts[b]
-            if c < _BIN_SLOTS:
-                items[b * _BIN_SLOTS + c] = q
-            else:
-                fits = False
-            counts[b] = c + 1
-    bin_lo = np.empty(nb, dtype=np.int64)
-    bin_hi = np.empty(nb, dtype=np.int64)
-    if fits:
-        for b in range(nb):
-            bin_lo[b] = b * _BIN_SLOTS
-            bin_hi[b] = b * _BIN_SLOTS + counts[b]
-    else:
-        total = 0
-        for b in range(nb):
-            bin_lo[b] = total
-            bin_hi[b] = total  # the fill cursor
-            total += counts[b]
-        items = np.empty(total, dtype=np.int32)
-        for q in range(m):
-            b0 = first[q]
-            cnt = nspan[q]
-            for b in range(b0, min(b0 + cnt, nb)):
-                items[bin_hi[b]] = q
-                bin_hi[b] += 1
-            for b in range(0, b0 + cnt - nb):
-                items[bin_hi[b]] = q
-                bin_hi[b] += 1
+            counts[b + 1] += 1
+    for b in range(nb):
+        counts[b + 1] += counts[b]
+    cursor = counts[:nb].copy()
+    items = np.empty(counts[nb], dtype=np.int64)
+    for q in range(m):
+        b0 = first[q]
+        cnt = nspan[q]
+        for b in range(b0, min(b0 + cnt, nb)):
+            items[cursor[b]] = q
+            cursor[b] += 1
+        for b in range(0, b0 + cnt - nb):
+            items[cursor[b]] = q
+            cursor[b] += 1
     for j in range(n_rays):
         dx = dxs[j]
         dy = dys[j]
@@ -512,7 +486,7 @@ def cast_dirs(
         if b >= nb:
             b = nb - 1
         out[j] = _first_hit(
-            dx, dy, cax, cay, cbx, cby, ck, bin_lo[b], bin_hi[b], items, max_range
+            dx, dy, cax, cay, cbx, cby, ck, counts[b], counts[b + 1], items, max_range
         )
 
 

@@ -273,17 +273,3 @@ def test_angular_bins_never_drop_the_nearest_wall_bit_for_bit() -> None:
             continue  # the sensor lies on a wall
         ref = same_formula_every_segment(segs, float(x), float(y), angles, 3.5)
         np.testing.assert_array_equal(got, ref)
-
-
-def test_a_bin_with_more_candidates_than_slots_gives_the_same_scan() -> None:
-    # 100 short walls stacked along the +x beam fall into the same one or two angular bins:
-    # more than a bin's slots, so the caster packs its bins into one list instead.
-    xs = 1.0 + 0.02 * np.arange(100)
-    stack = np.c_[xs, np.full(100, -0.001), xs, np.full(100, 0.001)]
-    segs = np.concatenate([stack, room(3.5)])
-    index = SegmentIndex(segs)
-    angles = np.arange(360) * (2 * math.pi / 360)
-    for x, y in [(0.0, 0.0), (0.3, 0.0004), (-1.0, 0.2)]:
-        got = cast_rays(index, x, y, angles, 3.5)
-        np.testing.assert_array_equal(got, same_formula_every_segment(segs, x, y, angles, 3.5))
-    assert cast_rays(index, 0.0, 0.0, [0.0], 3.5)[0] == 1.0
