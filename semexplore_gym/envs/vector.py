@@ -370,11 +370,16 @@ class FastSyncVectorEnv(SyncVectorEnv):
         return self._map_rows
 
     def _returned(self, obs: Any) -> Any:
-        """What a step or reset returns: with ``copy=False``, once direct steps have put
-        the envs' maps into the batch, the batch with its read-only map."""
-        if obs is self._observations and self._map_batch is not None:
-            if self._map_batch is cast(dict, obs)["map"]:
-                return self._read_only_batch
+        """What a step or reset returns: with ``copy=False`` and envs that direct steps put
+        into the batch (from the first reset on, so that no writable handle to the batch is
+        ever out), the batch with its read-only map."""
+        if (
+            obs is self._observations
+            and self._direct_candidates
+            and self.autoreset_mode != AutoresetMode.SAME_STEP
+        ):
+            self._map_rows_of_batch(cast(dict, obs))
+            return self._read_only_batch
         return obs
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:

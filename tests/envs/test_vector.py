@@ -189,8 +189,11 @@ def test_direct_steps_keep_each_env_map_in_its_batch_row(copy) -> None:
     ref = SyncVectorEnv([_fn(static_info="reset")] * 2, copy=copy)
     rng = np.random.default_rng(4)
     try:
-        fast.reset(seed=1)
+        first, _ = fast.reset(seed=1)
         ref.reset(seed=1)
+        if not copy:  # no writable handle to the batch, even before the first step
+            with pytest.raises(ValueError, match="read-only"):
+                first["map"][0, 0, 0] = 0
         kept_fast, kept_ref = [], []
         for _ in range(12):
             a = rng.uniform(0, 1, size=(2, 2)).astype(np.float32)
