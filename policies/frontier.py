@@ -1,8 +1,8 @@
 """Frontier-exploration baselines: ROS ``frontier_exploration`` (FE) and Yamauchi's nearest frontier.
 
-Both drive with the same move_base-like :class:`~policies.navigation.Navigator` (Navfn global
+Both drive with the same move_base-like :class:`~semexplore_gym.policies.navigation.Navigator` (Navfn global
 plan, DWA local control, planner and controller patience, rotate recoveries, abort), and skip
-goals near aborted ones with a :class:`~policies.navigation.GoalBlacklist`.
+goals near aborted ones with a :class:`~semexplore_gym.policies.navigation.GoalBlacklist`.
 
 :class:`FrontierExplorationPolicy` (``"frontier"``) follows ``frontier_exploration``
 (``explore_server`` + ``BoundedExploreLayer``, indigo; blacklist of the melodic plugin):
@@ -55,9 +55,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-
-from policies.base import Policy, StepStats, read_env_facts
-from policies.navigation import (
+from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
+from semexplore_gym.policies.navigation import (
     GoalBlacklist,
     MoveBaseParams,
     Navigator,
@@ -66,6 +65,7 @@ from policies.navigation import (
     check_positive,
     warm_up_navigation_kernels,
 )
+
 from semexplore_gym.core.frontiers.detection import GridFrontier, detect_frontiers
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 from semexplore_gym.core.planning.dwa import scan_points_m

@@ -11,7 +11,7 @@ The weights (and the expert's cost weights and switch margin) were fitted by bla
 optimisation over missions on training worlds (:mod:`semexplore_gym.training.frontier_value`);
 a fitted set ships as ``pretrained:frontier_value`` (``policies/pretrained``)::
 
-    from policies.registry import make_policy
+    from semexplore_gym.policies.registry import make_policy
     policy = make_policy("pretrained:frontier_value")
     policy = make_policy("frontier-value", **{"value.w_path_m": 0.1, "expert.switch_margin": 0.3})
 """
@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
-from policies.semantic_expert import SemanticExpertPolicy
-from policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.core.features.frontier_value import FEATURE_NAMES, frontier_value_features
 from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.graph_search import FrontierCandidate

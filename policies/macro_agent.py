@@ -4,10 +4,10 @@
 ``SemanticExploreWeights-v0`` (``--algo ppo``) saves an SB3 model whose actions are decisions,
 not wheel commands: which of the top-``K`` frontier candidates to explore next, or which cost
 weights ``(w_v, w_p, w_I)`` the expert plans with for the next ``decision_period_s``. Between
-decisions the expert's navigation stack drives (:class:`~policies.macro_driver.ExpertDriver`).
+decisions the expert's navigation stack drives (:class:`~semexplore_gym.policies.macro_driver.ExpertDriver`).
 
 :class:`MacroAgentPolicy` replays exactly that decision loop inside the ordinary
-:class:`~policies.base.Policy` interface, so a macro agent runs wherever a policy spec is
+:class:`~semexplore_gym.policies.base.Policy` interface, so a macro agent runs wherever a policy spec is
 accepted (``semexplore explore``, ``benchmark``, ``compare-weights --agents``) and is compared
 with the expert on the same worlds and seeds. It decides when the macro env would: at the
 first step, and afterwards once the commanded frontier is finished (reached, mapped, given up
@@ -28,10 +28,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.macro_driver import ExpertDriver
+from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 
-from policies.base import Policy
-from policies.macro_driver import ExpertDriver
-from policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,

@@ -1,6 +1,6 @@
 """The semantic expert as a low-level driver for macro-action agents.
 
-:class:`ExpertDriver` is the scripted :class:`~policies.semantic_expert.SemanticExpertPolicy`
+:class:`ExpertDriver` is the scripted :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`
 with two outside hooks, so that a learning agent makes the high-level choice and the expert's
 navigation stack (potential field, entry detours, local-minimum escape, stuck recovery,
 blacklisting, grid fallback) does the driving:
@@ -18,10 +18,10 @@ The wrappers in :mod:`semexplore_gym.wrappers.frontier_choice` use this class th
 the env-id entry points in :mod:`semexplore_gym.macro_envs` join the two.
 
 It uses only the expert's public hooks: it overrides
-:meth:`~policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
-:meth:`~policies.semantic_expert.SemanticExpertPolicy.on_replan_due` and
-:meth:`~policies.semantic_expert.SemanticExpertPolicy.on_replanned`, and calls
-:meth:`~policies.semantic_expert.SemanticExpertPolicy.request_replan`.
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replan_due` and
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replanned`, and calls
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.request_replan`.
 """
 
 from __future__ import annotations
@@ -31,13 +31,13 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-
-from policies.semantic_expert import (
+from semexplore_gym.policies.semantic_expert import (
     PlanSource,
     Segmenter,
     SemanticExpertParams,
     SemanticExpertPolicy,
 )
+
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
 _GOAL_DONE_REASONS = ("goal_reached", "goal_vanished", "path_done")
@@ -48,7 +48,7 @@ class ExpertDriver(SemanticExpertPolicy):
 
     Args:
         params: Expert parameters (default: the paper's).
-        segmenter: See :class:`~policies.semantic_expert.SemanticExpertPolicy`.
+        segmenter: See :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`.
 
     Attributes:
         goal_finished: The commanded goal is done (reached, vanished, blacklisted or gone);

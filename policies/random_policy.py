@@ -5,8 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-
-from policies.base import Policy, StepStats
+from semexplore_gym.policies.base import Policy, StepStats
 
 
 class RandomPolicy(Policy):

@@ -2,11 +2,11 @@
 
 Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
-value, :mod:`policies.frontier_value`), ``"frontier"`` (ROS frontier_exploration
+value, :mod:`semexplore_gym.policies.frontier_value`), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
 agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
-:class:`~policies.base.Policy` subclass or factory, so ``semexplore benchmark`` can compare it
+:class:`~semexplore_gym.policies.base.Policy` subclass or factory, so ``semexplore benchmark`` can compare it
 with the built-in ones). A spec may carry an argument after a colon. Keyword overrides set
 fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted
 (``**{"cost.w_v": 2}``); ``params=`` gives the layer to start from (a parameter object, a
@@ -19,7 +19,8 @@ import re
 from collections.abc import Callable
 from typing import Any
 
-from policies.base import Policy
+from semexplore_gym.policies.base import Policy
+
 from semexplore_gym.core.params import build_params
 
 Factory = Callable[[str, dict[str, Any]], Policy]
@@ -38,29 +39,29 @@ def _expert_like(
 
 
 def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+    from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 
     return _expert_like("semantic", arg, overrides, SemanticExpertPolicy, SemanticExpertParams)
 
 
 def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
-    """The paper's method alone: :data:`~policies.semantic_expert_params.PAPER_PURE`."""
-    from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-    from policies.semantic_expert_params import PAPER_PURE
+    """The paper's method alone: :data:`~semexplore_gym.policies.semantic_expert_params.PAPER_PURE`."""
+    from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
     layers = (SemanticExpertParams, PAPER_PURE)
     return _expert_like("semantic-paper", arg, overrides, SemanticExpertPolicy, *layers)
 
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
-    """The expert choosing frontiers by a learned value (:mod:`policies.frontier_value`)."""
-    from policies.frontier_value import FrontierValueParams, FrontierValuePolicy
+    """The expert choosing frontiers by a learned value (:mod:`semexplore_gym.policies.frontier_value`)."""
+    from semexplore_gym.policies.frontier_value import FrontierValueParams, FrontierValuePolicy
 
     return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.frontier import (
+    from semexplore_gym.policies.frontier import (
         FrontierExplorationParams,
         FrontierExplorationPolicy,
         NearestFrontierParams,
@@ -87,7 +88,7 @@ def _nearest(arg: str, overrides: dict[str, Any]) -> Policy:
 
 
 def _random(arg: str, overrides: dict[str, Any]) -> Policy:
-    from policies.random_policy import RandomPolicy
+    from semexplore_gym.policies.random_policy import RandomPolicy
 
     if arg or overrides:
         raise ValueError(
@@ -100,14 +101,14 @@ def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
     if not arg:
         raise ValueError("policy 'sb3' needs a model path: 'sb3:path/to/model.zip'")
     overrides.pop("params", None)
-    from policies.macro_agent import MacroAgentPolicy, read_macro_run
+    from semexplore_gym.policies.macro_agent import MacroAgentPolicy, read_macro_run
 
     # A model trained on a macro-action env id decides frontiers or weights; the expert drives.
     try:
         run = read_macro_run(arg)
         if run is not None:
             return MacroAgentPolicy(arg, run=run, **overrides)
-        from policies.sb3_policy import SB3Policy
+        from semexplore_gym.policies.sb3_policy import SB3Policy
 
         return SB3Policy(arg, **overrides)
     except (ValueError, FileNotFoundError, ImportError):
@@ -119,8 +120,8 @@ def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
 
 
 def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
-    """``pretrained:NAME``: a model shipped in :mod:`policies.pretrained` (``semexplore pretrained``)."""
-    from policies.pretrained import get_pretrained
+    """``pretrained:NAME``: a model shipped in :mod:`semexplore_gym.policies.pretrained` (``semexplore pretrained``)."""
+    from semexplore_gym.policies.pretrained import get_pretrained
 
     model = get_pretrained(arg)
     if model.model_path.suffix == ".yaml":
@@ -135,7 +136,7 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
 def _python(arg: str, overrides: dict[str, Any]) -> Policy:
     """``py:MODULE:NAME`` or ``py:path/to/file.py:NAME``: a user's own policy.
 
-    ``NAME`` is a :class:`~policies.base.Policy` subclass or a factory function returning a
+    ``NAME`` is a :class:`~semexplore_gym.policies.base.Policy` subclass or a factory function returning a
     policy; the overrides are passed to it as keyword arguments.
     """
     import hashlib
@@ -199,7 +200,7 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
     if not isinstance(policy, Policy):
         raise ValueError(
             f"policy 'py:{arg}': {attr}() returned a {type(policy).__name__}, "
-            "not a policies.base.Policy"
+            "not a semexplore_gym.policies.base.Policy"
         )
     return policy
 

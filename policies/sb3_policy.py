@@ -28,9 +28,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from semexplore_gym.policies.base import Policy, StepStats
+from semexplore_gym.policies.sb3_model import learner_action, load_model
 
-from policies.base import Policy, StepStats
-from policies.sb3_model import learner_action, load_model
 from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
 from semexplore_gym.core.features.map_window import MAP_ANCHORS, map_window, window_origin
 from semexplore_gym.core.grid import GridGeometry

@@ -16,9 +16,9 @@ static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), nev
 
 What the paper leaves open (replanning events, goal commitment, narrow frontiers, the
 grid-frontier fallback, stop confirmation, local minima, stuck recovery, blacklisting) and the
-parameters for it are described in :mod:`policies.semantic_expert_params`. Goals are
+parameters for it are described in :mod:`semexplore_gym.policies.semantic_expert_params`. Goals are
 blacklisted, progress is watched and stuck recoveries are driven by the navigation stack the
-frontier baselines share (:mod:`policies.navigation`).
+frontier baselines share (:mod:`semexplore_gym.policies.navigation`).
 
 Subclasses steer the expert through its public hooks: :meth:`SemanticExpertPolicy.choose_goal`
 (which scored frontier to pursue), :meth:`~SemanticExpertPolicy.on_replan_due` and
@@ -36,11 +36,11 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
+from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
+from semexplore_gym.policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.semantic_expert_persistence import TRAIL_CELL_M, GoalPersistence
 
-from policies.base import Policy, StepStats, read_env_facts
-from policies.navigation import BackoffRecovery, GoalBlacklist, ProgressWatch
-from policies.semantic_expert_params import SemanticExpertParams
-from policies.semantic_expert_persistence import TRAIL_CELL_M, GoalPersistence
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,

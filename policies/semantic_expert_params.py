@@ -1,4 +1,4 @@
-"""Parameters of the semantic expert (:class:`~policies.semantic_expert.SemanticExpertPolicy`).
+"""Parameters of the semantic expert (:class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`).
 
 What the paper leaves open, and how the expert handles it (parameters in
 :class:`SemanticExpertParams`, all times in simulated seconds):

@@ -1,10 +1,10 @@
 """The semantic expert's goal persistence: retries, dropped goals that come back, looks at
 narrow frontiers, and the stop rule (issue #13: never give up on a reachable frontier).
 
-:class:`GoalPersistence` is a mixin of :class:`~policies.semantic_expert.SemanticExpertPolicy`:
+:class:`GoalPersistence` is a mixin of :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`:
 it holds the methods that decide what happens when the approach to a goal fails, when a goal is
 reached without clearing its frontier, and when no frontier is left. The parameters are
-documented in :mod:`policies.semantic_expert_params`.
+documented in :mod:`semexplore_gym.policies.semantic_expert_params`.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from semexplore_gym.policies.navigation.approaches import side_approach
+from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
 
-from policies.navigation.approaches import side_approach
-from policies.navigation.frontier_memory import FrontierMemory
 from semexplore_gym.core.frontiers.reachable import (
     clearance_field_m,
     grid_path_to,
@@ -25,7 +25,7 @@ from semexplore_gym.core.frontiers.reachable import (
 from semexplore_gym.core.planning.potential_field import resample_polyline
 
 if TYPE_CHECKING:
-    from policies.semantic_expert import _Plan
+    from semexplore_gym.policies.semantic_expert import _Plan
 
 __all__ = ["GoalPersistence"]
 
@@ -157,7 +157,7 @@ class GoalPersistence:
             self._retry = None
             self._drop(grid, goal, "grid")
             return None, clearance
-        from policies.semantic_expert import _Plan
+        from semexplore_gym.policies.semantic_expert import _Plan
 
         plan = _Plan("retry", target, resample_polyline(path, res_m), None, frontier_xy_m=goal)
         return plan, clearance
@@ -201,7 +201,7 @@ class GoalPersistence:
                 and near
                 and not self._been_near(found.frontier_xy_m, prm.look_seen_radius_m)
             ):
-                from policies.semantic_expert import _Plan
+                from semexplore_gym.policies.semantic_expert import _Plan
 
                 plan = _Plan("look", (float(path[-1, 0]), float(path[-1, 1])), path, None)
                 plan.frontier_xy_m = found.frontier_xy_m
@@ -222,7 +222,7 @@ class GoalPersistence:
         fits where it stands, so it leaves over cells with the clearance of its radius plus
         ``pocket_clearance_margin_m`` to the nearest region that is not a pocket, and the check
         runs again from there with the full clearance (see
-        :mod:`policies.semantic_expert_params`). The plan is both legs; none when the check
+        :mod:`semexplore_gym.policies.semantic_expert_params`). The plan is both legs; none when the check
         from outside finds nothing either.
         """
         prm = self.params
@@ -249,7 +249,7 @@ class GoalPersistence:
         )
         if found is None:
             return None
-        from policies.semantic_expert import _Plan
+        from semexplore_gym.policies.semantic_expert import _Plan
 
         self.counters["pocket_escapes"] += 1
         self._log(

@@ -91,10 +91,10 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     import gymnasium as gym
+    from semexplore_gym.policies.config import load_policy_config
+    from semexplore_gym.policies.registry import make_policy
 
     import semexplore_gym  # noqa: F401
-    from policies.config import load_policy_config
-    from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.evaluation.rollout import run_mission
 

@@ -113,9 +113,9 @@ def summarise(rows: list[dict[str, Any]], ok_coverage: float) -> str:
 
 def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverage: float) -> None:
     import gymnasium as gym
+    from semexplore_gym.policies.registry import make_policy
 
     import semexplore_gym  # noqa: F401
-    from policies.registry import make_policy
     from semexplore_gym.evaluation.rollout import run_mission
 
     gif_dir = out / "failures"

@@ -21,10 +21,10 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from policies.macro_driver import ExpertDriver
-from policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.core.params import build_params
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+from semexplore_gym.policies.macro_driver import ExpertDriver
+from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.wrappers.frontier_choice import FrontierChoice, MacroParams, PlannerWeights
 
 

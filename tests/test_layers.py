@@ -34,7 +34,7 @@ class Layer:
     @property
     def module(self) -> str:
         """The dotted module name the layer's files are imported as."""
-        return self.path.removesuffix("/__init__.py").removesuffix(".py").replace("/", ".")
+        return _module_of_path(self.path.removesuffix("/__init__.py").removesuffix(".py"))
 
 
 _CORE = "semexplore_gym/core"
@@ -121,10 +121,16 @@ def _files(root: Path, layer: Layer, layers: list[Layer]) -> list[Path]:
     ]
 
 
+def _module_of_path(rel: str) -> str:
+    """``policies/...`` is installed and imported as ``semexplore_gym.policies...``."""
+    dotted = rel.replace("/", ".")
+    return "semexplore_gym." + dotted if dotted.split(".")[0] == "policies" else dotted
+
+
 def _module_of_file(root: Path, f: Path) -> str:
     rel = f.relative_to(root).with_suffix("")
     parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
-    return ".".join(parts)
+    return _module_of_path("/".join(parts))
 
 
 def layer_violations(root: Path, index: int, layers: list[Layer] = LAYERS) -> list[str]:

@@ -1,15 +1,15 @@
 """The navigation stack the policies share.
 
-* :mod:`policies.navigation.navigator`: the move_base-like :class:`Navigator` (Navfn global
+* :mod:`semexplore_gym.policies.navigation.navigator`: the move_base-like :class:`Navigator` (Navfn global
   plan, DWA local control, patience, rotate recoveries) that drives the frontier baselines.
-* :mod:`policies.navigation.bookkeeping`: :class:`GoalBlacklist` and :class:`ProgressWatch`,
+* :mod:`semexplore_gym.policies.navigation.bookkeeping`: :class:`GoalBlacklist` and :class:`ProgressWatch`,
   the goal blacklist and no-progress watch of the baselines and the semantic expert alike.
-* :mod:`policies.navigation.recovery`: the recovery manoeuvres, :class:`RotateRecovery`
+* :mod:`semexplore_gym.policies.navigation.recovery`: the recovery manoeuvres, :class:`RotateRecovery`
   (move_base's, the baselines') and :class:`BackoffRecovery` (the expert's).
 """
 
-from policies.navigation.bookkeeping import GoalBlacklist, ProgressWatch
-from policies.navigation.navigator import (
+from semexplore_gym.policies.navigation.bookkeeping import GoalBlacklist, ProgressWatch
+from semexplore_gym.policies.navigation.navigator import (
     MoveBaseParams,
     Navigator,
     NavStatus,
@@ -17,7 +17,7 @@ from policies.navigation.navigator import (
     check_positive,
     warm_up_navigation_kernels,
 )
-from policies.navigation.recovery import BackoffRecovery, RotateRecovery
+from semexplore_gym.policies.navigation.recovery import BackoffRecovery, RotateRecovery
 
 __all__ = [
     "BackoffRecovery",

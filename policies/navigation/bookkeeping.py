@@ -2,7 +2,7 @@
 
 :class:`GoalBlacklist` holds the goals a policy gave up on and says whether a new goal lies near
 one of them. :class:`ProgressWatch` says when the robot has made no progress for a while. The
-move_base-like :class:`~policies.navigation.navigator.Navigator` of the frontier baselines and
+move_base-like :class:`~semexplore_gym.policies.navigation.navigator.Navigator` of the frontier baselines and
 the semantic expert use the same two classes, each parametrised to its own rules:
 
 ==================  ===================================  =====================================

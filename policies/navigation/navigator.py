@@ -1,6 +1,6 @@
 """A move_base-like navigator: Navfn global plan, DWA local control, patience and recoveries.
 
-:class:`Navigator` drives the frontier baselines (:mod:`policies.frontier`) to their goals as
+:class:`Navigator` drives the frontier baselines (:mod:`semexplore_gym.policies.frontier`) to their goals as
 ROS move_base does (:class:`MoveBaseParams`): a Navfn-like global planner on an inflated
 costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planner
 (:mod:`semexplore_gym.core.planning.dwa`), with move_base's failure handling:
@@ -28,7 +28,7 @@ costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planne
   measures displacement from the last reset point, and a circle wider than
   ``oscillation_distance_m`` keeps resetting it.
 
-The oscillation check is a :class:`~policies.navigation.bookkeeping.ProgressWatch`, the same
+The oscillation check is a :class:`~semexplore_gym.policies.navigation.bookkeeping.ProgressWatch`, the same
 progress watch the semantic expert uses for its stuck detection.
 """
 
@@ -41,10 +41,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from semexplore_gym.policies.base import StepStats
+from semexplore_gym.policies.navigation.bookkeeping import ProgressWatch
+from semexplore_gym.policies.navigation.recovery import RotateRecovery
 
-from policies.base import StepStats
-from policies.navigation.bookkeeping import ProgressWatch
-from policies.navigation.recovery import RotateRecovery
 from semexplore_gym.core.frontiers.detection import detect_frontiers
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.dwa import DWAParams, DWAPlanner

@@ -1,7 +1,7 @@
 """Recovery manoeuvres: what a policy does once its :class:`ProgressWatch` says it is stuck.
 
 * :class:`RotateRecovery`, move_base's ``rotate_recovery``: turn in place by a fixed angle
-  (the :class:`~policies.navigation.navigator.Navigator` of the frontier baselines; it plans
+  (the :class:`~semexplore_gym.policies.navigation.navigator.Navigator` of the frontier baselines; it plans
   again afterwards and aborts the goal after ``max_recoveries``).
 * :class:`BackoffRecovery`, the semantic expert's: back off for a fixed time, turning towards
   open space when the way back is blocked (the expert then blacklists the goal and replans).

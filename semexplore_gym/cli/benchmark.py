@@ -46,7 +46,7 @@ def _split_worlds(text: str) -> list[str]:
 
 def _split_policies(text: str) -> list[str]:
     """Comma-separated policy specs; commas inside ``[...]`` stay with their spec."""
-    from policies.registry import split_specs
+    from semexplore_gym.policies.registry import split_specs
 
     return split_specs(text)
 
@@ -75,7 +75,7 @@ def _check_policies(policies: list[str]) -> None:
     Raises:
         ValueError: an unknown policy, a malformed bracket, an unknown parameter, a bad file.
     """
-    from policies.registry import make_policy, parse_spec, policy_factories
+    from semexplore_gym.policies.registry import make_policy, parse_spec, policy_factories
 
     known = policy_factories()
     for p in policies:

@@ -351,11 +351,11 @@ def _check_run_args(
         from semexplore_gym.envs.config import load_env_config
 
         load_env_config(args.env_config)
-    from policies.registry import split_specs
+    from semexplore_gym.policies.registry import split_specs
 
     agents = split_specs(args.agents)
     if agents:
-        from policies.registry import make_policy, strip_label
+        from semexplore_gym.policies.registry import make_policy, strip_label
 
         for spec in agents:
             if strip_label(spec).partition(":")[0] == "semantic":

@@ -120,12 +120,12 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
-    from policies.config import load_policy_config
-    from policies.registry import make_policy
     from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.core.safe_io import check_output_file
     from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
+    from semexplore_gym.policies.config import load_policy_config
+    from semexplore_gym.policies.registry import make_policy
 
     if not (0 < args.max_time_s <= 1e7):
         raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")

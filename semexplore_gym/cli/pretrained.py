@@ -33,7 +33,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from policies.pretrained import pretrained_models
+    from semexplore_gym.policies.pretrained import pretrained_models
 
     models = pretrained_models()
     if args.json:

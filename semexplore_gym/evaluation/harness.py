@@ -142,13 +142,13 @@ def _warm_up_config_key(env_config: Any) -> str:
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
-    from policies.registry import make_policy
     from semexplore_gym.evaluation.rollout import (
         make_mission_env,
         map_observation_for,
         run_mission,
     )
     from semexplore_gym.evaluation.warmup import warm_up
+    from semexplore_gym.policies.registry import make_policy
 
     # Kernels compiled or loaded before the mission's clocks start.
     warm_up(

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from policies.base import Policy, StepStats
+from semexplore_gym.policies.base import Policy, StepStats
 
 #: Stages of the per-stage wall-time split, in the order they are reported.
 STAGES: tuple[str, ...] = (

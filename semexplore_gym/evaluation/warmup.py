@@ -112,7 +112,7 @@ def warm_up(
     return {"wall_s": wall_s, "compiled": float(compiled), "loaded": float(loaded)}
 
 
-def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym", "policies")) -> int:
+def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym",)) -> int:
     """Load every signature the disk cache holds for the kernels of the imported modules.
 
     Returns:

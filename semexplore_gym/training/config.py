@@ -35,7 +35,7 @@ class EnvSection:
 
 @dataclass(frozen=True)
 class ExpertSection:
-    """The labelling expert (a ``policies.registry`` spec) and how much to record.
+    """The labelling expert (a ``semexplore_gym.policies.registry`` spec) and how much to record.
 
     ``noise_std`` > 0 records the first ``noise_fraction`` of the episodes with DART noise on
     the executed actions (labels stay clean); ``save_interval_s`` throttles dataset rewrites;

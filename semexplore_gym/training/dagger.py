@@ -10,8 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from policies.base import Policy
 from semexplore_gym.core.features.egocentric import EgocentricParams
+from semexplore_gym.policies.base import Policy
 from semexplore_gym.training.bc import train_bc
 from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
 from semexplore_gym.training.progress import with_progress

@@ -1,6 +1,6 @@
 """One labelled roll-out: the expert (or a beta-mix of expert and learner) drives and labels.
 
-The expert is any :class:`policies.base.Policy` (normally the scripted semantic expert); it sees
+The expert is any :class:`semexplore_gym.policies.base.Policy` (normally the scripted semantic expert); it sees
 the raw observation, the learner the egocentric features computed from that same observation
 (:class:`EgocentricEncoder`).
 """
@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from policies.base import Policy
-from policies.sb3_model import learner_action
 from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
+from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.sb3_model import learner_action
 from semexplore_gym.training.dataset import ImitationDataset
 
 

@@ -49,7 +49,7 @@ def make_learner_env(cfg: TrainConfig, max_episode_steps: int | None = None) -> 
 
 
 def make_expert(cfg: TrainConfig) -> Any:
-    """The labelling expert ``cfg.expert.spec`` (a ``policies.registry`` spec)."""
-    from policies.registry import make_policy
+    """The labelling expert ``cfg.expert.spec`` (a ``semexplore_gym.policies.registry`` spec)."""
+    from semexplore_gym.policies.registry import make_policy
 
     return make_policy(cfg.expert.spec)

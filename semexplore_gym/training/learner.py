@@ -3,7 +3,7 @@
 The learner is an SB3 actor-critic policy (``MultiInputActorCriticPolicy`` for the Dict
 observation of :class:`semexplore_gym.wrappers.egocentric.EgocentricObservation`), so a
 behaviour-cloned model can be fine-tuned with PPO. The zips written here are read by
-:func:`policies.sb3_model.load_model`, which defines the format.
+:func:`semexplore_gym.policies.sb3_model.load_model`, which defines the format.
 """
 
 from __future__ import annotations
@@ -15,13 +15,13 @@ import zipfile
 from pathlib import Path
 from typing import Any
 
-from policies.sb3_model import (
+from semexplore_gym.core.features.egocentric import EgocentricParams
+from semexplore_gym.policies.sb3_model import (
     FORMAT_POLICY,
     FORMAT_SB3_ALGORITHM,
     MODEL_META_NAME,
     POLICY_ENTRY_NAME,
 )
-from semexplore_gym.core.features.egocentric import EgocentricParams
 
 
 def make_learner_policy(
@@ -42,7 +42,7 @@ def make_learner_policy(
 
 
 def save_policy(policy: Any, path: str | os.PathLike, params: EgocentricParams) -> Path:
-    """Save a bare SB3 policy as a zip that ``policies.sb3_model.load_model`` and ``SB3Policy`` read."""
+    """Save a bare SB3 policy as a zip that ``semexplore_gym.policies.sb3_model.load_model`` and ``SB3Policy`` read."""
     import torch as th
 
     p = Path(path)

@@ -107,7 +107,7 @@ def save_tagged_model(model: Any, path: Path, params: EgocentricParams) -> None:
 
 def _load_init_weights(cfg: TrainConfig, model: Any, init_from: str) -> None:
     """Start ``model`` from the BC/DAgger model ``init_from`` (same features and network)."""
-    from policies.sb3_model import load_model
+    from semexplore_gym.policies.sb3_model import load_model
 
     if is_macro(cfg):
         raise ValueError(

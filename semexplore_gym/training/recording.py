@@ -11,8 +11,8 @@ import os
 from collections.abc import Callable
 from typing import Any
 
-from policies.base import Policy
 from semexplore_gym.core.features.egocentric import EgocentricParams
+from semexplore_gym.policies.base import Policy
 from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
 from semexplore_gym.training.progress import with_progress
 from semexplore_gym.training.workers import (

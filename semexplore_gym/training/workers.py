@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from policies.base import Policy
 from semexplore_gym.core.features.egocentric import EgocentricParams
+from semexplore_gym.policies.base import Policy
 from semexplore_gym.training.episodes import EpisodeRecord, rollout_episode
 
 #: Spawn-key streams of :func:`episode_rng`: expert recording and DAgger never share numbers.

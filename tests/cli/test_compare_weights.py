@@ -66,7 +66,7 @@ def test_weight_sets_ablate_the_paper_terms() -> None:
 
 
 def test_ablation_labels_are_the_specs_that_explore_and_benchmark_run() -> None:
-    from policies.registry import make_policy
+    from semexplore_gym.policies.registry import make_policy
 
     for label, overrides in weight_sets({"cost.w_v": 1.0}).items():
         built = make_policy(label, **overrides).params

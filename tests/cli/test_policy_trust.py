@@ -27,7 +27,7 @@ class _Payload:
 
 
 def test_a_model_zip_that_runs_code_is_refused(tmp_path, capsys) -> None:
-    from policies.sb3_model import MODEL_META_NAME, POLICY_ENTRY_NAME
+    from semexplore_gym.policies.sb3_model import MODEL_META_NAME, POLICY_ENTRY_NAME
 
     marker = tmp_path / "pwned"
     buf = io.BytesIO()

@@ -6,8 +6,8 @@ import json
 from pathlib import Path
 
 import pytest
+from semexplore_gym.policies.pretrained import pretrained_models
 
-from policies.pretrained import pretrained_models
 from semexplore_gym.cli import main
 
 

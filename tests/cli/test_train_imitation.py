@@ -81,7 +81,7 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
     import gymnasium as gym
 
     env = gym.make("SemanticExplore-v0", world=WORLD, overrides=["episode.random_start=true"])
-    registry = pytest.importorskip("policies.registry")
+    registry = pytest.importorskip("semexplore_gym.policies.registry")
     try:
         semantic = registry.make_policy("semantic")
         obs, info = env.reset(seed=0)
@@ -151,7 +151,7 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
     recorded = json.loads((ppo_out / "args.json").read_text())
     assert recorded["command_line"].startswith("semexplore train --algo ppo --out ")
     assert "ppo.total_timesteps=64" in recorded["command_line"]
-    from policies.sb3_policy import SB3Policy
+    from semexplore_gym.policies.sb3_policy import SB3Policy
 
     assert SB3Policy(ppo_out / "model.zip").params.crop_cells == 36
     explore = Path(repo / "semexplore_gym/cli/explore.py")

@@ -7,10 +7,10 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.base import Policy, StepStats
+from semexplore_gym.policies.random_policy import RandomPolicy
 
 import semexplore_gym  # noqa: F401
-from policies.base import Policy, StepStats
-from policies.random_policy import RandomPolicy
 from semexplore_gym.evaluation.rollout import STAGES, run_mission, time_to_coverage
 
 

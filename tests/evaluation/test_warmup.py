@@ -10,10 +10,10 @@ import gymnasium as gym
 import numpy as np
 from numba import njit
 from numba.core.dispatcher import Dispatcher
+from semexplore_gym.policies.base import Policy, StepStats
+from semexplore_gym.policies.registry import make_policy
 
 import semexplore_gym  # noqa: F401  (registers the env)
-from policies.base import Policy, StepStats
-from policies.registry import make_policy
 from semexplore_gym.evaluation.rollout import run_mission
 from semexplore_gym.evaluation.warmup import COMPILE_MESSAGE, warm_up
 

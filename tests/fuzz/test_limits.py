@@ -225,7 +225,7 @@ def test_compare_weights_fails_before_tuning(tmp_path, capsys, flag, value, frag
         (["explore", "--policy", "py:sys:exit", "--max-time-s", "1"], "SystemExit"),
         (
             ["explore", "--policy", "py:builtins:dict", "--max-time-s", "1"],
-            "not a policies.base.Policy",
+            "not a semexplore_gym.policies.base.Policy",
         ),
         (["explore", "--gif-every-s", "0", "--max-time-s", "1"], "--gif-every-s"),
         (["explore", "--gif", "{d}", "--max-time-s", "1"], "is a directory"),

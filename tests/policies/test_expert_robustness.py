@@ -9,13 +9,13 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.navigation.approaches import side_approach
+from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
+from semexplore_gym.policies.registry import make_policy
+from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
 import semexplore_gym  # noqa: F401
-from policies.navigation.approaches import side_approach
-from policies.navigation.frontier_memory import FrontierMemory
-from policies.registry import make_policy
-from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-from policies.semantic_expert_params import PAPER_PURE
 from semexplore_gym.core.frontiers.reachable import clearance_field_m, pocket_exit_path
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.params import build_params
@@ -254,7 +254,7 @@ def test_side_approach_comes_from_away_from_the_failure() -> None:
 
 
 def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
-    from policies.config import load_policy_config
+    from semexplore_gym.policies.config import load_policy_config
 
     cfg = load_policy_config(REPO / "configs" / "expert" / "paper_pure.yaml")
     from_yaml = build_params(SemanticExpertParams, cfg.params)

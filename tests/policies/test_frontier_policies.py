@@ -6,15 +6,15 @@ import math
 
 import numpy as np
 import pytest
-
-from policies.base import Policy
-from policies.frontier import (
+from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.frontier import (
     FrontierExplorationParams,
     FrontierExplorationPolicy,
     NearestFrontierPolicy,
 )
-from policies.navigation import NavStatus
-from policies.registry import make_policy
+from semexplore_gym.policies.navigation import NavStatus
+from semexplore_gym.policies.registry import make_policy
+
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.params import ConfigError
 

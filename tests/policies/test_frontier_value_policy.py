@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from semexplore_gym.policies.frontier_value import (
+    FrontierValueParams,
+    FrontierValuePolicy,
+    FrontierValueWeights,
+)
+from semexplore_gym.policies.registry import make_policy
 
-from policies.frontier_value import FrontierValueParams, FrontierValuePolicy, FrontierValueWeights
-from policies.registry import make_policy
 from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
 
 WORLD = "maze:seed=3,size_m=6"
@@ -71,7 +75,7 @@ def test_params_come_from_dotted_overrides_and_bad_weights_fail() -> None:
 
 
 def test_the_shipped_model_is_a_learned_value() -> None:
-    from policies.pretrained import get_pretrained
+    from semexplore_gym.policies.pretrained import get_pretrained
 
     model = get_pretrained("frontier_value")
     assert model.model_path.name == "model.yaml"

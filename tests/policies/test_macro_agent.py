@@ -44,8 +44,8 @@ def trained(tmp_path_factory, tiny_macro_train_args) -> dict[str, Path]:
 
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_policy_replays_the_macro_env_exactly(trained, kind) -> None:
-    from policies.macro_agent import MacroAgentPolicy
-    from policies.registry import make_policy
+    from semexplore_gym.policies.macro_agent import MacroAgentPolicy
+    from semexplore_gym.policies.registry import make_policy
 
     policy = make_policy(f"sb3:{trained[kind]}")
     assert isinstance(policy, MacroAgentPolicy) and policy.kind == kind
@@ -90,7 +90,7 @@ def test_explore_cli_runs_a_macro_agent(trained, capsys) -> None:
 
 
 def test_not_a_macro_run_and_mismatched_params_are_clear_errors(trained, tmp_path) -> None:
-    from policies.macro_agent import MacroAgentPolicy, read_macro_run
+    from semexplore_gym.policies.macro_agent import MacroAgentPolicy, read_macro_run
 
     lone = tmp_path / "lone" / "model.zip"
     lone.parent.mkdir()

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from semexplore_gym.policies.config import ConfigError, build_params, load_policy_config
+from semexplore_gym.policies.registry import make_policy
+from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 
-from policies.config import ConfigError, build_params, load_policy_config
-from policies.registry import make_policy
-from policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.core.features.macro import WEIGHT_RANGES
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams

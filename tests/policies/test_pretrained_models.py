@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import pytest
-
-from policies.pretrained import MAX_MODEL_BYTES, get_pretrained, pretrained_models
-from policies.registry import make_policy
+from semexplore_gym.policies.pretrained import MAX_MODEL_BYTES, get_pretrained, pretrained_models
+from semexplore_gym.policies.registry import make_policy
 
 NAMES = [m.name for m in pretrained_models()]
 

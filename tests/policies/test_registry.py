@@ -7,14 +7,13 @@ import textwrap
 
 import numpy as np
 import pytest
-
-from policies.base import Policy
-from policies.registry import make_policy
+from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.registry import make_policy
 
 USER_POLICY = textwrap.dedent(
     """
     import numpy as np
-    from policies.base import Policy, StepStats
+    from semexplore_gym.policies.base import Policy, StepStats
 
     class Spinner(Policy):
         name = "spinner"
@@ -67,7 +66,7 @@ def test_py_spec_loads_a_factory_from_a_module(user_file, monkeypatch) -> None:
         ("py:{dir}/missing.py:Spinner", "no such file"),
         ("py:{file}:Nope", "has no attribute 'Nope'"),
         ("py:{file}:NOT_CALLABLE", "not a class or function"),
-        ("py:{file}:not_a_policy", "returned a str, not a policies.base.Policy"),
+        ("py:{file}:not_a_policy", "returned a str, not a semexplore_gym.policies.base.Policy"),
         ("py:no_such_module_xyz:Spinner", "cannot import module 'no_such_module_xyz'"),
     ],
 )

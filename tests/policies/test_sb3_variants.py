@@ -10,7 +10,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from policies.registry import make_policy
+from semexplore_gym.policies.registry import make_policy
+
 from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
 
 WORLD = "maze:seed=0,size_m=4"

@@ -6,9 +6,13 @@ import math
 
 import numpy as np
 import pytest
+from semexplore_gym.policies.registry import make_policy
+from semexplore_gym.policies.semantic_expert import (
+    SemanticExpertParams,
+    SemanticExpertPolicy,
+    area_type_raster,
+)
 
-from policies.registry import make_policy
-from policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy, area_type_raster
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.topometric.types import (
     Area,
@@ -204,7 +208,7 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
         )
 
     pol = SemanticExpertPolicy(SemanticExpertParams(switch_margin=0.5))
-    from policies.semantic_expert import _Plan
+    from semexplore_gym.policies.semantic_expert import _Plan
 
     current = cand(3.0, 1.0, 7)
     pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)

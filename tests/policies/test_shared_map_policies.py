@@ -12,10 +12,10 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.registry import make_policy, policy_factories
 
 import semexplore_gym  # noqa: F401
-from policies.base import Policy
-from policies.registry import make_policy, policy_factories
 from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
 
 #: Registered names that need an argument (a model file, a module) are not built here.

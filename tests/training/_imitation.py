@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from semexplore_gym.policies.base import Policy
 
-from policies.base import Policy
 from semexplore_gym.training.dataset import ImitationDataset
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 

@@ -6,9 +6,9 @@ import json
 import math
 
 import pytest
+from semexplore_gym.policies.frontier_value import FrontierValuePolicy
+from semexplore_gym.policies.registry import make_policy
 
-from policies.frontier_value import FrontierValuePolicy
-from policies.registry import make_policy
 from semexplore_gym.training.frontier_value import (
     FrontierValueTrainConfig,
     SearchParam,

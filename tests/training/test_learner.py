@@ -13,7 +13,8 @@ pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def test_saved_policy_runs_through_sb3_policy(tmp_path: Path) -> None:
-    from policies.sb3_policy import SB3Policy
+    from semexplore_gym.policies.sb3_policy import SB3Policy
+
     from semexplore_gym.training.learner import save_policy
     from semexplore_gym.wrappers.egocentric import egocentric_features
 
@@ -36,7 +37,7 @@ def test_saved_policy_runs_through_sb3_policy(tmp_path: Path) -> None:
 
 def test_sb3_policy_rejects_bad_files(tmp_path: Path) -> None:
     pytest.importorskip("torch")
-    from policies.sb3_policy import SB3Policy
+    from semexplore_gym.policies.sb3_policy import SB3Policy
 
     with pytest.raises(FileNotFoundError):
         SB3Policy(tmp_path / "missing.zip")
@@ -48,7 +49,7 @@ def test_sb3_policy_rejects_bad_files(tmp_path: Path) -> None:
 
 
 def test_registry_builds_sb3_policy(tmp_path: Path) -> None:
-    registry = pytest.importorskip("policies.registry")
+    registry = pytest.importorskip("semexplore_gym.policies.registry")
     from semexplore_gym.training.learner import save_policy
 
     pytest.importorskip("torch")

@@ -5,7 +5,7 @@ semantic topometric map (Algorithm 1, ranked by the frontier cost ``C``) plus a 
 features, and answers with a candidate index (frontier choice) or with three numbers mapped to
 the cost weights (:func:`action_to_weights`). The env wrappers in
 :mod:`semexplore_gym.wrappers.frontier_choice` and the policy that runs a trained macro agent,
-:class:`policies.macro_agent.MacroAgentPolicy`, both build their vectors here, so a trained
+:class:`semexplore_gym.policies.macro_agent.MacroAgentPolicy`, both build their vectors here, so a trained
 model sees the same numbers in training and in a benchmark.
 
 Observation (``(K * 8 + 4,)`` float32 in ``[-1, 1]``): ``K`` rows of candidate features, padded

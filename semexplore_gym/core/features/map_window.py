@@ -1,7 +1,7 @@
 """A fixed-size window of the occupancy map: cells ``[r0, r0 + size) x [c0, c0 + size)``.
 
 The one implementation of the pad/crop behind the :class:`~semexplore_gym.wrappers.FixedSizeMap`
-wrapper, shared with :class:`~policies.sb3_policy.SB3Policy` so a model trained on the wrapped
+wrapper, shared with :class:`~semexplore_gym.policies.sb3_policy.SB3Policy` so a model trained on the wrapped
 observation runs as a policy on raw observations. Cells outside the map read as UNKNOWN.
 Grid indices are ``(row, col)``.
 """

@@ -5,8 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-
-from policies.navigation import GoalBlacklist, ProgressWatch
+from semexplore_gym.policies.navigation import GoalBlacklist, ProgressWatch
 
 
 def test_blacklist_disc_and_box_include_their_boundary() -> None:

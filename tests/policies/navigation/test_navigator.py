@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from semexplore_gym.policies.base import StepStats
+from semexplore_gym.policies.navigation import MoveBaseParams, Navigator, NavStatus
 
-from policies.base import StepStats
-from policies.navigation import MoveBaseParams, Navigator, NavStatus
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 
 RES_M = 0.05

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from semexplore_gym.policies.navigation import BackoffRecovery, RotateRecovery
 
-from policies.navigation import BackoffRecovery, RotateRecovery
 from semexplore_gym.core.grid import FREE, GridGeometry
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams, RobotLimits
 
