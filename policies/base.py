@@ -117,6 +117,15 @@ class Policy(abc.ABC):
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
         """Return the action for this step: float32 ``(2,)`` in ``[-1, 1]`` (scaled v, omega)."""
 
+    def mission_metrics(self) -> dict[str, Any]:
+        """Extra per-mission figures for benchmark rows, read once when a mission ends.
+
+        Name -> int, float, str or None; a policy returns the same names in every mission.
+        The benchmark harness writes the names it has columns for (for the semantic expert:
+        ``scored_replans`` and ``semantic_share``). Empty by default.
+        """
+        return {}
+
     def overlay(self) -> dict[str, Any]:
         """Drawing hints for the renderer (see :mod:`semexplore_gym.rendering`); empty by default."""
         return {}
