@@ -28,8 +28,8 @@ from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.core.features.frontier_value import FEATURE_NAMES, frontier_value_features
-from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
+from semexplore_gym.core.validation import require_finite
 
 __all__ = ["FrontierValueParams", "FrontierValuePolicy", "FrontierValueWeights"]
 

@@ -32,6 +32,7 @@ from semexplore_gym.policies.base import Policy
 from semexplore_gym.policies.macro_driver import ExpertDriver
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 
+from semexplore_gym.config.params import build_params
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
@@ -39,7 +40,6 @@ from semexplore_gym.core.features.macro import (
     observation_size,
     observation_vector,
 )
-from semexplore_gym.core.params import build_params
 from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
 
 #: Macro env ids and the kind of decision their agents make.
@@ -63,7 +63,7 @@ def read_macro_run(model_path: str | os.PathLike) -> dict[str, Any] | None:
     cfg_path = run_dir / "config.yaml"
     if not cfg_path.is_file():
         return None
-    from semexplore_gym.core.safe_io import load_yaml_file
+    from semexplore_gym.config.loading import load_yaml_file
 
     cfg = load_yaml_file(cfg_path, "run config") or {}  # bounded; ValueError names the file
     if not isinstance(cfg, dict) or not isinstance(cfg.get("env") or {}, dict):

@@ -10,18 +10,19 @@ agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
 with the built-in ones). A spec may carry an argument after a colon. Keyword overrides set
 fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted
 (``**{"cost.w_v": 2}``); ``params=`` gives the layer to start from (a parameter object, a
-mapping or a YAML file), all merged by :func:`semexplore_gym.core.params.build_params`.
+mapping or a YAML file), all merged by :func:`semexplore_gym.config.params.build_params`.
+Spec strings and their brackets are parsed by :mod:`semexplore_gym.policies.specs`.
 """
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from typing import Any
 
 from semexplore_gym.policies.base import Policy
+from semexplore_gym.policies.specs import parse_spec
 
-from semexplore_gym.core.params import build_params
+from semexplore_gym.config.params import build_params
 
 Factory = Callable[[str, dict[str, Any]], Policy]
 
@@ -220,109 +221,12 @@ def policy_factories() -> dict[str, Factory]:
     }
 
 
-def _bracket(spec: str) -> tuple[str, str | None]:
-    """``"semantic[x]"`` -> ``("semantic", "x")``; a spec without a trailing bracket -> (spec, None)."""
-    spec = spec.strip()
-    if spec.endswith("]") and "[" in spec:
-        i = spec.rindex("[")
-        return spec[:i].strip(), spec[i + 1 : -1].strip()
-    return spec, None
-
-
-def split_specs(text: str) -> list[str]:
-    """Split comma-separated policy specs; commas inside ``[...]`` belong to the spec.
-
-    ``"semantic[cost.w_v=0,cost.w_p=0],nearest"`` -> ``["semantic[cost.w_v=0,cost.w_p=0]",
-    "nearest"]``.
-
-    Raises:
-        ValueError: an unbalanced bracket (the message names the text).
-    """
-    out: list[str] = []
-    depth = 0
-    current = ""
-    for ch in text or "":
-        if ch == "[":
-            depth += 1
-        elif ch == "]":
-            depth -= 1
-            if depth < 0:
-                raise ValueError(f"policy specs {text!r}: unbalanced brackets (']' without '[')")
-        if ch == "," and depth == 0:
-            out.append(current)
-            current = ""
-        else:
-            current += ch
-    if depth != 0:
-        raise ValueError(f"policy specs {text!r}: unbalanced brackets ('[' without ']')")
-    out.append(current)
-    return [s.strip() for s in out if s.strip()]
-
-
-def parse_spec(spec: str) -> tuple[str, str | None, dict[str, Any]]:
-    """Split a policy spec into ``(base spec, label, parameter overrides)``.
-
-    A trailing bracket is either a label or a set of parameter overrides, never both:
-
-    - ``"semantic[tuned]"``: no ``=`` inside, a label that only names the variant in tables;
-    - ``"semantic[cost.w_v=0]"``, ``"semantic[cost.w_v=0;cost.w_p=0]"`` (``;`` or ``,``
-      between items): dotted ``key=value`` overrides of the policy's parameters, applied by
-      :func:`make_policy` on top of its keyword overrides. The table label is the whole spec.
-
-    Raises:
-        ValueError: an empty bracket, a bracket mixing labels and ``key=value`` items, or an
-            item that is not ``key=value``; the message names the spec.
-    """
-    from semexplore_gym.core.params import ConfigError, parse_override
-
-    if not isinstance(spec, str) or not spec.strip():
-        raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
-    base, inner = _bracket(spec)
-    if inner is None:
-        if "[" in spec or "]" in spec:
-            raise ValueError(
-                f"policy spec {spec!r}: unbalanced brackets; one bracket closes the spec, as in "
-                "'semantic[cost.w_v=0]' or 'semantic[my label]'"
-            )
-        return base, None, {}
-    if not inner:
-        raise ValueError(f"policy spec {spec!r}: empty brackets; give a label or key=value items")
-    if not base:
-        raise ValueError(f"policy spec {spec!r}: no policy name before the bracket")
-    if "=" not in inner:
-        return base, inner, {}
-    items = [t.strip() for t in re.split(r"[;,]", inner)]
-    overrides: dict[str, Any] = {}
-    for item in items:
-        if not item or "=" not in item:
-            raise ValueError(
-                f"policy spec {spec!r}: {item!r} is not key=value; a bracket is either a label "
-                "(no '=') or parameter overrides such as [cost.w_v=0;cost.w_p=0], not both"
-            )
-        try:
-            keys, value = parse_override(item)
-        except ConfigError as e:
-            raise ValueError(f"policy spec {spec!r}: {e}") from None
-        key = ".".join(k.strip() for k in keys)
-        if not all(k.strip() for k in keys):
-            raise ValueError(f"policy spec {spec!r}: {item!r} has an empty key")
-        if key in overrides:
-            raise ValueError(f"policy spec {spec!r}: {key!r} is set twice")
-        overrides[key] = value
-    return base, None, overrides
-
-
-def strip_label(spec: str) -> str:
-    """``"semantic[tuned]"`` or ``"semantic[cost.w_v=0]"`` -> ``"semantic"``."""
-    return _bracket(spec)[0]
-
-
 def make_policy(spec: str, **overrides: Any) -> Policy:
     """Create a policy from ``spec`` (``"name"``, ``"name:argument"``, either with a bracket).
 
     A trailing ``[label]`` (``"semantic[tuned]"``) only names a variant in benchmark tables;
     a trailing ``[key=value;...]`` (``"semantic[cost.w_v=0]"``) sets parameters, on top of
-    ``overrides`` (see :func:`parse_spec`).
+    ``overrides`` (see :func:`~semexplore_gym.policies.specs.parse_spec`).
 
     Raises:
         ValueError: unknown name, a bad argument or bracket, or a bad parameter override

@@ -92,10 +92,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.core.topometric.params import SegmentationParams
+from semexplore_gym.core.validation import require_finite
 
 __all__ = ["PAPER_PURE", "SemanticExpertParams"]
 

@@ -47,7 +47,7 @@ from semexplore_gym.core.planning.graph_search import FrontierCostWeights, searc
 from semexplore_gym.core.planning.grid_search import geodesic_distance_m
 from semexplore_gym.core.topometric import TopometricSegmenter
 from semexplore_gym.core.topometric.types import AreaType
-from semexplore_gym.core.worlds.registry import make_world
+from semexplore_gym.maps import make_world
 
 PROCEDURAL = [f"maze:seed=0,size_m={s}" for s in (7, 10, 15, 20, 30, 40)] + [
     f"office:seed=0,size_m={s}" for s in (10, 15, 20, 30, 40)

@@ -63,11 +63,10 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     import gymnasium as gym
-    from semexplore_gym.policies.config import load_policy_config
     from semexplore_gym.policies.registry import make_policy
+    from semexplore_gym.policies.specs import load_policy_config
 
     import semexplore_gym  # noqa: F401
-    from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.core.topometric import TopometricSegmenter
     from semexplore_gym.evaluation.rollout import STAGES, map_observation_for, run_mission
 
@@ -87,9 +86,7 @@ def main(argv: list[str] | None = None) -> int:
             return tmap
 
     cfg = load_policy_config(args.policy_config)
-    kwargs = merge_overrides(None, args.overrides)
-    if cfg.params:
-        kwargs["params"] = cfg.params
+    kwargs = cfg.policy_kwargs(args.overrides)
     if args.map_observation == "auto":
         env_kwargs = map_observation_for(make_policy("semantic", **dict(kwargs)))
     elif args.map_observation == "shared":

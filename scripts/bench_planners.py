@@ -44,7 +44,7 @@ from semexplore_gym.core.planning.grid_search import (
     navfn_cell_costs,
     plan_path,
 )
-from semexplore_gym.core.worlds.registry import make_world
+from semexplore_gym.maps import make_world
 
 #: World used for each map size (the map is padded to exactly that size).
 WORLDS = {224: "maze1", 1000: "office:seed=0,size_m=46"}

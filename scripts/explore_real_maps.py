@@ -91,11 +91,10 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     import gymnasium as gym
-    from semexplore_gym.policies.config import load_policy_config
     from semexplore_gym.policies.registry import make_policy
+    from semexplore_gym.policies.specs import load_policy_config
 
     import semexplore_gym  # noqa: F401
-    from semexplore_gym.core.params import merge_overrides
     from semexplore_gym.evaluation.rollout import run_mission
 
     if not args.maps_dir.is_dir():
@@ -107,9 +106,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"unknown map {n!r}; known: {', '.join(sorted(names))}", file=sys.stderr)
             return 2
     cfg = load_policy_config(args.policy_config)
-    kwargs = merge_overrides(None, args.overrides)
-    if cfg.params:
-        kwargs["params"] = cfg.params
+    kwargs = cfg.policy_kwargs(args.overrides)
 
     header = f"{'map':16s} {'coverage':>8s} {'time_s':>8s} {'stopped':>7s} {'coll':>4s} {'path_m':>7s} {'wall_s':>7s}  stop reason"
     print(header, flush=True)

@@ -19,11 +19,11 @@ import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds import (
-    make_world,
     rasterize_free,
     sample_start_pose,
     world_from_free_mask,
 )
+from semexplore_gym.maps import make_world
 
 DEFAULT_MAPS = Path(__file__).resolve().parents[1] / ".." / "shared" / "maps"
 BUILTIN = [

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from semexplore_gym.core.topometric import segment_map
-from semexplore_gym.core.worlds.ros_map import load_ros_map
+from semexplore_gym.maps.ros_map import load_ros_map
 
 DEFAULT_MAPS = Path(__file__).resolve().parents[1] / ".." / "shared" / "maps"
 

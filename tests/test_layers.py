@@ -38,6 +38,7 @@ class Layer:
 
 
 _CORE = "semexplore_gym/core"
+_CONFIG = "semexplore_gym/config"
 LAYERS: list[Layer] = [
     # numpy/scipy/numba only: no simulator, no gym, no learners, no drawing.
     Layer(
@@ -50,8 +51,23 @@ LAYERS: list[Layer] = [
             "sb3_contrib",
             "matplotlib",
             "pygame",
+            # no file or network I/O: reading configs and maps is the job of the layers above
+            "yaml",
+            "json",
+            "pickle",
+            "csv",
+            "io",
+            "urllib",
+            "http",
+            "socket",
+            "tempfile",
+            "shutil",
+            "zipfile",
+            "PIL",
         ),
     ),
+    # Config and file input: build_params, bounded YAML/JSON reading, output path checks.
+    Layer(_CONFIG),
     # The package root registers the env ids by string; `import semexplore_gym.core` runs it,
     # so it must not pull gymnasium in at import time.
     Layer("semexplore_gym/__init__.py", lazy_only=("gymnasium",)),
@@ -60,11 +76,12 @@ LAYERS: list[Layer] = [
     Layer("semexplore_gym/sim", forbid=("gymnasium",)),
     Layer("semexplore_gym/envs"),
     Layer("semexplore_gym/wrappers"),
-    # A policy turns observations into actions: core and observations only. Loading a trained
-    # model may need torch, SB3 and the gymnasium space classes pickled in it (inside functions).
+    # A policy turns observations into actions: core, config and observations only. Loading a
+    # trained model may need torch, SB3 and the gymnasium space classes pickled in it (inside
+    # functions).
     Layer(
         "policies",
-        only=(_CORE,),
+        only=(_CORE, _CONFIG),
         forbid=("pymunk",),
         lazy_only=("gymnasium", "torch", "stable_baselines3", "sb3_contrib"),
     ),

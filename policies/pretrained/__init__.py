@@ -88,7 +88,7 @@ def pretrained_models() -> list[PretrainedModel]:
     Raises:
         ValueError: the index is malformed (a missing or unknown field).
     """
-    from semexplore_gym.core.safe_io import load_yaml_file
+    from semexplore_gym.config.loading import load_yaml_file
 
     data = load_yaml_file(INDEX_PATH, "pretrained model index") or {}
     entries = data.get("models") if isinstance(data, dict) else None

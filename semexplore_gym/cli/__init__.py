@@ -74,7 +74,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     except (ValueError, OSError, KeyError, RecursionError, MemoryError) as e:
         # Bad input ends here as one short line; never a traceback or a flood of output.
-        from semexplore_gym.core.safe_io import one_line
+        from semexplore_gym.core.validation import one_line
 
         text = one_line(str(e), 600) or type(e).__name__
         if isinstance(e, (RecursionError, MemoryError)):

@@ -33,3 +33,19 @@ class _RenamedFlag(argparse.Action):
 def add_renamed_flag(parser: argparse.ArgumentParser, old: str, hint: str) -> None:
     """Register ``old`` as a removed flag whose use exits with ``"OLD was renamed: HINT"``."""
     parser.add_argument(old, dest=f"_renamed_{old.lstrip('-')}", action=_RenamedFlag, hint=hint)
+
+
+def check_output_flag(
+    flag: str, path: str, suffixes: tuple[str, ...] = (), *, parent_must_exist: bool = True
+) -> None:
+    """:func:`~semexplore_gym.config.output_paths.check_output_file`, its error naming ``flag``.
+
+    Raises:
+        ValueError: ``"--gif 'x.txt' must end in .gif"``: the flag, then what is wrong.
+    """
+    from semexplore_gym.config.output_paths import check_output_file
+
+    try:
+        check_output_file(path, suffixes, parent_must_exist=parent_must_exist)
+    except ValueError as e:
+        raise ValueError(f"{flag} {e}") from None

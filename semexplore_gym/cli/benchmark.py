@@ -26,7 +26,7 @@ from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
-from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.core.validation import short_repr
 
 
 def _split(text: str) -> list[str]:
@@ -46,7 +46,7 @@ def _split_worlds(text: str) -> list[str]:
 
 def _split_policies(text: str) -> list[str]:
     """Comma-separated policy specs; commas inside ``[...]`` stay with their spec."""
-    from semexplore_gym.policies.registry import split_specs
+    from semexplore_gym.policies.specs import split_specs
 
     return split_specs(text)
 
@@ -58,7 +58,7 @@ def _check_worlds(worlds: list[str], seed: int) -> None:
         ValueError: an unknown or malformed world spelling (the message names it).
         FileNotFoundError: a map file that does not exist.
     """
-    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.maps import make_world
 
     for world in worlds:
         try:
@@ -75,7 +75,8 @@ def _check_policies(policies: list[str]) -> None:
     Raises:
         ValueError: an unknown policy, a malformed bracket, an unknown parameter, a bad file.
     """
-    from semexplore_gym.policies.registry import make_policy, parse_spec, policy_factories
+    from semexplore_gym.policies.registry import make_policy, policy_factories
+    from semexplore_gym.policies.specs import parse_spec
 
     known = policy_factories()
     for p in policies:
@@ -248,7 +249,7 @@ def run(args: argparse.Namespace) -> int:
     _check_policies(policies)
     from pathlib import Path
 
-    from semexplore_gym.core.params import to_dict
+    from semexplore_gym.config.params import to_dict
     from semexplore_gym.envs.config import load_env_config
 
     suites: list[dict[str, Any]] = []

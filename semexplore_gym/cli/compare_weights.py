@@ -42,7 +42,7 @@ from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
-from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.core.validation import short_repr
 
 #: Defaults of --runs, --test-seed0 and --max-time-s with --test-worlds.
 DEFAULT_TEST_RUNS = 5
@@ -351,11 +351,12 @@ def _check_run_args(
         from semexplore_gym.envs.config import load_env_config
 
         load_env_config(args.env_config)
-    from semexplore_gym.policies.registry import split_specs
+    from semexplore_gym.policies.specs import split_specs
 
     agents = split_specs(args.agents)
     if agents:
-        from semexplore_gym.policies.registry import make_policy, strip_label
+        from semexplore_gym.policies.registry import make_policy
+        from semexplore_gym.policies.specs import strip_label
 
         for spec in agents:
             if strip_label(spec).partition(":")[0] == "semantic":

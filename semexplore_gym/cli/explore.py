@@ -15,7 +15,7 @@ import json
 import sys
 from typing import Any
 
-from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.cli._flags import add_renamed_flag, check_output_flag
 
 #: Keys of the ``--json`` object, in order.
 JSON_KEYS: tuple[str, ...] = (
@@ -120,12 +120,10 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
-    from semexplore_gym.core.params import merge_overrides
-    from semexplore_gym.core.safe_io import check_output_file
     from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
-    from semexplore_gym.policies.config import load_policy_config
     from semexplore_gym.policies.registry import make_policy
+    from semexplore_gym.policies.specs import load_policy_config
 
     if not (0 < args.max_time_s <= 1e7):
         raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")
@@ -137,12 +135,10 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     if args.gif is not None:
         # the GIF writer creates missing parent directories
-        check_output_file(args.gif, "--gif", (".gif",), parent_must_exist=False)
+        check_output_flag("--gif", args.gif, (".gif",), parent_must_exist=False)
     cfg = load_policy_config(args.policy_config)
     spec = args.policy or cfg.policy or "semantic"
-    policy_kwargs: dict[str, Any] = merge_overrides(None, args.overrides)  # nested by key path
-    if cfg.params:
-        policy_kwargs["params"] = cfg.params
+    policy_kwargs: dict[str, Any] = cfg.policy_kwargs(args.overrides)
     policy = make_policy(spec, **policy_kwargs)
 
     env_config = args.env_config if args.env_config is not None else cfg.env

@@ -72,7 +72,7 @@ def _size(n_bytes: int) -> str:
 
 
 def _list(files: bool = False) -> int:
-    from semexplore_gym.core.worlds.catalogue import CATALOGUE
+    from semexplore_gym.maps.catalogue import CATALOGUE
 
     rows = [(m.name, _size(m.size_bytes), m.licence, m.source) for m in CATALOGUE.values()]
     widths = [max(len(r[i]) for r in rows) for i in range(3)]
@@ -85,12 +85,12 @@ def _list(files: bool = False) -> int:
 
 
 def _get(args: argparse.Namespace) -> int:
-    from semexplore_gym.core.worlds.catalogue import (
+    from semexplore_gym.maps.catalogue import (
         RAW_GITHUB_BASE,
         get_catalogue_map,
         maps_cache_dir,
     )
-    from semexplore_gym.maps import MapFetchError, copy_map, download_map
+    from semexplore_gym.maps.download import MapFetchError, copy_map, download_map
 
     if not (args.timeout_s > 0):
         raise ValueError(f"--timeout-s must be positive, got {args.timeout_s!r}")
@@ -116,7 +116,7 @@ def _get(args: argparse.Namespace) -> int:
 
 
 def _path(args: argparse.Namespace) -> int:
-    from semexplore_gym.core.worlds.catalogue import maps_cache_dir, resolve_map_file
+    from semexplore_gym.maps.catalogue import maps_cache_dir, resolve_map_file
 
     print(resolve_map_file(args.name) if args.name else maps_cache_dir())
     return 0

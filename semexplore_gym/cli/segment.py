@@ -4,7 +4,7 @@ The map is split into intersections, pathways, dead ends and pathways leading to
 semantic topometric map of the paper); the time of the segmentation itself is printed.
 
 ``MAP_OR_WORLD`` is a ROS map (``.yaml``, unknown cells kept) or any world spec accepted by
-:func:`semexplore_gym.core.worlds.registry.make_world` (``maze1``, ``office:seed=3``, a HouseExpo
+:func:`semexplore_gym.maps.world_specs.make_world` (``maze1``, ``office:seed=3``, a HouseExpo
 ``.json``); a world is rasterised from its ground-truth free space (free inside, occupied
 elsewhere) at ``--resolution``. The picture shows the areas tinted by type, the openings
 (frontiers in magenta), the areas' paths and the frontier targets. ``--json`` prints the
@@ -23,8 +23,9 @@ from typing import cast
 import numpy as np
 
 from semexplore_gym.cli import describe
+from semexplore_gym.cli._flags import check_output_flag
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
-from semexplore_gym.core.safe_io import check_output_file, short_repr
+from semexplore_gym.core.validation import short_repr
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -89,11 +90,11 @@ def load_grid(
         path = Path(spec)
         if not path.is_file():
             raise FileNotFoundError(f"map file not found: {path}")
-        from semexplore_gym.core.worlds.ros_map import load_ros_map
+        from semexplore_gym.maps.ros_map import load_ros_map
 
         grid, geometry = load_ros_map(path)
         return grid, geometry, str(spec)
-    from semexplore_gym.core.worlds.registry import make_world
+    from semexplore_gym.maps import make_world
 
     world = make_world(spec, rng=np.random.default_rng(seed))
     g0 = world.free_geometry
@@ -178,9 +179,9 @@ def validate_args(args: argparse.Namespace) -> None:
     if args.seed < 0 or args.seed > 2**32 - 1:
         raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     if args.out is not None:
-        check_output_file(args.out, "--out", (".png",))
+        check_output_flag("--out", args.out, (".png",))
     if args.export is not None:
-        check_output_file(args.export, "--export", (".json",))
+        check_output_flag("--export", args.export, (".json",))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -47,10 +47,10 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
-    from semexplore_gym.core.safe_io import check_output_file
+    from semexplore_gym.cli._flags import check_output_flag
     from semexplore_gym.rendering.renderer import Renderer, RenderSnapshot
 
-    check_output_file(args.out, "--out", (".png",))
+    check_output_flag("--out", args.out, (".png",))
     if not (0 <= args.seed <= 2**32 - 1):
         raise ValueError(f"--seed must be in 0..2**32-1, got {args.seed}")
     t0 = time.perf_counter()

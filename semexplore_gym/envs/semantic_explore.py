@@ -16,8 +16,7 @@ from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
-from semexplore_gym.core.safe_io import short_repr
-from semexplore_gym.core.worlds import make_world
+from semexplore_gym.core.validation import short_repr
 from semexplore_gym.core.worlds.start import (
     reachable_free_mask,
     sample_start_pose,
@@ -25,6 +24,7 @@ from semexplore_gym.core.worlds.start import (
 )
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.envs.config import EnvConfig, load_env_config
+from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
 

@@ -421,7 +421,7 @@ def _panels(plt: Any, n: int, width_in: float) -> tuple[Any, list[Any]]:
 def _trajectory_figure(
     out: Path, groups: Any, worlds: list[str], policies: list[str], colours: dict, plt: Any
 ) -> Path:
-    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.maps import make_world
 
     fig, axes = plt.subplots(
         len(worlds), len(policies), figsize=(3.6 * len(policies), 3.6 * len(worlds)), squeeze=False

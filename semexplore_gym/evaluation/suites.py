@@ -28,7 +28,7 @@ from typing import Any
 
 import yaml
 
-from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.core.validation import short_repr
 
 #: Where named suites live (the repository's ``configs/suites``), unless
 #: ``SEMEXPLORE_SUITES_DIR`` names another directory.
@@ -256,9 +256,9 @@ def suite_tasks(
         ValueError: an unknown or repeated suite, a world in two suites, a world that cannot
             be built; each message names ``flag`` and the value.
     """
-    from semexplore_gym.core.worlds import make_world
     from semexplore_gym.envs.config import load_env_config
     from semexplore_gym.evaluation.harness import expand_tasks
+    from semexplore_gym.maps import make_world
 
     if not names:
         raise ValueError(f"{flag} is empty")

@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import BinaryIO
 
-from semexplore_gym.core.worlds.catalogue import (
+from semexplore_gym.maps.catalogue import (
     RAW_GITHUB_BASE,
     CatalogueMap,
     MapFile,

@@ -17,7 +17,7 @@ import pymunk
 from pymunk._chipmunk import ffi as _ffi
 from pymunk._chipmunk import lib as _cp
 
-from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.validation import require_finite
 from semexplore_gym.core.worlds.world import World
 
 WALL_COLLISION_TYPE = 1

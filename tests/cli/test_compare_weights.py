@@ -153,8 +153,8 @@ def test_compare_weights_tests_on_a_suite_as_benchmark_runs_it(tmp_path: Path, c
     assert {r["seed"] for r in rows} == {"0", "1"}
     times = {(r["world"], r["policy"]): float(r["mission_time_s"]) for r in rows}
     assert max(t for (w, _), t in times.items() if w.startswith("cave")) <= 6.0 + 1e-6
-    from semexplore_gym.core.worlds import make_world
     from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
+    from semexplore_gym.maps import make_world
 
     maze = make_world("maze:seed=1,size_m=4")
     area_m2 = float(maze.free_mask.sum()) * maze.free_geometry.resolution_m**2

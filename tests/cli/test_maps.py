@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from semexplore_gym.cli import main
-from semexplore_gym.core.worlds.catalogue import CATALOGUE
+from semexplore_gym.maps.catalogue import CATALOGUE
 
 SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
 needs_shared = pytest.mark.skipif(

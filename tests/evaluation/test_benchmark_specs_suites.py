@@ -175,7 +175,7 @@ def test_a_malformed_bracket_is_a_clear_error(tmp_path, capsys, spec, fragment, 
 
 
 def test_spec_splitting_respects_brackets() -> None:
-    from semexplore_gym.policies.registry import parse_spec, split_specs
+    from semexplore_gym.policies.specs import parse_spec, split_specs
 
     assert split_specs("semantic[cost.w_v=0,cost.w_p=0], nearest,sb3:m.zip[a, b]") == [
         "semantic[cost.w_v=0,cost.w_p=0]",

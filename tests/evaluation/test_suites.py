@@ -6,7 +6,6 @@ from pathlib import Path
 
 import pytest
 
-from semexplore_gym.core.worlds import make_world
 from semexplore_gym.evaluation.suites import (
     Suite,
     SuiteWorld,
@@ -17,6 +16,7 @@ from semexplore_gym.evaluation.suites import (
     world_family,
     world_time_limit_s,
 )
+from semexplore_gym.maps import make_world
 
 SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
 
@@ -26,7 +26,7 @@ def test_the_shipped_suites_are_there() -> None:
 
 
 def test_the_real_suite_names_catalogue_maps(monkeypatch: pytest.MonkeyPatch) -> None:
-    from semexplore_gym.core.worlds.catalogue import CATALOGUE
+    from semexplore_gym.maps.catalogue import CATALOGUE
 
     suite = load_suite("real")
     names = [w.world.removeprefix("map:") for w in suite.worlds]

@@ -24,9 +24,9 @@ from PIL import Image
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.cli import main
-from semexplore_gym.core.worlds import make_world
-from semexplore_gym.core.worlds.catalogue import CATALOGUE, CatalogueMap, MapFile
-from semexplore_gym.maps import MapFetchError, copy_map, download_map
+from semexplore_gym.maps import make_world
+from semexplore_gym.maps.catalogue import CATALOGUE, CatalogueMap, MapFile
+from semexplore_gym.maps.download import MapFetchError, copy_map, download_map
 
 SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
 needs_shared = pytest.mark.skipif(

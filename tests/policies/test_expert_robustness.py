@@ -16,9 +16,9 @@ from semexplore_gym.policies.semantic_expert import SemanticExpertParams, Semant
 from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
 import semexplore_gym  # noqa: F401
+from semexplore_gym.config.params import build_params
 from semexplore_gym.core.frontiers.reachable import clearance_field_m, pocket_exit_path
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from semexplore_gym.core.params import build_params
 from semexplore_gym.core.worlds.build import world_from_free_mask
 from semexplore_gym.evaluation.rollout import run_mission
 
@@ -254,7 +254,7 @@ def test_side_approach_comes_from_away_from_the_failure() -> None:
 
 
 def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
-    from semexplore_gym.policies.config import load_policy_config
+    from semexplore_gym.policies.specs import load_policy_config
 
     cfg = load_policy_config(REPO / "configs" / "expert" / "paper_pure.yaml")
     from_yaml = build_params(SemanticExpertParams, cfg.params)

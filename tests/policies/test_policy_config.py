@@ -5,10 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from semexplore_gym.policies.config import ConfigError, build_params, load_policy_config
 from semexplore_gym.policies.registry import make_policy
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams
+from semexplore_gym.policies.specs import load_policy_config
 
+from semexplore_gym.config.params import ConfigError, build_params
 from semexplore_gym.core.features.macro import WEIGHT_RANGES
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams

@@ -10,7 +10,7 @@ import pytest
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
 from semexplore_gym.core.mapping.raycast import SegmentIndex
-from semexplore_gym.core.worlds import make_world
+from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar, LidarParams
 
 

@@ -39,7 +39,6 @@ which SB3's ``MultiInputPolicy`` recognises as an image and feeds to its CNN.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -162,9 +161,6 @@ class EgocentricParams:
         if unknown:
             raise ValueError(f"unknown egocentric parameter(s) {unknown}; valid: {sorted(names)}")
         return cls(**d)
-
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict(), sort_keys=True)
 
 
 @njit(cache=True)

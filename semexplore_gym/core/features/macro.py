@@ -36,8 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from semexplore_gym.core.grid import UNKNOWN
-from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.graph_search import FrontierCandidate, FrontierCostWeights
+from semexplore_gym.core.validation import require_finite
 
 N_CANDIDATE_FEATURES = 8
 N_GLOBAL_FEATURES = 4

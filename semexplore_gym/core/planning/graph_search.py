@@ -47,10 +47,10 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
 import numpy as np
 
 from semexplore_gym.core.grid import wrap_angle_rad
-from semexplore_gym.core.lazy import LazyField
-from semexplore_gym.core.params import require_finite
+from semexplore_gym.core.lazy_field import LazyField
 from semexplore_gym.core.planning.graph_search_kernels import first_leg_offers, search_by_opening
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
+from semexplore_gym.core.validation import require_finite
 
 
 @dataclass(frozen=True)

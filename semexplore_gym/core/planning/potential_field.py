@@ -35,8 +35,8 @@ import numpy.typing as npt
 from numba import njit
 
 from semexplore_gym.core.grid import OCCUPIED, GridGeometry, wrap_angle_rad
-from semexplore_gym.core.params import require_finite
 from semexplore_gym.core.planning.line_of_sight import farthest_visible_index
+from semexplore_gym.core.validation import require_finite
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.lazy import LazyField
+from semexplore_gym.core.lazy_field import LazyField
 
 
 class AreaType(IntEnum):

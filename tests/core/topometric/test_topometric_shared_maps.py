@@ -17,7 +17,7 @@ SMALL_CELLS = 1_000_000  # maps above this run in the slow test
 
 
 def _load(path: Path):
-    from semexplore_gym.core.worlds.ros_map import load_ros_map
+    from semexplore_gym.maps.ros_map import load_ros_map
 
     return load_ros_map(path)
 

@@ -7,7 +7,8 @@ import pytest
 from scipy import ndimage
 
 from semexplore_gym.core.worlds.forest import ForestParams, place_trunks
-from semexplore_gym.core.worlds.registry import list_world_names, make_world
+from semexplore_gym.core.worlds.procedural import list_world_names
+from semexplore_gym.maps import make_world
 
 
 def _components(mask: np.ndarray) -> int:

@@ -14,7 +14,6 @@ from semexplore_gym.core.worlds import (
     distance_to_segments_m,
     fixed_mazes,
     list_world_names,
-    make_world,
     parse_world_spec,
     rasterize_free,
     reachable_free_mask,
@@ -24,6 +23,7 @@ from semexplore_gym.core.worlds import (
     world_family_parameters,
     world_from_segments,
 )
+from semexplore_gym.maps import make_world
 
 ROBOT_RADIUS_M = 0.105
 CLEARANCE_M = ROBOT_RADIUS_M + 0.05

@@ -16,7 +16,6 @@ Example::
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import types
 import typing
@@ -24,27 +23,14 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
-from semexplore_gym.core.safe_io import UnsafeInputError, load_yaml_file, load_yaml_text, short_repr
+from semexplore_gym.config.loading import UnsafeInputError, load_yaml_file, load_yaml_text
+from semexplore_gym.core.validation import short_repr
 
 T = TypeVar("T")
 
 
 class ConfigError(ValueError):
     """A configuration value or key is invalid; the message names its dotted path."""
-
-
-def require_finite(obj: Any, names: Iterable[str], *, positive: bool, prefix: str = "") -> None:
-    """Raise a ValueError naming the first of ``obj``'s fields ``names`` that is not a finite
-    number ``> 0`` (``positive``) or ``>= 0``: the ``__post_init__`` check of parameter sets."""
-    for name in names:
-        v = getattr(obj, name)
-        if (
-            isinstance(v, bool)
-            or not isinstance(v, (int, float))
-            or not (math.isfinite(v) and (v > 0.0 if positive else v >= 0.0))
-        ):
-            what = "a positive finite number" if positive else "a finite number >= 0"
-            raise ValueError(f"{prefix}{name} must be {what}, got {short_repr(v)}")
 
 
 def _field_types(cls: type) -> dict[str, Any]:

@@ -19,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from semexplore_gym.config.loading import load_json_file
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.safe_io import load_json_file, one_line, short_repr
+from semexplore_gym.core.validation import one_line, short_repr
 from semexplore_gym.core.worlds.build import (
     DEFAULT_VECTOR_RESOLUTION_M,
     check_wall_segments,

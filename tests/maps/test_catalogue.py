@@ -14,8 +14,8 @@ import pytest
 import yaml
 from PIL import Image
 
-from semexplore_gym.core.worlds import make_world
-from semexplore_gym.core.worlds.catalogue import (
+from semexplore_gym.maps import make_world
+from semexplore_gym.maps.catalogue import (
     CATALOGUE,
     CatalogueMap,
     MapFile,
@@ -26,7 +26,7 @@ from semexplore_gym.core.worlds.catalogue import (
     validate_map_name,
 )
 
-SHARED_MAPS = Path(__file__).resolve().parents[3].parent / "shared" / "maps"
+SHARED_MAPS = Path(__file__).resolve().parents[2].parent / "shared" / "maps"
 _RAW = re.compile(r"^https://raw\.githubusercontent\.com/[\w.-]+/[\w.-]+/[0-9a-f]{7,40}/[\w./-]+$")
 
 

@@ -1,8 +1,8 @@
 """The map catalogue: public ROS maps of real places, pinned to a commit, with checksums.
 
-``world="map:NAME"`` (see :func:`~semexplore_gym.core.worlds.registry.make_world`) loads a
+``world="map:NAME"`` (see :func:`~semexplore_gym.maps.world_specs.make_world`) loads a
 catalogue map from disk; this module knows what the maps are and where they live, and does no
-network I/O. Fetching them is ``semexplore maps get NAME`` (:mod:`semexplore_gym.maps`).
+network I/O. Fetching them is ``semexplore maps get NAME`` (:mod:`semexplore_gym.maps.download`).
 
 Every file has a sha256 and a size. Upstream files are fetched from
 ``raw.githubusercontent.com/OWNER/REPO/COMMIT/PATH`` at the full commit hash given (checked

@@ -34,8 +34,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from semexplore_gym.config.loading import load_yaml_file
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from semexplore_gym.core.safe_io import load_yaml_file, one_line, short_repr
+from semexplore_gym.core.validation import one_line, short_repr
 from semexplore_gym.core.worlds.build import (
     DEFAULT_MIN_FREE_CELLS,
     MAX_WORLD_CELLS,

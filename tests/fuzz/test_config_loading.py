@@ -7,15 +7,15 @@ import time
 import pytest
 
 from semexplore_gym.cli import main
-from semexplore_gym.core.params import ConfigError, load_yaml, merge_overrides, parse_override
-from semexplore_gym.core.safe_io import (
+from semexplore_gym.config.loading import (
     UnsafeInputError,
     load_json_file,
     load_json_text,
     load_yaml_file,
     load_yaml_text,
-    short_repr,
 )
+from semexplore_gym.config.params import ConfigError, load_yaml, merge_overrides, parse_override
+from semexplore_gym.core.validation import short_repr
 
 
 def alias_bomb(levels: int = 9, width: int = 9, key: str = "image") -> str:

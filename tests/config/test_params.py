@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import pytest
 
-from semexplore_gym.core.params import (
+from semexplore_gym.config.params import (
     ConfigError,
     build_params,
     from_dict,

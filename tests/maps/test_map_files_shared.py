@@ -9,15 +9,14 @@ import pytest
 
 from semexplore_gym.core.grid import FREE
 from semexplore_gym.core.worlds import (
-    load_ros_map,
-    make_world,
     rasterize_free,
     sample_start_pose,
     validate_start_pose,
 )
 from semexplore_gym.core.worlds.geometry import crossed_links
+from semexplore_gym.maps import load_ros_map, make_world
 
-MAPS = Path(__file__).resolve().parents[3] / ".." / "shared" / "maps"
+MAPS = Path(__file__).resolve().parents[2] / ".." / "shared" / "maps"
 
 pytestmark = [
     pytest.mark.shared_maps,

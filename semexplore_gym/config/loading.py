@@ -1,4 +1,4 @@
-"""Bounded loading of YAML / JSON and bounded printing of values.
+"""Bounded loading of YAML / JSON documents.
 
 Every YAML or JSON document the package reads from a user (map yaml, config files, ``--set``
 values, HouseExpo JSON) goes through :func:`load_yaml_text` / :func:`load_json_text` or their
@@ -11,7 +11,8 @@ file forms. They bound what a small file can turn into:
   ``&a`` / ``*a`` aliases expand to billions of values once copied or printed,
 - recursive aliases (a value that contains itself) are refused.
 
-Error messages quote values through :func:`short_repr`, so a huge value never floods stderr.
+Error messages quote values through :func:`~semexplore_gym.core.validation.short_repr`, so a
+huge value never floods stderr.
 All errors are :class:`UnsafeInputError` (a ``ValueError``) naming the file or the source.
 """
 
@@ -19,11 +20,12 @@ from __future__ import annotations
 
 import json
 import os
-import reprlib
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from semexplore_gym.core.validation import one_line, short_repr
 
 #: Largest YAML / JSON text read from a config, map yaml or ``--set`` value.
 MAX_YAML_BYTES = 1 << 20
@@ -39,35 +41,6 @@ MAX_NODES = 1_000_000
 
 class UnsafeInputError(ValueError):
     """A YAML / JSON document is malformed or beyond the loader's bounds; names its source."""
-
-
-_REPR = reprlib.Repr()
-_REPR.maxlevel = 3
-_REPR.maxlist = _REPR.maxtuple = _REPR.maxset = _REPR.maxdict = 6
-_REPR.maxstring = 80
-_REPR.maxother = 80
-_REPR.maxlong = 40
-
-
-def short_repr(value: Any, limit: int = 80) -> str:
-    """``repr(value)`` cut to at most ``limit`` characters (``...`` marks the cut).
-
-    Cheap on huge or deeply nested values: only the first few items of each container are
-    looked at, so printing an alias-expanded document costs no more than printing a small one.
-    """
-    try:
-        text = _REPR.repr(value)
-    except Exception:  # noqa: BLE001 - a broken __repr__ must not hide the real error
-        text = f"<{type(value).__name__}>"
-    if len(text) > limit:
-        text = text[: max(0, limit - 3)] + "..."
-    return text
-
-
-def one_line(text: str, limit: int = 200) -> str:
-    """``text`` on one line (whitespace runs collapsed), cut to ``limit`` characters."""
-    flat = " ".join(str(text).split())
-    return flat if len(flat) <= limit else flat[: max(0, limit - 3)] + "..."
 
 
 def _read_text(path: str | os.PathLike, max_bytes: int, what: str) -> str:
@@ -243,34 +216,3 @@ def load_json_file(path: str | os.PathLike, what: str = "JSON file", **bounds: i
     max_bytes = bounds.pop("max_bytes", MAX_JSON_BYTES)
     text = _read_text(path, max_bytes, what)
     return load_json_text(text, str(path), max_bytes=max_bytes, **bounds)
-
-
-def check_output_file(
-    path: str, flag: str, suffixes: tuple[str, ...] = (), *, parent_must_exist: bool = True
-) -> None:
-    """Refuse an output file path that cannot be written as asked, before any work is done.
-
-    Raises:
-        ValueError: ``path`` is empty, a directory, has another suffix than ``suffixes``, its
-            name is too long, or (``parent_must_exist``) its parent directory does not exist;
-            the message names ``flag``.
-    """
-    if not path or not str(path).strip():
-        raise ValueError(f"{flag} is empty; give a file path")
-    p = Path(path)
-    shown = short_repr(str(path), 120)
-    if len(p.name.encode()) > 255:
-        raise ValueError(f"{flag} {shown}: the file name is longer than 255 bytes")
-    try:
-        is_dir = p.is_dir()
-        parent_ok = p.parent.is_dir()
-    except (OSError, ValueError) as e:
-        raise ValueError(f"{flag} {shown}: {one_line(str(e))}") from None
-    if is_dir:
-        raise ValueError(f"{flag} {shown} is a directory; give a file path")
-    if suffixes and p.suffix.lower() not in suffixes:
-        raise ValueError(f"{flag} {shown} must end in {' or '.join(suffixes)}")
-    if parent_must_exist and not parent_ok:
-        raise ValueError(
-            f"{flag} {shown}: directory {short_repr(str(p.parent), 120)} does not exist"
-        )
