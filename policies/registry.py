@@ -17,6 +17,7 @@ Spec strings and their brackets are parsed by :mod:`semexplore_gym.policies.spec
 from __future__ import annotations
 
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any
 
 from semexplore_gym.policies.base import Policy
@@ -134,49 +135,18 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
     return policy
 
 
-def _python(arg: str, overrides: dict[str, Any]) -> Policy:
-    """``py:MODULE:NAME`` or ``py:path/to/file.py:NAME``: a user's own policy.
-
-    ``NAME`` is a :class:`~semexplore_gym.policies.base.Policy` subclass or a factory function returning a
-    policy; the overrides are passed to it as keyword arguments.
-    """
+def _user_module(arg: str, source: str) -> ModuleType:
+    """The module of a ``py:`` spec: ``source`` is a ``.py`` file (run once per path) or a
+    dotted module name on ``sys.path``; its failures become ValueErrors naming the spec."""
     import hashlib
     import importlib
     import importlib.util
     import sys
     from pathlib import Path
 
-    source, sep, attr = arg.rpartition(":")
-    if not sep or not source or not attr:
-        raise ValueError(
-            f"policy 'py:{arg}' must name a module or .py file and an object: "
-            "'py:my_package.planner:MyPolicy' or 'py:path/to/planner.py:MyPolicy'"
-        )
-    if source.endswith(".py"):
-        path = Path(source).resolve()
-        if not path.is_file():
-            raise FileNotFoundError(f"policy 'py:{arg}': no such file {path}")
-        digest = hashlib.sha1(str(path).encode()).hexdigest()[:12]
-        mod_name = f"_semexplore_user_policy_{path.stem}_{digest}"
-        module = sys.modules.get(mod_name)
-        if module is None:
-            spec = importlib.util.spec_from_file_location(mod_name, path)
-            assert spec is not None and spec.loader is not None
-            module = importlib.util.module_from_spec(spec)
-            sys.modules[mod_name] = module
-            try:
-                spec.loader.exec_module(module)
-            except BaseException as e:
-                del sys.modules[mod_name]
-                if isinstance(e, (Exception, SystemExit)):
-                    raise ValueError(
-                        f"policy 'py:{arg}': running {path.name} raised {type(e).__name__}: "
-                        f"{str(e)[:200]}"
-                    ) from None
-                raise
-    else:
+    if not source.endswith(".py"):
         try:
-            module = importlib.import_module(source)
+            return importlib.import_module(source)
         except ModuleNotFoundError as e:
             raise ValueError(
                 f"policy 'py:{arg}': cannot import module {source!r} ({e}); is it on PYTHONPATH?"
@@ -185,6 +155,43 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
             raise ValueError(
                 f"policy 'py:{arg}': importing {source!r} raised {type(e).__name__}: {str(e)[:200]}"
             ) from None
+    path = Path(source).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"policy 'py:{arg}': no such file {path}")
+    digest = hashlib.sha1(str(path).encode()).hexdigest()[:12]
+    mod_name = f"_semexplore_user_policy_{path.stem}_{digest}"
+    module = sys.modules.get(mod_name)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(mod_name, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[mod_name] = module
+        try:
+            spec.loader.exec_module(module)
+        except BaseException as e:
+            del sys.modules[mod_name]
+            if isinstance(e, (Exception, SystemExit)):
+                raise ValueError(
+                    f"policy 'py:{arg}': running {path.name} raised {type(e).__name__}: "
+                    f"{str(e)[:200]}"
+                ) from None
+            raise
+    return module
+
+
+def _python(arg: str, overrides: dict[str, Any]) -> Policy:
+    """``py:MODULE:NAME`` or ``py:path/to/file.py:NAME``: a user's own policy.
+
+    ``NAME`` is a :class:`~semexplore_gym.policies.base.Policy` subclass or a factory function returning a
+    policy; the overrides are passed to it as keyword arguments.
+    """
+    source, sep, attr = arg.rpartition(":")
+    if not sep or not source or not attr:
+        raise ValueError(
+            f"policy 'py:{arg}' must name a module or .py file and an object: "
+            "'py:my_package.planner:MyPolicy' or 'py:path/to/planner.py:MyPolicy'"
+        )
+    module = _user_module(arg, source)
     if not hasattr(module, attr):
         raise ValueError(f"policy 'py:{arg}': module {source!r} has no attribute {attr!r}")
     target = getattr(module, attr)

@@ -64,6 +64,8 @@ LAYERS: list[Layer] = [
             "shutil",
             "zipfile",
             "PIL",
+            "os",
+            "pathlib",
         ),
     ),
     # Config and file input: build_params, bounded YAML/JSON reading, output path checks.

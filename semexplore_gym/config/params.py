@@ -38,6 +38,7 @@ def _field_types(cls: type) -> dict[str, Any]:
 
 
 def _coerce(value: Any, tp: Any, path: str) -> Any:
+    """``value`` checked against the annotation ``tp`` and converted; errors name ``path``."""
     origin = typing.get_origin(tp)
     args = typing.get_args(tp)
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
@@ -77,6 +78,11 @@ def _coerce(value: Any, tp: Any, path: str) -> Any:
         inner = args[0] if args else Any
         seq = [_coerce(v, inner, f"{path}[{i}]") for i, v in enumerate(value)]
         return tuple(seq) if origin is tuple else seq
+    return _coerce_scalar(value, tp, path)
+
+
+def _coerce_scalar(value: Any, tp: Any, path: str) -> Any:
+    """``value`` as the scalar type ``tp`` (bool, int, float, str; strings are parsed)."""
     if tp is Any:
         return value
     if tp is bool:

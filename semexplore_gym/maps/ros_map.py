@@ -139,29 +139,7 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
             f"{MAX_RESOLUTION_M} m per cell, got {resolution_m!r}"
         )
 
-    if "origin" not in doc:
-        raise ValueError(f"{yaml_path}: missing required key 'origin'")
-    origin = doc["origin"]
-    if (
-        not isinstance(origin, (list, tuple))
-        or len(origin) not in (2, 3)
-        or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
-            for v in origin
-        )
-    ):
-        raise ValueError(
-            f"{yaml_path}: key 'origin' must be [x, y, yaw] numbers, got {short_repr(origin)}"
-        )
-    if max(abs(float(v)) for v in origin[:2]) > MAX_ORIGIN_M:
-        raise ValueError(
-            f"{yaml_path}: key 'origin' {short_repr(origin)} is more than {MAX_ORIGIN_M:g} m "
-            "from 0 (float precision); move the origin"
-        )
-    if len(origin) == 3 and abs(float(origin[2])) > 1e-9:
-        raise ValueError(
-            f"{yaml_path}: key 'origin' has yaw {short_repr(origin[2])}; only yaw 0 maps are supported"
-        )
+    origin = _origin(doc, yaml_path)
 
     negate_raw = doc.get("negate", 0)
     if negate_raw not in (0, 1):
@@ -189,6 +167,34 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
         free_thresh=free_thresh,
         mode=mode.strip().lower(),
     )
+
+
+def _origin(doc: dict, yaml_path: Path) -> list:
+    """The yaml's ``origin``, checked: ``[x, y]`` or ``[x, y, 0]`` finite numbers near 0."""
+    if "origin" not in doc:
+        raise ValueError(f"{yaml_path}: missing required key 'origin'")
+    origin = doc["origin"]
+    if (
+        not isinstance(origin, (list, tuple))
+        or len(origin) not in (2, 3)
+        or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+            for v in origin
+        )
+    ):
+        raise ValueError(
+            f"{yaml_path}: key 'origin' must be [x, y, yaw] numbers, got {short_repr(origin)}"
+        )
+    if max(abs(float(v)) for v in origin[:2]) > MAX_ORIGIN_M:
+        raise ValueError(
+            f"{yaml_path}: key 'origin' {short_repr(origin)} is more than {MAX_ORIGIN_M:g} m "
+            "from 0 (float precision); move the origin"
+        )
+    if len(origin) == 3 and abs(float(origin[2])) > 1e-9:
+        raise ValueError(
+            f"{yaml_path}: key 'origin' has yaw {short_repr(origin[2])}; only yaw 0 maps are supported"
+        )
+    return origin
 
 
 def _resolve_image(yaml_path: Path, image: str) -> Path:
