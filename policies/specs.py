@@ -78,7 +78,7 @@ def load_policy_config(source: str | os.PathLike | Mapping[str, Any] | None) -> 
     return PolicyRunConfig(env=data.get("env"), policy=policy, params=dict(params))
 
 
-def _bracket(spec: str) -> tuple[str, str | None]:
+def split_bracket(spec: str) -> tuple[str, str | None]:
     """``"semantic[x]"`` -> ``("semantic", "x")``; a spec without a trailing bracket -> (spec, None)."""
     spec = spec.strip()
     if spec.endswith("]") and "[" in spec:
@@ -133,7 +133,7 @@ def parse_spec(spec: str) -> tuple[str, str | None, dict[str, Any]]:
     """
     if not isinstance(spec, str) or not spec.strip():
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
-    base, inner = _bracket(spec)
+    base, inner = split_bracket(spec)
     if inner is None:
         if "[" in spec or "]" in spec:
             raise ValueError(
@@ -170,4 +170,4 @@ def parse_spec(spec: str) -> tuple[str, str | None, dict[str, Any]]:
 
 def strip_label(spec: str) -> str:
     """``"semantic[tuned]"`` or ``"semantic[cost.w_v=0]"`` -> ``"semantic"``."""
-    return _bracket(spec)[0]
+    return split_bracket(spec)[0]

@@ -465,11 +465,14 @@ def policy_label(spec: str) -> str:
     ``sb3:runs/fc/model.zip`` becomes ``sb3:model.zip``; built-in specs such as
     ``semantic[paper]`` are returned unchanged (tables always keep the full spec).
     """
+    from semexplore_gym.policies.specs import split_bracket
+
     name, _, rest = spec.partition(":")
     if name not in ("sb3", "py") or not rest:
         return spec
-    if spec.endswith("]") and "[" in spec:
-        return spec[spec.rindex("[") + 1 : -1].strip() or spec
+    inner = split_bracket(spec)[1]
+    if inner is not None:
+        return inner or spec
     return f"{name}:{Path(rest).name}"
 
 
