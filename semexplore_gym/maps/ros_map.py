@@ -169,7 +169,7 @@ def read_ros_map_yaml(path: str | os.PathLike) -> RosMapMetadata:
     )
 
 
-def _origin(doc: dict, yaml_path: Path) -> list:
+def _origin(doc: dict, yaml_path: Path) -> list | tuple:
     """The yaml's ``origin``, checked: ``[x, y]`` or ``[x, y, 0]`` finite numbers near 0."""
     if "origin" not in doc:
         raise ValueError(f"{yaml_path}: missing required key 'origin'")
