@@ -32,7 +32,7 @@ from semexplore_gym.policies.base import Policy
 from semexplore_gym.policies.macro_driver import ExpertDriver
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,

@@ -10,7 +10,7 @@ agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
 with the built-in ones). A spec may carry an argument after a colon. Keyword overrides set
 fields of the policy's parameter dataclass, nested (``cost={"w_v": 2}``) or dotted
 (``**{"cost.w_v": 2}``); ``params=`` gives the layer to start from (a parameter object, a
-mapping or a YAML file), all merged by :func:`semexplore_gym.config.params.build_params`.
+mapping or a YAML file), all merged by :func:`semexplore_gym.config.build_params`.
 Spec strings and their brackets are parsed by :mod:`semexplore_gym.policies.specs`.
 """
 
@@ -23,7 +23,7 @@ from typing import Any
 from semexplore_gym.policies.base import Policy
 from semexplore_gym.policies.specs import parse_spec
 
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 
 Factory = Callable[[str, dict[str, Any]], Policy]
 

@@ -10,7 +10,7 @@
   ``key=value`` items into ``make_policy`` keyword arguments.
 
 A policy's parameters are then built like every other parameter set, by
-:func:`semexplore_gym.config.params.build_params`: layers (a mapping with nested or dotted
+:func:`semexplore_gym.config.build_params`: layers (a mapping with nested or dotted
 keys, a YAML file, a parameter object) then ``key=value`` overrides.
 
 An explore/benchmark config file (e.g. ``configs/expert/paper.yaml``) has up to three sections::
@@ -31,7 +31,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from semexplore_gym.config.params import ConfigError, load_yaml, merge_overrides, parse_override
+from semexplore_gym.config import ConfigError, load_yaml, merge_overrides, parse_override
 
 
 @dataclass(frozen=True)

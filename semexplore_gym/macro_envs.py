@@ -21,7 +21,7 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 from semexplore_gym.policies.macro_driver import ExpertDriver
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams

@@ -249,7 +249,7 @@ def run(args: argparse.Namespace) -> int:
     _check_policies(policies)
     from pathlib import Path
 
-    from semexplore_gym.config.params import to_dict
+    from semexplore_gym.config import to_dict
     from semexplore_gym.envs.config import load_env_config
 
     suites: list[dict[str, Any]] = []

@@ -31,7 +31,7 @@ from typing import Any
 import yaml
 
 from semexplore_gym.cli._flags import add_renamed_flag
-from semexplore_gym.config.params import ConfigError, to_dict
+from semexplore_gym.config import ConfigError, to_dict
 
 ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value")
 

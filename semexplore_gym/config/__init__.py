@@ -1,15 +1,13 @@
 """Configuration and file input, one layer above the pure algorithms of ``core``.
 
-- :mod:`~semexplore_gym.config.params`: the one config path, :func:`build_params` (preset ->
+- :mod:`~semexplore_gym.config.builder`: the one config path, :func:`build_params` (preset ->
   YAML -> mapping -> ``a.b=value`` overrides into a frozen dataclass), :func:`from_dict`,
   :func:`to_dict`, :func:`merge_overrides` and :class:`ConfigError`.
 - :mod:`~semexplore_gym.config.loading`: bounded YAML / JSON reading (size, depth, aliases).
 - :mod:`~semexplore_gym.config.output_paths`: output file checks made before any work is done.
 """
 
-from semexplore_gym.config.loading import UnsafeInputError, load_json_file, load_yaml_file
-from semexplore_gym.config.output_paths import check_output_file
-from semexplore_gym.config.params import (
+from semexplore_gym.config.builder import (
     ConfigError,
     build_params,
     from_dict,
@@ -19,6 +17,8 @@ from semexplore_gym.config.params import (
     parse_override,
     to_dict,
 )
+from semexplore_gym.config.loading import UnsafeInputError, load_json_file, load_yaml_file
+from semexplore_gym.config.output_paths import check_output_file
 
 __all__ = [
     "ConfigError",

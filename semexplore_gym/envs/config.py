@@ -8,7 +8,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
 from semexplore_gym.sim.lidar import LidarParams
@@ -145,7 +145,7 @@ def load_env_config(
 ) -> EnvConfig:
     """Resolve ``config`` (None, a preset name, a YAML path, a mapping or an EnvConfig) plus overrides.
 
-    :func:`~semexplore_gym.config.params.build_params` with the env's :data:`PRESETS`.
+    :func:`~semexplore_gym.config.build_params` with the env's :data:`PRESETS`.
 
     Args:
         config: What to start from; a string that is not a preset name is read as a YAML file.

@@ -132,7 +132,7 @@ def _warm_up_config_key(env_config: Any) -> str:
     suite worlds that differ only in ``episode.max_time_s`` warm up once."""
     if env_config is None or isinstance(env_config, str):
         return repr(env_config)
-    from semexplore_gym.config.params import to_dict
+    from semexplore_gym.config import to_dict
 
     d = to_dict(env_config)
     if not isinstance(d, dict):
@@ -327,7 +327,7 @@ def run_fingerprint(
     When every mission shares one time limit and env config they are stored once
     (``max_time_s``, ``env_config``); a suite's per-world limits go to ``world_settings``.
     """
-    from semexplore_gym.config.params import to_dict
+    from semexplore_gym.config import to_dict
 
     per_world: dict[str, Any] = {}
     for t in tasks:

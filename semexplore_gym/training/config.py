@@ -1,7 +1,7 @@
 """The configuration of a training run (``semexplore train``): frozen sections, strict keys.
 
 One YAML file (``configs/agents/*.yml``) plus ``key.path=value`` overrides, read by
-:func:`load_train_config` with :func:`semexplore_gym.config.params.from_dict`; the ``egocentric``
+:func:`load_train_config` with :func:`semexplore_gym.config.from_dict`; the ``egocentric``
 section is :class:`EgocentricParams` itself, so the features the learner sees are defined once.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 from semexplore_gym.core.features.egocentric import EgocentricParams
 
 #: The base env id; any other ``env.env_id`` is a macro-action env with its own observation.

@@ -130,7 +130,7 @@ class FrontierValueTrainConfig:
 
 def load_frontier_value_config(path: str | None, overrides: list[str]) -> FrontierValueTrainConfig:
     """Config from YAML ``path`` (or defaults) with ``key=value`` overrides applied."""
-    from semexplore_gym.config.params import build_params
+    from semexplore_gym.config import build_params
 
     return build_params(FrontierValueTrainConfig, path, overrides=overrides)
 

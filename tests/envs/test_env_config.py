@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from semexplore_gym.config.params import ConfigError, build_params
+from semexplore_gym.config import ConfigError, build_params
 from semexplore_gym.envs.config import PRESETS, EnvConfig, load_env_config
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import semexplore_gym  # noqa: F401  (registers the env)
-from semexplore_gym.config.params import ConfigError
+from semexplore_gym.config import ConfigError
 
 
 def test_free_area_change_is_the_net_change_of_the_maps_free_area() -> None:

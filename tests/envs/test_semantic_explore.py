@@ -11,7 +11,7 @@ import pytest
 
 import semexplore_gym
 from semexplore_gym import FREE, OCCUPIED, UNKNOWN
-from semexplore_gym.config.params import ConfigError
+from semexplore_gym.config import ConfigError
 
 
 def _make(**kw):

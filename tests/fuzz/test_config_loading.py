@@ -7,6 +7,7 @@ import time
 import pytest
 
 from semexplore_gym.cli import main
+from semexplore_gym.config import ConfigError, load_yaml, merge_overrides, parse_override
 from semexplore_gym.config.loading import (
     UnsafeInputError,
     load_json_file,
@@ -14,7 +15,6 @@ from semexplore_gym.config.loading import (
     load_yaml_file,
     load_yaml_text,
 )
-from semexplore_gym.config.params import ConfigError, load_yaml, merge_overrides, parse_override
 from semexplore_gym.core.validation import short_repr
 
 

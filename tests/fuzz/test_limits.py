@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.cli import main
-from semexplore_gym.config.params import ConfigError
+from semexplore_gym.config import ConfigError
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.build import (
     MAX_WALL_SEGMENTS,

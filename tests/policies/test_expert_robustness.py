@@ -16,7 +16,7 @@ from semexplore_gym.policies.semantic_expert import SemanticExpertParams, Semant
 from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
 import semexplore_gym  # noqa: F401
-from semexplore_gym.config.params import build_params
+from semexplore_gym.config import build_params
 from semexplore_gym.core.frontiers.reachable import clearance_field_m, pocket_exit_path
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.worlds.build import world_from_free_mask

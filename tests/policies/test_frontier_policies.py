@@ -15,7 +15,7 @@ from semexplore_gym.policies.frontier import (
 from semexplore_gym.policies.navigation import NavStatus
 from semexplore_gym.policies.registry import make_policy
 
-from semexplore_gym.config.params import ConfigError
+from semexplore_gym.config import ConfigError
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 
 RES_M = 0.05

@@ -9,7 +9,7 @@ from semexplore_gym.policies.registry import make_policy
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.policies.specs import load_policy_config
 
-from semexplore_gym.config.params import ConfigError, build_params
+from semexplore_gym.config import ConfigError, build_params
 from semexplore_gym.core.features.macro import WEIGHT_RANGES
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import pytest
 
-from semexplore_gym.config.params import (
+from semexplore_gym.config import (
     ConfigError,
     build_params,
     from_dict,
