@@ -82,3 +82,11 @@ def test_make_policy_layers_params_then_keyword_overrides():
     assert make_policy("semantic", params=base).params == base
     with pytest.raises(ConfigError, match="cost.w_q"):
         make_policy("semantic", **{"cost.w_q": 1.0})
+
+
+def test_policy_kwargs_put_set_items_on_the_files_params():
+    cfg = load_policy_config(REPO / "configs" / "expert" / "paper.yaml")
+    kwargs = cfg.policy_kwargs(["cost.w_v=2.5", "cost.w_p=0.5"])
+    assert kwargs == {"cost": {"w_v": 2.5, "w_p": 0.5}, "params": cfg.params}
+    assert make_policy("semantic", **kwargs).params.cost.w_v == 2.5
+    assert load_policy_config(None).policy_kwargs() == {}
