@@ -15,7 +15,8 @@ Stage                   Module
 9. Paths and graph      :mod:`.paths` (cell paths), :mod:`.graph` (requests, edges, ``L_path``)
 ======================  =================================================================
 
-Stage 10 (identity) is plain Python (:mod:`.._identity`); :mod:`.._stages` calls the stages.
+Stage 10 (identity) is plain Python (:mod:`..area_identity`); :mod:`..stages` calls the
+stages.
 
 All grid kernels work on a *work grid*: a crop of the input grid whose free cells are at least
 two cells away from its edge, so neighbour look-ups of free cells never leave the array. Cells
