@@ -56,9 +56,9 @@ from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
+    PotentialFieldFollower,
     RobotLimits,
     beam_angles_rad,
-    potential_field_command,
     resample_polyline,
 )
 from semexplore_gym.core.topometric.types import TopometricMap
@@ -641,14 +641,12 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         assert plan is not None
         prm = self.params
         escaping = self._time_s < self._escape_until_s
-        cmd = potential_field_command(
+        cmd = PotentialFieldFollower(self.limits, prm.potential_field).command(
             scan,
             pose,
             plan.path_m,
             grid,
             self.geometry,
-            self.limits,
-            prm.potential_field,
             start_index=plan.progress,
             repulsion_scale=prm.escape_repulsion_scale if escaping else 1.0,
         )
