@@ -42,6 +42,7 @@ from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.policies.semantic_expert_persistence import TRAIL_CELL_M, GoalPersistence
 
 from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
@@ -567,8 +568,8 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             self.geometry,
             pose[:2],
             self.clearance_m,
+            frontiers=FrontierFilter(**self._fallback_search_kwargs()),
             clearance_field=clearance,
-            **self._fallback_search_kwargs(),
         )
         if found is None:
             return None
