@@ -2,7 +2,7 @@
 
 Only the choice of frontier changes. At each replan the expert's candidates (Algorithm 1's
 frontiers with their paper cost ``C``) are re-ranked by ``C'``, the paper's cost plus a linear
-value over the features of :mod:`semexplore_gym.core.features.frontier_value` (path length in
+value over the features of :mod:`semexplore_gym.core.features.frontier_features` (path length in
 metres, unknown area round the goal, isolation from the other frontiers, ...); the expert's goal
 commitment then works on ``C'``. Navigation, safety, retries, the grid fallback and the stop
 rule are the expert's own. With every weight at 0 it is the expert, decision for decision.
@@ -27,7 +27,7 @@ import numpy as np
 from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
-from semexplore_gym.core.features.frontier_value import FEATURE_NAMES, frontier_value_features
+from semexplore_gym.core.features.frontier_features import FEATURE_NAMES, frontier_value_features
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.validation import require_finite
 

@@ -42,6 +42,7 @@ from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 from semexplore_gym.policies.semantic_expert_persistence import TRAIL_CELL_M, GoalPersistence
 
 from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
@@ -56,9 +57,9 @@ from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
+    PotentialFieldFollower,
     RobotLimits,
     beam_angles_rad,
-    potential_field_command,
     resample_polyline,
 )
 from semexplore_gym.core.topometric.types import TopometricMap
@@ -567,8 +568,8 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
             self.geometry,
             pose[:2],
             self.clearance_m,
+            frontiers=FrontierFilter(**self._fallback_search_kwargs()),
             clearance_field=clearance,
-            **self._fallback_search_kwargs(),
         )
         if found is None:
             return None
@@ -641,14 +642,12 @@ class SemanticExpertPolicy(GoalPersistence, Policy):
         assert plan is not None
         prm = self.params
         escaping = self._time_s < self._escape_until_s
-        cmd = potential_field_command(
+        cmd = PotentialFieldFollower(self.limits, prm.potential_field).command(
             scan,
             pose,
             plan.path_m,
             grid,
             self.geometry,
-            self.limits,
-            prm.potential_field,
             start_index=plan.progress,
             repulsion_scale=prm.escape_repulsion_scale if escaping else 1.0,
         )

@@ -17,6 +17,7 @@ from semexplore_gym.policies.navigation.approaches import side_approach
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
 
 from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
     clearance_field_m,
     grid_path_to,
     nearest_reachable_frontier,
@@ -185,11 +186,13 @@ class GoalPersistence:
                 self.geometry,
                 pose[:2],
                 self.clearance_m * prm.look_clearance_fraction,
-                min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
-                min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
-                reach_m=prm.fallback_reach_m,
-                excluded_xy_m=self.memory.active_points(),
-                excluded_radius_m=prm.blacklist_radius_m,
+                FrontierFilter(
+                    min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
+                    min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
+                    reach_m=prm.fallback_reach_m,
+                    excluded_xy_m=self.memory.active_points(),
+                    excluded_radius_m=prm.blacklist_radius_m,
+                ),
                 clearance_field=clearance,
             )
             if found is None:
@@ -244,8 +247,8 @@ class GoalPersistence:
             self.geometry,
             outside,
             self.clearance_m,
+            frontiers=FrontierFilter(**self._fallback_search_kwargs()),
             clearance_field=clearance,
-            **self._fallback_search_kwargs(),
         )
         if found is None:
             return None

@@ -55,6 +55,25 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--seed", type=int, default=0, help="seed for env.reset and the policy (default: 0)"
     )
+    _add_config_flags(p)
+    p.add_argument(
+        "--max-time-s",
+        type=float,
+        default=1200.0,
+        help="simulated time limit of the mission (default: 1200)",
+    )
+    _add_output_flags(p)
+    add_renamed_flag(
+        p, "--config", "use --policy-config FILE (policy config) or --env-config (env config)"
+    )
+    add_renamed_flag(
+        p, "--set", "use --policy-set KEY=VALUE (policy parameter) or --env-set (env config)"
+    )
+    return p
+
+
+def _add_config_flags(p: argparse.ArgumentParser) -> None:
+    """The policy and env config files and their ``KEY=VALUE`` overrides."""
     p.add_argument(
         "--policy-config",
         default=None,
@@ -81,12 +100,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="SECTION.KEY=VALUE",
         help="env config override, e.g. robot.max_linear_speed_mps=0.15 (repeatable)",
     )
-    p.add_argument(
-        "--max-time-s",
-        type=float,
-        default=1200.0,
-        help="simulated time limit of the mission (default: 1200)",
-    )
+
+
+def _add_output_flags(p: argparse.ArgumentParser) -> None:
+    """What the command writes besides its metrics: the GIF, JSON, the progress bar."""
     p.add_argument(
         "--gif",
         default=None,
@@ -105,13 +122,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="print the result as one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    add_renamed_flag(
-        p, "--config", "use --policy-config FILE (policy config) or --env-config (env config)"
-    )
-    add_renamed_flag(
-        p, "--set", "use --policy-set KEY=VALUE (policy parameter) or --env-set (env config)"
-    )
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -103,6 +103,33 @@ def plot_topometric_map(
         extent=(xmin, xmax, ymin, ymax),
         interpolation="nearest",
     )
+    _draw_lines(ax, tmap, show_paths, show_edges)
+    _draw_markers(ax, tmap, show_ids)
+    from matplotlib.patches import Patch
+
+    handles = [
+        # matplotlib's stubs leave out the RGB arrays it accepts as colours.
+        Patch(color=np.asarray(TYPE_COLOURS[t]) / 255.0, label=_TYPE_LABELS[t])  # type: ignore[arg-type]
+        for t in TYPE_COLOURS
+    ]
+    ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8)
+    if title is None:
+        c = tmap.counts()
+        title = (
+            f"{c['intersections']} intersections, {c['pathways']} pathways, {c['dead_ends']} dead ends, "
+            f"{c['frontier_pathways']} frontier pathways ({tmap.time_ms:.0f} ms)"
+        )
+    ax.set_title(title, fontsize=9)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_xlim(xmin, xmax)
+    ax.set_ylim(ymin, ymax)
+    ax.set_aspect("equal")
+    return fig
+
+
+def _draw_lines(ax: Any, tmap: TopometricMap, show_paths: bool, show_edges: bool) -> None:
+    """Graph edges (optional), area paths (optional) and openings."""
     lw = 1.2
     if show_edges:
         for e in tmap.edges:
@@ -124,6 +151,10 @@ def plot_topometric_map(
             color=(0.85, 0.1, 0.75) if o.is_frontier else (0.1, 0.1, 0.1),
             lw=2.0 if o.is_frontier else 1.5,
         )
+
+
+def _draw_markers(ax: Any, tmap: TopometricMap, show_ids: bool) -> None:
+    """Intersection centres, frontier targets and (optional) area ids."""
     cx = [a.centre_m[0] for a in tmap.areas_of_type(AreaType.INTERSECTION)]
     cy = [a.centre_m[1] for a in tmap.areas_of_type(AreaType.INTERSECTION)]
     if cx:
@@ -160,27 +191,6 @@ def plot_topometric_map(
                 va="center",
                 zorder=7,
             )
-    from matplotlib.patches import Patch
-
-    handles = [
-        # matplotlib's stubs leave out the RGB arrays it accepts as colours.
-        Patch(color=np.asarray(TYPE_COLOURS[t]) / 255.0, label=_TYPE_LABELS[t])  # type: ignore[arg-type]
-        for t in TYPE_COLOURS
-    ]
-    ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8)
-    if title is None:
-        c = tmap.counts()
-        title = (
-            f"{c['intersections']} intersections, {c['pathways']} pathways, {c['dead_ends']} dead ends, "
-            f"{c['frontier_pathways']} frontier pathways ({tmap.time_ms:.0f} ms)"
-        )
-    ax.set_title(title, fontsize=9)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_xlim(xmin, xmax)
-    ax.set_ylim(ymin, ymax)
-    ax.set_aspect("equal")
-    return fig
 
 
 def save_topometric_png(

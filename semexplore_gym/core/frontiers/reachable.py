@@ -104,19 +104,49 @@ def frontier_groups(
     return remap[labels], int(keep.sum())
 
 
+@dataclass(frozen=True)
+class FrontierFilter:
+    """Which frontier cells :func:`nearest_reachable_frontier` may drive to.
+
+    Attributes:
+        min_frontier_cells: Smaller frontier groups are ignored.
+        reach_m: A goal cell lies within this distance of a frontier cell.
+        min_unknown_depth_cells: Frontier groups without unknown space this deep (in cells)
+            next to them are ignored (see :func:`frontier_groups`).
+        excluded_xy_m: Frontier cells within ``excluded_radius_m`` of these points are ignored
+            (the expert's blacklist).
+        excluded_radius_m: See ``excluded_xy_m``.
+    """
+
+    min_frontier_cells: int = 3
+    reach_m: float = 0.3
+    min_unknown_depth_cells: float = 0.0
+    excluded_xy_m: Sequence[tuple[float, float]] = ()
+    excluded_radius_m: float = 0.5
+
+
+@dataclass(frozen=True)
+class StepCost:
+    """The grid searches' step cost near walls (see the module docstring).
+
+    Attributes:
+        wall_cost: Extra step cost near walls; 0 gives shortest paths.
+        prefer_extra_m: Cells farther than ``clearance_m + prefer_extra_m`` from walls cost no
+            extra.
+    """
+
+    wall_cost: float = WALL_COST
+    prefer_extra_m: float = PREFER_EXTRA_M
+
+
 def nearest_reachable_frontier(
     grid: npt.ArrayLike,
     geometry: GridGeometry,
     start_xy_m: tuple[float, float],
     clearance_m: float,
-    min_frontier_cells: int = 3,
-    reach_m: float = 0.3,
-    min_unknown_depth_cells: float = 0.0,
-    excluded_xy_m: Sequence[tuple[float, float]] = (),
-    excluded_radius_m: float = 0.5,
+    frontiers: FrontierFilter = FrontierFilter(),
     clearance_field: np.ndarray | None = None,
-    wall_cost: float = WALL_COST,
-    prefer_extra_m: float = PREFER_EXTRA_M,
+    step_cost: StepCost = StepCost(),
 ) -> ReachableFrontier | None:
     """Search from the robot to the nearest usable cell next to a frontier.
 
@@ -126,16 +156,9 @@ def nearest_reachable_frontier(
         start_xy_m: Robot position. When its cell is not usable (too close to a wall), the
             search starts from the nearest usable cell within 0.5 m.
         clearance_m: Minimum distance from usable cells to OCCUPIED cells.
-        min_frontier_cells: Smaller frontier groups are ignored.
-        min_unknown_depth_cells: Frontier groups without unknown space this deep (in cells)
-            next to them are ignored (see :func:`frontier_groups`).
-        reach_m: A goal cell lies within this distance of a frontier cell.
-        excluded_xy_m: Frontier cells within ``excluded_radius_m`` of these points are ignored
-            (the expert's blacklist).
-        excluded_radius_m: See ``excluded_xy_m``.
+        frontiers: Which frontier cells count, and how near the goal must be to them.
         clearance_field: A precomputed :func:`clearance_field_m` of ``grid`` (optional).
-        wall_cost: Extra step cost near walls (see the module docstring); 0 gives shortest paths.
-        prefer_extra_m: Cells farther than ``clearance_m + prefer_extra_m`` from walls cost no extra.
+        step_cost: The step cost near walls.
 
     Returns:
         The :class:`ReachableFrontier`, or None when no frontier can be reached.
@@ -146,32 +169,26 @@ def nearest_reachable_frontier(
     g = checked_encoded_grid(grid)
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
+    f = frontiers
     for name, value in (
         ("clearance_m", clearance_m),
-        ("reach_m", reach_m),
-        ("excluded_radius_m", excluded_radius_m),
+        ("reach_m", f.reach_m),
+        ("excluded_radius_m", f.excluded_radius_m),
     ):
         if not (math.isfinite(value) and value >= 0.0):
             raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     res = geometry.resolution_m
-    labels, n = frontier_groups(g, min_frontier_cells, min_unknown_depth_cells)
+    labels, n = frontier_groups(g, f.min_frontier_cells, f.min_unknown_depth_cells)
     if n == 0:
         return None
-    if len(excluded_xy_m):
-        fr, fc = np.nonzero(labels)
-        fx, fy = geometry.grid_to_world(fr, fc)
-        drop = np.zeros(len(fr), dtype=bool)
-        for ex, ey in excluded_xy_m:
-            drop |= np.hypot(fx - ex, fy - ey) <= excluded_radius_m
-        labels[fr[drop], fc[drop]] = 0
-        if not labels.any():
-            return None
+    if len(f.excluded_xy_m) and not _drop_excluded(labels, geometry, f):
+        return None
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
     usable = _usable(g, dist, clearance_m)
-    near = _dilate(labels > 0, reach_m / res) if reach_m > 0 else labels > 0
+    near = _dilate(labels > 0, f.reach_m / res) if f.reach_m > 0 else labels > 0
     goal_mask = usable & near
 
-    cost = _step_cost(dist, usable, clearance_m, wall_cost, prefer_extra_m)
+    cost = _step_cost(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
     path = _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
     if path is None:
         return None
@@ -192,6 +209,17 @@ def nearest_reachable_frontier(
     )
 
 
+def _drop_excluded(labels: np.ndarray, geometry: GridGeometry, frontiers: FrontierFilter) -> bool:
+    """Unlabel (in place) the frontier cells near the excluded points; False if none is left."""
+    fr, fc = np.nonzero(labels)
+    fx, fy = geometry.grid_to_world(fr, fc)
+    drop = np.zeros(len(fr), dtype=bool)
+    for ex, ey in frontiers.excluded_xy_m:
+        drop |= np.hypot(fx - ex, fy - ey) <= frontiers.excluded_radius_m
+    labels[fr[drop], fc[drop]] = 0
+    return bool(labels.any())
+
+
 def grid_path_to(
     grid: npt.ArrayLike,
     geometry: GridGeometry,
@@ -200,8 +228,7 @@ def grid_path_to(
     clearance_m: float,
     goal_radius_m: float = 0.15,
     clearance_field: np.ndarray | None = None,
-    wall_cost: float = WALL_COST,
-    prefer_extra_m: float = PREFER_EXTRA_M,
+    step_cost: StepCost = StepCost(),
 ) -> np.ndarray | None:
     """Path over usable cells (see the module docstring) from ``start_xy_m`` to a usable cell
     within ``goal_radius_m`` of ``goal_xy_m``; ``(K, 2)`` world polyline, or None if unreachable."""
@@ -227,7 +254,7 @@ def grid_path_to(
     goal_mask &= usable
     if not goal_mask.any():
         return None
-    cost = _step_cost(dist, usable, clearance_m, wall_cost, prefer_extra_m)
+    cost = _step_cost(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
     return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
 
 

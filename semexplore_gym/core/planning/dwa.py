@@ -39,11 +39,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
-from scipy import ndimage
 
-from semexplore_gym.core.grid import OCCUPIED, GridGeometry
-from semexplore_gym.core.planning.grid_search import distance_field
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.planning.dwa_fields import distance_maps, local_clearance
+from semexplore_gym.core.planning.dwa_kernels import evaluate_trajectories
 
 __all__ = ["DWACommand", "DWAParams", "DWAPlanner", "scan_points_m"]
 
@@ -247,16 +246,7 @@ class DWAPlanner:
             The command; ``goal_reached`` when within tolerance of the path end.
         """
         prm = self.params
-        p = np.asarray(pose, dtype=np.float64).ravel()
-        if p.shape[0] < 3 or not np.isfinite(p[:3]).all():
-            raise ValueError(f"pose must be a finite (x, y, yaw), got {pose!r}")
-        x0, y0, yaw0 = float(p[0]), float(p[1]), float(p[2])
-        if np.shape(grid) != geometry.shape:
-            raise ValueError(
-                f"grid shape {np.shape(grid)} does not match geometry {geometry.shape}"
-            )
-        if not all(math.isfinite(float(v)) for v in velocity[:2]):
-            raise ValueError(f"velocity must be a finite (v, omega), got {velocity!r}")
+        x0, y0, yaw0 = _checked_pose(pose, velocity, grid, geometry)
         if self._path.shape[0] == 0:
             return DWACommand(0.0, 0.0, True, True, 0.0, np.array([[x0, y0]]))
         goal = self._path[-1]
@@ -268,6 +258,48 @@ class DWAPlanner:
             max_v = min(max_v, float(limits[0]))
             max_w = min(max_w, float(limits[1]))
         min_v = min(prm.min_linear_speed_mps, max_v)
+        vs, ws = self._dynamic_window(velocity, min_v, max_v, max_w)
+
+        res = geometry.resolution_m
+        near, clear, wx0, wy0 = local_clearance(
+            grid, geometry, x0, y0, prm.local_window_m, obstacle_points_m
+        )
+        local_path, local_goal = self._local_path(x0, y0, wx0, wy0, prm.local_window_m)
+        to_goal = math.hypot(goal[0] - x0, goal[1] - y0)
+        near_goal = to_goal <= prm.forward_point_distance_m
+        # Within one horizon at the minimum speed of the final goal the filter is lifted, or every
+        # admissible trajectory would overshoot a goal the robot can no longer settle on.
+        settling = to_goal <= prm.min_trans_speed_mps * prm.sim_time_s
+        fields = distance_maps(
+            clear,
+            wx0,
+            wy0,
+            res,
+            local_path,
+            (x0, y0),
+            prm.robot_radius_m,
+            prm.forward_point_distance_m,
+        )
+        n_steps = max(1, int(round(prm.sim_time_s / prm.sim_step_s)))
+        # 2: alignment and goal-front terms; 1: goal front only (near the goal, as ROS);
+        # 0: settling, score the position after one control period (a nose aimed beyond a
+        # goal by a wall, or a horizon end beyond it, would pin the robot short of it).
+        front_mode = 0 if settling else (1 if near_goal else 2)
+        best_i, best_j, best_cost = self._evaluate(
+            (x0, y0, yaw0), vs, ws, n_steps, near, fields, (wx0, wy0, res), local_goal, front_mode
+        )
+        if best_i < 0:
+            return DWACommand(0.0, 0.0, False, False, math.inf, np.array([[x0, y0]]))
+        v = float(np.clip(vs[best_i], min_v, max_v))
+        w = float(np.clip(ws[best_j], -max_w, max_w))
+        traj = _rollout(x0, y0, yaw0, v, w, n_steps, prm.sim_time_s / n_steps)
+        return DWACommand(v, w, True, False, float(best_cost), traj)
+
+    def _dynamic_window(
+        self, velocity: tuple[float, float], min_v: float, max_v: float, max_w: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The linear and angular speeds reachable within one control period, sampled."""
+        prm = self.params
         v_now, w_now = float(velocity[0]), float(velocity[1])
         vs = _samples(
             v_now, prm.linear_accel_mps2 * prm.control_period_s, min_v, max_v, prm.linear_samples
@@ -279,25 +311,34 @@ class DWAPlanner:
             max_w,
             prm.angular_samples,
         )
+        return vs, ws
 
-        res = geometry.resolution_m
-        near, clear, wx0, wy0 = _local_clearance(
-            grid, geometry, x0, y0, prm.local_window_m, obstacle_points_m
-        )
-        local_path, local_goal = self._local_path(x0, y0, wx0, wy0, prm.local_window_m)
-        to_goal = math.hypot(goal[0] - x0, goal[1] - y0)
-        near_goal = to_goal <= prm.forward_point_distance_m
-        # Within one horizon at the minimum speed of the final goal the filter is lifted, or every
-        # admissible trajectory would overshoot a goal the robot can no longer settle on.
-        settling = to_goal <= prm.min_trans_speed_mps * prm.sim_time_s
-        path_field, goal_field, front_field = _distance_maps(
-            clear, wx0, wy0, res, local_path, (x0, y0), prm
-        )
-        n_steps = max(1, int(round(prm.sim_time_s / prm.sim_step_s)))
-        best_i, best_j, best_cost = _evaluate(
-            x0,
-            y0,
-            yaw0,
+    def _evaluate(
+        self,
+        pose: tuple[float, float, float],
+        vs: np.ndarray,
+        ws: np.ndarray,
+        n_steps: int,
+        near: np.ndarray,
+        fields: tuple[np.ndarray, np.ndarray, np.ndarray],
+        window: tuple[float, float, float],
+        local_goal: np.ndarray,
+        front_mode: int,
+    ) -> tuple[int, int, float]:
+        """The best sample ``(i, j)`` of ``vs x ws`` and its cost (``i < 0``: none is valid).
+
+        ``fields`` are the path, goal and nose distance fields of the local window whose corner
+        and resolution are ``window``; ``front_mode`` is 2 (alignment and goal front), 1 (goal
+        front only) or 0 (settling).
+        """
+        prm = self.params
+        path_field, goal_field, front_field = fields
+        wx0, wy0, res = window
+        settling = front_mode == 0
+        return evaluate_trajectories(
+            pose[0],
+            pose[1],
+            pose[2],
             vs,
             ws,
             n_steps,
@@ -310,10 +351,7 @@ class DWAPlanner:
             wy0,
             res,
             prm.forward_point_distance_m,
-            # 2: alignment and goal-front terms; 1: goal front only (near the goal, as ROS);
-            # 0: settling, score the position after one control period (a nose aimed beyond a
-            # goal by a wall, or a horizon end beyond it, would pin the robot short of it).
-            0 if settling else (1 if near_goal else 2),
+            front_mode,
             max(1, int(round(prm.control_period_s / (prm.sim_time_s / n_steps)))),
             float(local_goal[0]),
             float(local_goal[1]),
@@ -330,12 +368,6 @@ class DWAPlanner:
             # at the fastest rate it can reach (ROS would declare failure and run a recovery).
             min(prm.min_rot_speed_radps, float(np.abs(ws).max())),
         )
-        if best_i < 0:
-            return DWACommand(0.0, 0.0, False, False, math.inf, np.array([[x0, y0]]))
-        v = float(np.clip(vs[best_i], min_v, max_v))
-        w = float(np.clip(ws[best_j], -max_w, max_w))
-        traj = _rollout(x0, y0, yaw0, v, w, n_steps, prm.sim_time_s / n_steps)
-        return DWACommand(v, w, True, False, float(best_cost), traj)
 
     def _local_path(
         self, x0: float, y0: float, wx0: float, wy0: float, window_m: float
@@ -361,6 +393,20 @@ class DWAPlanner:
         return local, local[-1]
 
 
+def _checked_pose(
+    pose: npt.ArrayLike, velocity: tuple[float, float], grid: np.ndarray, geometry: GridGeometry
+) -> tuple[float, float, float]:
+    """``(x, y, yaw)`` of a finite pose; raises on a bad pose, grid shape or velocity."""
+    p = np.asarray(pose, dtype=np.float64).ravel()
+    if p.shape[0] < 3 or not np.isfinite(p[:3]).all():
+        raise ValueError(f"pose must be a finite (x, y, yaw), got {pose!r}")
+    if np.shape(grid) != geometry.shape:
+        raise ValueError(f"grid shape {np.shape(grid)} does not match geometry {geometry.shape}")
+    if not all(math.isfinite(float(v)) for v in velocity[:2]):
+        raise ValueError(f"velocity must be a finite (v, omega), got {velocity!r}")
+    return float(p[0]), float(p[1]), float(p[2])
+
+
 def _samples(now: float, reach: float, lo: float, hi: float, n: int) -> np.ndarray:
     a = max(lo, now - reach)
     b = min(hi, now + reach)
@@ -372,118 +418,6 @@ def _samples(now: float, reach: float, lo: float, hi: float, n: int) -> np.ndarr
     return np.unique(np.concatenate([s, np.asarray(extra, dtype=np.float64)]))
 
 
-def _local_clearance(
-    grid: np.ndarray,
-    geometry: GridGeometry,
-    x0: float,
-    y0: float,
-    window_m: float,
-    points: npt.ArrayLike | None,
-) -> tuple[np.ndarray, np.ndarray, float, float]:
-    res = geometry.resolution_m
-    n = int(math.ceil(window_m / res))
-    r_c, c_c = geometry.world_to_grid(x0, y0)
-    r0 = int(r_c) - n // 2
-    c0 = int(c_c) - n // 2
-    win = np.zeros((n, n), dtype=bool)
-    h, w = geometry.shape
-    rs, re = max(r0, 0), min(r0 + n, h)
-    cs, ce = max(c0, 0), min(c0 + n, w)
-    if rs < re and cs < ce:
-        win[rs - r0 : re - r0, cs - c0 : ce - c0] = np.asarray(grid)[rs:re, cs:ce] == OCCUPIED
-    wx0 = geometry.origin_x_m + c0 * res
-    wy0 = geometry.origin_y_m + r0 * res
-    if points is not None:
-        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        pr = np.floor((pts[:, 1] - wy0) / res).astype(np.int64)
-        pc = np.floor((pts[:, 0] - wx0) / res).astype(np.int64)
-        ok = (pr >= 0) & (pr < n) & (pc >= 0) & (pc < n)
-        win[pr[ok], pc[ok]] = True
-    # Per window cell, the world position of its nearest obstacle cell centre; the rollouts
-    # measure the exact distance from each trajectory point to it, which removes most of the
-    # error of reading a per-cell distance at a point that may lie anywhere in the cell.
-    near = np.full((2, n, n), np.nan)
-    clear = np.full((n, n), np.inf)
-    if win.any():
-        d, idx = ndimage.distance_transform_edt(~win, return_indices=True)
-        near[0] = wx0 + (idx[1] + 0.5) * res
-        near[1] = wy0 + (idx[0] + 0.5) * res
-        clear = d * res
-    return np.ascontiguousarray(near), clear, wx0, wy0
-
-
-def _distance_maps(
-    clear: np.ndarray,
-    wx0: float,
-    wy0: float,
-    res: float,
-    local_path: np.ndarray,
-    robot_xy: tuple[float, float],
-    prm: DWAParams,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Flood fills over the local window (ROS MapGrid): to the path, the goal, the nose target.
-
-    Obstacle cells block the flood and cells whose centre is within the robot radius of one
-    cost 20 times more to cross, so distances are path lengths round obstacles rather than
-    straight lines through them, yet stay finite where a robot that is already too close
-    stands (ROS would mark them as obstacles and leave the robot to its recovery behaviours).
-    """
-    n = clear.shape[0]
-    cost = np.where(clear > prm.robot_radius_m, res, 20.0 * res)
-    cost[clear <= 0.0] = np.inf
-
-    def cells(points: np.ndarray) -> np.ndarray:
-        r = np.floor((points[:, 1] - wy0) / res).astype(np.int64)
-        c = np.floor((points[:, 0] - wx0) / res).astype(np.int64)
-        ok = (r >= 0) & (r < n) & (c >= 0) & (c < n)
-        return r[ok] * n + c[ok]  # flat indices; duplicates are harmless
-
-    def flood(sources: np.ndarray, start_cost: np.ndarray | None = None) -> np.ndarray:
-        rc = np.column_stack([sources // n, sources % n])
-        return distance_field(cost, rc, start_cost)[0]
-
-    def flood_from_point(p: np.ndarray) -> np.ndarray | None:
-        # Seed the 3 x 3 cells round the point with their exact distance to it, so that with
-        # bilinear lookups the field is close to Euclidean near the point, not cell-quantised.
-        r0 = int(np.floor((p[1] - wy0) / res))
-        c0 = int(np.floor((p[0] - wx0) / res))
-        rr, cc = np.mgrid[r0 - 1 : r0 + 2, c0 - 1 : c0 + 2]
-        ok = (rr >= 0) & (rr < n) & (cc >= 0) & (cc < n)
-        rr, cc = rr[ok], cc[ok]
-        if len(rr) == 0:
-            return None
-        idx = rr * n + cc
-        keep = np.isfinite(cost.ravel()[idx])
-        if not keep.any():
-            return None
-        idx, rr, cc = idx[keep], rr[keep], cc[keep]
-        d0 = np.hypot(wx0 + (cc + 0.5) * res - p[0], wy0 + (rr + 0.5) * res - p[1])
-        return flood(idx, d0)
-
-    path_idx = cells(local_path)
-    if len(path_idx) == 0:
-        inf = np.full((n, n), np.inf)
-        return inf, inf, inf
-    path_field = flood(path_idx)
-    goal = local_path[-1]
-    goal_field = flood_from_point(goal)
-    if goal_field is None:
-        goal_field = flood(path_idx[-1:])
-    # ROS aims the nose at a point beyond the local goal, along the robot-to-goal direction, so
-    # the robot centre can settle on the goal itself (goal_front_costs).
-    d = np.array([goal[0] - robot_xy[0], goal[1] - robot_xy[1]])
-    norm = float(np.hypot(*d))
-    front_field = goal_field
-    if norm > 1e-9:
-        front = goal + prm.forward_point_distance_m * d / norm
-        front_idx = cells(front[None, :])
-        if len(front_idx) and cost.ravel()[front_idx[0]] == res:
-            shifted = flood_from_point(front)
-            if shifted is not None:
-                front_field = shifted
-    return path_field, goal_field, front_field
-
-
 def _rollout(x, y, yaw, v, w, n_steps, dt) -> np.ndarray:
     out = np.empty((n_steps + 1, 2))
     out[0] = (x, y)
@@ -493,160 +427,3 @@ def _rollout(x, y, yaw, v, w, n_steps, dt) -> np.ndarray:
         yaw += w * dt
         out[k] = (x, y)
     return out
-
-
-@njit(cache=True)
-def _evaluate(
-    x0,
-    y0,
-    yaw0,
-    vs,
-    ws,
-    n_steps,
-    dt,
-    near,
-    path_field,
-    goal_field,
-    front_field,
-    wx0,
-    wy0,
-    res,
-    fwd,
-    front_mode,
-    ctrl_steps,
-    gx,
-    gy,
-    min_clear,
-    path_bias,
-    goal_bias,
-    occ_scale,
-    inscribed,
-    infl_radius,
-    scaling,
-    min_trans,
-    min_rot,
-    min_spin,
-):  # pragma: no cover - numba
-    n = near.shape[1]
-    now_clear = _clearance(near, x0, y0, wx0, wy0, res)
-    # A robot already too close may not get closer (give or take 5 mm, so that it can still
-    # leave along a wall at a heading a hair off parallel); otherwise keep the full clearance.
-    limit = min(min_clear, now_clear - 0.005)
-    best_cost = np.inf
-    best_i = -1
-    best_j = -1
-    # Faster samples first so that ties go to the faster trajectory.
-    for ii in range(vs.shape[0]):
-        i = vs.shape[0] - 1 - ii
-        v = vs[i]
-        for j in range(ws.shape[0]):
-            w = ws[j]
-            if abs(v) < min_trans and abs(w) < min_rot and not (v == 0.0 and abs(w) >= min_spin):
-                continue
-            x = x0
-            y = y0
-            yaw = yaw0
-            lowest = np.inf
-            ok = True
-            xc = x0
-            yc = y0
-            for k in range(n_steps):
-                x += v * math.cos(yaw) * dt
-                y += v * math.sin(yaw) * dt
-                yaw += w * dt
-                if k + 1 == ctrl_steps:
-                    xc = x
-                    yc = y
-                r = int(math.floor((y - wy0) / res))
-                c = int(math.floor((x - wx0) / res))
-                if r < 0 or r >= n or c < 0 or c >= n:
-                    ok = False
-                    break
-                d = _clearance(near, x, y, wx0, wy0, res)
-                if d < lowest:
-                    lowest = d
-                if d < limit:
-                    ok = False
-                    break
-            if not ok:
-                continue
-            # Inside the margin a trajectory must end at least as far out as it started, so
-            # that repeated small dips cannot ratchet the robot into the wall.
-            if now_clear < min_clear and _clearance(near, x, y, wx0, wy0, res) < now_clear:
-                continue
-            pd_end = _lookup(path_field, x, y, wx0, wy0, res)
-            gd_end = _lookup(goal_field, x, y, wx0, wy0, res)
-            if not (pd_end < np.inf and gd_end < np.inf):
-                continue  # end point cut off from the path or the goal (ROS: invalid)
-            fx = x + fwd * math.cos(yaw)
-            fy = y + fwd * math.sin(yaw)
-            pd_front = _lookup(path_field, fx, fy, wx0, wy0, res)
-            gd_front = _lookup(front_field, fx, fy, wx0, wy0, res)
-            # A nose inside a wall or off the window scores as if it were one step further.
-            if not pd_front < np.inf:
-                pd_front = pd_end + fwd
-            if not gd_front < np.inf:
-                gd_front = _lookup(front_field, x, y, wx0, wy0, res) + fwd
-                if not gd_front < np.inf:
-                    gd_front = gd_end + fwd
-            if lowest <= inscribed:
-                occ = 253.0
-            elif lowest > infl_radius:
-                occ = 0.0
-            else:
-                occ = math.floor(252.0 * math.exp(-scaling * (lowest - inscribed)))
-            if front_mode == 2:
-                cost = 0.5 * path_bias * (pd_end + pd_front) + 0.5 * goal_bias * (gd_end + gd_front)
-            elif front_mode == 1:
-                cost = 0.5 * path_bias * pd_end + 0.5 * goal_bias * (gd_end + gd_front)
-            else:
-                # Settling: where the robot will be after this control period, as near the goal
-                # as possible (the horizon's end point would overshoot at any admissible speed).
-                # The obstacle cost is left out, or a goal in the inflated band next to a wall
-                # could never be reached; the clearance test still applies.
-                occ = 0.0
-                cost = goal_bias * math.hypot(xc - gx, yc - gy)
-            cost += occ_scale * occ
-            if cost < best_cost - 1e-12:
-                best_cost = cost
-                best_i = i
-                best_j = j
-    return best_i, best_j, best_cost
-
-
-@njit(cache=True, inline="always")
-def _lookup(field, x, y, wx0, wy0, res):  # pragma: no cover - numba
-    """Bilinear interpolation between cell centres; the nearest cell where a corner is inf."""
-    n = field.shape[0]
-    r = int(math.floor((y - wy0) / res))
-    c = int(math.floor((x - wx0) / res))
-    if r < 0 or r >= n or c < 0 or c >= n:
-        return np.inf
-    fy = (y - wy0) / res - 0.5
-    fx = (x - wx0) / res - 0.5
-    r0 = int(math.floor(fy))
-    c0 = int(math.floor(fx))
-    if r0 < 0 or c0 < 0 or r0 + 1 >= n or c0 + 1 >= n:
-        return field[r, c]
-    a = field[r0, c0]
-    b = field[r0, c0 + 1]
-    cc = field[r0 + 1, c0]
-    d = field[r0 + 1, c0 + 1]
-    if not (a < np.inf and b < np.inf and cc < np.inf and d < np.inf):
-        return field[r, c]
-    ty = fy - r0
-    tx = fx - c0
-    return (a * (1 - tx) + b * tx) * (1 - ty) + (cc * (1 - tx) + d * tx) * ty
-
-
-@njit(cache=True, inline="always")
-def _clearance(near, x, y, wx0, wy0, res):  # pragma: no cover - numba
-    n = near.shape[1]
-    r = int(math.floor((y - wy0) / res))
-    c = int(math.floor((x - wx0) / res))
-    if r < 0 or r >= n or c < 0 or c >= n:
-        return np.inf
-    ox = near[0, r, c]
-    if not ox == ox:  # NaN: no obstacle in the window
-        return np.inf
-    return math.hypot(x - ox, y - near[1, r, c])

@@ -42,13 +42,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, NamedTuple, cast
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 import numpy as np
 
-from semexplore_gym.core.grid import wrap_angle_rad
 from semexplore_gym.core.lazy_field import LazyField
-from semexplore_gym.core.planning.graph_search_kernels import first_leg_offers, search_by_opening
+from semexplore_gym.core.planning.graph_paths import PathParts, SearchPath, first_legs, path_parts
+from semexplore_gym.core.planning.graph_search_kernels import search_by_opening
+from semexplore_gym.core.planning.polyline import heading_angle, polyline_length
 from semexplore_gym.core.topometric.types import Frontier, TopometricMap
 from semexplore_gym.core.validation import require_finite
 
@@ -81,25 +82,6 @@ class FrontierCostWeights:
             )
 
 
-class _PathParts:
-    """A candidate's polyline as the pieces :func:`_assemble` joins (built when first read: a
-    replan scores tens of frontiers and drives to one)."""
-
-    __slots__ = ("parts",)
-
-    def __init__(self, parts: list[np.ndarray]) -> None:
-        self.parts = parts
-
-    def __getstate__(self) -> dict[str, Any]:
-        return {"parts": self.parts}
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.parts = state["parts"]
-
-    def build(self) -> np.ndarray:
-        return _dedupe(np.concatenate(self.parts, axis=0))
-
-
 @dataclass(frozen=True)
 class FrontierCandidate:
     """The cheapest path found to one frontier, with every term of its cost.
@@ -125,7 +107,7 @@ class FrontierCandidate:
     if TYPE_CHECKING:
         path_m: np.ndarray
     else:
-        path_m: np.ndarray = LazyField(_PathParts, _PathParts.build)
+        path_m: np.ndarray = LazyField(PathParts, PathParts.build)
     opening_ids: tuple[int, ...]
     d_m: float
     v_rad: float
@@ -155,15 +137,6 @@ class SearchStats:
     n_pushed: int
     n_popped: int
     n_pruned: int
-
-
-class _Partial(NamedTuple):
-    """A path of the search (a named tuple: the search builds thousands)."""
-
-    nodes: tuple[int, ...]
-    edges: tuple[int, ...]
-    cost: float
-    length_m: float
 
 
 def resolve_path_length_m(tmap: TopometricMap, weights: FrontierCostWeights) -> float:
@@ -251,36 +224,10 @@ def search_frontier_paths(
             frontier_at[f.opening_id] = f
 
     by_opening = prune_by == "opening"
-
-    def slot(node: int, via_edge: int | None) -> int | tuple[str, int]:
-        # Which A_cost entry a path ending at `node` competes for (by opening: the node).
-        if by_opening:
-            return node
-        here = tmap.edges[via_edge].area_id if via_edge is not None else robot_area
-        ids = tmap.openings[node].area_ids if 0 <= node < len(tmap.openings) else (here,)
-        beyond = [a for a in ids if a >= 0 and a != here]
-        # A frontier opening leads into unknown space: it keeps its own slot.
-        return ("a", beyond[0]) if beyond else ("o", node)
-
-    first_legs = _first_legs(tmap, robot_area, (rx, ry))
-    a_cost: dict[int | tuple[str, int], float] = {}
-    search_list: list[_Partial] = []
-    n_pushed = n_popped = n_pruned = 0
-    leg_start_angle: dict[int, float] = {}
-    for node, leg in first_legs.items():
-        v = _heading_angle(leg, (rx, ry), yaw, w.heading_lookahead_m)
-        leg_start_angle[node] = v
-        leg_m = _polyline_length(leg)
-        cost = w.w_v * v + leg_m / l_path
-        key = slot(node, None)
-        if a_cost.get(key, math.inf) <= cost:
-            n_pruned += 1
-            continue
-        a_cost[key] = cost
-        search_list.append(_Partial((node,), (), cost, leg_m))
-        n_pushed += 1
-    n_seeds = n_pushed
-
+    slot = _slot_function(tmap, robot_area, by_opening)
+    legs = first_legs(tmap, robot_area, (rx, ry))
+    a_cost, search_list, leg_start_angle, n_pruned = _seed(legs, (rx, ry), yaw, w, l_path, slot)
+    n_seeds = n_pushed = len(search_list)
     if by_opening:
         best, counts = _search_by_opening(
             tmap, robot_area, frontier_at, a_cost, search_list, l_path
@@ -290,11 +237,58 @@ def search_frontier_paths(
             tmap, robot_area, frontier_at, a_cost, search_list, l_path, slot
         )
     n_pushed += counts[0]
-    n_popped += counts[1]
+    n_popped = counts[1]
     n_pruned += counts[2]
 
-    candidates = _score_candidates(tmap, best, frontier_at, first_legs, leg_start_angle, l_path, w)
+    candidates = _score_candidates(tmap, best, frontier_at, legs, leg_start_angle, l_path, w)
     return candidates, SearchStats(robot_area, n_seeds, n_pushed, n_popped, n_pruned)
+
+
+def _slot_function(
+    tmap: TopometricMap, robot_area: int, by_opening: bool
+) -> Callable[[int, int | None], Any]:
+    """Which ``A_cost`` entry a path ending at ``node`` (entered by edge ``via_edge``) competes
+    for: by opening, the node; by area, the area beyond the node."""
+
+    def slot(node: int, via_edge: int | None) -> int | tuple[str, int]:
+        if by_opening:
+            return node
+        here = tmap.edges[via_edge].area_id if via_edge is not None else robot_area
+        ids = tmap.openings[node].area_ids if 0 <= node < len(tmap.openings) else (here,)
+        beyond = [a for a in ids if a >= 0 and a != here]
+        # A frontier opening leads into unknown space: it keeps its own slot.
+        return ("a", beyond[0]) if beyond else ("o", node)
+
+    return slot
+
+
+def _seed(
+    legs: dict[int, np.ndarray],
+    robot_xy: tuple[float, float],
+    yaw: float,
+    w: FrontierCostWeights,
+    l_path: float,
+    slot: Callable[[int, int | None], Any],
+) -> tuple[dict[Any, float], list[SearchPath], dict[int, float], int]:
+    """The first neighbours: one search path per first leg, costing ``w_v * v`` plus the leg's
+    length over ``L_path``. Returns ``A_cost``, the search list, each leg's angle ``v`` and the
+    seeds pruned."""
+    a_cost: dict[Any, float] = {}
+    search_list: list[SearchPath] = []
+    leg_start_angle: dict[int, float] = {}
+    n_pruned = 0
+    for node, leg in legs.items():
+        v = heading_angle(leg, robot_xy, yaw, w.heading_lookahead_m)
+        leg_start_angle[node] = v
+        leg_m = polyline_length(leg)
+        cost = w.w_v * v + leg_m / l_path
+        key = slot(node, None)
+        if a_cost.get(key, math.inf) <= cost:
+            n_pruned += 1
+            continue
+        a_cost[key] = cost
+        search_list.append(SearchPath((node,), (), cost, leg_m))
+    return a_cost, search_list, leg_start_angle, n_pruned
 
 
 def _edge_lists(
@@ -322,9 +316,9 @@ def _search_by_opening(
     robot_area: int,
     frontier_at: dict[int, Frontier],
     a_cost: dict[Any, float],
-    seeds: list[_Partial],
+    seeds: list[SearchPath],
     l_path: float,
-) -> tuple[dict[int, tuple[float, _Partial]], tuple[int, int, int]]:
+) -> tuple[dict[int, tuple[float, SearchPath]], tuple[int, int, int]]:
     """The search loop with one ``A_cost`` slot per opening, compiled
     (:func:`~semexplore_gym.core.planning.graph_search_kernels.search_by_opening`).
 
@@ -359,7 +353,7 @@ def _search_by_opening(
         )
     )  # fmt: skip
     rec_node_l, rec_edge_l, rec_parent_l = rec_node.tolist(), rec_edge.tolist(), rec_parent.tolist()
-    best: dict[int, tuple[float, _Partial]] = {}
+    best: dict[int, tuple[float, SearchPath]] = {}
     for d in order.tolist():
         r = int(best_rec[d])
         nodes: list[int] = []
@@ -373,7 +367,7 @@ def _search_by_opening(
         cost = float(rec_cost[r])
         best[ids[d]] = (
             cost,
-            _Partial(tuple(nodes[::-1]), tuple(edges[::-1]), cost, float(rec_len[r])),
+            SearchPath(tuple(nodes[::-1]), tuple(edges[::-1]), cost, float(rec_len[r])),
         )
     return best, (int(n_pushed) - len(seeds), int(n_popped), int(n_pruned))
 
@@ -383,10 +377,10 @@ def _search_by_area(
     robot_area: int,
     frontier_at: dict[int, Frontier],
     a_cost: dict[Any, float],
-    search_list: list[_Partial],
+    search_list: list[SearchPath],
     l_path: float,
     slot: Callable[[int, int | None], Any],
-) -> tuple[dict[int, tuple[float, _Partial]], tuple[int, int, int]]:
+) -> tuple[dict[int, tuple[float, SearchPath]], tuple[int, int, int]]:
     """The search loop with one ``A_cost`` slot per area (the paper's pseudocode), in Python.
 
     Returns the cheapest path to each frontier reached and the pushes, pops and prunings after
@@ -396,7 +390,7 @@ def _search_by_area(
     for a, b, k, d_m in zip(*_edge_lists(tmap, robot_area), strict=True):
         adjacency.setdefault(a, []).append((b, k, d_m))
     n_pushed = n_popped = n_pruned = 0
-    best: dict[int, tuple[float, _Partial]] = {}
+    best: dict[int, tuple[float, SearchPath]] = {}
     while search_list:
         path = search_list.pop()
         n_popped += 1
@@ -420,7 +414,7 @@ def _search_by_area(
                 continue
             a_cost[key] = new_cost
             search_list.append(
-                _Partial(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m)
+                SearchPath(path.nodes + (nbr,), path.edges + (k,), new_cost, path.length_m + d_m)
             )
             n_pushed += 1
     return best, (n_pushed, n_popped, n_pruned)
@@ -428,7 +422,7 @@ def _search_by_area(
 
 def _score_candidates(
     tmap: TopometricMap,
-    best: dict[int, tuple[float, _Partial]],
+    best: dict[int, tuple[float, SearchPath]],
     frontier_at: dict[int, Frontier],
     first_legs: dict[int, np.ndarray],
     leg_start_angle: dict[int, float],
@@ -444,7 +438,7 @@ def _score_candidates(
         f = frontier_at[node]
         p_l, n_open, n_fp = semantic_terms(tmap, f)
         gain = w.w_p * p_l + w.w_i * (n_open + n_fp)
-        poly = _path_parts(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
+        poly = path_parts(tmap, path, first_legs[path.nodes[0]], f.midpoint_m, polylines)
         candidates.append(
             FrontierCandidate(
                 frontier=f,
@@ -464,188 +458,3 @@ def _score_candidates(
         )
     candidates.sort(key=lambda c: (c.cost, c.d_m))
     return candidates
-
-
-# --- metric helpers -------------------------------------------------------------------------
-
-
-def _polyline_length(poly: np.ndarray) -> float:
-    if len(poly) < 2:
-        return 0.0
-    d = poly[1:] - poly[:-1]
-    return float(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).sum())
-
-
-def _heading_angle(
-    poly: np.ndarray, robot_xy: tuple[float, float], yaw: float, lookahead_m: float
-) -> float:
-    """Angle in [0, pi] between the heading and the direction to the point ``lookahead_m`` along ``poly``."""
-    target = point_along(poly, lookahead_m)
-    dx, dy = target[0] - robot_xy[0], target[1] - robot_xy[1]
-    if math.hypot(dx, dy) < 1e-9:
-        # The leg has no length: the path starts where the robot is, along its first segment
-        # beyond the robot, or (none) straight ahead.
-        rest = poly[np.hypot(poly[:, 0] - robot_xy[0], poly[:, 1] - robot_xy[1]) > 1e-9]
-        if len(rest) == 0:
-            return 0.0
-        dx, dy = rest[0, 0] - robot_xy[0], rest[0, 1] - robot_xy[1]
-    return abs(wrap_angle_rad(math.atan2(dy, dx) - yaw))
-
-
-def point_along(poly: np.ndarray, s_m: float) -> np.ndarray:
-    """The point at arc length ``s_m`` along a polyline (clamped to its ends)."""
-    if len(poly) == 1 or s_m <= 0.0:
-        return poly[0].copy()
-    seg = np.hypot(*np.diff(poly, axis=0).T)
-    cum = np.concatenate(([0.0], np.cumsum(seg)))
-    if s_m >= cum[-1]:
-        return poly[-1].copy()
-    i = int(np.searchsorted(cum, s_m, side="right") - 1)
-    t = (s_m - cum[i]) / seg[i] if seg[i] > 0 else 0.0
-    return poly[i] + t * (poly[i + 1] - poly[i])
-
-
-def project_onto_polyline(
-    poly: np.ndarray, xy: tuple[float, float]
-) -> tuple[float, np.ndarray, int, float]:
-    """Nearest point of a polyline to ``xy``.
-
-    Returns:
-        ``(distance, point, segment_index, arc_length)`` where the point lies on segment
-        ``segment_index`` (from vertex ``i`` to ``i + 1``) at ``arc_length`` from the start.
-    """
-    p = np.asarray(xy, dtype=np.float64)
-    if len(poly) == 1:
-        return float(np.hypot(*(poly[0] - p))), poly[0].copy(), 0, 0.0
-    a = poly[:-1]
-    b = poly[1:]
-    ab = b - a
-    den = np.einsum("ij,ij->i", ab, ab)
-    t = np.where(den > 0, np.einsum("ij,ij->i", p - a, ab) / np.where(den > 0, den, 1.0), 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    q = a + t[:, None] * ab
-    dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
-    i = int(np.argmin(dist))
-    seg = np.sqrt(den)
-    s = float(seg[:i].sum() + t[i] * seg[i])
-    return float(dist[i]), q[i], i, s
-
-
-def _dedupe(poly: np.ndarray, tol_m: float = 1e-6) -> np.ndarray:
-    if len(poly) < 2:
-        return poly
-    d = poly[1:] - poly[:-1]
-    keep = np.empty(len(poly), dtype=bool)
-    keep[0] = True
-    keep[1:] = (np.abs(d[:, 0]) > tol_m) | (np.abs(d[:, 1]) > tol_m)
-    return poly if keep.all() else poly[keep]
-
-
-def _oriented(
-    path_m: np.ndarray, start_xy: tuple[float, float], end_xy: tuple[float, float]
-) -> np.ndarray:
-    """``path_m`` ordered so that it starts at the end nearer ``start_xy`` (ties: ``end_xy`` decides)."""
-    p = np.asarray(path_m, dtype=np.float64).reshape(-1, 2)
-    x0, y0 = float(p[0, 0]), float(p[0, 1])
-    x1, y1 = float(p[-1, 0]), float(p[-1, 1])
-    sx, sy = float(start_xy[0]), float(start_xy[1])
-    ex, ey = float(end_xy[0]), float(end_xy[1])
-    d_fwd = math.hypot(x0 - sx, y0 - sy) + math.hypot(x1 - ex, y1 - ey)
-    d_rev = math.hypot(x1 - sx, y1 - sy) + math.hypot(x0 - ex, y0 - ey)
-    return p if d_fwd <= d_rev else p[::-1].copy()
-
-
-def _edge_polyline(tmap: TopometricMap, k: int, from_node: int) -> np.ndarray:
-    e = tmap.edges[k]
-    to_node = e.opening_b if from_node == e.opening_a else e.opening_a
-    return _oriented(
-        e.path_m, tmap.openings[from_node].midpoint_m, tmap.openings[to_node].midpoint_m
-    )
-
-
-def _first_legs(
-    tmap: TopometricMap, area_id: int, robot_xy: tuple[float, float]
-) -> dict[int, np.ndarray]:
-    """Polylines from the robot to every opening of its area, along the area's own paths.
-
-    The robot joins the nearest point of each path of its area in a straight line, then follows
-    that path to the opening. Openings no path reaches are joined in a straight line. The
-    projections and lengths of the area's edge paths come from one compiled call
-    (:func:`~semexplore_gym.core.planning.graph_search_kernels.first_leg_offers`, the same values as
-    :func:`project_onto_polyline` and ``_polyline_length``); each opening's polyline is built
-    once, for the shortest offer (the first of equals).
-    """
-    area = tmap.areas[area_id]
-    r = np.asarray(robot_xy, dtype=np.float64)
-    # node -> (length, nearest point q, the rest of the way after q)
-    best: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
-
-    def offer(node: int, length: float, q: np.ndarray, rest: np.ndarray) -> None:
-        if node not in best or length < best[node][0]:
-            best[node] = (length, q, rest)
-
-    edges = [(k, e) for k, e in enumerate(tmap.edges) if e.area_id == area_id]
-    if edges:
-        polys = [_edge_polyline(tmap, k, e.opening_a) for k, e in edges]
-        sizes = [len(p) for p in polys]
-        if min(sizes) == 0:
-            raise ValueError(f"an edge of area {area_id} has an empty path")
-        starts = np.zeros(len(polys) + 1, dtype=np.int64)
-        np.cumsum(sizes, out=starts[1:])
-        seg_idx = np.empty(len(polys), dtype=np.int64)
-        q_xy = np.empty((len(polys), 2))
-        lengths = np.empty((len(polys), 2))
-        first_leg_offers(
-            np.concatenate(polys), starts, float(r[0]), float(r[1]), seg_idx, q_xy, lengths
-        )
-        for (_k, e), poly, i, q, (back_m, on_m) in zip(
-            edges, polys, seg_idx.tolist(), q_xy, lengths.tolist(), strict=True
-        ):
-            offer(e.opening_a, back_m, q, poly[: i + 1][::-1])
-            offer(e.opening_b, on_m, q, poly[i + 1 :])
-    for oid, path in area.paths_m.items():
-        if oid in best or oid not in area.opening_ids:
-            continue
-        # Single-opening areas (dead ends) have no edges; their path starts at the opening.
-        poly = _oriented(path, tmap.openings[oid].midpoint_m, tuple(np.asarray(path)[-1]))
-        dist, q, i, _ = project_onto_polyline(poly, robot_xy)
-        rest = poly[: i + 1][::-1]
-        offer(oid, dist + _polyline_length(np.vstack([q, rest])), q, rest)
-    for oid in area.opening_ids:
-        if oid not in best and 0 <= oid < len(tmap.openings):
-            m = np.asarray(tmap.openings[oid].midpoint_m, dtype=np.float64)
-            offer(oid, float(np.hypot(*(m - r))), m, np.empty((0, 2)))
-    return {node: _dedupe(np.vstack([r, q, rest])) for node, (_, q, rest) in best.items()}
-
-
-def _assemble(
-    tmap: TopometricMap,
-    path: _Partial,
-    first_leg: np.ndarray,
-    goal_xy: tuple[float, float],
-    polylines: dict[tuple[int, int], np.ndarray] | None = None,
-) -> np.ndarray:
-    """The candidate's polyline: first leg, the edges' paths, the goal. ``polylines`` caches
-    :func:`_edge_polyline` by ``(edge, from_node)`` across calls."""
-    return _path_parts(tmap, path, first_leg, goal_xy, polylines).build()
-
-
-def _path_parts(
-    tmap: TopometricMap,
-    path: _Partial,
-    first_leg: np.ndarray,
-    goal_xy: tuple[float, float],
-    polylines: dict[tuple[int, int], np.ndarray] | None = None,
-) -> _PathParts:
-    """The pieces of :func:`_assemble`'s polyline, not yet joined."""
-    parts = [first_leg]
-    for j, k in enumerate(path.edges):
-        key = (k, path.nodes[j])
-        poly = polylines.get(key) if polylines is not None else None
-        if poly is None:
-            poly = _edge_polyline(tmap, k, path.nodes[j])
-            if polylines is not None:
-                polylines[key] = poly
-        parts.append(poly)
-    parts.append(np.asarray([goal_xy], dtype=np.float64))
-    return _PathParts(parts)

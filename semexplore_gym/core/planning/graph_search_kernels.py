@@ -9,8 +9,8 @@ pushes hundreds of paths).
 :func:`first_leg_offers` projects the robot onto every path of its area and measures the two
 ways along each path, in one call instead of a dozen small numpy calls per path (on Willow
 Garage an area holds ~40 paths per replan). Every value is the same floating-point expression
-as :func:`~semexplore_gym.core.planning.graph_search.project_onto_polyline` and
-``_polyline_length`` evaluate: the projection's products and sums in the same order, the
+as :func:`~semexplore_gym.core.planning.polyline.project_onto_polyline` and
+:func:`~semexplore_gym.core.planning.polyline.polyline_length` evaluate: the projection's products and sums in the same order, the
 segment lengths as ``sqrt(dx * dx + dy * dy)``, and their sum by numpy's own pairwise
 summation (:func:`pairwise_sum`), so the offers, and every plan built from them, do not change
 in the last bit (tested against the numpy forms on random and degenerate polylines).

@@ -32,10 +32,17 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
-from semexplore_gym.core.grid import OCCUPIED, GridGeometry, wrap_angle_rad
+from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.planning.line_of_sight import farthest_visible_index
+from semexplore_gym.core.planning.potential_field_kernels import (
+    field_force_xy,
+    free_along,
+    guarded_velocity,
+    map_points_xy,
+    min_valid_range,
+    scan_points_xy,
+)
 from semexplore_gym.core.validation import require_finite
 
 
@@ -216,7 +223,7 @@ def field_force(
     scan = np.ascontiguousarray(scan_m, dtype=np.float64)
     a = np.ascontiguousarray(angles_rad, dtype=np.float64)
     f_o = params.f_o * params.reference_n_beams / len(scan) * repulsion_scale
-    fx, fy = _force(
+    fx, fy = field_force_xy(
         scan, np.cos(a), np.sin(a), float(max_range_m), float(goal_angle_rad), params.f_g, f_o
     )
     return float(fx), float(fy)
@@ -231,7 +238,7 @@ def obstacle_points(
     """``(K, 2)`` obstacle points in the robot frame: the scan's returns plus ``extra_points_xy``."""
     scan = np.ascontiguousarray(scan_m, dtype=np.float64)
     a = np.ascontiguousarray(angles_rad, dtype=np.float64)
-    px, py = _scan_points(scan, np.cos(a), np.sin(a), float(max_range_m))
+    px, py = scan_points_xy(scan, np.cos(a), np.sin(a), float(max_range_m))
     pts = np.column_stack([px, py])
     if extra_points_xy is not None and len(extra_points_xy):
         pts = np.vstack([pts, extra_points_xy])
@@ -255,7 +262,7 @@ def free_distance_along(
     pts = np.ascontiguousarray(points_xy, dtype=np.float64).reshape(-1, 2)
     hard = -1.0 if contact_half_width_m is None else float(contact_half_width_m)
     return float(
-        _free_along(
+        free_along(
             pts[:, 0].copy(), pts[:, 1].copy(), float(heading_rad), float(half_width_m), hard
         )
     )
@@ -283,7 +290,7 @@ def nearby_obstacle_points(
 ) -> np.ndarray:
     """Centres of the OCCUPIED cells within ``radius_m`` of the robot, ``(K, 2)`` in the robot frame."""
     x, y, yaw = (float(v) for v in pose)
-    px, py = _map_points(
+    px, py = map_points_xy(
         grid,
         geometry.origin_x_m,
         geometry.origin_y_m,
@@ -370,30 +377,125 @@ def potential_field_command(
     limits: RobotLimits,
     params: PotentialFieldParams | None = None,
     start_index: int = 0,
-    repulsion_scale: float = 1.0,
 ) -> PotentialFieldCommand:
-    """One step of path following with the modified potential field.
+    """One step of path following with the modified potential field (the paper's field).
+
+    ``PotentialFieldFollower(limits, params).command(...)`` with the arguments of
+    :meth:`PotentialFieldFollower.command`; build the follower once to step it many times, or
+    to scale the repulsion.
+    """
+    follower = PotentialFieldFollower(limits, params)
+    return follower.command(scan_m, pose, path_m, grid, geometry, start_index=start_index)
+
+
+class PotentialFieldFollower:
+    """Follows a global path with the modified potential field, for one robot.
 
     Args:
-        scan_m: ``(N,)`` LiDAR ranges, beam ``i`` at ``i * 2 pi / N`` from the heading
-            (0 = invalid, ``max_range_m`` = no return).
-        pose: Robot ``(x_m, y_m, yaw_rad)`` in the map frame.
-        path_m: ``(K, 2)`` global path, densely sampled (see :func:`resample_polyline`).
-        grid: Encoded occupancy grid (uint8, matching ``geometry``) for the line-of-sight test.
-        geometry: Frame of ``grid``.
         limits: Robot radius, speed limits and LiDAR range.
         params: Field parameters (default: the paper's).
-        start_index: Path points before this index are ignored (the part already travelled).
-        repulsion_scale: Multiplies ``f_o`` (local-minimum escape lowers it).
-
-    Returns:
-        The :class:`PotentialFieldCommand`; ``|v| <= max_linear_speed_mps`` and
-        ``|omega| <= max_angular_speed_radps``.
-
-    Raises:
-        ValueError: on an empty or malformed path or scan, or a non-finite pose.
     """
-    p = params if params is not None else PotentialFieldParams()
+
+    def __init__(self, limits: RobotLimits, params: PotentialFieldParams | None = None) -> None:
+        self.limits = limits
+        self.params = params if params is not None else PotentialFieldParams()
+
+    def command(
+        self,
+        scan_m: npt.ArrayLike,
+        pose: tuple[float, float, float],
+        path_m: np.ndarray,
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        *,
+        start_index: int = 0,
+        repulsion_scale: float = 1.0,
+    ) -> PotentialFieldCommand:
+        """One step of path following.
+
+        Args:
+            scan_m: ``(N,)`` LiDAR ranges, beam ``i`` at ``i * 2 pi / N`` from the heading
+                (0 = invalid, ``max_range_m`` = no return).
+            pose: Robot ``(x_m, y_m, yaw_rad)`` in the map frame.
+            path_m: ``(K, 2)`` global path, densely sampled (see :func:`resample_polyline`).
+            grid: Encoded occupancy grid (uint8, matching ``geometry``) for the line-of-sight
+                test.
+            geometry: Frame of ``grid``.
+            start_index: Path points before this index are ignored (the part already
+                travelled).
+            repulsion_scale: Multiplies ``f_o`` (local-minimum escape lowers it).
+
+        Returns:
+            The :class:`PotentialFieldCommand`; ``|v| <= max_linear_speed_mps`` and
+            ``|omega| <= max_angular_speed_radps``.
+
+        Raises:
+            ValueError: on an empty or malformed path or scan, or a non-finite pose.
+        """
+        p, limits = self.params, self.limits
+        scan, path, (x, y, yaw) = _checked_inputs(scan_m, path_m, pose)
+        n = len(scan)
+        cos_a, sin_a = _beam_trig(n)
+        l_min = float(min_valid_range(scan, limits.max_range_m))
+        lookahead = min(max(p.f_l * l_min, p.min_lookahead_m), p.max_lookahead_m)
+        gi, visible = select_lookahead(
+            path, (x, y), lookahead, grid, geometry, start_index, p.lookahead_clearance_m, l_min
+        )
+        gx, gy = float(path[gi, 0]), float(path[gi, 1])
+        goal_angle = wrap_angle_rad(math.atan2(gy - y, gx - x) - yaw)
+        if math.hypot(gx - x, gy - y) < 1e-6:
+            goal_angle = 0.0
+        f_o = p.f_o * p.reference_n_beams / n * repulsion_scale
+        fx, fy = field_force_xy(scan, cos_a, sin_a, limits.max_range_m, goal_angle, p.f_g, f_o)
+        px, py = self._guard_points(scan, cos_a, sin_a, grid, geometry, (x, y, yaw))
+        v, omega, front = guarded_velocity(fx, fy, px, py, *_guard_args(limits, p))
+        return PotentialFieldCommand(
+            float(v),
+            float(omega),
+            (gx, gy),
+            int(gi),
+            bool(visible),
+            (float(fx), float(fy)),
+            l_min,
+            lookahead,
+            float(front),
+        )
+
+    def _guard_points(
+        self,
+        scan: np.ndarray,
+        cos_a: np.ndarray,
+        sin_a: np.ndarray,
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        pose: tuple[float, float, float],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Obstacle points for the collision guard (robot frame): the scan's returns, plus the
+        mapped walls within ``map_guard_radius_m``."""
+        px, py = scan_points_xy(scan, cos_a, sin_a, self.limits.max_range_m)
+        radius = self.params.map_guard_radius_m
+        if radius > 0:
+            x, y, yaw = pose
+            mx, my = map_points_xy(
+                grid,
+                geometry.origin_x_m,
+                geometry.origin_y_m,
+                geometry.resolution_m,
+                x,
+                y,
+                yaw,
+                radius,
+            )
+            if len(mx):
+                px = np.concatenate((px, mx))
+                py = np.concatenate((py, my))
+        return px, py
+
+
+def _checked_inputs(
+    scan_m: npt.ArrayLike, path_m: np.ndarray, pose: tuple[float, float, float]
+) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float]]:
+    """The scan and path as float arrays and the pose as floats; raises on malformed ones."""
     scan = np.asarray(scan_m, dtype=np.float64)
     if scan.ndim != 1 or len(scan) == 0:
         raise ValueError(f"scan_m must be a non-empty 1-D array, got shape {scan.shape}")
@@ -403,47 +505,7 @@ def potential_field_command(
     x, y, yaw = (float(v) for v in pose)
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(yaw)):
         raise ValueError(f"pose must be finite, got {pose!r}")
-
-    n = len(scan)
-    cos_a, sin_a = _beam_trig(n)
-    l_min = float(_min_valid(scan, limits.max_range_m))
-    lookahead = min(max(p.f_l * l_min, p.min_lookahead_m), p.max_lookahead_m)
-    gi, visible = select_lookahead(
-        path, (x, y), lookahead, grid, geometry, start_index, p.lookahead_clearance_m, l_min
-    )
-    gx, gy = float(path[gi, 0]), float(path[gi, 1])
-    goal_angle = wrap_angle_rad(math.atan2(gy - y, gx - x) - yaw)
-    if math.hypot(gx - x, gy - y) < 1e-6:
-        goal_angle = 0.0
-    f_o = p.f_o * p.reference_n_beams / n * repulsion_scale
-    fx, fy = _force(scan, cos_a, sin_a, limits.max_range_m, goal_angle, p.f_g, f_o)
-    px, py = _scan_points(scan, cos_a, sin_a, limits.max_range_m)
-    if p.map_guard_radius_m > 0:
-        mx, my = _map_points(
-            grid,
-            geometry.origin_x_m,
-            geometry.origin_y_m,
-            geometry.resolution_m,
-            x,
-            y,
-            yaw,
-            p.map_guard_radius_m,
-        )
-        if len(mx):
-            px = np.concatenate((px, mx))
-            py = np.concatenate((py, my))
-    v, omega, front = _to_velocity(fx, fy, px, py, *_guard_args(limits, p))
-    return PotentialFieldCommand(
-        float(v),
-        float(omega),
-        (gx, gy),
-        int(gi),
-        bool(visible),
-        (float(fx), float(fy)),
-        l_min,
-        lookahead,
-        float(front),
-    )
+    return scan, path, (x, y, yaw)
 
 
 def force_to_velocity(
@@ -464,7 +526,7 @@ def force_to_velocity(
         ``(v_mps, omega_radps, front_free_m)``.
     """
     pts = obstacle_points(scan, angles, limits.max_range_m, extra_points_xy)
-    v, omega, front = _to_velocity(
+    v, omega, front = guarded_velocity(
         float(fx),
         float(fy),
         np.ascontiguousarray(pts[:, 0]),
@@ -488,144 +550,3 @@ def _guard_args(limits: RobotLimits, params: PotentialFieldParams) -> tuple[floa
         params.braking_time_s,
         bool(params.braking_guard),
     )
-
-
-# --- numba kernels ----------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _force(scan, cos_a, sin_a, max_range, goal_angle, f_g, f_o):  # pragma: no cover - numba
-    sx = 0.0
-    sy = 0.0
-    for i in range(scan.shape[0]):
-        r = scan[i]
-        if r > 0.0 and r < max_range:
-            sx += cos_a[i] / r
-            sy += sin_a[i] / r
-    return f_g * math.cos(goal_angle) - f_o * sx, f_g * math.sin(goal_angle) - f_o * sy
-
-
-@njit(cache=True)
-def _free_along(px, py, heading, soft, hard):  # pragma: no cover - numba
-    # See free_distance_along; hard < 0 means no contact rule.
-    c = math.cos(heading)
-    s = math.sin(heading)
-    best = math.inf
-    soft2 = soft * soft
-    hard2 = hard * hard
-    for i in range(px.shape[0]):
-        x = c * px[i] + s * py[i]
-        if x <= 0.0:
-            continue
-        y = -s * px[i] + c * py[i]
-        ay = abs(y)
-        if ay >= soft:
-            continue
-        free = x - math.sqrt(soft2 - y * y)
-        if free < 0.0 and hard >= 0.0:
-            if ay >= hard:
-                continue
-            free = x - math.sqrt(max(hard2 - y * y, 0.0))
-        if free < best:
-            best = free
-    return max(best, 0.0)
-
-
-@njit(cache=True)
-def _to_velocity(
-    fx,
-    fy,
-    px,
-    py,
-    soft,
-    hard,
-    steer_max,
-    steer_step,
-    need,
-    turn_in_place,
-    gain,
-    vmax,
-    wmax,
-    braking,
-    brake,
-):  # pragma: no cover - numba
-    phi = math.atan2(fy, fx) if (fx != 0.0 or fy != 0.0) else 0.0
-    front = _free_along(px, py, 0.0, soft, hard)
-    if steer_max > 0.0 and abs(phi) <= turn_in_place:
-        # Guard steering: the way along F is blocked within the braking distance: aim at the
-        # nearest open heading, alternating sides.
-        if _free_along(px, py, phi, soft, hard) < need:
-            n = int(steer_max / steer_step + 1e-9)
-            found = False
-            for k in range(1, n + 1):
-                for sign in (1.0, -1.0):
-                    cand = phi + sign * k * steer_step
-                    if _free_along(px, py, cand, soft, hard) >= need:
-                        phi = cand
-                        found = True
-                        break
-                if found:
-                    break
-    omega = max(-wmax, min(wmax, gain * phi))
-    if abs(phi) > turn_in_place:
-        v = 0.0
-    else:
-        v = vmax * max(0.0, math.cos(phi))
-    if brake:
-        v = min(v, front / braking)
-    return v, omega, front
-
-
-@njit(cache=True)
-def _min_valid(scan, max_range):  # pragma: no cover - numba
-    best = math.inf
-    for i in range(scan.shape[0]):
-        r = scan[i]
-        if r > 0.0 and r < max_range and r < best:
-            best = r
-    return best
-
-
-@njit(cache=True)
-def _scan_points(scan, cos_a, sin_a, max_range):  # pragma: no cover - numba
-    n = 0
-    for i in range(scan.shape[0]):
-        if scan[i] > 0.0 and scan[i] < max_range:
-            n += 1
-    px = np.empty(n)
-    py = np.empty(n)
-    k = 0
-    for i in range(scan.shape[0]):
-        r = scan[i]
-        if r > 0.0 and r < max_range:
-            px[k] = r * cos_a[i]
-            py[k] = r * sin_a[i]
-            k += 1
-    return px, py
-
-
-@njit(cache=True)
-def _map_points(grid, ox, oy, res, x, y, yaw, radius):  # pragma: no cover - numba
-    h, w = grid.shape
-    r0 = max(int(math.floor((y - radius - oy) / res)), 0)
-    r1 = min(int(math.floor((y + radius - oy) / res)), h - 1)
-    c0 = max(int(math.floor((x - radius - ox) / res)), 0)
-    c1 = min(int(math.floor((x + radius - ox) / res)), w - 1)
-    c = math.cos(yaw)
-    s = math.sin(yaw)
-    cap = max(0, (r1 - r0 + 1) * (c1 - c0 + 1))
-    px = np.empty(cap)
-    py = np.empty(cap)
-    k = 0
-    for r in range(r0, r1 + 1):
-        for cc in range(c0, c1 + 1):
-            if grid[r, cc] != OCCUPIED:
-                continue
-            dx = ox + (cc + 0.5) * res - x
-            dy = oy + (r + 0.5) * res - y
-            if dx * dx + dy * dy > radius * radius:
-                continue
-            px[k] = c * dx + s * dy
-            py[k] = -s * dx + c * dy
-            k += 1
-    return px[:k], py[:k]

@@ -54,11 +54,12 @@ Algorithm (a clearance-aware skeleton segmentation, in the spirit of GRID-FAST's
 
 Where each stage lives
 ----------------------
-``_stages._Segmenter.run`` calls one method per stage, in order. The numba kernels are in the
-package :mod:`.kernels`, one module per stage (paths relative to ``core/topometric/``):
+``stages.SegmentationStages.run`` calls one method per stage, in order. The numba kernels are
+in the package :mod:`.kernels`, one module per stage (paths relative to ``core/topometric/``):
 
 =============================  ===========================================  =========================
-Stage                          Module                                       ``_Segmenter`` method
+Stage                          Module                                       ``SegmentationStages``
+                                                                            method
 =============================  ===========================================  =========================
 1. Crop and clean              ``kernels/clean.py``                         ``_crop``, ``_clean``
 2. Configuration space         ``kernels/cspace.py``                        ``_configuration_space``
@@ -69,13 +70,14 @@ Stage                          Module                                       ``_S
 6. Regions                     ``kernels/regions.py`` (the cut at the       ``_regions``
                                openings runs in ``_openings``)
 7. Frontiers                   ``kernels/frontiers.py``                     ``_frontiers``
-8. Types                       ``kernels/graph.py`` (``area_types``)        ``_assemble``
+8. Types                       ``kernels/graph.py`` (``area_types``)        ``_types``
 9. Paths and graph             ``kernels/paths.py``, ``kernels/graph.py``,  ``_paths``, ``_assemble``
-                               records: ``_records.py``
-10. Identity                   ``_identity.py``                             ``_identities``
+                               records: ``map_records.py``
+10. Identity                   ``area_identity.py``                         ``_identities``
 =============================  ===========================================  =========================
 
-This module holds the entry points and the input checks.
+This module holds the entry points and the input checks; ``scratch.py`` the scratch arrays
+a :class:`TopometricSegmenter` keeps between calls.
 
 Cost is linear in the number of cells (no pairwise loops over openings): numba kernels for the
 grid work, Python only to build the output records. See ``scripts/bench_segmentation.py`` for
@@ -94,8 +96,9 @@ import numpy as np
 import numpy.typing as npt
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry, from_ros_values
-from semexplore_gym.core.topometric._stages import _Segmenter
 from semexplore_gym.core.topometric.params import SegmentationParams
+from semexplore_gym.core.topometric.scratch import ScratchArrays
+from semexplore_gym.core.topometric.stages import SegmentationStages
 from semexplore_gym.core.topometric.types import TopometricMap
 
 # ----------------------------------------------------------------------------------------------
@@ -156,37 +159,6 @@ def _check_clearance(clearance_m: float) -> float:
 # ----------------------------------------------------------------------------------------------
 
 
-class _Scratch:
-    """Grid-sized scratch arrays, kept by a :class:`TopometricSegmenter` between calls.
-
-    Fresh arrays of a few MB cost more in page faults than the pass that fills them (a 1600^2
-    map needs about 50 MB of scratch: 10-15 % of its segmentation time when freshly mapped).
-    """
-
-    def __init__(self, keep: bool) -> None:
-        self.keep = keep
-        self._bufs: dict[str, np.ndarray] = {}
-
-    def take(self, name: str, n: int, dtype: type, fill: int | None = None) -> np.ndarray:
-        """A 1-D array of ``n`` elements, all ``fill`` (or undefined), reused while large enough."""
-        b = self._bufs.get(name)
-        if b is not None and b.size >= n:
-            b = b[:n]
-            if fill is not None:
-                b.fill(fill)
-            return b
-        # headroom when kept: an explored map grows a little between successive calls
-        size = n + n // 4 + 1024 if self.keep else n
-        # zeros come from calloc: pages nobody touches are never faulted in
-        b = np.zeros(size, dtype) if fill == 0 else np.empty(size, dtype)
-        if self.keep:
-            self._bufs[name] = b
-        b = b[:n]
-        if fill:
-            b.fill(fill)
-        return b
-
-
 class TopometricSegmenter:
     """:func:`segment_map` as an object that keeps its scratch memory between calls.
 
@@ -212,7 +184,7 @@ class TopometricSegmenter:
         if params is not None and not isinstance(params, SegmentationParams):
             raise TypeError(f"params must be a SegmentationParams, got {type(params).__name__}")
         self.params = params if params is not None else SegmentationParams()
-        self._scratch = _Scratch(keep=True)
+        self._scratch = ScratchArrays(keep=True)
 
     def __call__(
         self,
@@ -237,7 +209,7 @@ class TopometricSegmenter:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.params = state["params"]
-        self._scratch = _Scratch(keep=True)
+        self._scratch = ScratchArrays(keep=True)
 
 
 def segment_map(
@@ -273,7 +245,7 @@ def segment_map(
     results faster by reusing its scratch memory.
     """
     return _segment(
-        grid, geometry_or_resolution, clearance_m, params, previous, _Scratch(keep=False)
+        grid, geometry_or_resolution, clearance_m, params, previous, ScratchArrays(keep=False)
     )
 
 
@@ -293,7 +265,9 @@ def _segment(grid, geometry_or_resolution, clearance_m, params, previous, scratc
     was_enabled = gc.isenabled()
     gc.disable()
     try:
-        return _Segmenter(enc, geometry, clearance, params, previous, t_start, scratch).run()
+        return SegmentationStages(
+            enc, geometry, clearance, params, previous, t_start, scratch
+        ).run()
     finally:
         if was_enabled:
             gc.enable()

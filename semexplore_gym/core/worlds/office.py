@@ -180,22 +180,18 @@ def _carve_rooms(
                     free[dy : dy + dw, wall_col : wall_col + t] = True
 
 
-def generate_office(params: OfficeParams, name: str | None = None) -> World:
-    """A procedural office world (deterministic for ``params.seed``).
-
-    The start pose is in the first corridor, facing +x.
-    """
-    rng = np.random.default_rng(params.seed)
-    n = _cells(params.size_m)
+def _horizontal_corridors(
+    free: np.ndarray, cw: int, d_min: int, rng: np.random.Generator
+) -> tuple[list[tuple[int, int]], list[tuple[int, int, str]]]:
+    """Cut the map into bands, each a corridor of ``cw`` cells with a row of rooms on either
+    side (walls drawn in ``free``). Returns the corridors' ``(y0, y1)`` and the room rows'
+    ``(y0, y1, side of the corridor: "above"/"below")``."""
+    n = free.shape[0]
     t = _WALL_CELLS
-    cw = _cells(params.corridor_width_m)
-    d_min = _cells(_MIN_ROOM_DEPTH_M)
-    free = np.ones((n, n), dtype=bool)
-
     n_bands = max(1, n // (2 * d_min + cw + 3 * t))
     edges = np.round(np.linspace(0, n, n_bands + 1)).astype(int)
     corridors: list[tuple[int, int]] = []
-    room_rows: list[tuple[int, int, str]] = []  # (y0, y1, side of the corridor: "above"/"below")
+    room_rows: list[tuple[int, int, str]] = []
     for i in range(n_bands):
         lo = edges[i] + (t - t // 2 if i > 0 else 0)
         hi = edges[i + 1] - (t // 2 if i < n_bands - 1 else 0)
@@ -211,28 +207,54 @@ def generate_office(params: OfficeParams, name: str | None = None) -> World:
         corridors.append((y0, y1))
         room_rows.append((lo, y0 - t, "above"))
         room_rows.append((y1 + t, hi, "below"))
+    return corridors, room_rows
 
+
+def _vertical_corridors(
+    free: np.ndarray, cw: int, corridors: list[tuple[int, int]], rng: np.random.Generator
+) -> list[tuple[int, int]]:
+    """With two bands or more, one or two vertical corridors joining them (carved in
+    ``free``); their ``(x0, x1)``, left to right."""
+    n = free.shape[0]
+    t = _WALL_CELLS
     verticals: list[tuple[int, int]] = []
-    if n_bands >= 2:
-        room_w = _cells(_MIN_ROOM_WIDTH_M)
-        x0 = int(rng.integers(n // 4, max(n // 4 + 1, 3 * n // 4 - cw)))
-        verticals.append((x0, x0 + cw))
-        if rng.random() < 0.5:
-            # A second vertical corridor near the end farther from the first closes a loop.
-            if x0 > n // 2:
-                x2 = int(rng.integers(room_w + t, 2 * room_w + t))
-            else:
-                x2 = n - cw - int(rng.integers(room_w + t, 2 * room_w + t))
-            if abs(x2 - x0) > cw + 2 * t + room_w:
-                verticals.append((x2, x2 + cw))
-        verticals.sort()
-        ya, yb = corridors[0][0], corridors[-1][1]
-        for vx0, vx1 in verticals:
-            free[ya:yb, vx0 - t : vx0] = False
-            free[ya:yb, vx1 : vx1 + t] = False
-            free[ya:yb, vx0:vx1] = True
-        for cy0, cy1 in corridors:
-            free[cy0:cy1, :] = True
+    if len(corridors) < 2:
+        return verticals
+    room_w = _cells(_MIN_ROOM_WIDTH_M)
+    x0 = int(rng.integers(n // 4, max(n // 4 + 1, 3 * n // 4 - cw)))
+    verticals.append((x0, x0 + cw))
+    if rng.random() < 0.5:
+        # A second vertical corridor near the end farther from the first closes a loop.
+        if x0 > n // 2:
+            x2 = int(rng.integers(room_w + t, 2 * room_w + t))
+        else:
+            x2 = n - cw - int(rng.integers(room_w + t, 2 * room_w + t))
+        if abs(x2 - x0) > cw + 2 * t + room_w:
+            verticals.append((x2, x2 + cw))
+    verticals.sort()
+    ya, yb = corridors[0][0], corridors[-1][1]
+    for vx0, vx1 in verticals:
+        free[ya:yb, vx0 - t : vx0] = False
+        free[ya:yb, vx1 : vx1 + t] = False
+        free[ya:yb, vx0:vx1] = True
+    for cy0, cy1 in corridors:
+        free[cy0:cy1, :] = True
+    return verticals
+
+
+def generate_office(params: OfficeParams, name: str | None = None) -> World:
+    """A procedural office world (deterministic for ``params.seed``).
+
+    The start pose is in the first corridor, facing +x.
+    """
+    rng = np.random.default_rng(params.seed)
+    n = _cells(params.size_m)
+    cw = _cells(params.corridor_width_m)
+    d_min = _cells(_MIN_ROOM_DEPTH_M)
+    free = np.ones((n, n), dtype=bool)
+
+    corridors, room_rows = _horizontal_corridors(free, cw, d_min, rng)
+    verticals = _vertical_corridors(free, cw, corridors, rng)
 
     _carve_rooms(free, room_rows, corridors, verticals, params, rng)
 

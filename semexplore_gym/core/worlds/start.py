@@ -163,19 +163,7 @@ def reachable_free_mask(
     allowed = free_mask & (dist >= clearance_m)
 
     h, w = geometry.shape
-    seeds = np.zeros((h, w), dtype=bool)
-    row, col = (int(v) for v in geometry.world_to_grid(sx, sy))
-    if 0 <= row < h and 0 <= col < w and allowed[row, col]:
-        seeds[row, col] = True
-    else:
-        # The start may sit a fraction of a cell closer to a wall than its neighbours' centres.
-        r0, r1 = max(0, row - 2), min(h, row + 3)
-        c0, c1 = max(0, col - 2), min(w, col + 3)
-        if r0 < r1 and c0 < c1:
-            rr, cc = np.mgrid[r0:r1, c0:c1]
-            xs, ys = geometry.grid_to_world(rr, cc)
-            near = np.hypot(xs - sx, ys - sy) <= 1.5 * res
-            seeds[r0:r1, c0:c1] = near & allowed[r0:r1, c0:c1]
+    seeds = _start_seeds(geometry, allowed, sx, sy)
     if not seeds.any():
         raise ValueError(
             f"start ({sx:g}, {sy:g}) has no free cell with {clearance_m:g} m wall clearance within 1.5 cells "
@@ -201,6 +189,26 @@ def reachable_free_mask(
     out = np.zeros((h, w), dtype=bool)
     out[r0:r1, c0:c1] = _dilate_disk(component[r0:r1, c0:c1], grow_cells)
     return out & free_mask
+
+
+def _start_seeds(geometry: GridGeometry, allowed: np.ndarray, sx: float, sy: float) -> np.ndarray:
+    """The start cell if allowed, else the allowed cells within 1.5 cells of the start."""
+    h, w = geometry.shape
+    res = geometry.resolution_m
+    seeds = np.zeros((h, w), dtype=bool)
+    row, col = (int(v) for v in geometry.world_to_grid(sx, sy))
+    if 0 <= row < h and 0 <= col < w and allowed[row, col]:
+        seeds[row, col] = True
+    else:
+        # The start may sit a fraction of a cell closer to a wall than its neighbours' centres.
+        r0, r1 = max(0, row - 2), min(h, row + 3)
+        c0, c1 = max(0, col - 2), min(w, col + 3)
+        if r0 < r1 and c0 < c1:
+            rr, cc = np.mgrid[r0:r1, c0:c1]
+            xs, ys = geometry.grid_to_world(rr, cc)
+            near = np.hypot(xs - sx, ys - sy) <= 1.5 * res
+            seeds[r0:r1, c0:c1] = near & allowed[r0:r1, c0:c1]
+    return seeds
 
 
 def _dilate_disk(mask: np.ndarray, radius_cells: float) -> np.ndarray:

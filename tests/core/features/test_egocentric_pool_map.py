@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import semexplore_gym  # noqa: F401
-from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams, _min_pool
+from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
+from semexplore_gym.core.features.egocentric_kernels import min_pool
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 
 TRAIN = EgocentricParams(
@@ -29,7 +30,7 @@ def test_min_pool_is_the_block_minimum_with_unknown_beyond_the_map() -> None:
         grid = rng.choice(values, size=(h, w), p=[0.1, 0.3, 0.6])
         ho, wo = -(-h // f), -(-w // f)
         out = np.empty((ho, wo), np.uint8)
-        _min_pool(grid, f, out)
+        min_pool(grid, f, out)
         padded = np.full((ho * f, wo * f), UNKNOWN, np.uint8)
         padded[:h, :w] = grid
         np.testing.assert_array_equal(out, padded.reshape(ho, f, wo, f).min(axis=(1, 3)))
@@ -57,7 +58,7 @@ def test_pool_map_is_the_plain_encoder_on_the_pooled_map() -> None:
     pooled = np.empty(coarse.shape, np.uint8)
     n_fd_levels = set()
     for step in range(120):
-        _min_pool(obs["map"], f, pooled)
+        min_pool(obs["map"], f, pooled)
         got = pooled_enc.encode(obs)
         want = plain_enc.encode({**obs, "map": pooled})
         for key in ("image", "scan", "features"):

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
     clearance_field_m,
     frontier_groups,
     nearest_reachable_frontier,
@@ -31,7 +32,9 @@ MAP = """
 def test_bfs_reaches_the_frontier_through_the_wide_corridor_only():
     grid = parse_ascii_grid(MAP)
     geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
-    f = nearest_reachable_frontier(grid, geom, (0.25, 0.35), clearance_m=0.2, reach_m=0.0)
+    f = nearest_reachable_frontier(
+        grid, geom, (0.25, 0.35), clearance_m=0.2, frontiers=FrontierFilter(reach_m=0.0)
+    )
     assert f is not None
     # The goal is a frontier cell of the corridor's open end (column 13), usable (>= 0.2 m from walls).
     row, col = geom.world_to_grid(*f.goal_xy_m)
@@ -65,21 +68,21 @@ def test_frontier_behind_a_narrow_slot_is_reachable_only_within_reach():
     # The slot cell itself is 0.1 m from the walls: the robot cannot stand in it.
     assert (
         nearest_reachable_frontier(
-            grid, geom, (0.55, 0.35), clearance_m=0.2, min_frontier_cells=1, reach_m=0.0
+            grid, geom, (0.55, 0.35), clearance_m=0.2, frontiers=FrontierFilter(1, reach_m=0.0)
         )
         is None
     )
     # It can get within 0.3 m of it (row 3, the first such cell on its way), close enough to
     # look through.
     f = nearest_reachable_frontier(
-        grid, geom, (0.55, 0.35), clearance_m=0.2, min_frontier_cells=1, reach_m=0.3
+        grid, geom, (0.55, 0.35), clearance_m=0.2, frontiers=FrontierFilter(1, reach_m=0.3)
     )
     assert f is not None
     assert tuple(int(v) for v in geom.world_to_grid(*f.goal_xy_m)) == (3, 5)
     # Excluding it (the blacklist) leaves nothing.
     assert (
         nearest_reachable_frontier(
-            grid, geom, (0.55, 0.35), 0.2, 1, 0.3, excluded_xy_m=[(0.55, 0.7)]
+            grid, geom, (0.55, 0.35), 0.2, FrontierFilter(1, 0.3, excluded_xy_m=[(0.55, 0.7)])
         )
         is None
     )
@@ -88,9 +91,9 @@ def test_frontier_behind_a_narrow_slot_is_reachable_only_within_reach():
 def test_small_groups_are_ignored_and_reach_extends_the_goal():
     grid = parse_ascii_grid(MAP)
     geom = GridGeometry(0.1, 0.0, 0.0, *grid.shape)
-    assert nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, min_frontier_cells=6) is None
-    near = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, reach_m=0.5)
-    far = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, reach_m=0.0)
+    assert nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, FrontierFilter(6)) is None
+    near = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, FrontierFilter(reach_m=0.5))
+    far = nearest_reachable_frontier(grid, geom, (0.25, 0.35), 0.2, FrontierFilter(reach_m=0.0))
     assert near is not None and far is not None
     assert near.path_length_m < far.path_length_m - 0.3
 
@@ -133,11 +136,14 @@ def test_thin_unknown_pockets_can_be_ignored():
     assert n == 1 and labels[3, 1] > 0
     assert (
         nearest_reachable_frontier(
-            grid, geom, (0.25, 0.25), 0.05, 1, 0.2, min_unknown_depth_cells=2.0
+            grid, geom, (0.25, 0.25), 0.05, FrontierFilter(1, 0.2, min_unknown_depth_cells=2.0)
         )
         is None
     )
-    assert nearest_reachable_frontier(grid, geom, (0.25, 0.25), 0.05, 1, 0.2) is not None
+    assert (
+        nearest_reachable_frontier(grid, geom, (0.25, 0.25), 0.05, FrontierFilter(1, 0.2))
+        is not None
+    )
 
 
 # 0.1 m cells: a 3 x 3 nook whose only way out is a one-cell slot into the room on the right.

@@ -12,9 +12,9 @@ from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     find_frontier_paths,
-    project_onto_polyline,
     search_frontier_paths,
 )
+from semexplore_gym.core.planning.polyline import project_onto_polyline
 from semexplore_gym.core.topometric.types import (
     Area,
     AreaType,
@@ -126,12 +126,10 @@ def brute_force_costs(
     Uses the same first legs (robot to each opening of its area), so only the graph part is
     recomputed here.
     """
-    from semexplore_gym.core.planning.graph_search import (
-        _first_legs,
-        _heading_angle,
-        _polyline_length,
-        resolve_path_length_m,
-    )
+    from semexplore_gym.core.planning.graph_paths import first_legs as _first_legs
+    from semexplore_gym.core.planning.graph_search import resolve_path_length_m
+    from semexplore_gym.core.planning.polyline import heading_angle as _heading_angle
+    from semexplore_gym.core.planning.polyline import polyline_length as _polyline_length
 
     l_path = resolve_path_length_m(tmap, w)
     start_area = tmap.area_at(*robot_xy)
@@ -382,7 +380,7 @@ def test_projection_onto_polyline():
 def test_candidate_paths_are_joined_when_read_and_survive_pickling():
     import pickle
 
-    from semexplore_gym.core.planning.graph_search import _PathParts
+    from semexplore_gym.core.planning.graph_paths import PathParts as _PathParts
 
     tmap = build_map(OPENINGS, AREAS, l_path_m=4.0)
     cands, _ = search_frontier_paths(tmap, (0.0, 0.0), math.pi, FrontierCostWeights())

@@ -5,15 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from semexplore_gym.core.planning.graph_search import (
-    _dedupe,
-    _edge_polyline,
-    _first_legs,
-    _oriented,
-    _polyline_length,
-    project_onto_polyline,
-)
+from semexplore_gym.core.planning.graph_paths import edge_polyline as _edge_polyline
+from semexplore_gym.core.planning.graph_paths import first_legs as _first_legs
 from semexplore_gym.core.planning.graph_search_kernels import first_leg_offers, pairwise_sum
+from semexplore_gym.core.planning.polyline import dedupe_polyline as _dedupe
+from semexplore_gym.core.planning.polyline import oriented_polyline as _oriented
+from semexplore_gym.core.planning.polyline import polyline_length as _polyline_length
+from semexplore_gym.core.planning.polyline import project_onto_polyline
 from semexplore_gym.core.topometric.segmentation import segment_map
 
 
@@ -120,11 +118,8 @@ def test_compiled_search_equals_the_python_loop_on_a_large_graph() -> None:
     counts, on lattices big enough to outgrow the kernel's first buffers."""
     from types import SimpleNamespace
 
-    from semexplore_gym.core.planning.graph_search import (
-        _Partial,
-        _search_by_area,
-        _search_by_opening,
-    )
+    from semexplore_gym.core.planning.graph_paths import SearchPath as _Partial
+    from semexplore_gym.core.planning.graph_search import _search_by_area, _search_by_opening
     from semexplore_gym.core.topometric.types import GraphEdge
 
     rng = np.random.default_rng(4)

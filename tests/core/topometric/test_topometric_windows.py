@@ -16,8 +16,8 @@ import pytest
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.topometric import TopometricSegmenter, segment_map
-from semexplore_gym.core.topometric._stages import _Segmenter
 from semexplore_gym.core.topometric.kernels.clean import scan_grid, scan_grid_cells
+from semexplore_gym.core.topometric.stages import SegmentationStages
 from semexplore_gym.core.topometric.types import AreaRasterCrop
 
 CLEARANCE_M = 0.155
@@ -114,7 +114,7 @@ def test_ids_matched_by_cell_equal_ids_matched_by_world_point(monkeypatch, origi
         return out
 
     by_cell = chain()
-    monkeypatch.setattr(_Segmenter, "_same_frame", lambda self, other: False)
+    monkeypatch.setattr(SegmentationStages, "_same_frame", lambda self, other: False)
     by_point = chain()
     for (ra, aa, na), (rb, ab, nb) in zip(by_cell, by_point, strict=True):
         assert np.array_equal(ra, rb) and aa == ab and na == nb

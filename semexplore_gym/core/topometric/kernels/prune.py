@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from semexplore_gym.core.topometric.kernels.skeleton import _zs_tables, reduce_blobs
+from semexplore_gym.core.topometric.kernels.skeleton import reduce_blobs, zhang_suen_tables
 
 
 @njit(cache=True, error_model="numpy")
@@ -159,4 +159,4 @@ def remove_pixels(sk, px, gone):
     f = sk.ravel()
     for k in range(gone.size):
         f[gone[k]] = 0
-    return reduce_blobs(sk, px, _zs_tables()[2])  # skips and drops the cleared pixels
+    return reduce_blobs(sk, px, zhang_suen_tables()[2])  # skips and drops the cleared pixels

@@ -2,8 +2,8 @@
 
 :func:`thin` is Zhang-Suen thinning with a work list; :func:`reduce_blobs` then removes the
 simple points left in 2x2 blobs so that the skeleton is one pixel wide under m-adjacency
-(:func:`_mdeg`). Pruning (:mod:`.prune`) reuses both after it removes spurs. The skeleton is read
-as a graph in :mod:`.skeleton_graph`.
+(:func:`m_degree`). Pruning (:mod:`.prune`) reuses both after it removes spurs. The skeleton is
+read as a graph in :mod:`.skeleton_graph`.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ def _zs_ok(img: np.ndarray, r: int, c: int, sub: int) -> bool:
 
 
 @njit(cache=True, error_model="numpy")
-def _mdeg(f: np.ndarray, W: int, i: int) -> int:
+def m_degree(f: np.ndarray, W: int, i: int) -> int:
     """Degree of flat pixel ``i`` under m-adjacency (diagonals count only without a shared
     4-neighbour). Flat indexing: no division per pixel."""
     up = f[i + W] != 0
@@ -75,7 +75,7 @@ def _mdeg(f: np.ndarray, W: int, i: int) -> int:
 def reduce_blobs(img: np.ndarray, px: np.ndarray, simple: np.ndarray) -> np.ndarray:
     """Remove simple pixels of m-degree >= 3 (junction blobs) in place; returns the kept pixels.
 
-    ``simple`` is row 2 of :func:`_zs_tables` (simple point by neighbour code).
+    ``simple`` is row 2 of :func:`zhang_suen_tables` (simple point by neighbour code).
     """
     H, W = img.shape
     f = img.ravel()
@@ -84,7 +84,7 @@ def reduce_blobs(img: np.ndarray, px: np.ndarray, simple: np.ndarray) -> np.ndar
         changed = False
         for k in range(px.size):
             i = px[k]
-            if f[i] and _mdeg(f, W, i) >= 3 and simple[_code(f, i, W)]:
+            if f[i] and m_degree(f, W, i) >= 3 and simple[_code(f, i, W)]:
                 f[i] = 0
                 changed = True
     return _still_set(f, px)
@@ -107,7 +107,7 @@ def _still_set(f: np.ndarray, px: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def _zs_tables() -> np.ndarray:
+def zhang_suen_tables() -> np.ndarray:
     """Deletability of a pixel by its 8-neighbour code (bit k = P(k+2), P2 = row-1), per mode.
 
     Mode 0/1: the two Zhang-Suen sub-iterations; mode 2: simple point with 2..6 neighbours.
@@ -150,7 +150,7 @@ def thin(img: np.ndarray, allfg: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     """
     H, W = img.shape
     f = img.ravel()
-    tab = _zs_tables()
+    tab = zhang_suen_tables()
     n_fg = allfg.size
     cand = scratch[: n_fg + 1]
     nxt = scratch[n_fg + 1 : 2 * n_fg + 2]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from semexplore_gym.core.topometric.kernels.skeleton import _mdeg
+from semexplore_gym.core.topometric.kernels.skeleton import m_degree
 
 
 @njit(cache=True, error_model="numpy")
@@ -63,7 +63,7 @@ def extract_graph(sk: np.ndarray, px: np.ndarray, dcell: np.ndarray, st: np.ndar
     nb = np.empty(8, np.int64)
     nb2 = np.empty(8, np.int64)
     for k in range(n):
-        st[px[k]] = -2 if _mdeg(skf, W, px[k]) == 2 else -4
+        st[px[k]] = -2 if m_degree(skf, W, px[k]) == 2 else -4
     # cluster node pixels
     node_of = np.full(n, -1, np.int64)  # node id per px entry (only node pixels)
     stack = np.empty(n + 1, np.int64)

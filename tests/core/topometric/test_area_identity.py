@@ -6,7 +6,7 @@ import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.topometric import Area, AreaType, TopometricMap
-from semexplore_gym.core.topometric._identity import match_area_ids, next_area_id
+from semexplore_gym.core.topometric.area_identity import match_area_ids, next_area_id
 
 RES_M = 0.5
 GEO = GridGeometry(RES_M, 0.0, 0.0, 4, 6)

@@ -1,28 +1,21 @@
 """The stages of :func:`~semexplore_gym.core.topometric.segmentation.segment_map`, in order.
 
-:meth:`_Segmenter.run` calls one method per stage of the algorithm described in
+:meth:`SegmentationStages.run` calls one method per stage of the algorithm described in
 :mod:`semexplore_gym.core.topometric.segmentation`; each method hands the crop's arrays to the
 numba kernels of that stage (:mod:`.kernels`) and keeps what later stages need. The output
-records are built by :mod:`._records`, the area ids by :mod:`._identity`.
+records are built by :mod:`.map_records`, the area ids by :mod:`.area_identity`.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry, validate_encoded_grid
-from semexplore_gym.core.topometric._identity import match_area_ids, next_area_id
-from semexplore_gym.core.topometric._records import (
-    area_path_pieces,
-    area_records,
-    edge_records,
-    frontier_records,
-    opening_records,
-)
+from semexplore_gym.core.topometric.area_identity import match_area_ids, next_area_id
 from semexplore_gym.core.topometric.kernels.clean import filter_small_blobs, scan_grid
 from semexplore_gym.core.topometric.kernels.cspace import clearance_field
 from semexplore_gym.core.topometric.kernels.frontiers import frontier_cells, frontier_groups
@@ -44,11 +37,16 @@ from semexplore_gym.core.topometric.kernels.regions import (
 )
 from semexplore_gym.core.topometric.kernels.skeleton import thin
 from semexplore_gym.core.topometric.kernels.skeleton_graph import skeleton_graph
+from semexplore_gym.core.topometric.map_records import (
+    area_records,
+    edge_records,
+    frontier_records,
+    opening_records,
+    world_paths,
+)
 from semexplore_gym.core.topometric.params import SegmentationParams
+from semexplore_gym.core.topometric.scratch import ScratchArrays
 from semexplore_gym.core.topometric.types import AreaRasterCrop, AreaType, TopometricMap
-
-if TYPE_CHECKING:
-    from semexplore_gym.core.topometric.segmentation import _Scratch
 
 _MARGIN = 2
 _GRAPH_FIELDS = ("n", "rep", "r", "deg", "noff", "npx", "ne", "ea", "eb", "eoff", "epx", "alive")
@@ -77,7 +75,7 @@ def empty_map(
     )
 
 
-class _Segmenter:
+class SegmentationStages:
     """One segmentation run (internal; holds the intermediate arrays of the crop).
 
     Arrays of the crop (the *work grid*, ``H x W``, flat index ``row * W + col``) kept between
@@ -94,7 +92,7 @@ class _Segmenter:
         params: SegmentationParams,
         previous: TopometricMap | None,
         t_start: float,
-        scratch: _Scratch,
+        scratch: ScratchArrays,
     ) -> None:
         self.enc = enc
         self.scratch = scratch
@@ -358,6 +356,49 @@ class _Segmenter:
     # --- 8-10. types, paths and graph, identity; the output records -------------------------------
     def _assemble(self, graph, ops, centres, counts, fr) -> TopometricMap:
         """Area types, paths, graph edges and ids (stages 8-10) as a :class:`TopometricMap`."""
+        rtype, plan = self._types(graph, ops, centres, fr)  # 8. types, and stage 9's requests
+        op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_twin, zf_fo, req = plan
+        vcells, voff, vlen = self._paths(req)  # 9. paths
+        vxy, anchor_xy, centre_xy, ends_xy, mids, widths_m = self._world_coordinates(
+            vcells, op_anchor, centres, zf_fo, op_front, ops, fr
+        )
+        n_reg = self.n_reg
+        n_zf = int(zf_fo.size)
+        n_prov = n_reg + n_zf
+        paths = world_paths(vxy, voff, vlen, req, zf_twin, zf_fo, anchor_xy, n_reg)
+        prov_type = np.concatenate([rtype, np.full(n_zf, int(AreaType.FRONTIER_PATHWAY), np.int64)])
+        ids, next_id = self._identities(n_prov, centre_xy)  # 10. identity
+        ids_l = ids.tolist()
+        edges2, pairs, plen, fronts, fronts_len, lpath = graph_summary(
+            prov_type, aoff, aops, op_a0, op_a1, req, vlen, zf_twin, zf_fo, n_reg
+        )
+        self._lap("paths")
+
+        openings = opening_records(ids, op_a0, op_a1, ends_xy, mids, widths_m, anchor_xy)
+        areas = area_records(ids_l[:n_prov], prov_type, centre_xy, aoff, aops, paths, counts, n_reg)
+        edges = edge_records(edges2, pairs, plen, ids_l, paths)
+        frontiers = frontier_records(fronts, fronts_len, ids_l, openings)
+        n_inter = int(np.count_nonzero(prov_type == int(AreaType.INTERSECTION)))
+        l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
+        area_raster = self._area_raster(ids)
+        self._lap("assemble")
+        extras = self._extras(next_id)
+        return TopometricMap(
+            geometry=self.g,
+            area_ids=cast(np.ndarray, area_raster),  # the field accepts the window too
+            areas=areas,
+            openings=openings,
+            frontiers=frontiers,
+            edges=edges,
+            mean_intersection_path_m=l_path,
+            clearance_m=self.clear_m,
+            time_ms=(time.perf_counter() - self.t_start) * 1000.0,
+            extras=extras,
+        )
+
+    def _types(self, graph, ops, centres, fr) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+        """Stage 8's region types, and stage 9's path requests (provisional indices, see
+        :mod:`.kernels.graph`)."""
         side_core, side_far = opening_sides(
             ops["edge"],
             ops["idx"],
@@ -368,7 +409,6 @@ class _Segmenter:
             graph["eb"],
             graph["rep"],
         )
-        # 8. types, and the path requests of stage 9 (provisional indices, see kernels.graph)
         rtype = area_types(self.n_reg, ops["core"], ops["far"], fr["region"])
         plan = plan_paths(
             rtype,
@@ -386,10 +426,14 @@ class _Segmenter:
             self.st,
             self.lab,
         )
-        op_a0, op_a1, op_front, op_anchor, aoff, aops, zf_twin, zf_fo, req = plan
-        vcells, voff, vlen = self._paths(req)  # 9. paths
+        return rtype, plan
+
+    def _world_coordinates(
+        self, vcells, op_anchor, centres, zf_fo, op_front, ops, fr
+    ) -> tuple[np.ndarray, ...]:
+        """Paths, anchors, centres, opening ends and middles (world metres) and widths (m)."""
         g = self.g
-        vxy, anchor_xy, centre_xy, ends_xy, mids, widths_m = world_coordinates(
+        return world_coordinates(
             vcells,
             op_anchor,
             centres,
@@ -407,46 +451,14 @@ class _Segmenter:
             g.origin_y_m,
             g.resolution_m,
         )
-        n_reg = self.n_reg
-        n_zf = int(zf_fo.size)
-        n_prov = n_reg + n_zf
-        pieces, area_paths = area_path_pieces(vxy, voff, req, zf_twin, zf_fo, anchor_xy, n_reg)
-        prov_type = np.concatenate([rtype, np.full(n_zf, int(AreaType.FRONTIER_PATHWAY), np.int64)])
-        ids, next_id = self._identities(n_prov, centre_xy)  # 10. identity
-        ids_l = ids.tolist()
-        edges2, pairs, plen, fronts, fronts_len, lpath = graph_summary(
-            prov_type, aoff, aops, op_a0, op_a1, req, vlen, zf_twin, zf_fo, n_reg
-        )
-        self._lap("paths")
 
-        openings = opening_records(ids, op_a0, op_a1, ends_xy, mids, widths_m, anchor_xy)
-        areas = area_records(
-            ids_l[:n_prov], prov_type, centre_xy, aoff, aops, area_paths, counts, n_reg, n_zf
-        )
-        edges = edge_records(edges2, pairs, plen, ids_l, vlen, vxy, voff, pieces, area_paths)
-        frontiers = frontier_records(fronts, fronts_len, ids_l, openings)
-        n_inter = int(np.count_nonzero(prov_type == int(AreaType.INTERSECTION)))
-        l_path = float(np.mean(lpath)) if n_inter >= 2 and lpath.size else float("nan")
-        # Only the work grid's window is labelled: the full raster is built if someone reads it.
+    def _area_raster(self, ids: np.ndarray) -> AreaRasterCrop:
+        """The area ids of the work grid's window; the full raster is built if someone reads it."""
         H0, W0 = self.g.shape
         ra, rb = max(0, -self.r0), min(self.H, H0 - self.r0)
         ca, cb = max(0, -self.c0), min(self.W, W0 - self.c0)
-        window = window_labels(self.lab, ids[:n_reg].astype(np.int32), self.W, ra, rb, ca, cb)
-        area_raster = AreaRasterCrop(self.g.shape, self.r0 + ra, self.c0 + ca, window)
-        self._lap("assemble")
-        extras = self._extras(next_id)
-        return TopometricMap(
-            geometry=self.g,
-            area_ids=cast(np.ndarray, area_raster),  # the field accepts the window too
-            areas=areas,
-            openings=openings,
-            frontiers=frontiers,
-            edges=edges,
-            mean_intersection_path_m=l_path,
-            clearance_m=self.clear_m,
-            time_ms=(time.perf_counter() - self.t_start) * 1000.0,
-            extras=extras,
-        )
+        window = window_labels(self.lab, ids[: self.n_reg].astype(np.int32), self.W, ra, rb, ca, cb)
+        return AreaRasterCrop(self.g.shape, self.r0 + ra, self.c0 + ca, window)
 
     def _paths(self, req: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Stage 9's cell paths for the requests, simplified: cells, offsets, lengths (m)."""

@@ -1,11 +1,11 @@
-"""Features of the learned frontier value (``core/features/frontier_value.py``)."""
+"""Features of the learned frontier value (``core/features/frontier_features.py``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from semexplore_gym.core.features.frontier_value import (
+from semexplore_gym.core.features.frontier_features import (
     FEATURE_NAMES,
     frontier_value_features,
     unknown_fraction_near,

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import deque
 from itertools import repeat
 from operator import setitem
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,15 +23,34 @@ _TYPE_OF = {int(t): t for t in AreaType}
 _tnew = tuple.__new__
 
 
-def area_path_pieces(
+class WorldPaths(NamedTuple):
+    """Stage 9's simplified paths in world metres, as columns and per area.
+
+    Attributes:
+        xy: ``(n, 2)`` points of every path, one after another.
+        offsets: Path ``j`` is ``xy[offsets[j]:offsets[j + 1]]``.
+        lengths_m: Length of every path, metres.
+        pieces: Every path as its own ``(k, 2)`` view of ``xy``, in request order.
+        by_area: Per provisional area, its paths by opening index.
+    """
+
+    xy: np.ndarray
+    offsets: np.ndarray
+    lengths_m: np.ndarray
+    pieces: list[np.ndarray]
+    by_area: list[dict[int, np.ndarray]]
+
+
+def world_paths(
     vxy: np.ndarray,
     voff: np.ndarray,
+    vlen: np.ndarray,
     req: np.ndarray,
     zf_twin: np.ndarray,
     zf_fo: np.ndarray,
     anchor_xy: np.ndarray,
     n_reg: int,
-) -> tuple[list[np.ndarray], list[dict[int, np.ndarray]]]:
+) -> WorldPaths:
     """The path of every request (world metres), and per provisional area its paths by opening.
 
     A zero-area frontier pathway's two openings share one degenerate path at its anchor.
@@ -47,7 +67,7 @@ def area_path_pieces(
     for z, (twin, fo) in enumerate(zip(zf_twin.tolist(), zf_fo.tolist(), strict=True)):
         pt = np.repeat(anchor_xy[fo : fo + 1], 2, axis=0)
         area_paths[n_reg + z] = {twin: pt, fo: pt}
-    return pieces, area_paths
+    return WorldPaths(vxy, voff, vlen, pieces, area_paths)
 
 
 def opening_records(
@@ -86,13 +106,14 @@ def area_records(
     centre_xy: np.ndarray,
     aoff: np.ndarray,
     aops: np.ndarray,
-    area_paths: list[dict[int, np.ndarray]],
+    paths: WorldPaths,
     counts: np.ndarray,
     n_reg: int,
-    n_zf: int,
 ) -> dict[int, Area]:
-    """The :class:`Area` records by final id (regions, then zero-area frontier pathways)."""
-    n_prov = n_reg + n_zf
+    """The :class:`Area` records by final id (``n_reg`` regions, then zero-area frontier
+    pathways)."""
+    n_prov = len(area_ids)
+    n_zf = n_prov - n_reg
     aops_l = aops.tolist()
     aoff_l = aoff.tolist()
     area_recs = map(
@@ -103,7 +124,7 @@ def area_records(
             map(_TYPE_OF.__getitem__, prov_type.tolist()),
             map(tuple, centre_xy.tolist()),
             map(tuple, map(aops_l.__getitem__, map(slice, aoff_l[:n_prov], aoff_l[1:]))),
-            area_paths,
+            paths.by_area,
             counts.tolist()[:n_reg] + [0] * n_zf,
             strict=True,
         ),
@@ -116,14 +137,11 @@ def edge_records(
     pairs: np.ndarray,
     plen: np.ndarray,
     ids_l: list[int],
-    vlen: np.ndarray,
-    vxy: np.ndarray,
-    voff: np.ndarray,
-    pieces: list[np.ndarray],
-    area_paths: list[dict[int, np.ndarray]],
+    paths: WorldPaths,
 ) -> list[GraphEdge]:
     """Graph edges: areas with two openings, then every pair of an intersection's legs."""
-    vlen_l = vlen.tolist()
+    vlen_l = paths.lengths_m.tolist()
+    pieces, area_paths = paths.pieces, paths.by_area
     edges: list[GraphEdge] = [
         _tnew(GraphEdge, (o1, o2, ids_l[a], vlen_l[j], pieces[j]))
         if j >= 0
@@ -131,7 +149,7 @@ def edge_records(
         for o1, o2, a, j in edges2.tolist()
     ]
     if pairs.shape[1]:
-        jxy, joff = join_legs(vxy, voff, pairs[0], pairs[1])
+        jxy, joff = join_legs(paths.xy, paths.offsets, pairs[0], pairs[1])
         joff_l = joff.tolist()
         n_pair = int(pairs.shape[1])
         jpieces = map(jxy.__getitem__, map(slice, joff_l[:n_pair], joff_l[1 : n_pair + 1]))
