@@ -55,7 +55,10 @@ def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
     """The expert choosing frontiers by a learned value (:mod:`semexplore_gym.policies.frontier_value`)."""
-    from semexplore_gym.policies.frontier_value import FrontierValueParams, FrontierValuePolicy
+    from semexplore_gym.policies.learned_frontier_value import (
+        FrontierValueParams,
+        FrontierValuePolicy,
+    )
 
     return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
 

@@ -28,7 +28,7 @@ costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planne
   measures displacement from the last reset point, and a circle wider than
   ``oscillation_distance_m`` keeps resetting it.
 
-The oscillation check is a :class:`~semexplore_gym.policies.navigation.bookkeeping.ProgressWatch`, the same
+The oscillation check is a :class:`~semexplore_gym.policies.navigation.progress_watch.ProgressWatch`, the same
 progress watch the semantic expert uses for its stuck detection.
 """
 
@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.base import StepStats
-from semexplore_gym.policies.navigation.bookkeeping import ProgressWatch
+from semexplore_gym.policies.navigation.progress_watch import ProgressWatch
 from semexplore_gym.policies.navigation.recovery import RotateRecovery
 
 from semexplore_gym.core.frontiers.detection import detect_frontiers

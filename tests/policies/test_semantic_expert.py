@@ -208,10 +208,10 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
         )
 
     pol = SemanticExpertPolicy(SemanticExpertParams(switch_margin=0.5))
-    from semexplore_gym.policies.semantic_expert import _Plan
+    from semexplore_gym.policies.semantic_expert import Plan, PlanKind
 
     current = cand(3.0, 1.0, 7)
-    pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)
+    pol._plan = Plan(PlanKind.SEMANTIC, current.goal_xy_m, current.path_m, current)
     other = cand(-2.0, 0.8, 8)
     moved = cand(3.4, 1.1, 7)  # the same frontier pathway, its frontier receded
     assert pol.choose_goal([other, moved]) is moved
@@ -336,10 +336,10 @@ def test_semantic_decisive_counts_replans_where_the_metric_cost_alone_disagrees(
     def cands(*metric: float) -> list:
         return [SimpleNamespace(metric_cost=m) for m in metric]  # cheapest C first
 
-    pol._count_semantic_decisive(cands(1.0, 2.0))  # same choice
-    pol._count_semantic_decisive(cands(2.0, 1.0))  # the semantic gain overturned the metric
-    pol._count_semantic_decisive(cands(1.0, 1.0))  # a metric tie is no disagreement
-    pol._count_semantic_decisive([])  # nothing scored
+    pol.counts.record_scored_replan(cands(1.0, 2.0))  # same choice
+    pol.counts.record_scored_replan(cands(2.0, 1.0))  # the semantic gain overturned the metric
+    pol.counts.record_scored_replan(cands(1.0, 1.0))  # a metric tie is no disagreement
+    pol.counts.record_scored_replan([])  # nothing scored
     assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (3, 1)
     pol.act(obs, INFO)  # a real replan with one candidate
     assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (4, 1)
