@@ -1,4 +1,5 @@
-"""The semantic expert's plan record: :class:`Plan` and where it comes from, :class:`PlanKind`."""
+"""The semantic expert's plan record (:class:`Plan`, where it comes from: :class:`PlanKind`) and
+what the expert is doing (:class:`ExpertMode`)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
-__all__ = ["Plan", "PlanKind", "StrValueEnum"]
+__all__ = ["ExpertMode", "Plan", "PlanKind", "StrValueEnum"]
 
 
 class StrValueEnum(str, Enum):
@@ -67,3 +68,18 @@ class Plan:
     def remaining_m(self) -> float:
         """Length of the path from :attr:`progress` to its end."""
         return float(self.arc_m[-1] - self.arc_m[self.progress])
+
+
+class ExpertMode(StrValueEnum):
+    """What the expert is doing (equal to and printed as its value)."""
+
+    IDLE = "idle"
+    SEMANTIC = "semantic"
+    FALLBACK = "fallback"
+    RETRY = "retry"
+    LOOK = "look"
+    COMMANDED = "commanded"
+    ESCAPE = "escape"
+    RECOVERY = "recovery"
+    WAITING = "waiting"
+    DONE = "done"

@@ -60,6 +60,8 @@ __all__ = [
     "PocketEscape",
     "RetryFailedGoal",
     "SemanticFrontier",
+    "insert_plan_source",
+    "standable_prefix",
     "unknown_near",
 ]
 
@@ -428,3 +430,27 @@ DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
     PocketEscape(),
     LookAtNarrowFrontier(),
 )
+
+
+def insert_plan_source(
+    sources: tuple[PlanSource, ...],
+    source: PlanSource,
+    *,
+    before: str | None = None,
+    after: str | None = None,
+) -> tuple[PlanSource, ...]:
+    """``sources`` with ``source`` inserted before or after the source named so (else last).
+
+    Raises:
+        ValueError: no source has that name, or both ``before`` and ``after`` are given.
+    """
+    if before is not None and after is not None:
+        raise ValueError("give before or after, not both")
+    anchor = before if before is not None else after
+    if anchor is None:
+        return (*sources, source)
+    names = [s.name for s in sources]
+    if anchor not in names:
+        raise ValueError(f"no plan source named {anchor!r}; have {names}")
+    i = names.index(anchor) + (0 if before is not None else 1)
+    return (*sources[:i], source, *sources[i:])

@@ -11,9 +11,8 @@ Each replanning step (section II of Fredriksson et al.):
    (:mod:`semexplore_gym.core.planning.potential_field`) follows the path to ``F*``.
 4. **Stop.** The mission ends when no frontier remains.
 
-The policy is honest: it reads only the observation (``map``, ``pose``, ``scan``) and the
-static facts of ``info`` (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), never ground truth.
-What the paper leaves open and the parameters for it are described in
+The policy is honest: it reads only the observation and the static facts of ``info``, never
+ground truth. What the paper leaves open, and the parameters for it:
 :mod:`semexplore_gym.policies.semantic_expert_params`.
 
 The parts
@@ -45,17 +44,19 @@ Override :meth:`~SemanticExpertPolicy.choose_goal` to pick outright::
 
     expert = SemanticExpertPolicy(ranker=lambda cands: sorted(cands, key=lambda c: c.d_m))
 
-*Add a plan source*: a :class:`PlanSource` whose ``propose(ctx)`` returns a
-:class:`Plan` or None, put where it belongs in the order (a class attribute, or the
-``plan_sources`` argument)::
+*Add a plan source*: a :class:`PlanSource` whose ``propose(ctx)`` returns a :class:`Plan` or
+None, put where it belongs in the order (the class attribute ``plan_sources``, or the
+argument of the same name; :func:`insert_plan_source` places one by name)::
 
-    class Wait(PlanSource):
-        name = "wait"
+    class TeamGoal(PlanSource):  # a coordinator's assignment before the expert's own choice
+        name = "team"
         def propose(self, ctx):
-            return Plan(PlanKind.FALLBACK, ctx.xy_m, np.array([ctx.xy_m, ctx.xy_m]))
+            goal = coordinator.assignment(ctx.xy_m)  # None: no assignment now
+            path = None if goal is None else ctx.grid_route(goal)
+            return None if path is None else Plan(PlanKind.COMMANDED, goal, ctx.resampled(path))
 
-    class Patient(SemanticExpertPolicy):
-        plan_sources = (*DEFAULT_PLAN_SOURCES, Wait())  # never gives up
+    class TeamExpert(SemanticExpertPolicy):
+        plan_sources = insert_plan_source(DEFAULT_PLAN_SOURCES, TeamGoal(), before="semantic")
 
 *Drive to this goal*: :meth:`~SemanticExpertPolicy.drive_to` commands a point in world
 coordinates; the expert's navigation drives there over a clearance-aware grid route (with its
@@ -66,11 +67,8 @@ commanded_goal_xy_m` turns None once the goal is reached, failed or unreachable:
     while expert.commanded_goal_xy_m is not None:
         obs, *_ = env.step(expert.act(obs, info))
 
-The hooks :meth:`~SemanticExpertPolicy.on_replan_due`, :meth:`~SemanticExpertPolicy.
-on_replanned` and :meth:`~SemanticExpertPolicy.request_replan` tell about replans and force
-one; :meth:`~SemanticExpertPolicy.frontier_candidates` scores any observation's frontiers
-without changing the plan (:class:`~semexplore_gym.policies.expert_driver.ExpertDriver` and
-:class:`~semexplore_gym.policies.learned_frontier_value.FrontierValuePolicy` are built on them).
+Also: ``on_replan_due``, ``on_replanned``, ``request_replan`` (replans), ``frontier_candidates``
+(score any observation's frontiers); ``expert_driver`` and ``learned_frontier_value`` use them.
 """
 
 from __future__ import annotations
@@ -85,11 +83,12 @@ from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
 from semexplore_gym.policies.expert_counters import ExpertCounters
 from semexplore_gym.policies.expert_goal_memory import GoalMemory
 from semexplore_gym.policies.expert_path_following import PathFollower
-from semexplore_gym.policies.expert_plan import Plan, PlanKind, StrValueEnum
+from semexplore_gym.policies.expert_plan import ExpertMode, Plan, PlanKind
 from semexplore_gym.policies.expert_plan_sources import (
     DEFAULT_PLAN_SOURCES,
     PlanContext,
     PlanSource,
+    insert_plan_source,
     unknown_near,
 )
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
@@ -116,6 +115,7 @@ __all__ = [
     "SemanticExpertParams",
     "SemanticExpertPolicy",
     "area_type_raster",
+    "insert_plan_source",
 ]
 
 Segmenter = Callable[..., TopometricMap]
@@ -125,21 +125,6 @@ FrontierRanker = Callable[[list[FrontierCandidate]], list[FrontierCandidate]]
 
 #: Why a replan runs (``counters["replan_<reason>"]``, :meth:`SemanticExpertPolicy.on_replan_due`).
 REPLAN_REASONS = ("no_plan", "period", "goal_reached", "path_done", "goal_vanished")
-
-
-class ExpertMode(StrValueEnum):
-    """What the expert is doing (equal to and printed as its value)."""
-
-    IDLE = "idle"
-    SEMANTIC = "semantic"
-    FALLBACK = "fallback"
-    RETRY = "retry"
-    LOOK = "look"
-    COMMANDED = "commanded"
-    ESCAPE = "escape"
-    RECOVERY = "recovery"
-    WAITING = "waiting"
-    DONE = "done"
 
 
 class SemanticExpertPolicy(Policy):
@@ -437,13 +422,8 @@ class SemanticExpertPolicy(Policy):
     def frontier_candidates(
         self, obs: dict[str, np.ndarray], weights: FrontierCostWeights | None = None
     ) -> list[FrontierCandidate]:
-        """Scored, non-blacklisted frontier candidates of ``obs`` (cheapest ``C`` first).
-
-        Runs the pose identification and Algorithm 1 without changing the plan.
-
-        Args:
-            obs: The env observation (``map``, ``pose``).
-            weights: Cost weights to score with (default: the policy's current ones).
+        """Scored, non-blacklisted frontier candidates of ``obs`` (``map``, ``pose``), cheapest
+        ``C`` by ``weights`` (default: the current ones) first; the plan stays as it is.
 
         Raises:
             ValueError: called before ``reset``.
