@@ -64,7 +64,7 @@ def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
-    from semexplore_gym.policies.frontier import (
+    from semexplore_gym.policies.frontier_baselines import (
         FrontierExplorationParams,
         FrontierExplorationPolicy,
         NearestFrontierParams,

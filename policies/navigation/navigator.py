@@ -1,6 +1,6 @@
 """A move_base-like navigator: Navfn global plan, DWA local control, patience and recoveries.
 
-:class:`Navigator` drives the frontier baselines (:mod:`semexplore_gym.policies.frontier`) to their goals as
+:class:`Navigator` drives the frontier baselines (:mod:`semexplore_gym.policies.frontier_baselines`) to their goals as
 ROS move_base does (:class:`MoveBaseParams`): a Navfn-like global planner on an inflated
 costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planner
 (:mod:`semexplore_gym.core.planning.dwa`), with move_base's failure handling:
