@@ -82,8 +82,11 @@ class GoalMemory:
         self.geometry: GridGeometry | None = None
         self.reset(None)
 
-    def reset(self, geometry: GridGeometry | None) -> None:
-        """Forget everything: a new mission on a map of ``geometry``."""
+    def reset(self, geometry: GridGeometry | None, params: GoalMemoryParams | None = None) -> None:
+        """Forget everything: a new mission on a map of ``geometry`` (with ``params``, if
+        given, from now on)."""
+        if params is not None:
+            self.params = params
         prm = self.params
         self.geometry = geometry
         self.frontiers = FrontierMemory(

@@ -81,8 +81,12 @@ class PathFollower:
         dt_s: float,
         xy_m: tuple[float, float],
         known_cells: int,
+        params: PathFollowingParams | None = None,
     ) -> None:
-        """Start a mission with the robot at ``xy_m`` on a map with ``known_cells`` known."""
+        """Start a mission with the robot at ``xy_m`` on a map with ``known_cells`` known (with
+        ``params``, if given, from now on)."""
+        if params is not None:
+            self.params = params
         prm = self.params
         self.geometry = geometry
         self.limits = limits

@@ -1,10 +1,10 @@
 """The sources that propose the semantic expert's plans.
 
-A :class:`~semexplore_gym.policies.expert_plan.Plan` is where the robot drives and along which path. At each replan the expert asks
-its :class:`PlanSource` objects in order (:attr:`~semexplore_gym.policies.semantic_expert.
-SemanticExpertPolicy.plan_sources`); the first plan proposed is adopted, and when every source
-passes the expert waits a step and, after ``stop_confirmations`` such replans, stops. The
-default order (:data:`DEFAULT_PLAN_SOURCES`):
+A :class:`~semexplore_gym.policies.expert_plan.Plan` is where the robot drives and along which
+path. At each replan the expert asks its :class:`PlanSource` objects in order
+(``SemanticExpertPolicy.plan_sources``); the first plan proposed is adopted, and when every
+source passes the expert waits a step and, after ``stop_confirmations`` such replans, stops.
+The default order (:data:`DEFAULT_PLAN_SOURCES`; :func:`insert_plan_source` adds one):
 
 =====================  ======================================================================
 source                 proposes

@@ -197,19 +197,21 @@ class SemanticExpertPolicy(Policy):
         self.clearance_m = self.limits.radius_m + self.params.clearance_margin_m
         self.tmap, self.candidates, self.mode, self.events = None, [], ExpertMode.IDLE, []
         self.counts.clear()
-        self._time_s = 0.0
-        self._plan = None
-        self._next_replan_s = 0.0
+        self._time_s, self._next_replan_s, self._plan = 0.0, 0.0, None
         self._last_reason = ""
-        self._seg_known_cells = 0
-        self._empty_replans = 0
+        self._seg_known_cells = self._empty_replans = 0
         self._area_types: np.ndarray | None = None
         self._known_cells = known_cell_count(obs["map"])
-        self.goal_memory.params = self.params.goal_memory
-        self.goal_memory.reset(self.geometry)
-        self.follower.params = self.params.path_following
+        self.goal_memory.reset(self.geometry, self.params.goal_memory)
         xy_m = (float(obs["pose"][0]), float(obs["pose"][1]))
-        self.follower.reset(self.geometry, self.limits, self.dt_s, xy_m, self._known_cells)
+        self.follower.reset(
+            self.geometry,
+            self.limits,
+            self.dt_s,
+            xy_m,
+            self._known_cells,
+            self.params.path_following,
+        )
 
     # ------------------------------------------------------------------ stepping
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
