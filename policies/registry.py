@@ -2,7 +2,7 @@
 
 Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
-value, :mod:`semexplore_gym.policies.frontier_value`), ``"frontier"`` (ROS frontier_exploration
+value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
 agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
@@ -56,14 +56,17 @@ def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
 
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
-    """The expert choosing frontiers by a learned value (:mod:`semexplore_gym.policies.frontier_value`)."""
-    from semexplore_gym.policies.frontier_value import FrontierValueParams, FrontierValuePolicy
+    """The expert choosing frontiers by a learned value (:mod:`semexplore_gym.policies.learned_frontier_value`)."""
+    from semexplore_gym.policies.learned_frontier_value import (
+        FrontierValueParams,
+        FrontierValuePolicy,
+    )
 
     return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
-    from semexplore_gym.policies.frontier import (
+    from semexplore_gym.policies.frontier_baselines import (
         FrontierExplorationParams,
         FrontierExplorationPolicy,
         NearestFrontierParams,

@@ -89,15 +89,66 @@ switches them all off: the paper's method alone).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Literal
+from dataclasses import dataclass, field, fields
+from typing import Literal, TypeVar
 
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.validation import require_finite
 
-__all__ = ["PAPER_PURE", "SemanticExpertParams"]
+__all__ = ["PAPER_PURE", "GoalMemoryParams", "PathFollowingParams", "SemanticExpertParams"]
+
+_Group = TypeVar("_Group")
+
+
+@dataclass(frozen=True)
+class PathFollowingParams:
+    """The path follower's group of :class:`SemanticExpertParams` (same names and meaning).
+
+    :class:`~semexplore_gym.policies.expert_path_following.PathFollower` reads these: the
+    potential field, the local-minimum escape, the progress watch and the stuck recovery.
+    """
+
+    potential_field: PotentialFieldParams
+    local_min_escape: bool
+    local_min_timeout_s: float
+    escape_duration_s: float
+    escape_repulsion_scale: float
+    stuck_recovery: bool
+    stuck_timeout_s: float
+    stuck_radius_m: float
+    progress_timeout_s: float
+    progress_min_new_cells: int
+    backoff_duration_s: float
+    backoff_speed_fraction: float
+    goal_time_factor: float
+    min_goal_time_s: float
+
+
+@dataclass(frozen=True)
+class GoalMemoryParams:
+    """The goal memory's group of :class:`SemanticExpertParams` (same names and meaning).
+
+    :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` reads these: dropping,
+    retrying and reviving goals, the oscillation guard and the stop reason.
+    """
+
+    blacklist_radius_m: float
+    max_goal_reaches: int
+    max_goal_attempts: int
+    revive_window_m: float
+    revive_min_changed_cells: int
+    max_revivals: int
+    reach_blacklist: bool
+    oscillation_guard: bool
+    oscillation_window_s: float
+    grid_fallback: bool
+
+
+def _group(cls: type[_Group], params: SemanticExpertParams) -> _Group:
+    """The fields of ``cls`` taken from ``params`` (YAML keys stay flat: one level)."""
+    return cls(**{f.name: getattr(params, f.name) for f in fields(cls)})  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -290,6 +341,16 @@ class SemanticExpertParams:
             raise ValueError(f"max_look_drives must be >= 0, got {self.max_look_drives!r}")
         if int(self.max_revivals) < 0:
             raise ValueError(f"max_revivals must be >= 0, got {self.max_revivals!r}")
+
+    @property
+    def path_following(self) -> PathFollowingParams:
+        """The path follower's parameters (a view of this object's fields)."""
+        return _group(PathFollowingParams, self)
+
+    @property
+    def goal_memory(self) -> GoalMemoryParams:
+        """The goal memory's parameters (a view of this object's fields)."""
+        return _group(GoalMemoryParams, self)
 
 
 #: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level

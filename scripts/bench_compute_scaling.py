@@ -38,7 +38,10 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 from semexplore_gym.policies.base import StepStats
-from semexplore_gym.policies.frontier import FrontierExplorationPolicy, NearestFrontierPolicy
+from semexplore_gym.policies.frontier_baselines import (
+    FrontierExplorationPolicy,
+    NearestFrontierPolicy,
+)
 
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid

@@ -1,6 +1,6 @@
 """A move_base-like navigator: Navfn global plan, DWA local control, patience and recoveries.
 
-:class:`Navigator` drives the frontier baselines (:mod:`semexplore_gym.policies.frontier`) to their goals as
+:class:`Navigator` drives the frontier baselines (:mod:`semexplore_gym.policies.frontier_baselines`) to their goals as
 ROS move_base does (:class:`MoveBaseParams`): a Navfn-like global planner on an inflated
 costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planner
 (:mod:`semexplore_gym.core.planning.dwa`), with move_base's failure handling:
@@ -28,7 +28,7 @@ costmap (:mod:`semexplore_gym.core.planning.grid_search`) and a DWA local planne
   measures displacement from the last reset point, and a circle wider than
   ``oscillation_distance_m`` keeps resetting it.
 
-The oscillation check is a :class:`~semexplore_gym.policies.navigation.bookkeeping.ProgressWatch`, the same
+The oscillation check is a :class:`~semexplore_gym.policies.navigation.progress_watch.ProgressWatch`, the same
 progress watch the semantic expert uses for its stuck detection.
 """
 
@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.base import StepStats
-from semexplore_gym.policies.navigation.bookkeeping import ProgressWatch
+from semexplore_gym.policies.navigation.progress_watch import ProgressWatch
 from semexplore_gym.policies.navigation.recovery import RotateRecovery
 
 from semexplore_gym.core.frontiers.detection import detect_frontiers
@@ -275,12 +275,7 @@ class Navigator:
         if self.status == NavStatus.RECOVERING:
             if self._rotation.active:
                 return self._command(0.0, self._rotation.turn(self.limits[1], self.dt_s))
-            # Recovery over: plan again (move_base goes back to PLANNING).
-            self.status = NavStatus.ACTIVE
-            self._need_plan = True
-            self._plan_fail_since = None
-            self._ctrl_fail_since = None
-            self._oscillation.reset(now_s)
+            self._end_recovery(now_s)
 
         if (
             prm.planner_frequency_hz > 0
@@ -291,29 +286,64 @@ class Navigator:
             pose, grid, geometry
         )
         if self._need_plan or blocked:
-            t0 = time.perf_counter()
-            path = self._plan(pose, grid, geometry)
-            stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
-            stats.replanned = True
-            self._last_plan_s = now_s
-            self.counters["plans"] += 1
-            if path is None:
-                self.last_plan_failed = True
-                self.counters["plan_failures"] += 1
-                self._need_plan = True
-                if self._plan_fail_since is None:
-                    self._plan_fail_since = now_s
-                if now_s - self._plan_fail_since >= prm.planner_patience_s:
-                    return self._recover(now_s)
-                return self._command(0.0, 0.0)
-            self.path = path
-            self.dwa.set_path(path.points_m)
-            self._need_plan = False
-            self._plan_fail_since = None
+            waiting = self._global_plan(now_s, pose, grid, geometry, stats)
+            if waiting is not None:
+                return waiting
 
         if self._oscillation.update(now_s, (float(pose[0]), float(pose[1]))):
             return self._recover(now_s)
+        return self._local_control(now_s, pose, grid, geometry, scan_pts, stats)
 
+    def _end_recovery(self, now_s: float) -> None:
+        """Recovery over: plan again (move_base goes back to PLANNING)."""
+        self.status = NavStatus.ACTIVE
+        self._need_plan = True
+        self._plan_fail_since = None
+        self._ctrl_fail_since = None
+        self._oscillation.reset(now_s)
+
+    def _global_plan(
+        self,
+        now_s: float,
+        pose: np.ndarray,
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        stats: StepStats,
+    ) -> tuple[float, float] | None:
+        """Plan the global path; the command to give instead of following it (None: follow)."""
+        prm = self.params
+        t0 = time.perf_counter()
+        path = self._plan(pose, grid, geometry)
+        stats.global_planning_ms += (time.perf_counter() - t0) * 1e3
+        stats.replanned = True
+        self._last_plan_s = now_s
+        self.counters["plans"] += 1
+        if path is None:
+            self.last_plan_failed = True
+            self.counters["plan_failures"] += 1
+            self._need_plan = True
+            if self._plan_fail_since is None:
+                self._plan_fail_since = now_s
+            if now_s - self._plan_fail_since >= prm.planner_patience_s:
+                return self._recover(now_s)
+            return self._command(0.0, 0.0)
+        self.path = path
+        self.dwa.set_path(path.points_m)
+        self._need_plan = False
+        self._plan_fail_since = None
+        return None
+
+    def _local_control(
+        self,
+        now_s: float,
+        pose: np.ndarray,
+        grid: np.ndarray,
+        geometry: GridGeometry,
+        scan_pts: np.ndarray | None,
+        stats: StepStats,
+    ) -> tuple[float, float]:
+        """Follow the global path with DWA (local planner failures lead to a recovery)."""
+        prm = self.params
         t0 = time.perf_counter()
         cmd = self.dwa.compute(
             pose, self.velocity, grid, geometry, obstacle_points_m=scan_pts, limits=self.limits

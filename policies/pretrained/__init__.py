@@ -1,7 +1,7 @@
 """Pretrained agents shipped inside the package: ``make_policy("pretrained:NAME")``.
 
 Each model lives in its own folder here, ``<name>/model.zip`` (an SB3 model) or
-``<name>/model.yaml`` (the weights of a learned frontier value, :mod:`semexplore_gym.policies.frontier_value`)
+``<name>/model.yaml`` (the weights of a learned frontier value, :mod:`semexplore_gym.policies.learned_frontier_value`)
 beside the resolved ``config.yaml`` of the ``semexplore train`` run that produced it (a
 macro-action agent reads its settings from it). ``index.yaml`` describes them: what each was trained on, the command and
 config that reproduce it, and its measured results. ``semexplore pretrained`` lists them, one
@@ -61,7 +61,7 @@ class PretrainedModel:
     def model_path(self) -> Path:
         """The model file: ``model.zip`` (an SB3 model; its folder also holds the run's
         ``config.yaml``), or ``model.yaml`` (the parameters of a learned frontier value,
-        :mod:`semexplore_gym.policies.frontier_value`) when the folder has no zip."""
+        :mod:`semexplore_gym.policies.learned_frontier_value`) when the folder has no zip."""
         folder = PRETRAINED_DIR / self.name
         if not (folder / "model.zip").is_file() and (folder / "model.yaml").is_file():
             return folder / "model.yaml"

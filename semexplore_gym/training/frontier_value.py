@@ -1,7 +1,7 @@
-"""Fit the learned frontier value (:mod:`semexplore_gym.policies.frontier_value`) by a cross-entropy method.
+"""Fit the learned frontier value (:mod:`semexplore_gym.policies.learned_frontier_value`) by a cross-entropy method.
 
 The searched parameters are dotted overrides of
-:class:`~semexplore_gym.policies.frontier_value.FrontierValueParams` (the value's feature weights, the
+:class:`~semexplore_gym.policies.learned_frontier_value.FrontierValueParams` (the value's feature weights, the
 expert's cost weights and switch margin), each with a start value, a start spread and bounds.
 Every generation:
 
@@ -18,7 +18,7 @@ Batches change each generation, so a parameter set that only fits a few worlds d
 survive; the result is the final mean. Missions run in ``workers`` processes; every draw comes
 from one ``np.random.Generator`` seeded by ``seed``. Each generation is appended to
 ``generations.jsonl``; the result is written as ``model.yaml`` (a
-:class:`~semexplore_gym.policies.frontier_value.FrontierValueParams` layer, the file ``pretrained:`` reads).
+:class:`~semexplore_gym.policies.learned_frontier_value.FrontierValueParams` layer, the file ``pretrained:`` reads).
 """
 
 from __future__ import annotations
@@ -302,7 +302,7 @@ def write_model(overrides: dict[str, float], path: Path, wall_s: float) -> None:
             node = node.setdefault(p, {})
         node[parts[-1]] = round(float(value), 6)
     head = (
-        "# Learned frontier value (semexplore_gym.policies.frontier_value.FrontierValueParams layer), fitted by\n"
+        "# Learned frontier value (semexplore_gym.policies.learned_frontier_value.FrontierValueParams layer), fitted by\n"
         f"# semexplore_gym.training.frontier_value in {wall_s:.0f} s wall.\n"
     )
     path.write_text(head + yaml.safe_dump(nested, sort_keys=True))

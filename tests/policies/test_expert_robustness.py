@@ -9,8 +9,8 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
-from semexplore_gym.policies.navigation.approaches import side_approach
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
+from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.registry import make_policy
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 from semexplore_gym.policies.semantic_expert_params import PAPER_PURE

@@ -208,10 +208,10 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
         )
 
     pol = SemanticExpertPolicy(SemanticExpertParams(switch_margin=0.5))
-    from semexplore_gym.policies.semantic_expert import _Plan
+    from semexplore_gym.policies.semantic_expert import Plan, PlanKind
 
     current = cand(3.0, 1.0, 7)
-    pol._plan = _Plan("semantic", current.goal_xy_m, current.path_m, current)
+    pol._plan = Plan(PlanKind.SEMANTIC, current.goal_xy_m, current.path_m, current)
     other = cand(-2.0, 0.8, 8)
     moved = cand(3.4, 1.1, 7)  # the same frontier pathway, its frontier receded
     assert pol.choose_goal([other, moved]) is moved
@@ -336,10 +336,10 @@ def test_semantic_decisive_counts_replans_where_the_metric_cost_alone_disagrees(
     def cands(*metric: float) -> list:
         return [SimpleNamespace(metric_cost=m) for m in metric]  # cheapest C first
 
-    pol._count_semantic_decisive(cands(1.0, 2.0))  # same choice
-    pol._count_semantic_decisive(cands(2.0, 1.0))  # the semantic gain overturned the metric
-    pol._count_semantic_decisive(cands(1.0, 1.0))  # a metric tie is no disagreement
-    pol._count_semantic_decisive([])  # nothing scored
+    pol.counts.record_scored_replan(cands(1.0, 2.0))  # same choice
+    pol.counts.record_scored_replan(cands(2.0, 1.0))  # the semantic gain overturned the metric
+    pol.counts.record_scored_replan(cands(1.0, 1.0))  # a metric tie is no disagreement
+    pol.counts.record_scored_replan([])  # nothing scored
     assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (3, 1)
     pol.act(obs, INFO)  # a real replan with one candidate
     assert (pol.counters["scored_replans"], pol.counters["semantic_decisive"]) == (4, 1)
@@ -369,3 +369,98 @@ def test_expert_mission_is_deterministic():
     b = _mission("maze1", seed=4, max_time_s=60.0)
     assert a.steps == 300
     np.testing.assert_array_equal(a.trajectory, b.trajectory)
+
+
+# ---------------------------------------------------------------------- the plug-in points
+def test_counters_keep_their_names_and_mission_metrics_follow_them():
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    pol.act(obs, INFO)
+    names = list(pol.counters)
+    assert names[:3] == ["replans", "segmentations", "semantic_plans"]
+    assert names[-3:] == ["scored_replans", "semantic_decisive", "replan_no_plan"]
+    assert len(names) == 19 and pol.counters["semantic_plans"] == 1
+    assert pol.mission_metrics() == {"scored_replans": 1, "semantic_share": 0.0}
+    pol.reset(obs, INFO, seed=0)
+    assert pol.mission_metrics() == {"scored_replans": 0, "semantic_share": None}
+    assert "replan_no_plan" not in pol.counters
+
+
+def test_a_ranker_reorders_the_frontiers_before_goal_commitment():
+    from semexplore_gym.core.planning.graph_search import FrontierCandidate
+
+    def cand(x: float, cost: float) -> FrontierCandidate:
+        f = Frontier(0, 0, (x, 1.0), 1.0, None, 1.0)
+        path = np.array([[0.0, 1.0], [x, 1.0]])
+        return FrontierCandidate(f, (x, 1.0), path, (0,), x, 0.0, 1.0, 0, 0, 2.0, cost, 0.0, cost)
+
+    near, far = cand(1.0, 1.0), cand(4.0, 2.0)
+    assert SemanticExpertPolicy().choose_goal([near, far]) is near
+    farthest_first = SemanticExpertPolicy(ranker=lambda cs: sorted(cs, key=lambda c: -c.d_m))
+    assert farthest_first.choose_goal([near, far]) is far
+
+
+def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
+    from semexplore_gym.policies.semantic_expert import (
+        DEFAULT_PLAN_SOURCES,
+        Plan,
+        PlanKind,
+        PlanSource,
+        insert_plan_source,
+    )
+
+    names = [s.name for s in DEFAULT_PLAN_SOURCES]
+    assert names == [
+        "commanded",
+        "retry",
+        "semantic",
+        "committed_fallback",
+        "nearest_fallback",
+        "pocket_escape",
+        "look",
+    ]
+
+    class Stay(PlanSource):
+        name = "stay"
+
+        def propose(self, ctx):  # type: ignore[no-untyped-def]
+            return Plan(PlanKind.FALLBACK, (1.0, 1.0), np.array([ctx.xy_m, (1.0, 1.0)]))
+
+    sources = insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), before="semantic")
+    assert [s.name for s in sources].index("stay") == 2
+    with pytest.raises(ValueError, match="no plan source named"):
+        insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), after="nope")
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap, plan_sources=sources)
+    obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    pol.act(obs, INFO)
+    assert pol.plan_source == "fallback" and pol.goal_xy_m == (1.0, 1.0)
+    # Without it the expert plans as always.
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    pol.reset(obs, INFO, seed=0)
+    pol.act(obs, INFO)
+    assert pol.plan_source == "semantic"
+
+
+def test_drive_to_a_goal_then_choose_again():
+    grid = corridor_grid()
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    obs = obs_at(grid, 0.5, 1.0, 0.0)
+    pol.reset(obs, INFO, seed=0)
+    pol.drive_to((2.0, 1.2))
+    a = pol.act(obs, INFO)
+    assert pol.plan_source == "commanded" and pol.mode == "commanded" and a[0] > 0.5
+    assert pol.goal_xy_m == (2.0, 1.2) and pol.commanded_goal_xy_m == (2.0, 1.2)
+    # The goal lies in known space: it lasts until reached, then the expert chooses again.
+    pol.request_replan()
+    pol.act(obs_at(grid, 1.0, 1.0, 0.0), INFO)
+    assert pol.plan_source == "commanded"
+    pol.act(obs_at(grid, 2.0, 1.15, 0.0), INFO)
+    assert pol.commanded_goal_xy_m is None and pol.plan_source == "semantic"
+    assert any(e == "command_reached" for _t, e, _d in pol.events)
+    # A goal inside a wall is unreachable: the command ends at once.
+    pol.drive_to((2.0, 0.1))
+    pol.act(obs_at(grid, 2.0, 1.15, 0.0), INFO)
+    assert pol.commanded_goal_xy_m is None and pol.plan_source == "semantic"
+    assert any(e == "command_unreachable" for _t, e, _d in pol.events)

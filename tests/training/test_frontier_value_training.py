@@ -6,7 +6,7 @@ import json
 import math
 
 import pytest
-from semexplore_gym.policies.frontier_value import FrontierValuePolicy
+from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
 from semexplore_gym.policies.registry import make_policy
 
 from semexplore_gym.training.frontier_value import (

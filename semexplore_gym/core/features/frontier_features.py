@@ -1,6 +1,6 @@
 """Features of a learned frontier value (pure numpy, no gymnasium).
 
-The learned-value agent (:class:`semexplore_gym.policies.frontier_value.FrontierValuePolicy`) ranks the
+The learned-value agent (:class:`semexplore_gym.policies.learned_frontier_value.FrontierValuePolicy`) ranks the
 frontier candidates of Algorithm 1 by ``C' = C + sum_k w_k * phi_k``: the paper's cost ``C``
 plus a linear value over the features below, whose weights ``w_k`` were fitted by black-box
 optimisation over missions on training worlds

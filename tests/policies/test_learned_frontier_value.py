@@ -1,10 +1,10 @@
-"""The expert with a learned frontier value (``policies/frontier_value.py``)."""
+"""The expert with a learned frontier value (``policies/learned_frontier_value.py``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from semexplore_gym.policies.frontier_value import (
+from semexplore_gym.policies.learned_frontier_value import (
     FrontierValueParams,
     FrontierValuePolicy,
     FrontierValueWeights,

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from semexplore_gym.policies.base import Policy
-from semexplore_gym.policies.frontier import (
+from semexplore_gym.policies.frontier_baselines import (
     FrontierExplorationParams,
     FrontierExplorationPolicy,
     NearestFrontierPolicy,

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
+from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.core.features.frontier_features import FEATURE_NAMES, frontier_value_features
@@ -91,7 +91,9 @@ class FrontierValuePolicy(SemanticExpertPolicy):
 
     name = "frontier-value"
 
-    def __init__(self, params: FrontierValueParams | None = None, segmenter: Any = None) -> None:
+    def __init__(
+        self, params: FrontierValueParams | None = None, segmenter: Segmenter | None = None
+    ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
         super().__init__(self.value_params.expert, segmenter=segmenter)
         self._obs: dict[str, np.ndarray] | None = None
@@ -122,6 +124,6 @@ class FrontierValuePolicy(SemanticExpertPolicy):
         order = sorted(range(len(out)), key=lambda i: out[i].cost)
         return [out[i] for i in order]
 
-    def choose_goal(self, candidates: list[FrontierCandidate]) -> FrontierCandidate:
-        """The expert's choice (goal commitment included) among the candidates ranked by ``C'``."""
-        return super().choose_goal(self.rescored(candidates))
+    def rank_frontiers(self, candidates: list[FrontierCandidate]) -> list[FrontierCandidate]:
+        """The candidates ranked by ``C'`` (the expert's goal commitment then works on it)."""
+        return self.rescored(candidates)

@@ -1,76 +1,15 @@
-"""Goal bookkeeping shared by every policy that drives to goals: blacklist and progress watch.
+"""When the robot has made no progress for a while: :class:`ProgressWatch`.
 
-:class:`GoalBlacklist` holds the goals a policy gave up on and says whether a new goal lies near
-one of them. :class:`ProgressWatch` says when the robot has made no progress for a while. The
-move_base-like :class:`~semexplore_gym.policies.navigation.navigator.Navigator` of the frontier baselines and
-the semantic expert use the same two classes, each parametrised to its own rules:
-
-==================  ===================================  =====================================
-                    frontier baselines (``Navigator``)   semantic expert
-==================  ===================================  =====================================
-blacklist near      FE: a box of half-size               a disc of ``blacklist_radius_m``
-                    ``blacklist_box_m`` (cleared when a
-                    goal succeeds); nearest: a disc
-progress is         moving ``oscillation_distance_m``    moving more than ``stuck_radius_m``
-                    or more (move_base's oscillation     or the map growing; and, separately,
-                    check)                               the rest of the path shrinking or
-                                                         the map growing
-on no progress      rotate in place, abort after         back off, then blacklist the goal
-                    ``max_recoveries``
-==================  ===================================  =====================================
-
-The recovery manoeuvres differ (move_base's in-place rotation against the expert's back-off) and
-stay with their owners; the bookkeeping that decides *when* to recover and *which* goals to skip
-is this module's.
+The move_base-like :class:`~semexplore_gym.policies.navigation.navigator.Navigator` of the frontier
+baselines and the semantic expert's path follower use the same class, each parametrised to its
+own rules (see :mod:`semexplore_gym.policies.navigation`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from typing import Literal, cast
 
-__all__ = ["GoalBlacklist", "ProgressWatch"]
-
-
-class GoalBlacklist:
-    """Goals given up on; a point near one of them is blacklisted too.
-
-    Args:
-        size_m: Radius of the disc (``shape="disc"``) or half-size of the axis-aligned box
-            (``shape="box"``, ROS ``frontier_exploration``'s ``blacklist_box_size``) round each
-            blacklisted goal.
-        shape: ``"disc"`` or ``"box"``; the boundary belongs to the blacklisted region.
-    """
-
-    def __init__(self, size_m: float, shape: Literal["disc", "box"] = "disc") -> None:
-        if shape not in ("disc", "box"):
-            raise ValueError(f"shape must be 'disc' or 'box', got {shape!r}")
-        self.size_m = float(size_m)
-        self.shape = shape
-        self.points_m: list[tuple[float, float]] = []
-
-    def add(self, xy_m: tuple[float, float]) -> None:
-        """Blacklist the goal at ``xy_m`` (metres, world frame)."""
-        self.points_m.append(xy_m)
-
-    def clear(self) -> None:
-        """Forget every blacklisted goal."""
-        self.points_m.clear()
-
-    def __contains__(self, xy_m: object) -> bool:
-        """Whether ``xy_m`` lies within the disc or box of a blacklisted goal."""
-        x, y = cast("tuple[float, float]", xy_m)
-        size = self.size_m
-        if self.shape == "box":
-            return any(abs(x - bx) <= size and abs(y - by) <= size for bx, by in self.points_m)
-        return any(math.dist((x, y), b) <= size for b in self.points_m)
-
-    def __len__(self) -> int:
-        return len(self.points_m)
-
-    def __iter__(self) -> Iterator[tuple[float, float]]:
-        return iter(self.points_m)
+__all__ = ["ProgressWatch"]
 
 
 class ProgressWatch:

@@ -17,11 +17,13 @@ The wrappers in :mod:`semexplore_gym.wrappers.frontier_choice` use this class th
 ``FrontierDriver`` protocol; they never import it (wrappers sit below policies in the layering),
 the env-id entry points in :mod:`semexplore_gym.macro_envs` join the two.
 
-It uses only the expert's public hooks: it overrides
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
+It uses only the expert's public plug-in points (see :mod:`semexplore_gym.policies.semantic_expert`):
+it overrides :meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
 :meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replan_due` and
 :meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replanned`, and calls
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.request_replan`.
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.request_replan`. To drive to
+a point rather than a frontier, use the expert's
+:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.drive_to`.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.semantic_expert import (
-    PlanSource,
+    PlanKind,
     Segmenter,
     SemanticExpertParams,
     SemanticExpertPolicy,
@@ -56,6 +58,7 @@ class ExpertDriver(SemanticExpertPolicy):
     """
 
     name = "semantic-driver"
+    params: SemanticExpertParams
 
     def __init__(
         self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
@@ -109,7 +112,7 @@ class ExpertDriver(SemanticExpertPolicy):
         if self._goal is not None and reason in _GOAL_DONE_REASONS:
             self.goal_finished = True
 
-    def on_replanned(self, source: PlanSource | None) -> None:
+    def on_replanned(self, source: PlanKind | None) -> None:
         """The commanded frontier is finished once it is no longer among the candidates."""
-        if self._goal is not None and source != "semantic":
+        if self._goal is not None and source != PlanKind.SEMANTIC:
             self.goal_finished = True

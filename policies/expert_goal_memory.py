@@ -1,0 +1,239 @@
+"""The semantic expert's goal memory: drops, reaches, retries, revivals, the trail, the commanded
+goal and the stop reason (issue #13: never give up on a reachable frontier).
+
+:class:`GoalMemory` is a part the expert owns. It decides what happens when the approach to a
+goal fails (retry it another way, or drop it), when a goal is reached without clearing its
+frontier, when the map round a dropped goal changes, and why the mission stopped. Its
+parameters are :class:`~semexplore_gym.policies.semantic_expert_params.GoalMemoryParams` (the
+fields of the same names in :class:`SemanticExpertParams`, documented in
+:mod:`semexplore_gym.policies.semantic_expert_params`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from semexplore_gym.policies.expert_counters import ExpertCounters
+from semexplore_gym.policies.expert_plan import Plan, PlanKind
+from semexplore_gym.policies.navigation.blacklist import GoalBlacklist
+from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
+from semexplore_gym.policies.semantic_expert_params import GoalMemoryParams
+
+from semexplore_gym.core.grid import GridGeometry
+
+__all__ = ["TRAIL_CELL_M", "GoalMemory", "Reach", "Retry"]
+
+#: Lattice of the robot's trail (metres per cell).
+TRAIL_CELL_M = 0.25
+
+
+@dataclass(frozen=True)
+class Retry:
+    """A goal whose approach failed, to be approached another way at the next replan.
+
+    Attributes:
+        goal_xy_m: The goal (the frontier's goal point, not a point beside it).
+        failures: Failed approaches so far (1: the next is a grid route; more: another side).
+        failed_at_xy_m: Where the robot stood when the first approach failed.
+    """
+
+    goal_xy_m: tuple[float, float]
+    failures: int
+    failed_at_xy_m: tuple[float, float]
+
+
+@dataclass
+class Reach:
+    """A place the robot reached as its goal, and how often, without the frontier clearing."""
+
+    xy_m: tuple[float, float]
+    count: int
+
+
+class GoalMemory:
+    """Failed approaches are retried, dropped goals come back, and the stop reason is told.
+
+    Args:
+        params: The goal memory's parameters.
+        counts: The expert's counters (``blacklisted``, ``retries``, ``revived``, ``looks``).
+        log: Records an event ``(name, detail)`` in the expert's event log.
+
+    Attributes:
+        frontiers: Failures, dropped goals (with revival) and abandoned goals.
+        blacklist: The dropped goals still active (what Algorithm 1's candidates skip).
+        retry: The goal to approach another way at the next replan (None: none).
+        reaches: Goals reached without their frontier clearing.
+        trail: Cells of a :data:`TRAIL_CELL_M` lattice the robot has been in.
+        commanded_xy_m: The goal commanded from outside (None: the expert chooses).
+    """
+
+    def __init__(
+        self,
+        params: GoalMemoryParams,
+        counts: ExpertCounters,
+        log: Callable[[str, str], None],
+    ) -> None:
+        self.params = params
+        self.counts = counts
+        self.log = log
+        self.geometry: GridGeometry | None = None
+        self.reset(None)
+
+    def reset(self, geometry: GridGeometry | None, params: GoalMemoryParams | None = None) -> None:
+        """Forget everything: a new mission on a map of ``geometry`` (with ``params``, if
+        given, from now on)."""
+        if params is not None:
+            self.params = params
+        prm = self.params
+        self.geometry = geometry
+        self.frontiers = FrontierMemory(
+            prm.blacklist_radius_m,
+            prm.revive_window_m,
+            prm.revive_min_changed_cells,
+            prm.max_revivals,
+            prm.max_goal_attempts,
+        )
+        self.blacklist = GoalBlacklist(prm.blacklist_radius_m)
+        self.retry: Retry | None = None
+        self.reaches: list[Reach] = []
+        # Where the robot has been, on a coarse lattice: a narrow frontier it already passed
+        # close to has had its closer look.
+        self.trail: set[tuple[int, int]] = set()
+        self.commanded_xy_m: tuple[float, float] | None = None
+
+    # ------------------------------------------------------------------ queries
+    def dropped_points(self) -> list[tuple[float, float]]:
+        """The dropped goals that have not come back."""
+        return self.frontiers.active_points()
+
+    def is_blacklisted(self, xy_m: tuple[float, float]) -> bool:
+        """Whether ``xy_m`` lies near a dropped goal."""
+        return xy_m in self.blacklist
+
+    def recently_abandoned(self, xy_m: tuple[float, float], now_s: float) -> bool:
+        """With the oscillation guard on: whether the robot switched away from a goal near
+        ``xy_m`` within ``oscillation_window_s``."""
+        return self.params.oscillation_guard and self.frontiers.recently_abandoned(
+            xy_m, now_s, self.params.oscillation_window_s
+        )
+
+    def been_near(self, xy_m: tuple[float, float], radius_m: float) -> bool:
+        """Whether the robot's trail passed within ``radius_m`` of ``xy_m``."""
+        c = TRAIL_CELL_M
+        k = int(math.ceil(radius_m / c))
+        ix, iy = int(xy_m[0] // c), int(xy_m[1] // c)
+        for i in range(ix - k, ix + k + 1):
+            for j in range(iy - k, iy + k + 1):
+                if (i, j) in self.trail and math.dist(((i + 0.5) * c, (j + 0.5) * c), xy_m) <= (
+                    radius_m
+                ):
+                    return True
+        return False
+
+    # ------------------------------------------------------------------ events
+    def visit(self, xy_m: tuple[float, float]) -> None:
+        """The robot is at ``xy_m`` (its trail)."""
+        self.trail.add((int(xy_m[0] // TRAIL_CELL_M), int(xy_m[1] // TRAIL_CELL_M)))
+
+    def abandon(self, goal_xy_m: tuple[float, float], now_s: float) -> None:
+        """The robot switched away from ``goal_xy_m``."""
+        self.frontiers.abandon(goal_xy_m, now_s)
+
+    def command(self, xy_m: tuple[float, float] | None) -> None:
+        """Drive to ``xy_m`` from the next replan on (None: the expert chooses again)."""
+        self.commanded_xy_m = xy_m
+
+    def end_command(self, why: str) -> None:
+        """The commanded goal is done (reached, failed or unreachable): forget it."""
+        if self.commanded_xy_m is not None:
+            self.log(why, f"goal={self.commanded_xy_m}")
+        self.commanded_xy_m = None
+
+    def drop(self, grid: np.ndarray, xy_m: tuple[float, float], reason: str) -> None:
+        """Give up on the goal at ``xy_m`` until the map round it changes."""
+        assert self.geometry is not None
+        self.frontiers.drop(xy_m, reason, grid, self.geometry)
+        self.blacklist.points_m[:] = self.frontiers.active_points()
+        self.counts.blacklisted += 1
+        self.log("blacklist", f"{reason}: {xy_m}")
+
+    def goal_failed(self, grid: np.ndarray, plan: Plan, robot_xy_m: tuple[float, float]) -> None:
+        """The approach to ``plan``'s goal failed (a stuck recovery ended): retry it another
+        way, or drop it. A commanded goal is given up at once."""
+        if plan.kind == PlanKind.COMMANDED:
+            self.end_command("command_failed")
+            return
+        # A retry's target may be a point beside the goal: the goal itself is what failed.
+        goal = (
+            plan.frontier_xy_m
+            if plan.kind == PlanKind.RETRY and plan.frontier_xy_m
+            else plan.goal_xy_m
+        )
+        n, failed_at = self.frontiers.record_failure(goal, robot_xy_m)
+        if n >= self.params.max_goal_attempts or plan.kind == PlanKind.LOOK:
+            self.retry = None
+            self.drop(grid, goal, "attempts")
+            return
+        self.retry = Retry(goal, n, failed_at)
+        self.counts.retries += 1
+        self.log("retry", f"attempt {n + 1} at {goal}")
+
+    def goal_reached(self, grid: np.ndarray, plan: Plan) -> None:
+        """The robot reached ``plan``'s goal (the replan that follows decides what next)."""
+        if plan.kind == PlanKind.COMMANDED:
+            self.end_command("command_reached")
+            return
+        if plan.kind == PlanKind.RETRY:
+            self.retry = None
+        if plan.kind == PlanKind.LOOK and plan.frontier_xy_m is not None:
+            # Looked from close by and the frontier is still there: the gap stays closed.
+            self.counts.looks += 1
+            self.drop(grid, plan.frontier_xy_m, "looked")
+        elif self.params.reach_blacklist:
+            self._register_reach(grid, plan.goal_xy_m)
+
+    def _register_reach(self, grid: np.ndarray, goal: tuple[float, float]) -> None:
+        r = self.params.blacklist_radius_m
+        for reach in self.reaches:
+            if math.hypot(goal[0] - reach.xy_m[0], goal[1] - reach.xy_m[1]) <= r:
+                reach.count += 1
+                if reach.count >= self.params.max_goal_reaches:
+                    reach.count = 0
+                    self.drop(grid, reach.xy_m, "reached")
+                return
+        self.reaches.append(Reach((goal[0], goal[1]), 1))
+        if self.params.max_goal_reaches <= 1:
+            self.drop(grid, goal, "reached")
+
+    def revive(self, grid: np.ndarray) -> None:
+        """Bring back the dropped goals round which the map changed enough."""
+        if not self.frontiers.dropped:
+            return
+        assert self.geometry is not None
+        back = self.frontiers.revive(grid, self.geometry)
+        if back:
+            self.blacklist.points_m[:] = self.frontiers.active_points()
+            self.counts.revived += len(back)
+            for xy in back:
+                self.log("revive", f"map changed round {xy}")
+
+    def stop_reason(self) -> str:
+        """Which rule ended the mission, and what was left behind."""
+        if not self.params.grid_fallback:
+            n = self.frontiers.count()
+            return "no semantic frontier left" + (f" ({n} frontier(s) dropped)" if n else "")
+        parts = []
+        for reason, text in (
+            ("attempts", f"failed {self.params.max_goal_attempts} approaches"),
+            ("grid", "no grid path"),
+            ("reached", f"reached {self.params.max_goal_reaches} times, not cleared"),
+            ("looked", "looked at, gap closed"),
+        ):
+            n = self.frontiers.count(reason)
+            if n:
+                parts.append(f"{n} {text}")
+        tail = f"; dropped: {', '.join(parts)}" if parts else ""
+        return f"no frontier left (grid check: none reachable{tail})"

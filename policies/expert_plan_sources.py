@@ -1,0 +1,459 @@
+"""The sources that propose the semantic expert's plans.
+
+A :class:`~semexplore_gym.policies.expert_plan.Plan` is where the robot drives and along which
+path. At each replan the expert asks its :class:`PlanSource` objects in order
+(``SemanticExpertPolicy.plan_sources``); the first plan proposed is adopted, and when every
+source passes the expert waits a step and, after ``stop_confirmations`` such replans, stops.
+The default order (:data:`DEFAULT_PLAN_SOURCES`; :func:`insert_plan_source` adds one):
+
+=====================  ======================================================================
+source                 proposes
+=====================  ======================================================================
+``commanded``          the goal commanded from outside (``drive_to``), over a grid route
+``retry``              another approach to a goal whose approach failed (a grid route, then
+                       another side of its frontier), or drops it
+``semantic``           Algorithm 1's chosen frontier along the topometric map (the paper)
+``committed_fallback`` the grid fallback's goal of the last plan, while it lasts
+``nearest_fallback``   the nearest frontier a clearance-aware grid search reaches
+``pocket_escape``      out of a pocket of the usable map, then to a frontier outside it
+``look``               close to a frontier too narrow to reach, to look again
+=====================  ======================================================================
+
+Every source reads what it needs from a :class:`PlanContext` and keeps no state of its own (the
+goal memory and the counters are the expert's), so one instance serves every expert. A source
+switched off by the parameters passes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from semexplore_gym.policies.expert_counters import ExpertCounters
+from semexplore_gym.policies.expert_goal_memory import GoalMemory
+from semexplore_gym.policies.expert_plan import Plan, PlanKind
+from semexplore_gym.policies.navigation.side_approach import side_approach
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
+    clearance_field_m,
+    grid_path_to,
+    nearest_reachable_frontier,
+    pocket_exit_path,
+)
+from semexplore_gym.core.grid import UNKNOWN, GridGeometry
+from semexplore_gym.core.planning.graph_search import FrontierCandidate
+from semexplore_gym.core.planning.line_of_sight import segment_is_clear
+from semexplore_gym.core.planning.potential_field import resample_polyline
+
+__all__ = [
+    "DEFAULT_PLAN_SOURCES",
+    "CommandedGoal",
+    "CommittedFallback",
+    "LookAtNarrowFrontier",
+    "NearestFallback",
+    "PlanContext",
+    "PlanSource",
+    "PocketEscape",
+    "RetryFailedGoal",
+    "SemanticFrontier",
+    "insert_plan_source",
+    "standable_prefix",
+    "unknown_near",
+]
+
+#: Narrow frontiers checked against the trail before one is worth driving to.
+MAX_LOOK_CANDIDATES = 8
+
+
+def unknown_near(
+    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], radius_m: float
+) -> bool:
+    """Whether an UNKNOWN cell lies in the box of half-size ``radius_m`` round ``xy`` (or the
+    box reaches past the map's edge, beyond which all is unknown)."""
+    g = geometry
+    # g.world_to_grid's arithmetic on scalars (called every step: no arrays)
+    ox, oy, res = g.origin_x_m, g.origin_y_m, g.resolution_m
+    c0 = math.floor((float(xy[0] - radius_m) - ox) / res)
+    r0 = math.floor((float(xy[1] - radius_m) - oy) / res)
+    c1 = math.floor((float(xy[0] + radius_m) - ox) / res)
+    r1 = math.floor((float(xy[1] + radius_m) - oy) / res)
+    if r0 < 0 or c0 < 0 or r1 >= g.height or c1 >= g.width:
+        return True
+    return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())
+
+
+@dataclass
+class PlanContext:
+    """What a plan source may read at one replan (built by the expert for each replan).
+
+    Attributes:
+        grid: The observed map.
+        pose: The robot's ``(x_m, y_m, yaw_rad)``.
+        geometry: The map's frame.
+        params: The expert's parameters.
+        clearance_m: The planners' clearance (robot radius plus ``clearance_margin_m``).
+        robot_radius_m: The robot's radius.
+        candidates: Algorithm 1's scored, non-blacklisted frontiers, cheapest ``C`` first.
+        current: The plan followed so far (None: none).
+        memory: The expert's goal memory (drops, retries, the commanded goal, the trail).
+        counts: The expert's counters.
+        choose_goal: The expert's goal choice among ``candidates``.
+        log: Records an event ``(name, detail)`` in the expert's event log.
+    """
+
+    grid: np.ndarray
+    pose: tuple[float, float, float]
+    geometry: GridGeometry
+    params: SemanticExpertParams
+    clearance_m: float
+    robot_radius_m: float
+    candidates: list[FrontierCandidate]
+    current: Plan | None
+    memory: GoalMemory
+    counts: ExpertCounters
+    choose_goal: Callable[[list[FrontierCandidate]], FrontierCandidate]
+    log: Callable[[str, str], None]
+    clearance_cache: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def xy_m(self) -> tuple[float, float]:
+        """The robot's position."""
+        return (self.pose[0], self.pose[1])
+
+    def clearance_field(self) -> np.ndarray:
+        """The grid's clearance field (computed once per replan, on first use)."""
+        if self.clearance_cache is None:
+            self.clearance_cache = clearance_field_m(self.grid, self.geometry.resolution_m)
+        return self.clearance_cache
+
+    def resampled(self, path_m: np.ndarray) -> np.ndarray:
+        """``path_m`` resampled at the map's resolution (what the path follower expects)."""
+        return resample_polyline(path_m, self.geometry.resolution_m)
+
+    def grid_route(self, goal_xy_m: tuple[float, float]) -> np.ndarray | None:
+        """A clearance-aware grid path from the robot to ``goal_xy_m`` (None: none)."""
+        return grid_path_to(
+            self.grid,
+            self.geometry,
+            self.xy_m,
+            goal_xy_m,
+            self.clearance_m,
+            clearance_field=self.clearance_field(),
+        )
+
+    def fallback_search_kwargs(self) -> dict[str, Any]:
+        """Which frontiers the grid fallback counts (the same for its every search)."""
+        prm = self.params
+        res_m = self.geometry.resolution_m
+        return {
+            "min_frontier_cells": max(1, math.ceil(prm.fallback_min_frontier_m / res_m - 1e-9)),
+            "min_unknown_depth_cells": prm.fallback_min_unknown_depth_m / res_m,
+            "reach_m": prm.fallback_reach_m,
+            "excluded_xy_m": self.memory.dropped_points(),
+            "excluded_radius_m": prm.blacklist_radius_m + prm.fallback_reach_m,
+        }
+
+
+class PlanSource:
+    """One way to find the next plan: :meth:`propose` a plan, or pass with None.
+
+    Subclasses set :attr:`name` (events and docs) and implement :meth:`propose`; they keep no
+    state of their own (see the module docstring).
+    """
+
+    name: str = "source"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        """The plan this source offers at this replan, or None to pass to the next source."""
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+class CommandedGoal(PlanSource):
+    """The goal commanded from outside (``drive_to``), over a grid route with the clearance.
+
+    A commanded goal no grid route reaches is given up (``command_unreachable`` event) and the
+    expert chooses again by itself.
+    """
+
+    name = "commanded"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        goal = ctx.memory.commanded_xy_m
+        if goal is None:
+            return None
+        path = ctx.grid_route(goal)
+        if path is None:
+            ctx.memory.end_command("command_unreachable")
+            return None
+        return Plan(PlanKind.COMMANDED, goal, ctx.resampled(path))
+
+
+class RetryFailedGoal(PlanSource):
+    """The next approach to a failed goal: a grid route, then another side (or drop it)."""
+
+    name = "retry"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        retry = ctx.memory.retry
+        if retry is None:
+            return None
+        goal = retry.goal_xy_m
+        if not unknown_near(ctx.grid, ctx.geometry, goal, ctx.params.goal_check_radius_m):
+            ctx.memory.retry = None  # its frontier got mapped meanwhile
+            return None
+        target, path = goal, None
+        if retry.failures == 1:
+            path = ctx.grid_route(goal)
+        else:
+            found = side_approach(
+                ctx.grid,
+                ctx.geometry,
+                ctx.xy_m,
+                goal,
+                retry.failed_at_xy_m,
+                ctx.clearance_m,
+                ctx.clearance_field(),
+            )
+            if found is not None:
+                target, path = found
+        if path is None:
+            # The grid planner finds no way for the robot's disc: the goal is unreachable now.
+            ctx.memory.retry = None
+            ctx.memory.drop(ctx.grid, goal, "grid")
+            return None
+        return Plan(PlanKind.RETRY, target, ctx.resampled(path), frontier_xy_m=goal)
+
+
+class SemanticFrontier(PlanSource):
+    """Algorithm 1's frontier (the expert's ``choose_goal``) along the topometric map's path.
+
+    With ``entry_detour``, when the straight first leg from the robot to the path crosses a
+    wall, a grid route leads onto the path instead (none: pass).
+    """
+
+    name = "semantic"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        if not ctx.candidates:
+            return None
+        chosen = ctx.choose_goal(ctx.candidates)
+        path: np.ndarray | None = chosen.path_m
+        if (
+            ctx.params.entry_detour
+            and len(chosen.path_m) >= 2
+            and not segment_is_clear(ctx.grid, ctx.geometry, ctx.xy_m, tuple(chosen.path_m[1]))
+        ):
+            detour = ctx.grid_route(tuple(chosen.path_m[1]))
+            path = None if detour is None else np.vstack([detour, chosen.path_m[2:]])
+            ctx.counts.entry_detours += int(detour is not None)
+        if path is None:
+            return None
+        return Plan(PlanKind.SEMANTIC, chosen.goal_xy_m, ctx.resampled(path), chosen)
+
+
+class CommittedFallback(PlanSource):
+    """Goal commitment for the grid fallback: the last fallback goal while it is there and
+    reachable, rather than whichever frontier is nearest right now."""
+
+    name = "committed_fallback"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        prm = ctx.params
+        old = ctx.current
+        if (
+            not prm.grid_fallback
+            or old is None
+            or old.kind != PlanKind.FALLBACK
+            or ctx.memory.is_blacklisted(old.goal_xy_m)
+            or math.hypot(ctx.pose[0] - old.goal_xy_m[0], ctx.pose[1] - old.goal_xy_m[1])
+            <= prm.goal_reached_radius_m
+            or not unknown_near(ctx.grid, ctx.geometry, old.goal_xy_m, prm.goal_check_radius_m)
+        ):
+            return None
+        path = ctx.grid_route(old.goal_xy_m)
+        if path is None:
+            return None
+        return Plan(PlanKind.FALLBACK, old.goal_xy_m, ctx.resampled(path))
+
+
+class NearestFallback(PlanSource):
+    """The nearest frontier a grid search with the robot's clearance reaches."""
+
+    name = "nearest_fallback"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        if not ctx.params.grid_fallback:
+            return None
+        found = nearest_reachable_frontier(
+            ctx.grid,
+            ctx.geometry,
+            ctx.xy_m,
+            ctx.clearance_m,
+            frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
+            clearance_field=ctx.clearance_field(),
+        )
+        if found is None:
+            return None
+        return Plan(PlanKind.FALLBACK, found.goal_xy_m, ctx.resampled(found.path_m))
+
+
+class PocketEscape(PlanSource):
+    """The grid check found nothing: if the robot stands in a pocket, check from outside it.
+
+    The potential field may leave the robot nearer a wall than the planner's clearance, in a
+    spot that a gap narrower than the clearance cuts off from the rest of the usable map; the
+    check, which starts where the robot stands, then sees only that pocket. The robot fits
+    where it stands, so it leaves over cells with the clearance of its radius plus
+    ``pocket_clearance_margin_m`` to the nearest region that is not a pocket, and the check
+    runs again from there with the full clearance (see
+    :mod:`semexplore_gym.policies.semantic_expert_params`). The plan is both legs; none when the
+    check from outside finds nothing either.
+    """
+
+    name = "pocket_escape"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        prm = ctx.params
+        if not (prm.grid_fallback and prm.pocket_escape):
+            return None
+        thin_m = ctx.robot_radius_m + prm.pocket_clearance_margin_m
+        clearance = ctx.clearance_field()
+        exit_path = pocket_exit_path(
+            ctx.grid,
+            ctx.geometry,
+            ctx.xy_m,
+            ctx.clearance_m,
+            min(thin_m, ctx.clearance_m),
+            prm.pocket_max_share,
+            clearance_field=clearance,
+        )
+        if exit_path is None:
+            return None
+        outside = (float(exit_path[-1, 0]), float(exit_path[-1, 1]))
+        found = nearest_reachable_frontier(
+            ctx.grid,
+            ctx.geometry,
+            outside,
+            ctx.clearance_m,
+            frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
+            clearance_field=clearance,
+        )
+        if found is None:
+            return None
+        ctx.counts.pocket_escapes += 1
+        ctx.log(
+            "pocket",
+            f"out at {tuple(round(v, 2) for v in outside)}, then to the frontier at "
+            f"{tuple(round(v, 2) for v in found.frontier_xy_m)}",
+        )
+        path = np.vstack([exit_path, found.path_m[1:]])
+        return Plan(PlanKind.FALLBACK, found.goal_xy_m, ctx.resampled(path))
+
+
+class LookAtNarrowFrontier(PlanSource):
+    """Before stopping: drive towards a frontier too narrow to reach, to look again.
+
+    The grid fallback already found no frontier the robot's disc can reach. A frontier that a
+    thinner robot (``look_clearance_fraction`` of the clearance) could reach is a gap narrower
+    than the robot *at first sight* (a door seen at a grazing angle, a passage seen through a
+    narrow slot); leaks through rasterised walls, one or two cells wide, are not. The robot
+    follows the thin robot's path as far as its own clearance allows, and looks from there,
+    once per place; if the robot already passed within ``look_seen_radius_m`` of the frontier
+    it had its look, and the frontier is dropped.
+    """
+
+    name = "look"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        prm = ctx.params
+        if not (prm.grid_fallback and prm.look_at_narrow_frontiers):
+            return None
+        res_m = ctx.geometry.resolution_m
+        if ctx.counts.look_drives >= prm.max_look_drives:
+            return None
+        clearance = ctx.clearance_field()
+        for _ in range(MAX_LOOK_CANDIDATES):
+            found = nearest_reachable_frontier(
+                ctx.grid,
+                ctx.geometry,
+                ctx.xy_m,
+                ctx.clearance_m * prm.look_clearance_fraction,
+                FrontierFilter(
+                    min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
+                    min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
+                    reach_m=prm.fallback_reach_m,
+                    excluded_xy_m=ctx.memory.dropped_points(),
+                    excluded_radius_m=prm.blacklist_radius_m,
+                ),
+                clearance_field=clearance,
+            )
+            if found is None:
+                return None
+            path = standable_prefix(ctx, found.path_m)
+            near = math.dist(tuple(path[-1]), found.frontier_xy_m) <= prm.look_reach_m
+            if (
+                len(path) >= 2
+                and near
+                and not ctx.memory.been_near(found.frontier_xy_m, prm.look_seen_radius_m)
+            ):
+                ctx.counts.look_drives += 1
+                goal = (float(path[-1, 0]), float(path[-1, 1]))
+                return Plan(PlanKind.LOOK, goal, path, frontier_xy_m=found.frontier_xy_m)
+            ctx.counts.looks += 1
+            ctx.memory.drop(ctx.grid, found.frontier_xy_m, "looked")
+        return None
+
+
+def standable_prefix(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
+    """The part of ``path_m`` from its start on which the robot's own clearance holds."""
+    dense = ctx.resampled(path_m)
+    rows, cols = ctx.geometry.world_to_grid(dense[:, 0], dense[:, 1])
+    ok = ctx.clearance_field()[rows, cols] >= ctx.clearance_m - 1e-9
+    # The robot may start closer to a wall than its clearance: skip that first stretch.
+    first = int(np.argmax(ok)) if ok.any() else len(ok)
+    bad = np.flatnonzero(~ok[first:])
+    return dense if len(bad) == 0 else dense[: first + int(bad[0])]
+
+
+#: The expert's plan sources, in the order they are asked (see the module docstring).
+DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
+    CommandedGoal(),
+    RetryFailedGoal(),
+    SemanticFrontier(),
+    CommittedFallback(),
+    NearestFallback(),
+    PocketEscape(),
+    LookAtNarrowFrontier(),
+)
+
+
+def insert_plan_source(
+    sources: tuple[PlanSource, ...],
+    source: PlanSource,
+    *,
+    before: str | None = None,
+    after: str | None = None,
+) -> tuple[PlanSource, ...]:
+    """``sources`` with ``source`` inserted before or after the source named so (else last).
+
+    Raises:
+        ValueError: no source has that name, or both ``before`` and ``after`` are given.
+    """
+    if before is not None and after is not None:
+        raise ValueError("give before or after, not both")
+    anchor = before if before is not None else after
+    if anchor is None:
+        return (*sources, source)
+    names = [s.name for s in sources]
+    if anchor not in names:
+        raise ValueError(f"no plan source named {anchor!r}; have {names}")
+    i = names.index(anchor) + (0 if before is not None else 1)
+    return (*sources[:i], source, *sources[i:])
