@@ -43,6 +43,7 @@ from typing import Any
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.safe_io import short_repr
+from semexplore_gym.evaluation.errors import ParameterError
 
 #: Defaults of --runs, --test-seed0 and --max-time-s with --test-worlds.
 DEFAULT_TEST_RUNS = 5
@@ -373,14 +374,16 @@ def _check_run_args(
         from semexplore_gym.evaluation.suites import suite_tasks
 
         seed0 = SUITE_SEED0 if args.test_seed0 is None else args.test_seed0
-        tasks, suites, test_worlds = suite_tasks(
-            _split(args.test_suite),
-            labels,
-            lambda runs: parse_seeds(args.runs or runs, seed0),
-            max_time_s=args.max_time_s,
-            env_config=args.env_config,
-            flag="--test-suite",
-        )
+        try:
+            tasks, suites, test_worlds = suite_tasks(
+                _split(args.test_suite),
+                labels,
+                lambda runs: parse_seeds(args.runs or runs, seed0),
+                max_time_s=args.max_time_s,
+                env_config=args.env_config,
+            )
+        except ParameterError as e:
+            raise e.for_flags({"names": "--test-suite", "runs": "--runs"}) from None
     else:
         suites = []
         seed0 = DEFAULT_TEST_SEED0 if args.test_seed0 is None else args.test_seed0
@@ -406,8 +409,18 @@ def _train_limit_s(args: argparse.Namespace) -> float:
     return DEFAULT_MAX_TIME_S
 
 
+def _run_test_missions(tasks: list[Any], out_dir: Path, args: argparse.Namespace) -> Any:
+    """The test missions through the benchmark harness, its errors in flag names."""
+    from semexplore_gym.evaluation.harness import run_benchmark
+
+    try:
+        return run_benchmark(tasks, out_dir, workers=args.workers, progress=not args.no_progress)
+    except ParameterError as e:
+        raise e.for_flags({"out_dir": "--out", "workers": "--workers"}) from None
+
+
 def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import read_runs, run_benchmark, write_manifest
+    from semexplore_gym.evaluation.harness import read_runs, write_manifest
     from semexplore_gym.evaluation.report import write_summary
     from semexplore_gym.training.weight_tuning import (
         PAPER_FIELD,
@@ -463,7 +476,7 @@ def run(args: argparse.Namespace) -> int:
     # OUT/test is a benchmark directory: its manifest names the suites for its summary.
     (out / "test").mkdir(exist_ok=True)
     write_manifest(out / "test", {"suites": suites or None, "weight_sets": sets})
-    res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
+    res = _run_test_missions(tasks, out / "test", args)
     rows = read_runs(out / "test" / "runs.csv")
     summary = write_summary(out / "test", reference=PAPER)
     labels = [*sets, *agents]
