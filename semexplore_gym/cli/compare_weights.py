@@ -426,6 +426,7 @@ def run(args: argparse.Namespace) -> int:
         PAPER_FIELD,
         PAPER_WEIGHTS,
         SearchSpace,
+        StudySettings,
         mission_objective,
         tune_weights,
     )
@@ -457,16 +458,12 @@ def run(args: argparse.Namespace) -> int:
             ws = ", ".join(f"{k.split('.')[-1]}={v:.3g}" for k, v in weights.items())
             print(f"trial {number}: {value:.2f} ({ws})", file=sys.stderr)
 
-    result = tune_weights(
-        objective,
-        args.trials,
-        space,
+    study = StudySettings(
         seed=args.seed,
-        enqueue=[start],
         storage_path=out / "tuning" / "study.sqlite",
         jsonl_path=out / "tuning" / "trials.jsonl",
-        on_trial=show,
     )
+    result = tune_weights(objective, args.trials, space, study, enqueue=[start], on_trial=show)
     sets = weight_sets(result.best_weights)
     (out / "weights.json").write_text(
         json.dumps({"sets": sets, "best_train_value": result.best_value}, indent=2)

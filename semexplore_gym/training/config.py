@@ -63,7 +63,16 @@ class PolicySection:
 
 @dataclass(frozen=True)
 class BCSection:
-    """``train_bc`` settings; ``mirror`` needs ``egocentric.scan_bins_centred`` and odd beams per bin."""
+    """:func:`~semexplore_gym.training.bc.train_bc` settings.
+
+    ``epochs`` passes over the data in minibatches of ``batch_size``; Adam with rate ``lr`` and
+    weight decay ``l2_weight``; ``ent_weight`` weighs the entropy bonus (keeps the action std
+    from collapsing too early). ``mirror`` replaces each minibatch sample by its left-right
+    mirror image with probability 1/2 (the data doubled for free; needs
+    ``egocentric.scan_bins_centred`` and odd beams per bin). ``select_best`` restores the
+    weights of the epoch with the lowest held-out action error at the end. The rate decays
+    along a cosine from ``lr`` to ``lr * lr_final_fraction`` (1: constant).
+    """
 
     epochs: int = 15
     batch_size: int = 64
