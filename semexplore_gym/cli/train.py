@@ -32,6 +32,7 @@ import yaml
 
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.params import ConfigError, to_dict
+from semexplore_gym.evaluation.errors import ParameterError
 
 ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value")
 
@@ -98,7 +99,10 @@ def run(args: argparse.Namespace) -> int:
         cfg = load_train_config(args.train_config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
-    check_train_config(cfg, args.algo)
+    try:
+        check_train_config(cfg, args.algo)
+    except ParameterError as e:
+        raise e.for_flags({"algo": "--algo"}) from None
     out = Path(args.out)
     _write_run_record(out, cfg, args)
     torch.set_num_threads(cfg.torch_threads)

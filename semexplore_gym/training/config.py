@@ -12,6 +12,7 @@ from typing import Any
 
 from semexplore_gym.core.features.egocentric import EgocentricParams
 from semexplore_gym.core.params import build_params
+from semexplore_gym.evaluation.errors import PARAM, ParameterError
 
 #: The base env id; any other ``env.env_id`` is a macro-action env with its own observation.
 BASE_ENV_ID = "SemanticExplore-v0"
@@ -161,7 +162,8 @@ def is_macro(cfg: TrainConfig) -> bool:
 
 
 def check_train_config(cfg: TrainConfig, algo: str) -> None:
-    """Raise a ValueError when ``cfg`` cannot run ``algo`` (checked before any work starts)."""
+    """Raise a ValueError when ``cfg`` cannot run ``algo`` (checked before any work starts);
+    a :class:`ParameterError` naming ``algo`` when the two do not fit together."""
     for key, value in (
         ("torch_threads", cfg.torch_threads),
         ("expert.workers", cfg.expert.workers),
@@ -178,10 +180,18 @@ def check_train_config(cfg: TrainConfig, algo: str) -> None:
     if cfg.ppo.vec_env not in VEC_ENV_KINDS:
         raise ValueError(f"ppo.vec_env must be one of {VEC_ENV_KINDS}, got {cfg.ppo.vec_env!r}")
     if algo == "maskable_ppo" and not is_macro(cfg):
-        raise ValueError(
-            f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
-        )
+        raise maskable_needs_macro(cfg)
     if algo in ("bc", "dagger") and is_macro(cfg):
-        raise ValueError(
-            f"--algo {algo} trains on the egocentric env only, not env.env_id={cfg.env.env_id!r}"
+        raise ParameterError(
+            "algo",
+            f"{PARAM} {algo} trains on the egocentric env only, not env.env_id={cfg.env.env_id!r}",
         )
+
+
+def maskable_needs_macro(cfg: TrainConfig) -> ParameterError:
+    """The error of ``algo="maskable_ppo"`` on an env without action masks."""
+    return ParameterError(
+        "algo",
+        f"{PARAM} maskable_ppo needs a macro-action env with action masks (env.env_id), "
+        f"got {cfg.env.env_id!r}",
+    )
