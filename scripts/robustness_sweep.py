@@ -167,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--ok-coverage must be in (0, 1], got {args.ok_coverage}")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
 
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
 
     worlds = sweep_worlds(families, args.per_family, args.seed0)

@@ -250,7 +250,7 @@ def _world_tasks(
 ) -> tuple[list[Any], list[str], list[int], Any]:
     """Tasks of ``--worlds``: ``(tasks, worlds, seeds, env config record)``."""
     from semexplore_gym.core.params import to_dict
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
 
     worlds = _split_worlds(args.worlds)

@@ -349,7 +349,7 @@ def _check_run_args(
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
     train_worlds = _checked_worlds("--train-worlds", args.train_worlds, train_seeds[0])
     if args.env_config is not None:
-        from semexplore_gym.envs.config import load_env_config
+        from semexplore_gym.envs.env_config import load_env_config
 
         load_env_config(args.env_config)
     from semexplore_gym.policies.registry import split_specs

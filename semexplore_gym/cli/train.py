@@ -10,11 +10,11 @@ the driving expert's parameters). Every run directory gets ``model.zip``, the re
 ``config.yaml``, ``args.json`` (arguments and command line), TensorBoard logs (CSV when
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
 ``frontier_value`` fits a learned frontier value for the expert
-(:mod:`semexplore_gym.training.frontier_value`, no torch needed) and writes ``model.yaml``,
+(:mod:`semexplore_gym.training.frontier_value_search`, no torch needed) and writes ``model.yaml``,
 ``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
 
 This module parses the arguments and writes the run directory; the configuration
-(:mod:`semexplore_gym.training.config`) and the runs (:mod:`semexplore_gym.training.imitation`,
+(:mod:`semexplore_gym.training.train_config`) and the runs (:mod:`semexplore_gym.training.imitation`,
 :mod:`semexplore_gym.training.ppo`) live in ``semexplore_gym.training``.
 """
 
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    from semexplore_gym.training.config import check_train_config, load_train_config
+    from semexplore_gym.training.train_config import check_train_config, load_train_config
 
     try:
         cfg = load_train_config(args.train_config, args.overrides)
@@ -117,8 +117,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_frontier_value(args: argparse.Namespace) -> int:
-    """``--algo frontier_value``: no torch; missions only (:mod:`~semexplore_gym.training.frontier_value`)."""
-    from semexplore_gym.training.frontier_value import (
+    """``--algo frontier_value``: no torch; missions only (:mod:`~semexplore_gym.training.frontier_value_search`)."""
+    from semexplore_gym.training.frontier_value_search import (
         load_frontier_value_config,
         train_frontier_value,
     )

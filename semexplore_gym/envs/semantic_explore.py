@@ -24,7 +24,7 @@ from semexplore_gym.core.worlds.start import (
     validate_start_pose,
 )
 from semexplore_gym.core.worlds.world import World
-from semexplore_gym.envs.config import EnvConfig, load_env_config
+from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
 from semexplore_gym.envs.observation_options import ObservationOptions

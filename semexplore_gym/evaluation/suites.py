@@ -239,7 +239,7 @@ def _mission_env_config(
     env_config: Any, random_start: bool, limit: float | None, env_overrides: Sequence[str]
 ) -> Any:
     """The env config of a suite world's missions."""
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
 
     # The env's own limit must not cut the mission short; the user's overrides win.
     overrides = [f"episode.random_start={'true' if random_start else 'false'}"]

@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.core.features.egocentric import EgocentricParams, mirror_observations
-from semexplore_gym.training.config import BCSection
 from semexplore_gym.training.dataset import ImitationDataset
 from semexplore_gym.training.progress import with_progress
+from semexplore_gym.training.train_config import BCSection
 
 
 def _to_tensors(obs: dict[str, np.ndarray], idx: np.ndarray, device: Any) -> dict[str, Any]:
@@ -109,7 +109,7 @@ def train_bc(
     Args:
         dataset: Egocentric observations and expert actions.
         policy: An SB3 ``ActorCriticPolicy`` (changed in place).
-        bc: The settings (:class:`~semexplore_gym.training.config.BCSection`; None: defaults).
+        bc: The settings (:class:`~semexplore_gym.training.train_config.BCSection`; None: defaults).
         seed: Seeds the minibatch order (numpy Generator) and torch.
         eval_data: Held-out samples; their :func:`action_error` is recorded after each epoch.
         egocentric: The data's egocentric parameters (needed by ``bc.mirror``).

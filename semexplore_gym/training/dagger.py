@@ -11,10 +11,10 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.training.bc import train_bc
-from semexplore_gym.training.config import TrainConfig
 from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
 from semexplore_gym.training.episodes import EpisodeRecord
 from semexplore_gym.training.progress import with_progress
+from semexplore_gym.training.train_config import TrainConfig
 from semexplore_gym.training.workers import (
     DAGGER_STREAM,
     EpisodeActors,

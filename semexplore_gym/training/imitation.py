@@ -15,12 +15,12 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.training.bc import action_error, train_bc
-from semexplore_gym.training.config import TrainConfig
 from semexplore_gym.training.dagger import run_dagger
 from semexplore_gym.training.dataset import ImitationDataset
 from semexplore_gym.training.factories import make_expert, make_raw_env
 from semexplore_gym.training.ppo import make_vec_env, new_ppo, save_tagged_model
 from semexplore_gym.training.recording import record_expert_dataset
+from semexplore_gym.training.train_config import TrainConfig
 from semexplore_gym.training.workers import EpisodeActors
 
 LogFn = Callable[[str, float, int], None]

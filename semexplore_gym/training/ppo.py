@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.core.features.egocentric import EgocentricParams
-from semexplore_gym.training.config import TrainConfig, is_macro, maskable_needs_macro
 from semexplore_gym.training.factories import make_learner_env
+from semexplore_gym.training.train_config import TrainConfig, is_macro, maskable_needs_macro
 
 
 def policy_kwargs(cfg: TrainConfig) -> dict[str, Any]:

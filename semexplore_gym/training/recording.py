@@ -12,9 +12,9 @@ from collections.abc import Callable
 from typing import Any
 
 from semexplore_gym.core.features.egocentric import EgocentricParams
-from semexplore_gym.training.config import ExpertSection
 from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
 from semexplore_gym.training.progress import with_progress
+from semexplore_gym.training.train_config import ExpertSection
 from semexplore_gym.training.workers import (
     EXPERT_STREAM,
     EpisodeActors,

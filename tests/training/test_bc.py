@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from _imitation import PARAMS, ReactiveExpert, imitation_env, learner_policy
 
-from semexplore_gym.training.config import BCSection, ExpertSection
+from semexplore_gym.training.train_config import BCSection, ExpertSection
 from semexplore_gym.training.workers import EpisodeActors
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 

@@ -23,14 +23,14 @@ def test_beta_schedule() -> None:
 
 
 def test_dagger_round_runs_and_grows_the_dataset(tmp_path: Path) -> None:
-    from semexplore_gym.training.config import (
+    from semexplore_gym.training.dagger import run_dagger
+    from semexplore_gym.training.recording import record_expert_dataset
+    from semexplore_gym.training.train_config import (
         BCSection,
         DaggerSection,
         ExpertSection,
         TrainConfig,
     )
-    from semexplore_gym.training.dagger import run_dagger
-    from semexplore_gym.training.recording import record_expert_dataset
     from semexplore_gym.training.workers import EpisodeActors
 
     env = imitation_env()

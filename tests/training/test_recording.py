@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from _imitation import PARAMS, ConstantExpert, ReactiveExpert, imitation_env
 
-from semexplore_gym.training.config import ExpertSection
 from semexplore_gym.training.dataset import ImitationDataset
+from semexplore_gym.training.train_config import ExpertSection
 from semexplore_gym.training.workers import EpisodeActors
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")

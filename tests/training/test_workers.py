@@ -10,8 +10,13 @@ import numpy as np
 import pytest
 from _imitation import ReactiveExpert
 
-from semexplore_gym.training.config import BCSection, DaggerSection, ExpertSection, TrainConfig
 from semexplore_gym.training.dataset import ImitationDataset
+from semexplore_gym.training.train_config import (
+    BCSection,
+    DaggerSection,
+    ExpertSection,
+    TrainConfig,
+)
 from semexplore_gym.training.workers import (
     DAGGER_STREAM,
     EXPERT_STREAM,

@@ -171,7 +171,7 @@ def _process_runner(cfg: FrontierValueTrainConfig) -> tuple[MissionRunner, Calla
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
 
     env_config = load_env_config(
         None, ["episode.random_start=true", f"episode.max_time_s={cfg.max_time_s!r}"]
@@ -314,6 +314,6 @@ def write_model(overrides: dict[str, float], path: Path, wall_s: float) -> None:
         node[parts[-1]] = round(float(value), 6)
     head = (
         "# Learned frontier value (semexplore_gym.policies.frontier_value.FrontierValueParams layer), fitted by\n"
-        f"# semexplore_gym.training.frontier_value in {wall_s:.0f} s wall.\n"
+        f"# semexplore_gym.training.frontier_value_search in {wall_s:.0f} s wall.\n"
     )
     path.write_text(head + yaml.safe_dump(nested, sort_keys=True))
