@@ -116,7 +116,7 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
     from semexplore_gym.policies.registry import make_policy
 
     import semexplore_gym  # noqa: F401
-    from semexplore_gym.evaluation.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import GifOptions, run_mission
 
     gif_dir = out / "failures"
     gif_dir.mkdir(exist_ok=True)
@@ -136,7 +136,7 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
         try:
             run_mission(
                 env, make_policy(policy), seed=int(r["seed"]), progress=False,
-                gif_path=path, gif_every_s=8.0, ignore_terminated=True,
+                gif=GifOptions(path, every_s=8.0), ignore_terminated=True,
             )  # fmt: skip
         finally:
             env.close()

@@ -184,6 +184,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="start every mission at the world's own start pose; seeds then repeat the same "
         "mission unless the world spelling has seed=*",
     )
+    _add_run_arguments(p)
+    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
+    add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
+    return p
+
+
+def _add_run_arguments(p: argparse.ArgumentParser) -> None:
+    """Where and how the missions run: workers, backend, progress and figures."""
     p.add_argument(
         "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
     )
@@ -200,9 +208,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
-    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
-    add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
-    return p
 
 
 def _suite_tasks(

@@ -283,6 +283,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="time limit of the tuning missions (default: --max-time-s, or "
         f"{DEFAULT_MAX_TIME_S:g})",
     )
+    _add_scoring_and_run_arguments(p)
+    return p
+
+
+def _add_scoring_and_run_arguments(p: argparse.ArgumentParser) -> None:
+    """The score, agent, seed, config and parallelism options of ``compare-weights``."""
     p.add_argument(
         "--target-coverage",
         type=float,
@@ -315,7 +321,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=1,
         help="test missions in parallel processes (default: %(default)s)",
     )
-    return p
 
 
 def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:

@@ -4,10 +4,21 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+
+@dataclass(frozen=True)
+class GifOptions:
+    """An animated GIF of a mission: written to ``path``, a frame every ``every_s`` simulated
+    seconds, played back at ``fps`` frames per second."""
+
+    path: str | os.PathLike
+    every_s: float = 2.0
+    fps: float = 10.0
 
 
 def _palette_frame(frame: np.ndarray, colors: int = 128) -> tuple[bytes, bytes, int, int]:

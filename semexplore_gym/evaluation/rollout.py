@@ -20,11 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from semexplore_gym.evaluation.gif import GifStreamWriter, save_gif
+from semexplore_gym.evaluation.gif import GifOptions, GifStreamWriter, save_gif
 from semexplore_gym.policies.base import Policy, StepStats
 
 __all__ = [
     "STAGES",
+    "GifOptions",
     "GifStreamWriter",
     "MissionResult",
     "make_mission_env",
@@ -267,18 +268,16 @@ class _GifRecorder:
         self.writer.abort()
 
 
-def _check_mission_args(
-    env: Any, max_time_s: float | None, gif_path: str | os.PathLike | None, gif_every_s: float
-) -> None:
+def _check_mission_args(env: Any, max_time_s: float | None, gif: GifOptions | None) -> None:
     if max_time_s is not None and not (max_time_s > 0 and math.isfinite(max_time_s)):
         raise ValueError(f"max_time_s must be a positive number or None, got {max_time_s!r}")
-    if gif_path is not None:
+    if gif is not None:
         if getattr(env, "render_mode", None) != "rgb_array":
             raise ValueError(
-                f"gif_path needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
+                f"gif needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
             )
-        if not gif_every_s > 0:
-            raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
+        if not gif.every_s > 0:
+            raise ValueError(f"gif.every_s must be positive, got {gif.every_s!r}")
 
 
 def run_mission(
@@ -287,13 +286,10 @@ def run_mission(
     seed: int | None,
     max_time_s: float | None = None,
     progress: bool = False,
-    gif_path: str | os.PathLike | None = None,
     on_step: Callable[[int, dict[str, Any], dict[str, Any], np.ndarray, Policy], None]
     | None = None,
     *,
-    gif_every_s: float = 2.0,
-    gif_fps: float = 10.0,
-    reset_options: dict[str, Any] | None = None,
+    gif: GifOptions | None = None,
     ignore_terminated: bool = False,
 ) -> MissionResult:
     """Run one mission of ``policy`` in ``env``.
@@ -305,11 +301,8 @@ def run_mission(
         max_time_s: Stop after this much simulated time (None: only the env's own truncation).
         progress: Show a tqdm bar on stderr (simulated seconds, coverage); off by default
             (the CLI turns it on).
-        gif_path: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         on_step: Called after every step as ``on_step(step, obs, info, action, policy)``.
-        gif_every_s: Simulated seconds between GIF frames.
-        gif_fps: GIF playback frame rate.
-        reset_options: ``options`` for ``env.reset``.
+        gif: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         ignore_terminated: Keep going when the env terminates (its coverage goal is reached),
             so that the mission lasts until the policy stops (or the time limit): the mission
             time is then the policy's own. Truncation still ends the mission.
@@ -318,13 +311,13 @@ def run_mission(
         The :class:`MissionResult`.
 
     Raises:
-        ValueError: a non-positive ``max_time_s``, or ``gif_path`` with an env that cannot render
+        ValueError: a non-positive ``max_time_s``, or ``gif`` with an env that cannot render
             RGB frames.
     """
-    _check_mission_args(env, max_time_s, gif_path, gif_every_s)
+    _check_mission_args(env, max_time_s, gif)
     cpu0 = time.process_time()
     wall0 = time.perf_counter()
-    obs, info = env.reset(seed=seed, options=reset_options)
+    obs, info = env.reset(seed=seed, options=None)
     t1 = time.perf_counter()
     log = _MissionLog(obs, info)
     log.stage["env_reset"] = t1 - wall0
@@ -333,9 +326,9 @@ def run_mission(
 
     world_name = _world_name(env)
     limit_s = max_time_s if max_time_s is not None else math.inf
-    gif = (
-        _GifRecorder(env, policy, gif_every_s, log.stage, gif_path, gif_fps)
-        if gif_path is not None
+    recorder = (
+        _GifRecorder(env, policy, gif.every_s, log.stage, gif.path, gif.fps)
+        if gif is not None
         else None
     )
     bar = _progress_bar(
@@ -343,21 +336,39 @@ def run_mission(
     )
     try:
         info, terminated, truncated = _drive(
-            env, policy, obs, info, log, gif, bar, on_step, limit_s, ignore_terminated
+            env, policy, obs, info, log, recorder, bar, on_step, limit_s, ignore_terminated
         )
     except BaseException:
-        if gif is not None:
-            gif.abort()
+        if recorder is not None:
+            recorder.abort()
         raise
     finally:
         if bar is not None:
             bar.close()
     reason = _stop_reason(policy, terminated, truncated, ignore_terminated, max_time_s)
     wall = time.perf_counter() - wall0
-    if gif is not None:
-        gif.save()
+    if recorder is not None:
+        recorder.save()
         wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
+    return _mission_result(
+        world_name, policy, seed, info, (terminated, truncated), reason, (wall, cpu), log
+    )
+
+
+def _mission_result(
+    world_name: str,
+    policy: Policy,
+    seed: int | None,
+    info: dict[str, Any],
+    ended: tuple[bool, bool],
+    reason: str,
+    clocks: tuple[float, float],
+    log: _MissionLog,
+) -> MissionResult:
+    """The :class:`MissionResult` of a finished mission (``ended``: terminated, truncated;
+    ``clocks``: wall and CPU seconds)."""
+    terminated, truncated = ended
     return MissionResult(
         world=world_name,
         policy=policy.name,
@@ -369,8 +380,8 @@ def run_mission(
         stop_reason=reason,
         path_length_m=float(info["path_length_m"]),
         collisions=int(info["collisions"]),
-        wall_time_s=wall,
-        cpu_time_s=cpu,
+        wall_time_s=clocks[0],
+        cpu_time_s=clocks[1],
         steps=log.steps,
         terminated=bool(terminated),
         truncated=bool(truncated or (not terminated and not policy.done)),

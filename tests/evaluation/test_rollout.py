@@ -11,7 +11,7 @@ from semexplore_gym.policies.base import Policy, StepStats
 from semexplore_gym.policies.random_policy import RandomPolicy
 
 import semexplore_gym  # noqa: F401
-from semexplore_gym.evaluation.rollout import STAGES, run_mission, time_to_coverage
+from semexplore_gym.evaluation.rollout import STAGES, GifOptions, run_mission, time_to_coverage
 
 
 class StopAfter(Policy):
@@ -65,7 +65,9 @@ def test_max_time_and_random_policy_determinism(env):
     with pytest.raises(ValueError, match="max_time_s"):
         run_mission(env, RandomPolicy(), seed=0, max_time_s=0.0, progress=False)
     with pytest.raises(ValueError, match="rgb_array"):
-        run_mission(env, RandomPolicy(), seed=0, max_time_s=1.0, progress=False, gif_path="x.gif")
+        run_mission(
+            env, RandomPolicy(), seed=0, max_time_s=1.0, progress=False, gif=GifOptions("x.gif")
+        )
 
 
 def test_on_step_and_gif(tmp_path):
@@ -78,9 +80,8 @@ def test_on_step_and_gif(tmp_path):
         seed=0,
         max_time_s=100.0,
         progress=False,
-        gif_path=out,
-        gif_every_s=0.6,
         on_step=lambda i, *_: seen.append(i),
+        gif=GifOptions(out, every_s=0.6),
     )
     e.close()
     assert seen == list(range(1, 11))
