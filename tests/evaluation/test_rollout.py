@@ -142,3 +142,23 @@ def test_explore_gif_every_0_2_s_through_the_cli(tmp_path, capsys):
     assert main([*argv, "--gif", str(out), "--gif-every-s", "0.2"]) == 0
     with Image.open(out) as im:
         assert im.n_frames == 17  # t = 0, 0.2, ..., 3.0 and the final frame
+
+
+class CountingStop(StopAfter):
+    """Reports its own figures for benchmark rows through ``mission_metrics``."""
+
+    def mission_metrics(self):
+        return {"scored_replans": self.calls, "semantic_share": 0.25, "other": "x"}
+
+
+def test_policy_columns_come_from_mission_metrics(env):
+    from semexplore_gym.evaluation.harness import Task, mission_row
+
+    res = run_mission(env, CountingStop(3), seed=0, max_time_s=10.0, progress=False)
+    assert res.policy_metrics == {"scored_replans": 4, "semantic_share": 0.25, "other": "x"}
+    row = mission_row(Task("maze1", "counting", 0), res).to_dict()
+    assert row["scored_replans"] == 4 and row["semantic_share"] == 0.25 and "other" not in row
+    plain = run_mission(env, StopAfter(3), seed=0, max_time_s=10.0, progress=False)
+    assert plain.policy_metrics == {}
+    row = mission_row(Task("maze1", "plain", 0), plain).to_dict()
+    assert row["scored_replans"] is None and row["semantic_share"] is None
