@@ -15,7 +15,7 @@ observation and returns the scored candidates (cheapest first), without changing
 
 The wrappers in :mod:`semexplore_gym.wrappers.frontier_choice` use this class through their
 ``FrontierDriver`` protocol; they never import it (wrappers sit below policies in the layering),
-the env-id entry points in :mod:`semexplore_gym.macro_envs` join the two.
+the env-id entry points in :mod:`semexplore_gym.expert_driven_envs` join the two.
 
 It uses only the expert's public plug-in points (see :mod:`semexplore_gym.policies.semantic_expert`):
 it overrides :meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.choose_goal`,

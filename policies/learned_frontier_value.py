@@ -8,7 +8,7 @@ commitment then works on ``C'``. Navigation, safety, retries, the grid fallback 
 rule are the expert's own. With every weight at 0 it is the expert, decision for decision.
 
 The weights (and the expert's cost weights and switch margin) were fitted by black-box
-optimisation over missions on training worlds (:mod:`semexplore_gym.training.frontier_value`);
+optimisation over missions on training worlds (:mod:`semexplore_gym.training.frontier_value_search`);
 a fitted set ships as ``pretrained:frontier_value`` (``policies/pretrained``)::
 
     from semexplore_gym.policies.registry import make_policy

@@ -26,8 +26,8 @@ class Collector:
     ``vec_env``, ready to time one rollout collection at a time."""
 
     def __init__(self, config: str, n_envs: int, vec_env: str, n_steps: int) -> None:
-        from semexplore_gym.training.config import load_train_config
         from semexplore_gym.training.ppo import make_vec_env, new_ppo
+        from semexplore_gym.training.train_config import load_train_config
 
         cfg = load_train_config(
             config, [f"ppo.n_envs={n_envs}", f"ppo.vec_env={vec_env}", f"ppo.n_steps={n_steps}"]

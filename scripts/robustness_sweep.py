@@ -116,7 +116,7 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
     from semexplore_gym.policies.registry import make_policy
 
     import semexplore_gym  # noqa: F401
-    from semexplore_gym.evaluation.rollout import run_mission
+    from semexplore_gym.evaluation.rollout import GifOptions, run_mission
 
     gif_dir = out / "failures"
     gif_dir.mkdir(exist_ok=True)
@@ -136,7 +136,7 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
         try:
             run_mission(
                 env, make_policy(policy), seed=int(r["seed"]), progress=False,
-                gif_path=path, gif_every_s=8.0, ignore_terminated=True,
+                gif=GifOptions(path, every_s=8.0), ignore_terminated=True,
             )  # fmt: skip
         finally:
             env.close()
@@ -167,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--ok-coverage must be in (0, 1], got {args.ok_coverage}")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
 
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
 
     worlds = sweep_worlds(families, args.per_family, args.seed0)

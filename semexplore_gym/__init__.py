@@ -26,8 +26,8 @@ def register_envs() -> None:
 
     ids = {
         "SemanticExplore-v0": "semexplore_gym.envs.semantic_explore:SemanticExploreEnv",
-        "SemanticExploreFrontier-v0": "semexplore_gym.macro_envs:make_frontier_choice_env",
-        "SemanticExploreWeights-v0": "semexplore_gym.macro_envs:make_planner_weights_env",
+        "SemanticExploreFrontier-v0": "semexplore_gym.expert_driven_envs:make_frontier_choice_env",
+        "SemanticExploreWeights-v0": "semexplore_gym.expert_driven_envs:make_planner_weights_env",
     }
     for env_id, entry_point in ids.items():
         if env_id not in registry:

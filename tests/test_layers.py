@@ -20,7 +20,7 @@ class Layer:
     """A package layer: a folder or a module, as a path relative to the checkout.
 
     Attributes:
-        path: ``semexplore_gym/core``, ``semexplore_gym/macro_envs.py``, ``policies``, ...
+        path: ``semexplore_gym/core``, ``semexplore_gym/expert_driven_envs.py``, ``policies``, ...
         only: if set, the only layers (paths) of this project it may import besides itself,
             instead of every layer listed before it.
         forbid: outside packages it must never import.
@@ -88,7 +88,7 @@ LAYERS: list[Layer] = [
         forbid=("pymunk",),
         lazy_only=("gymnasium", "torch", "stable_baselines3", "sb3_contrib"),
     ),
-    Layer("semexplore_gym/macro_envs.py"),
+    Layer("semexplore_gym/expert_driven_envs.py"),
     Layer("semexplore_gym/evaluation"),
     Layer("semexplore_gym/training"),
     Layer("semexplore_gym/cli"),
@@ -119,7 +119,7 @@ def _layer_of_module(module: str, layers: list[Layer]) -> int | None:
     best, best_len = None, -1
     for i, layer in enumerate(layers):
         name = layer.module
-        # A module layer (`macro_envs.py`, the package root) holds that module only.
+        # A module layer (`expert_driven_envs.py`, the package root) holds that module only.
         inside = module == name or (
             not layer.path.endswith(".py") and module.startswith(name + ".")
         )

@@ -27,6 +27,7 @@ from typing import Any
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.validation import short_repr
+from semexplore_gym.evaluation.errors import ParameterError
 
 
 def _split(text: str) -> list[str]:
@@ -184,6 +185,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="start every mission at the world's own start pose; seeds then repeat the same "
         "mission unless the world spelling has seed=*",
     )
+    _add_run_arguments(p)
+    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
+    add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
+    return p
+
+
+def _add_run_arguments(p: argparse.ArgumentParser) -> None:
+    """Where and how the missions run: workers, backend, progress and figures."""
     p.add_argument(
         "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
     )
@@ -200,9 +209,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
-    add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
-    add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
-    return p
 
 
 def _suite_tasks(
@@ -232,13 +238,64 @@ def _refuse_repeats(flag: str, items: list[str]) -> None:
         )
 
 
+#: Python parameters named in the harness's errors, and the flags that set them.
+FLAGS = {
+    "names": "--suite",
+    "out_dir": "--out",
+    "runs": "--runs",
+    "seeds": "--runs",
+    "workers": "--workers",
+    "backend": "--backend",
+    "worlds": "--worlds",
+    "policies": "--policies",
+}
+
+
+def _world_tasks(
+    args: argparse.Namespace, policies: list[str]
+) -> tuple[list[Any], list[str], list[int], Any]:
+    """Tasks of ``--worlds``: ``(tasks, worlds, seeds, env config record)``."""
+    from semexplore_gym.config import to_dict
+    from semexplore_gym.envs.env_config import load_env_config
+    from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
+
+    worlds = _split_worlds(args.worlds)
+    seeds = parse_seeds(args.runs or DEFAULT_RUNS, args.seed0)
+    if not worlds:
+        raise ValueError("--worlds is empty")
+    _refuse_repeats("--worlds", worlds)
+    _check_worlds(worlds, seeds[0])
+    if args.fixed_start and len(seeds) > 1:
+        same = [w for w in worlds if "seed=*" not in w]
+        if same:
+            print(
+                f"warning: --fixed-start: every seed repeats the same mission on "
+                f"{', '.join(same)} (no seed=* in the spelling); the summary will say "
+                "'no variation'",
+                file=sys.stderr,
+            )
+    # The env's own limit must not cut the mission short; the user's --env-set wins.
+    overrides = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
+    if args.max_time_s is not None:
+        overrides.append(f"episode.max_time_s={args.max_time_s!r}")
+    overrides += args.env_overrides
+    env_config = load_env_config(args.env_config, overrides)
+    tasks = expand_tasks(worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config)
+    return tasks, worlds, seeds, to_dict(env_config)
+
+
 def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import (
-        expand_tasks,
-        parse_seeds,
-        run_benchmark,
-        write_manifest,
-    )
+    try:
+        return _run(args)
+    except ParameterError as e:
+        # The harness names its parameters; the user typed flags.
+        raise e.for_flags(FLAGS) from None
+
+
+def _run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from semexplore_gym.evaluation.harness import parse_seeds, run_benchmark, write_manifest
     from semexplore_gym.evaluation.report import write_plots, write_summary
 
     validate_args(args)
@@ -247,11 +304,6 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--policies is empty")
     _refuse_repeats("--policies", policies)
     _check_policies(policies)
-    from pathlib import Path
-
-    from semexplore_gym.config import to_dict
-    from semexplore_gym.envs.config import load_env_config
-
     suites: list[dict[str, Any]] = []
     if args.suite is not None:
         tasks, suites, worlds = _suite_tasks(
@@ -260,31 +312,7 @@ def run(args: argparse.Namespace) -> int:
         seeds = sorted({t.seed for t in tasks})
         env_config_record: Any = "per world (suite)"
     else:
-        worlds = _split_worlds(args.worlds)
-        seeds = parse_seeds(args.runs or DEFAULT_RUNS, args.seed0)
-        if not worlds:
-            raise ValueError("--worlds is empty")
-        _refuse_repeats("--worlds", worlds)
-        _check_worlds(worlds, seeds[0])
-        if args.fixed_start and len(seeds) > 1:
-            same = [w for w in worlds if "seed=*" not in w]
-            if same:
-                print(
-                    f"warning: --fixed-start: every seed repeats the same mission on "
-                    f"{', '.join(same)} (no seed=* in the spelling); the summary will say "
-                    "'no variation'",
-                    file=sys.stderr,
-                )
-        # The env's own limit must not cut the mission short; the user's --env-set wins.
-        overrides = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
-        if args.max_time_s is not None:
-            overrides.append(f"episode.max_time_s={args.max_time_s!r}")
-        overrides += args.env_overrides
-        env_config = load_env_config(args.env_config, overrides)
-        env_config_record = to_dict(env_config)
-        tasks = expand_tasks(
-            worlds, policies, seeds, max_time_s=args.max_time_s, env_config=env_config
-        )
+        tasks, worlds, seeds, env_config_record = _world_tasks(args, policies)
 
     Path(args.out).mkdir(parents=True, exist_ok=True)
     write_manifest(

@@ -43,6 +43,7 @@ from typing import Any
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.core.validation import short_repr
+from semexplore_gym.evaluation.errors import ParameterError
 
 #: Defaults of --runs, --test-seed0 and --max-time-s with --test-worlds.
 DEFAULT_TEST_RUNS = 5
@@ -282,6 +283,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="time limit of the tuning missions (default: --max-time-s, or "
         f"{DEFAULT_MAX_TIME_S:g})",
     )
+    _add_scoring_and_run_arguments(p)
+    return p
+
+
+def _add_scoring_and_run_arguments(p: argparse.ArgumentParser) -> None:
+    """The score, agent, seed, config and parallelism options of ``compare-weights``."""
     p.add_argument(
         "--target-coverage",
         type=float,
@@ -314,7 +321,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=1,
         help="test missions in parallel processes (default: %(default)s)",
     )
-    return p
 
 
 def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:
@@ -348,7 +354,7 @@ def _check_run_args(
     train_seeds = parse_seeds(args.train_runs, args.train_seed0)
     train_worlds = _checked_worlds("--train-worlds", args.train_worlds, train_seeds[0])
     if args.env_config is not None:
-        from semexplore_gym.envs.config import load_env_config
+        from semexplore_gym.envs.env_config import load_env_config
 
         load_env_config(args.env_config)
     from semexplore_gym.policies.specs import split_specs
@@ -374,14 +380,16 @@ def _check_run_args(
         from semexplore_gym.evaluation.suites import suite_tasks
 
         seed0 = SUITE_SEED0 if args.test_seed0 is None else args.test_seed0
-        tasks, suites, test_worlds = suite_tasks(
-            _split(args.test_suite),
-            labels,
-            lambda runs: parse_seeds(args.runs or runs, seed0),
-            max_time_s=args.max_time_s,
-            env_config=args.env_config,
-            flag="--test-suite",
-        )
+        try:
+            tasks, suites, test_worlds = suite_tasks(
+                _split(args.test_suite),
+                labels,
+                lambda runs: parse_seeds(args.runs or runs, seed0),
+                max_time_s=args.max_time_s,
+                env_config=args.env_config,
+            )
+        except ParameterError as e:
+            raise e.for_flags({"names": "--test-suite", "runs": "--runs"}) from None
     else:
         suites = []
         seed0 = DEFAULT_TEST_SEED0 if args.test_seed0 is None else args.test_seed0
@@ -407,13 +415,24 @@ def _train_limit_s(args: argparse.Namespace) -> float:
     return DEFAULT_MAX_TIME_S
 
 
+def _run_test_missions(tasks: list[Any], out_dir: Path, args: argparse.Namespace) -> Any:
+    """The test missions through the benchmark harness, its errors in flag names."""
+    from semexplore_gym.evaluation.harness import run_benchmark
+
+    try:
+        return run_benchmark(tasks, out_dir, workers=args.workers, progress=not args.no_progress)
+    except ParameterError as e:
+        raise e.for_flags({"out_dir": "--out", "workers": "--workers"}) from None
+
+
 def run(args: argparse.Namespace) -> int:
-    from semexplore_gym.evaluation.harness import read_runs, run_benchmark, write_manifest
+    from semexplore_gym.evaluation.harness import read_runs, write_manifest
     from semexplore_gym.evaluation.report import write_summary
     from semexplore_gym.training.weight_tuning import (
         PAPER_FIELD,
         PAPER_WEIGHTS,
         SearchSpace,
+        StudySettings,
         mission_objective,
         tune_weights,
     )
@@ -445,16 +464,12 @@ def run(args: argparse.Namespace) -> int:
             ws = ", ".join(f"{k.split('.')[-1]}={v:.3g}" for k, v in weights.items())
             print(f"trial {number}: {value:.2f} ({ws})", file=sys.stderr)
 
-    result = tune_weights(
-        objective,
-        args.trials,
-        space,
+    study = StudySettings(
         seed=args.seed,
-        enqueue=[start],
         storage_path=out / "tuning" / "study.sqlite",
         jsonl_path=out / "tuning" / "trials.jsonl",
-        on_trial=show,
     )
+    result = tune_weights(objective, args.trials, space, study, enqueue=[start], on_trial=show)
     sets = weight_sets(result.best_weights)
     (out / "weights.json").write_text(
         json.dumps({"sets": sets, "best_train_value": result.best_value}, indent=2)
@@ -464,7 +479,7 @@ def run(args: argparse.Namespace) -> int:
     # OUT/test is a benchmark directory: its manifest names the suites for its summary.
     (out / "test").mkdir(exist_ok=True)
     write_manifest(out / "test", {"suites": suites or None, "weight_sets": sets})
-    res = run_benchmark(tasks, out / "test", workers=args.workers, progress=not args.no_progress)
+    res = _run_test_missions(tasks, out / "test", args)
     rows = read_runs(out / "test" / "runs.csv")
     summary = write_summary(out / "test", reference=PAPER)
     labels = [*sets, *agents]

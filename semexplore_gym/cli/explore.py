@@ -130,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import semexplore_gym  # noqa: F401  (registers the env)
-    from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
+    from semexplore_gym.evaluation.rollout import GifOptions, map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
     from semexplore_gym.policies.registry import make_policy
     from semexplore_gym.policies.specs import load_policy_config
@@ -171,8 +171,7 @@ def run(args: argparse.Namespace) -> int:
             seed=args.seed,
             max_time_s=args.max_time_s,
             progress=not args.no_progress,
-            gif_path=args.gif,
-            gif_every_s=args.gif_every_s,
+            gif=GifOptions(args.gif, every_s=args.gif_every_s) if args.gif else None,
             # The mission lasts until the policy stops (or the time limit), not until the env's
             # coverage goal: mission_time_s is the policy's own.
             ignore_terminated=True,

@@ -10,11 +10,11 @@ the driving expert's parameters). Every run directory gets ``model.zip``, the re
 ``config.yaml``, ``args.json`` (arguments and command line), TensorBoard logs (CSV when
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
 ``frontier_value`` fits a learned frontier value for the expert
-(:mod:`semexplore_gym.training.frontier_value`, no torch needed) and writes ``model.yaml``,
+(:mod:`semexplore_gym.training.frontier_value_search`, no torch needed) and writes ``model.yaml``,
 ``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
 
 This module parses the arguments and writes the run directory; the configuration
-(:mod:`semexplore_gym.training.config`) and the runs (:mod:`semexplore_gym.training.imitation`,
+(:mod:`semexplore_gym.training.train_config`) and the runs (:mod:`semexplore_gym.training.imitation`,
 :mod:`semexplore_gym.training.ppo`) live in ``semexplore_gym.training``.
 """
 
@@ -32,6 +32,7 @@ import yaml
 
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.config import ConfigError, to_dict
+from semexplore_gym.evaluation.errors import ParameterError
 
 ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value")
 
@@ -92,13 +93,16 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    from semexplore_gym.training.config import check_train_config, load_train_config
+    from semexplore_gym.training.train_config import check_train_config, load_train_config
 
     try:
         cfg = load_train_config(args.train_config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
-    check_train_config(cfg, args.algo)
+    try:
+        check_train_config(cfg, args.algo)
+    except ParameterError as e:
+        raise e.for_flags({"algo": "--algo"}) from None
     out = Path(args.out)
     _write_run_record(out, cfg, args)
     torch.set_num_threads(cfg.torch_threads)
@@ -113,8 +117,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_frontier_value(args: argparse.Namespace) -> int:
-    """``--algo frontier_value``: no torch; missions only (:mod:`~semexplore_gym.training.frontier_value`)."""
-    from semexplore_gym.training.frontier_value import (
+    """``--algo frontier_value``: no torch; missions only (:mod:`~semexplore_gym.training.frontier_value_search`)."""
+    from semexplore_gym.training.frontier_value_search import (
         load_frontier_value_config,
         train_frontier_value,
     )

@@ -23,19 +23,17 @@ from semexplore_gym.core.worlds.start import (
     validate_start_pose,
 )
 from semexplore_gym.core.worlds.world import World
-from semexplore_gym.envs.config import EnvConfig, load_env_config
+from semexplore_gym.envs.env_config import EnvConfig, load_env_config
+from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
+from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
+from semexplore_gym.envs.observation_options import ObservationOptions
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
 
 PROCEDURAL_FAMILIES = ("maze", "office", "cave")
-#: ``map_observation`` options: a fresh copy of the whole map, a fresh window around the robot,
-#: or a read-only live view of the env's map.
-MAP_OBSERVATIONS = ("copy", "window", "shared")
-#: The per-step numbers of ``info`` besides ``reward_terms`` (see ``_info_values``).
+#: The per-step numbers of ``info`` besides ``reward_terms`` (see :meth:`info_numbers`).
 INFO_NUMBERS = ("coverage", "explored_area_m2", "collisions", "sim_time_s", "path_length_m")
-#: ``static_info`` options: the static ``info`` entries in every step's ``info``, or at reset only.
-STATIC_INFO_MODES = ("every_step", "reset")
 
 
 def _is_unseeded_procedural(spec: Any) -> bool:
@@ -135,6 +133,9 @@ class SemanticExploreEnv(gym.Env):
       :class:`EnvConfig`.
     - ``overrides``: list of ``"section.key=value"`` strings applied on top of ``config``.
     - ``render_mode``: None, ``"rgb_array"`` or ``"human"``.
+    - ``observation_options``: an :class:`~semexplore_gym.envs.observation_options.ObservationOptions`
+      (None: the defaults) with the three speed options below; ``gym.make`` also takes them
+      one by one as keywords (``map_observation="shared"``), which replace its fields.
     - ``map_observation``: ``"copy"`` (default) gives a fresh copy of the whole map each step
       (1.3 MB per step on Willow Garage). ``"window"`` gives a fresh ``(map_window_cells,
       map_window_cells)`` window of it centred on the cell of ``obs["pose"]`` (north-up, cells
@@ -175,6 +176,9 @@ class SemanticExploreEnv(gym.Env):
       a dict of per-field arrays.
     - v0, issue #17: the ``map_observation`` (``"window"``, ``"shared"``) and ``static_info``
       (``"reset"``) options, off by default (the default observations and ``info`` are unchanged).
+    - v0, issue #28 (no change to observations, rewards or dynamics): the speed options are
+      one :class:`ObservationOptions` (``observation_options=``); the fast path the vector env
+      uses is public (:meth:`advance`, :meth:`write_obs_into`, :meth:`info_numbers`).
 
     ## Speed
     ``python scripts/bench_env.py`` times the step stage by stage; ``scripts/bench_vector_env.py``
@@ -200,24 +204,16 @@ class SemanticExploreEnv(gym.Env):
         config: EnvConfig | str | os.PathLike | dict | None = None,
         overrides: list[str] | None = None,
         render_mode: str | None = None,
-        map_observation: str = "copy",
-        static_info: str = "every_step",
-        map_window_cells: int = 160,
+        observation_options: ObservationOptions | None = None,
+        **option_fields: Any,
     ) -> None:
         super().__init__()
-        if map_observation not in MAP_OBSERVATIONS:
-            raise ValueError(
-                f"map_observation must be one of {MAP_OBSERVATIONS}, got {map_observation!r}"
-            )
-        if static_info not in STATIC_INFO_MODES:
-            raise ValueError(f"static_info must be one of {STATIC_INFO_MODES}, got {static_info!r}")
-        if isinstance(map_window_cells, bool) or not isinstance(map_window_cells, int | np.integer):
-            raise ValueError(f"map_window_cells must be an integer, got {map_window_cells!r}")
-        if not 8 <= map_window_cells <= 4096:
-            raise ValueError(f"map_window_cells must be in [8, 4096], got {map_window_cells!r}")
-        self.map_observation = map_observation
-        self.map_window_cells = int(map_window_cells)
-        self.static_info = static_info
+        opts = ObservationOptions.from_flags(observation_options, **option_fields)
+        self.observation_options = opts
+        # Read by wrappers and tools; the options object is the one source.
+        self.map_observation = opts.map_observation
+        self.map_window_cells = opts.map_window_cells
+        self.static_info = opts.static_info
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}"
@@ -240,12 +236,23 @@ class SemanticExploreEnv(gym.Env):
                 f"mapping.resolution_m={cfg.mapping.resolution_m}; raise mapping.resolution_m"
             )
         self._build_world_state()
+        self.observation_space = self._observation_space()
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        self._static_info = self._static_entries()
+        self._area_per_cell_m2 = cfg.mapping.resolution_m**2
+        self._static_every_step = self.static_info == "every_step"
+        self._overlay: dict[str, Any] = {}
+        self._renderer: Any = None
+        self._started = False
 
+    # ----------------------------------------------------------------- set-up
+    def _observation_space(self) -> spaces.Dict:
+        cfg = self.config
         h, w = self.map_geometry.shape
-        if map_observation == "window":
+        if self.map_observation == "window":
             h = w = self.map_window_cells
         big = np.float32(1e6)
-        self.observation_space = spaces.Dict(
+        space = spaces.Dict(
             {
                 "map": spaces.Box(0, 255, shape=(h, w), dtype=np.uint8),
                 "pose": spaces.Box(
@@ -258,13 +265,15 @@ class SemanticExploreEnv(gym.Env):
                 ),
             }
         )
-        if map_observation == "window":
+        if self.map_observation == "window":
             lim = 2**30
-            self.observation_space.spaces["map_offset_cells"] = spaces.Box(
-                -lim, lim, shape=(2,), dtype=np.int32
-            )
-        self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-        self._static_info: dict[str, Any] = {
+            space.spaces["map_offset_cells"] = spaces.Box(-lim, lim, shape=(2,), dtype=np.int32)
+        return space
+
+    def _static_entries(self) -> dict[str, Any]:
+        """The ``info`` entries fixed by the config (shared read-only mappings)."""
+        cfg = self.config
+        return {
             "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
             "robot": FrozenInfo(
                 {
@@ -285,13 +294,7 @@ class SemanticExploreEnv(gym.Env):
             ),
             "dt_s": cfg.episode.dt_s,
         }
-        self._area_per_cell_m2 = cfg.mapping.resolution_m**2
-        self._static_every_step = static_info == "every_step"
-        self._overlay: dict[str, Any] = {}
-        self._renderer: Any = None
-        self._started = False
 
-    # ----------------------------------------------------------------- set-up
     def _build_world_state(self) -> None:
         cfg = self.config
         self.sim = RobotSim(self.world, cfg.robot, cfg.physics)
@@ -358,16 +361,25 @@ class SemanticExploreEnv(gym.Env):
     def step(
         self, action: np.ndarray
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        reward, terminated, truncated, terms = self._advance(action)
-        info = self._info(terms, self._static_every_step)
+        reward, terminated, truncated, terms = self.advance(action)
+        info = self.step_info(terms)
         if self.render_mode == "human":
             self.render()
         return self._obs(), reward, terminated, truncated, info
 
-    def _advance(self, action: Any) -> tuple[float, bool, bool, dict[str, float]]:
-        """One control step of the world, robot, LiDAR and map: ``(reward, terminated,
-        truncated, reward_terms)``; :meth:`step` adds the observation and ``info``, and
-        :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv` writes them into its batch."""
+    # ------------------------------------------------- the vector env's fast path
+    # step() is advance() + _obs() + step_info(); FastSyncVectorEnv calls the public pieces
+    # itself (advance, write_obs_into, info_numbers, static_info_entries, step_info) to step
+    # straight into its batch. They must stay in step with step(): a change to what step()
+    # returns changes them too (tests/envs/test_vector.py compares with SyncVectorEnv).
+    def advance(self, action: Any) -> tuple[float, bool, bool, dict[str, float]]:
+        """One control step of the world, robot, LiDAR and map, without building the
+        observation or ``info``: ``(reward, terminated, truncated, reward_terms)``.
+
+        :meth:`step` is this, then the observation and :meth:`step_info`; a caller that
+        advances must read the observation with :meth:`write_obs_into` and the ``info``
+        numbers with :meth:`info_numbers` before the next call.
+        """
         v_mps, w_radps = self._scale_action(action)
         cfg = self.config
         before = self._true_pose
@@ -440,15 +452,29 @@ class SemanticExploreEnv(gym.Env):
         x, y, yaw = self._est_pose
         return x, y, wrap_angle_rad(yaw)
 
-    def _obs_into(self, batch: dict[str, np.ndarray], i: int, map_row: np.ndarray) -> None:
-        """Put what :meth:`_obs` returns into row ``i`` of ``batch`` (the same values; for
-        ``map_observation`` ``"copy"`` and ``"shared"``): the vector env's batch, no fresh
-        arrays. ``map_row`` is ``batch["map"][i]`` (the same view object every step): the
-        map is not copied there each step, the grid keeps its cells in it from the first
-        call on (:meth:`OccupancyGrid.keep_encoded_in`)."""
+    def write_obs_into(self, batch: dict[str, np.ndarray], i: int, map_row: np.ndarray) -> None:
+        """Put the observation :meth:`step` would return into row ``i`` of ``batch`` (the same
+        values; for ``map_observation`` ``"copy"`` and ``"shared"`` only): the vector env's
+        batch, no fresh arrays. ``map_row`` is ``batch["map"][i]`` (the same view object every
+        step): the map is not copied there each step, the grid keeps its cells in it from the
+        first call on (:meth:`OccupancyGrid.keep_encoded_in`)."""
         self.grid.keep_encoded_in(map_row)
         batch["pose"][i] = self._pose_values()
         batch["scan"][i] = self._scan
+
+    def _info(self, terms: dict[str, float], static: bool) -> dict[str, Any]:
+        # The static entries are shared read-only mappings; the top level is a fresh dict.
+        info = self._static_info.copy() if static else {}
+        # The keys of INFO_NUMBERS, in its order (a test checks they match).
+        (
+            info["coverage"],
+            info["explored_area_m2"],
+            info["collisions"],
+            info["sim_time_s"],
+            info["path_length_m"],
+        ) = self.info_numbers()
+        info["reward_terms"] = terms
+        return info
 
     def _window_obs(self, pose: np.ndarray) -> dict[str, np.ndarray]:
         g = self.map_geometry
@@ -463,22 +489,17 @@ class SemanticExploreEnv(gym.Env):
             "map_offset_cells": np.array(origin, dtype=np.int32),
         }
 
-    def _info(self, terms: dict[str, float], static: bool) -> dict[str, Any]:
-        # The static entries are shared read-only mappings; the top level is a fresh dict.
-        info = self._static_info.copy() if static else {}
-        # The keys of INFO_NUMBERS, in its order (a test checks they match).
-        (
-            info["coverage"],
-            info["explored_area_m2"],
-            info["collisions"],
-            info["sim_time_s"],
-            info["path_length_m"],
-        ) = self._info_values()
-        info["reward_terms"] = terms
-        return info
+    def step_info(self, terms: dict[str, float]) -> dict[str, Any]:
+        """The ``info`` :meth:`step` returns after :meth:`advance` gave ``terms``."""
+        return self._info(terms, self._static_every_step)
 
-    def _info_values(self) -> tuple[float, float, int, float, float]:
-        """The numbers of :meth:`_info` under :data:`INFO_NUMBERS`, in that order."""
+    def static_info_entries(self) -> dict[str, Any]:
+        """The static ``info`` entries (``map_geometry``, ``robot``, ``lidar``, ``dt_s``):
+        the same read-only mappings every step (with ``static_info="every_step"``) holds."""
+        return self._static_info
+
+    def info_numbers(self) -> tuple[float, float, int, float, float]:
+        """The per-step numbers of ``info`` under :data:`INFO_NUMBERS`, in that order."""
         grid = self.grid
         return (
             grid.n_free_in_mask / self._n_reachable,

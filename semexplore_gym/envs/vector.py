@@ -19,13 +19,20 @@ rewards, flags, ``info`` arrays and ``_key`` masks, same autoreset behaviour) bu
   keeps its cells in the env's row of the batch (``OccupancyGrid.keep_encoded_in``), so with
   ``copy=False`` the returned batch's ``map`` is read-only (writing into it would change the
   envs' maps; ``copy=True`` returns copies, as usual). Steps in which an env resets, and
-  ``AutoresetMode.SAME_STEP``, take the general path.
+  ``AutoresetMode.SAME_STEP``, take the general path. The env's public fast-path methods
+  (``advance``, ``write_obs_into``, ``info_numbers``, ``static_info_entries``, ``step_info``;
+  see ``SemanticExploreEnv.advance``) are what this path calls: they and ``step()`` change
+  together.
 
 Other observation spaces fall back to gymnasium's ``concatenate``/``deepcopy``. Use it like
 ``SyncVectorEnv``::
 
+    from semexplore_gym.envs.observation_options import ObservationOptions
     from semexplore_gym.envs.vector import FastSyncVectorEnv
-    venv = FastSyncVectorEnv([lambda: gym.make("SemanticExplore-v0", static_info="reset")] * 4)
+    options = ObservationOptions(static_info="reset")
+    venv = FastSyncVectorEnv(
+        [lambda: gym.make("SemanticExplore-v0", observation_options=options)] * 4
+    )
 
 ``AsyncVectorEnv`` runs each env in a worker process: it pays off only with a free core per
 worker and env steps long enough (hundreds of µs, e.g. large real maps) to hide the
@@ -281,12 +288,12 @@ class FastSyncVectorEnv(SyncVectorEnv):
         for i, (action, env) in enumerate(
             zip(actions if plain else iterate(self.action_space, actions), envs, strict=True)
         ):
-            reward, term, trunc, terms = env._advance(action)
+            reward, term, trunc, terms = env.advance(action)
             rewards.append(reward)
             if term or trunc:
                 ended.append((i, term, trunc))
-            env._obs_into(batch, i, map_rows[i])
-            values += env._info_values()
+            env.write_obs_into(batch, i, map_rows[i])
+            values += env.info_numbers()
             values += terms.values()
             all_terms.append(terms)
         n = self.num_envs
@@ -302,13 +309,10 @@ class FastSyncVectorEnv(SyncVectorEnv):
         if self._info_layout is None:
             self._info_layout = self._direct_layout(envs, values, all_terms)
         if self._info_layout:
-            info = self._direct_info(envs[0]._static_every_step, values)
+            info = self._direct_info(envs[0].static_info == "every_step", values)
         else:  # numbers of unusual types: gymnasium's own merge rules
-            static = envs[0]._static_every_step
             pairs = zip(envs, all_terms, strict=True)
-            info = self._merge_infos(
-                [(i, env._info(t, static)) for i, (env, t) in enumerate(pairs)]
-            )
+            info = self._merge_infos([(i, env.step_info(t)) for i, (env, t) in enumerate(pairs)])
         return obs, np.array(rewards, dtype=np.float64), terminations, truncations, info
 
     def _direct_layout(
@@ -328,8 +332,8 @@ class FastSyncVectorEnv(SyncVectorEnv):
             and list(terms) == keys[len(INFO_NUMBERS) :]
             for i, terms in enumerate(all_terms)
         )
-        if usual and envs[0]._static_every_step:
-            self._static_merged = self._merge_same_keys([env._static_info for env in envs])
+        if usual and envs[0].static_info == "every_step":
+            self._static_merged = self._merge_same_keys([env.static_info_entries() for env in envs])
             usual = self._static_merged is not None
         return [(k, "_" + k, t) for k, t in zip(keys, types, strict=True)] if usual else []
 

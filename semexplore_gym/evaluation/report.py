@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from semexplore_gym.evaluation.harness import file_slug, read_runs, task_stem
+from semexplore_gym.evaluation.run_row import read_runs
+from semexplore_gym.evaluation.run_writer import file_slug, task_stem
 
 #: The policy every other one is compared against in ``summary.md``.
 REFERENCE_POLICY = "semantic"

@@ -13,14 +13,28 @@ import math
 import os
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from semexplore_gym.evaluation.gif import GifOptions, GifStreamWriter, save_gif
 from semexplore_gym.policies.base import Policy, StepStats
+
+__all__ = [
+    "STAGES",
+    "GifOptions",
+    "GifStreamWriter",
+    "MissionResult",
+    "make_mission_env",
+    "map_observation_for",
+    "policy_mission_metrics",
+    "run_mission",
+    "save_gif",
+    "time_to_coverage",
+]
 
 #: Stages of the per-stage wall-time split, in the order they are reported.
 STAGES: tuple[str, ...] = (
@@ -64,6 +78,8 @@ class MissionResult:
         coverage_trace: ``(sim_time_s, coverage, explored_area_m2)`` after reset and every step.
         trajectory: ``(steps + 1, 3)`` poses ``x, y, yaw`` of the observations.
         policy_counters: The policy's ``counters`` dict, if it has one.
+        policy_metrics: The policy's ``mission_metrics()`` at the end of the mission
+            (policy-specific figures for benchmark rows; empty for most policies).
     """
 
     world: str
@@ -90,6 +106,7 @@ class MissionResult:
     coverage_trace: list[tuple[float, float, float]] = field(repr=False)
     trajectory: np.ndarray = field(repr=False)
     policy_counters: dict[str, int] = field(default_factory=dict)
+    policy_metrics: dict[str, Any] = field(default_factory=dict)
 
     @property
     def speedup(self) -> float:
@@ -251,18 +268,16 @@ class _GifRecorder:
         self.writer.abort()
 
 
-def _check_mission_args(
-    env: Any, max_time_s: float | None, gif_path: str | os.PathLike | None, gif_every_s: float
-) -> None:
+def _check_mission_args(env: Any, max_time_s: float | None, gif: GifOptions | None) -> None:
     if max_time_s is not None and not (max_time_s > 0 and math.isfinite(max_time_s)):
         raise ValueError(f"max_time_s must be a positive number or None, got {max_time_s!r}")
-    if gif_path is not None:
+    if gif is not None:
         if getattr(env, "render_mode", None) != "rgb_array":
             raise ValueError(
-                f"gif_path needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
+                f"gif needs an env made with render_mode='rgb_array', got render_mode={getattr(env, 'render_mode', None)!r}"
             )
-        if not gif_every_s > 0:
-            raise ValueError(f"gif_every_s must be positive, got {gif_every_s!r}")
+        if not gif.every_s > 0:
+            raise ValueError(f"gif.every_s must be positive, got {gif.every_s!r}")
 
 
 def run_mission(
@@ -271,13 +286,10 @@ def run_mission(
     seed: int | None,
     max_time_s: float | None = None,
     progress: bool = False,
-    gif_path: str | os.PathLike | None = None,
     on_step: Callable[[int, dict[str, Any], dict[str, Any], np.ndarray, Policy], None]
     | None = None,
     *,
-    gif_every_s: float = 2.0,
-    gif_fps: float = 10.0,
-    reset_options: dict[str, Any] | None = None,
+    gif: GifOptions | None = None,
     ignore_terminated: bool = False,
 ) -> MissionResult:
     """Run one mission of ``policy`` in ``env``.
@@ -289,11 +301,8 @@ def run_mission(
         max_time_s: Stop after this much simulated time (None: only the env's own truncation).
         progress: Show a tqdm bar on stderr (simulated seconds, coverage); off by default
             (the CLI turns it on).
-        gif_path: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         on_step: Called after every step as ``on_step(step, obs, info, action, policy)``.
-        gif_every_s: Simulated seconds between GIF frames.
-        gif_fps: GIF playback frame rate.
-        reset_options: ``options`` for ``env.reset``.
+        gif: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         ignore_terminated: Keep going when the env terminates (its coverage goal is reached),
             so that the mission lasts until the policy stops (or the time limit): the mission
             time is then the policy's own. Truncation still ends the mission.
@@ -302,13 +311,13 @@ def run_mission(
         The :class:`MissionResult`.
 
     Raises:
-        ValueError: a non-positive ``max_time_s``, or ``gif_path`` with an env that cannot render
+        ValueError: a non-positive ``max_time_s``, or ``gif`` with an env that cannot render
             RGB frames.
     """
-    _check_mission_args(env, max_time_s, gif_path, gif_every_s)
+    _check_mission_args(env, max_time_s, gif)
     cpu0 = time.process_time()
     wall0 = time.perf_counter()
-    obs, info = env.reset(seed=seed, options=reset_options)
+    obs, info = env.reset(seed=seed, options=None)
     t1 = time.perf_counter()
     log = _MissionLog(obs, info)
     log.stage["env_reset"] = t1 - wall0
@@ -317,9 +326,9 @@ def run_mission(
 
     world_name = _world_name(env)
     limit_s = max_time_s if max_time_s is not None else math.inf
-    gif = (
-        _GifRecorder(env, policy, gif_every_s, log.stage, gif_path, gif_fps)
-        if gif_path is not None
+    recorder = (
+        _GifRecorder(env, policy, gif.every_s, log.stage, gif.path, gif.fps)
+        if gif is not None
         else None
     )
     bar = _progress_bar(
@@ -327,21 +336,39 @@ def run_mission(
     )
     try:
         info, terminated, truncated = _drive(
-            env, policy, obs, info, log, gif, bar, on_step, limit_s, ignore_terminated
+            env, policy, obs, info, log, recorder, bar, on_step, limit_s, ignore_terminated
         )
     except BaseException:
-        if gif is not None:
-            gif.abort()
+        if recorder is not None:
+            recorder.abort()
         raise
     finally:
         if bar is not None:
             bar.close()
     reason = _stop_reason(policy, terminated, truncated, ignore_terminated, max_time_s)
     wall = time.perf_counter() - wall0
-    if gif is not None:
-        gif.save()
+    if recorder is not None:
+        recorder.save()
         wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
+    return _mission_result(
+        world_name, policy, seed, info, (terminated, truncated), reason, (wall, cpu), log
+    )
+
+
+def _mission_result(
+    world_name: str,
+    policy: Policy,
+    seed: int | None,
+    info: dict[str, Any],
+    ended: tuple[bool, bool],
+    reason: str,
+    clocks: tuple[float, float],
+    log: _MissionLog,
+) -> MissionResult:
+    """The :class:`MissionResult` of a finished mission (``ended``: terminated, truncated;
+    ``clocks``: wall and CPU seconds)."""
+    terminated, truncated = ended
     return MissionResult(
         world=world_name,
         policy=policy.name,
@@ -353,8 +380,8 @@ def run_mission(
         stop_reason=reason,
         path_length_m=float(info["path_length_m"]),
         collisions=int(info["collisions"]),
-        wall_time_s=wall,
-        cpu_time_s=cpu,
+        wall_time_s=clocks[0],
+        cpu_time_s=clocks[1],
         steps=log.steps,
         terminated=bool(terminated),
         truncated=bool(truncated or (not terminated and not policy.done)),
@@ -367,7 +394,15 @@ def run_mission(
         coverage_trace=log.trace,
         trajectory=np.asarray(log.poses),
         policy_counters=dict(getattr(policy, "counters", {}) or {}),
+        policy_metrics=policy_mission_metrics(policy),
     )
+
+
+def policy_mission_metrics(policy: Any) -> dict[str, Any]:
+    """The policy's ``mission_metrics()`` (empty when it has none)."""
+    hook = getattr(policy, "mission_metrics", None)
+    metrics = dict(hook() or {}) if callable(hook) else {}
+    return metrics
 
 
 def _drive(
@@ -438,132 +473,6 @@ def _stop_reason(
     if truncated:
         return "env truncated (episode time limit)"
     return f"max_time_s reached ({max_time_s:g} s)"
-
-
-def _palette_frame(frame: np.ndarray, colors: int = 128) -> tuple[bytes, bytes, int, int]:
-    """One RGB frame as GIF pieces: (colour table, LZW image data, width, height).
-
-    Pillow encodes the frame as a one-frame GIF (adaptive palette); the colour table and the
-    compressed image blocks are cut out of it, so frames can be appended to a file one by one.
-    """
-    import io
-
-    from PIL import Image
-
-    img = Image.fromarray(np.ascontiguousarray(frame[..., :3]).astype(np.uint8)).convert(
-        "P", palette=Image.Palette.ADAPTIVE, colors=colors
-    )
-    buf = io.BytesIO()
-    img.save(buf, format="GIF", interlace=False)
-    data = buf.getvalue()
-    if data[:3] != b"GIF":
-        raise ValueError("Pillow did not write a GIF")
-    packed = data[10]
-    table = b""
-    pos = 13
-    if packed & 0x80:
-        size = 3 * (2 ** ((packed & 0x07) + 1))
-        table = data[pos : pos + size]
-        pos += size
-    while pos < len(data):
-        block = data[pos]
-        if block == 0x21:  # extension: label, then sub-blocks
-            pos += 2
-            while data[pos]:
-                pos += data[pos] + 1
-            pos += 1
-        elif block == 0x2C:  # image descriptor
-            width = int.from_bytes(data[pos + 5 : pos + 7], "little")
-            height = int.from_bytes(data[pos + 7 : pos + 9], "little")
-            flags = data[pos + 9]
-            pos += 10
-            if flags & 0x80:  # a local table replaces the global one
-                size = 3 * (2 ** ((flags & 0x07) + 1))
-                table = data[pos : pos + size]
-                pos += size
-            start = pos
-            pos += 1  # LZW minimum code size
-            while data[pos]:
-                pos += data[pos] + 1
-            pos += 1
-            if flags & 0x40:
-                raise ValueError("Pillow wrote an interlaced GIF frame")
-            return table, data[start:pos], width, height
-        else:
-            break
-    raise ValueError("no image in the GIF Pillow wrote")
-
-
-class GifStreamWriter:
-    """An animated, looping GIF written frame by frame.
-
-    Each :meth:`append` encodes one frame (its own adaptive palette, as a local colour table)
-    and writes it to ``PATH.part``; :meth:`close` ends the file and moves it to ``path``.
-    Memory holds one frame, not the whole mission (Pillow's ``save_all`` needs every frame).
-    """
-
-    def __init__(self, path: str | os.PathLike, fps: float = 10.0, colors: int = 128) -> None:
-        self.path = Path(path)
-        self.delay_cs = max(2, int(round(100.0 / fps)))
-        self.colors = colors
-        self.n_frames = 0
-        self._size: tuple[int, int] | None = None
-        self._tmp = self.path.with_name(self.path.name + ".part")
-        self._f: Any = None
-
-    def append(self, frame: np.ndarray) -> None:
-        table, image, width, height = _palette_frame(frame, self.colors)
-        if self._f is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._f = self._tmp.open("wb")
-            self._size = (width, height)
-            # Header, logical screen (no global table), loop forever (NETSCAPE2.0).
-            self._f.write(b"GIF89a" + _u16(width) + _u16(height) + b"\x00\x00\x00")
-            self._f.write(b"\x21\xff\x0bNETSCAPE2.0\x03\x01" + _u16(0) + b"\x00")
-        elif (width, height) != self._size:
-            raise ValueError(f"GIF frame size {width}x{height} differs from {self._size}")
-        n_bits = max(1, (len(table) // 3 - 1).bit_length())
-        table = table.ljust(3 * 2**n_bits, b"\x00")
-        self._f.write(b"\x21\xf9\x04\x04" + _u16(self.delay_cs) + b"\x00\x00")  # keep frame
-        self._f.write(
-            b"\x2c" + _u16(0) + _u16(0) + _u16(width) + _u16(height) + bytes([0x80 | (n_bits - 1)])
-        )
-        self._f.write(table)
-        self._f.write(image)
-        self.n_frames += 1
-
-    def close(self) -> Path:
-        """Finish the file; raises ValueError if no frame was appended."""
-        if self._f is None:
-            raise ValueError("no frames to write")
-        self._f.write(b"\x3b")
-        self._f.close()
-        self._f = None
-        os.replace(self._tmp, self.path)
-        return self.path
-
-    def abort(self) -> None:
-        """Drop a half-written file (the mission failed)."""
-        if self._f is not None:
-            self._f.close()
-            self._f = None
-            self._tmp.unlink(missing_ok=True)
-
-
-def _u16(v: int) -> bytes:
-    return int(v).to_bytes(2, "little")
-
-
-def save_gif(frames: Iterable[np.ndarray], path: str | os.PathLike, fps: float = 10.0) -> Path:
-    """Write RGB frames as an animated, looping GIF, one frame in memory at a time."""
-    writer = GifStreamWriter(path, fps=fps)
-    try:
-        for f in frames:
-            writer.append(f)
-        return writer.close()
-    except BaseException:
-        writer.abort()
-        raise
 
 
 def _progress_bar(enabled: bool, total_s: float | None, world: str, policy: str) -> Any:

@@ -29,6 +29,7 @@ from typing import Any
 import yaml
 
 from semexplore_gym.core.validation import short_repr
+from semexplore_gym.evaluation.errors import PARAM, ParameterError
 
 #: Where named suites live (the repository's ``configs/suites``), unless
 #: ``SEMEXPLORE_SUITES_DIR`` names another directory.
@@ -225,6 +226,29 @@ def world_time_limit_s(suite: Suite, entry: SuiteWorld, free_area_m2: float | No
     return None
 
 
+def _warn_repeated_missions(suite_name: str, n_worlds: int) -> None:
+    print(
+        f"warning: suite {suite_name}: fixed start poses: every seed repeats the same "
+        f"mission on {n_worlds} world(s) without seed=*; the summary will say "
+        "'no variation'",
+        file=sys.stderr,
+    )
+
+
+def _mission_env_config(
+    env_config: Any, random_start: bool, limit: float | None, env_overrides: Sequence[str]
+) -> Any:
+    """The env config of a suite world's missions."""
+    from semexplore_gym.envs.env_config import load_env_config
+
+    # The env's own limit must not cut the mission short; the user's overrides win.
+    overrides = [f"episode.random_start={'true' if random_start else 'false'}"]
+    if limit is not None:
+        overrides.append(f"episode.max_time_s={limit!r}")
+    overrides += list(env_overrides)
+    return load_env_config(env_config, overrides)
+
+
 def suite_tasks(
     names: Sequence[str],
     policies: Sequence[str],
@@ -234,7 +258,6 @@ def suite_tasks(
     fixed_start: bool = False,
     env_config: Any = None,
     env_overrides: Sequence[str] = (),
-    flag: str = "--suite",
 ) -> tuple[list[Any], list[dict[str, Any]], list[str]]:
     """The benchmark tasks of the suites ``names``: every world with its suite's time limit,
     runs and start poses, for every policy.
@@ -247,21 +270,20 @@ def suite_tasks(
         fixed_start: start every mission at the world's fixed pose (warns when seeds repeat).
         env_config: env config preset or YAML the suite's overrides apply to.
         env_overrides: ``SECTION.KEY=VALUE`` env overrides (win over the suite's).
-        flag: the command-line flag named in errors.
 
     Returns:
         (tasks, ``[{"name", "version", "source"}]`` per suite, every world in order).
 
     Raises:
-        ValueError: an unknown or repeated suite, a world in two suites, a world that cannot
-            be built; each message names ``flag`` and the value.
+        ParameterError: an unknown or repeated suite, a world in two suites, a world that
+            cannot be built; each message names ``names`` and the value (the command line
+            puts its flag in its place).
     """
-    from semexplore_gym.envs.config import load_env_config
-    from semexplore_gym.evaluation.harness import expand_tasks
+    from semexplore_gym.evaluation.tasks import expand_tasks
     from semexplore_gym.maps import make_world
 
     if not names:
-        raise ValueError(f"{flag} is empty")
+        raise ParameterError("names", f"{PARAM} is empty")
     tasks: list[Any] = []
     records: list[dict[str, Any]] = []
     all_worlds: list[str] = []
@@ -269,42 +291,35 @@ def suite_tasks(
         try:
             suite = load_suite(name)
         except FileNotFoundError as e:
-            raise ValueError(f"{flag} {short_repr(name)}: {e}") from None
+            raise ParameterError("names", f"{PARAM} {short_repr(name)}: {e}") from None
         if any(r["name"] == suite.name for r in records):
-            raise ValueError(f"{flag} lists suite {suite.name!r} twice")
+            raise ParameterError("names", f"{PARAM} lists suite {suite.name!r} twice")
         records.append({"name": suite.name, "version": suite.version, "source": str(name)})
         seeds = seeds_for(suite.runs)
         random_start = suite.random_start and not fixed_start
         repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
         if not random_start and len(seeds) > 1 and repeated:
-            print(
-                f"warning: suite {suite.name}: fixed start poses: every seed repeats the same "
-                f"mission on {len(repeated)} world(s) without seed=*; the summary will say "
-                "'no variation'",
-                file=sys.stderr,
-            )
+            _warn_repeated_missions(suite.name, len(repeated))
         for entry in suite.worlds:
             if entry.world in all_worlds:
-                raise ValueError(
-                    f"{flag}: world {short_repr(entry.world)} is in two suites; each world must "
-                    "appear once (a repeat would count the same missions twice)"
+                raise ParameterError(
+                    "names",
+                    f"{PARAM}: world {short_repr(entry.world)} is in two suites; each world "
+                    "must appear once (a repeat would count the same missions twice)",
                 )
             all_worlds.append(entry.world)
             try:
                 world = make_world(entry.world.replace("seed=*", f"seed={seeds[0]}"))
             except (ValueError, FileNotFoundError) as e:
-                raise ValueError(f"{flag} {suite.name}: world {entry.world!r}: {e}") from None
+                raise ParameterError(
+                    "names", f"{PARAM} {suite.name}: world {entry.world!r}: {e}"
+                ) from None
             if max_time_s is not None:
                 limit: float | None = max_time_s
             else:
                 area_m2 = float(world.free_mask.sum()) * world.free_geometry.resolution_m**2
                 limit = world_time_limit_s(suite, entry, area_m2)
-            # The env's own limit must not cut the mission short; the user's overrides win.
-            overrides = [f"episode.random_start={'true' if random_start else 'false'}"]
-            if limit is not None:
-                overrides.append(f"episode.max_time_s={limit!r}")
-            overrides += list(env_overrides)
-            config = load_env_config(env_config, overrides)
+            config = _mission_env_config(env_config, random_start, limit, env_overrides)
             tasks += expand_tasks(
                 [entry.world], policies, seeds, max_time_s=limit, env_config=config
             )

@@ -4,19 +4,20 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from semexplore_gym.core.features.egocentric import EgocentricParams
-from semexplore_gym.policies.base import Policy
 from semexplore_gym.training.bc import train_bc
 from semexplore_gym.training.dataset import DatasetWriter, ImitationDataset
+from semexplore_gym.training.episodes import EpisodeRecord
 from semexplore_gym.training.progress import with_progress
+from semexplore_gym.training.train_config import TrainConfig
 from semexplore_gym.training.workers import (
     DAGGER_STREAM,
+    EpisodeActors,
     EpisodeJob,
     check_workers,
     run_jobs,
@@ -52,85 +53,55 @@ class DaggerResult:
 
 
 def run_dagger(
-    env: Any,
-    expert: Policy,
+    actors: EpisodeActors,
     learner: Any,
-    params: EgocentricParams,
-    rounds: int = 3,
-    beta: float | Sequence[float] | Callable[[int], float] = 0.5,
-    episodes_per_round: int = 2,
+    cfg: TrainConfig,
+    *,
     dataset: ImitationDataset | None = None,
     dataset_path: str | os.PathLike | None = None,
-    bc_kwargs: dict[str, Any] | None = None,
-    seed: int = 0,
-    max_steps: int = 1000,
+    eval_data: ImitationDataset | None = None,
     progress: bool = False,
     log_fn: Callable[[str, float, int], None] | None = None,
-    save_interval_s: float = 0.0,
-    workers: int = 1,
-    make_env: Callable[[], Any] | None = None,
-    make_expert: Callable[[], Policy] | None = None,
 ) -> DaggerResult:
     """DAgger: roll out the learner with beta-mixing, label with the expert, aggregate, refit.
 
     Args:
-        env: The raw env.
-        expert: Labelling policy.
-        learner: SB3 actor-critic policy, refit in place after each round.
-        params: Egocentric parameters of the learner's input.
-        rounds: Number of collect-and-refit rounds.
-        beta: Schedule of the probability of executing the expert's action (see :func:`beta_schedule`).
-        episodes_per_round: Episodes collected per round.
+        actors: The raw env and the labelling expert (and the workers' factories).
+        learner: SB3 actor-critic policy, refit in place after each round (its weights go to
+            the workers each round; it drives with one torch thread, whatever the workers).
+        cfg: ``dagger`` (rounds, episodes, :func:`beta_schedule`, workers), ``bc`` (each
+            refit, with ``dagger.epochs_per_round`` and ``dagger.select_best``),
+            ``expert.max_steps``, ``expert.save_interval_s`` (between rewrites of
+            ``dataset_path``), ``egocentric`` and ``seed``: episode ``k`` (over all rounds)
+            resets with ``seed + 10000 + k`` and flips its beta coins with
+            ``episode_rng(seed, k, DAGGER_STREAM)``; round ``r`` refits with ``seed + r``.
         dataset: Initial data (e.g. the BC dataset) to aggregate with.
         dataset_path: When given, the aggregate is rewritten there after every episode.
-        bc_kwargs: Keyword arguments of :func:`train_bc` for each refit.
-        seed: Base seed: DAgger episode ``k`` (counted over all rounds) resets with seed
-            ``seed + 10000 + k`` and flips its beta coins with ``episode_rng(seed, k,
-            DAGGER_STREAM)``; round ``r`` refits with seed ``seed + r``.
-        max_steps: Step cap per episode.
+        eval_data: Held-out samples each refit measures (see :func:`train_bc`).
         progress: tqdm bars.
-        log_fn: ``log_fn(tag, value, step)`` for per-round scalars.
-        save_interval_s: Minimum time between rewrites of ``dataset_path`` (it is always
-            written at the end of every round).
-        workers: Processes the episodes of a round run in (see :func:`record_expert_dataset`;
-            the learner's weights are shipped to them every round). The learner drives with one
-            torch thread in any case, so the data does not depend on ``workers``.
-        make_env: Factory of the workers' envs (default: copies of ``env``).
-        make_expert: Factory of the workers' experts (default: copies of ``expert``).
+        log_fn: ``log_fn(tag, value, step)`` for per-round scalars (and each refit's epochs,
+            counted on over the rounds).
     """
-    if rounds < 1 or episodes_per_round < 1:
+    d, params = cfg.dagger, cfg.egocentric
+    if d.rounds < 1 or d.episodes_per_round < 1:
         raise ValueError(
-            f"rounds and episodes_per_round must be >= 1, got {rounds}, {episodes_per_round}"
+            f"rounds and episodes_per_round must be >= 1, got {d.rounds}, {d.episodes_per_round}"
         )
-    workers = check_workers(workers)
-    sched = beta_schedule(beta)
+    check_workers(d.workers)
+    sched = beta_schedule(list(d.beta) if isinstance(d.beta, tuple) else d.beta)
     data = (
         dataset if dataset is not None else ImitationDataset.empty({"egocentric": params.to_dict()})
     )
-    writer = (
-        DatasetWriter(dataset_path, data.meta, min_interval_s=save_interval_s)
-        if dataset_path is not None
-        else None
-    )
-    if writer is not None and len(data):
-        writer.replace(data)
-        writer.flush()
-    bc_kwargs = dict(bc_kwargs or {})
-    epochs = int(bc_kwargs.get("epochs", 10))
+    writer = _aggregate_writer(dataset_path, data, cfg.expert.save_interval_s)
+    refit = replace(cfg.bc, epochs=d.epochs_per_round, select_best=d.select_best)
     history: list[dict[str, float]] = []
-    with worker_pool(workers, episodes_per_round) as pool:
-        for r in with_progress(range(rounds), progress, "DAgger rounds"):
+    with worker_pool(d.workers, d.episodes_per_round) as pool:
+        for r in with_progress(range(d.rounds), progress, "DAgger rounds"):
             b = float(sched(r))
             t0 = time.perf_counter()
             first_id = int(data.episode_ids.max()) + 1 if len(data) else 0
-            jobs = _round_jobs(r, episodes_per_round, seed, first_id, b, max_steps)
-            parts, covs, fracs = [], [], []
-            for rec in run_jobs(jobs, env, expert, params, learner, pool, make_env, make_expert):
-                parts.append(rec.data)
-                if writer is not None:
-                    writer.add(rec.data)
-                covs.append(rec.coverage)
-                fracs.append(rec.expert_fraction)
+            jobs = _round_jobs(r, d.episodes_per_round, cfg.seed, first_id, b, cfg.expert.max_steps)
+            parts, covs, fracs = _collect(run_jobs(jobs, actors, params, learner, pool), writer)
             # The writer already holds the aggregate: share it rather than copy it again.
             data = (
                 writer.data
@@ -140,16 +111,18 @@ def run_dagger(
             if writer is not None:
                 writer.flush()
             fit = train_bc(
-                data, learner, seed=seed + r, log_fn=log_fn, step_offset=r * epochs, **bc_kwargs
+                data,
+                learner,
+                refit,
+                seed=cfg.seed + r,
+                eval_data=eval_data,
+                egocentric=params,
+                log_fn=_shifted(log_fn, r * refit.epochs),
             )
             facts = {
-                "round": r,
-                "beta": b,
-                "coverage": float(np.mean(covs)),
-                "expert_fraction": float(np.mean(fracs)),
-                "new_samples": sum(len(p) for p in parts),
-                "dataset_size": len(data),
-                "bc_loss": fit["loss"][-1],
+                **{"round": r, "beta": b, "coverage": float(np.mean(covs))},
+                **{"expert_fraction": float(np.mean(fracs)), "dataset_size": len(data)},
+                **{"new_samples": sum(len(p) for p in parts), "bc_loss": fit["loss"][-1]},
                 "seconds": time.perf_counter() - t0,
             }
             history.append(facts)
@@ -157,6 +130,42 @@ def run_dagger(
                 for k in ("beta", "coverage", "expert_fraction", "dataset_size", "bc_loss"):
                     log_fn(f"dagger/{k}", float(facts[k]), r)
     return DaggerResult(data, history)
+
+
+def _aggregate_writer(
+    path: str | os.PathLike | None, data: ImitationDataset, min_interval_s: float
+) -> DatasetWriter | None:
+    """The writer of the aggregate at ``path`` (None: no file), holding ``data`` already."""
+    if path is None:
+        return None
+    writer = DatasetWriter(path, data.meta, min_interval_s=min_interval_s)
+    if len(data):
+        writer.replace(data)
+        writer.flush()
+    return writer
+
+
+def _collect(
+    records: Iterable[EpisodeRecord], writer: DatasetWriter | None
+) -> tuple[list[ImitationDataset], list[float], list[float]]:
+    """A round's episodes (written as they come): data, coverages, expert fractions."""
+    parts, covs, fracs = [], [], []
+    for rec in records:
+        parts.append(rec.data)
+        if writer is not None:
+            writer.add(rec.data)
+        covs.append(rec.coverage)
+        fracs.append(rec.expert_fraction)
+    return parts, covs, fracs
+
+
+def _shifted(
+    log_fn: Callable[[str, float, int], None] | None, offset: int
+) -> Callable[[str, float, int], None] | None:
+    """``log_fn`` with ``offset`` added to every step (a refit's epochs, counted on)."""
+    if log_fn is None:
+        return None
+    return lambda tag, value, step: log_fn(tag, value, step + offset)
 
 
 def _round_jobs(

@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from semexplore_gym.evaluation.rollout import make_mission_env
-from semexplore_gym.training.config import TrainConfig, is_macro
+from semexplore_gym.training.train_config import TrainConfig, is_macro
 
 
 def make_raw_env(cfg: TrainConfig) -> Any:

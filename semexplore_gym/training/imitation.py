@@ -15,12 +15,13 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.training.bc import action_error, train_bc
-from semexplore_gym.training.config import TrainConfig
 from semexplore_gym.training.dagger import run_dagger
 from semexplore_gym.training.dataset import ImitationDataset
 from semexplore_gym.training.factories import make_expert, make_raw_env
 from semexplore_gym.training.ppo import make_vec_env, new_ppo, save_tagged_model
 from semexplore_gym.training.recording import record_expert_dataset
+from semexplore_gym.training.train_config import TrainConfig
+from semexplore_gym.training.workers import EpisodeActors
 
 LogFn = Callable[[str, float, int], None]
 
@@ -38,19 +39,14 @@ def check_mirror(cfg: TrainConfig, raw_env: Any) -> None:
         )
 
 
-def bc_kwargs(cfg: TrainConfig, progress: bool) -> dict[str, Any]:
-    """:func:`train_bc` keyword arguments of the ``bc`` section (all but epochs and data)."""
-    bc = cfg.bc
-    return {
-        "batch_size": bc.batch_size,
-        "lr": bc.lr,
-        "ent_weight": bc.ent_weight,
-        "l2_weight": bc.l2_weight,
-        "progress": progress,
-        "mirror_params": cfg.egocentric if bc.mirror else None,
-        "select_best": bc.select_best,
-        "lr_final_fraction": bc.lr_final_fraction,
-    }
+def actors(cfg: TrainConfig, raw_env: Any, expert: Any) -> EpisodeActors:
+    """The run's env and expert, and the workers' factories of their own."""
+    return EpisodeActors(
+        raw_env,
+        expert,
+        make_env=functools.partial(make_raw_env, cfg),
+        make_expert=functools.partial(make_expert, cfg),
+    )
 
 
 def record(
@@ -58,65 +54,15 @@ def record(
 ) -> ImitationDataset:
     """The expert dataset of the ``expert`` section, written to ``path``."""
     return record_expert_dataset(
-        raw_env,
-        expert,
+        actors(cfg, raw_env, expert),
         path,
-        cfg.expert.episodes,
         cfg.egocentric,
+        cfg.expert,
         seed=cfg.seed,
-        max_steps=cfg.expert.max_steps,
         meta={"world": cfg.env.world, "expert_spec": cfg.expert.spec},
         progress=progress,
         log_fn=log,
-        noise_std=cfg.expert.noise_std,
-        noise_fraction=cfg.expert.noise_fraction,
-        save_interval_s=cfg.expert.save_interval_s,
-        workers=cfg.expert.workers,
-        make_env=functools.partial(make_raw_env, cfg),
-        make_expert=functools.partial(make_expert, cfg),
     )
-
-
-def dagger_rounds(
-    cfg: TrainConfig,
-    raw_env: Any,
-    expert: Any,
-    policy: Any,
-    train: ImitationDataset,
-    eval_data: ImitationDataset | None,
-    out: Path,
-    log: LogFn,
-    progress: bool,
-) -> list[dict[str, float]]:
-    """The ``dagger`` section's rounds on top of the BC fit; returns the per-round facts."""
-    d = cfg.dagger
-    result = run_dagger(
-        raw_env,
-        expert,
-        policy,
-        cfg.egocentric,
-        rounds=d.rounds,
-        beta=list(d.beta),
-        episodes_per_round=d.episodes_per_round,
-        dataset=train,
-        dataset_path=out / "dagger_dataset.npz",
-        bc_kwargs={
-            **bc_kwargs(cfg, progress),
-            "epochs": d.epochs_per_round,
-            "progress": False,
-            "eval_data": eval_data,
-            "select_best": d.select_best,
-        },
-        seed=cfg.seed,
-        max_steps=cfg.expert.max_steps,
-        progress=progress,
-        log_fn=log,
-        save_interval_s=cfg.expert.save_interval_s,
-        workers=d.workers,
-        make_env=functools.partial(make_raw_env, cfg),
-        make_expert=functools.partial(make_expert, cfg),
-    )
-    return result.rounds
 
 
 def train_imitation(
@@ -165,11 +111,12 @@ def train_imitation(
     hist = train_bc(
         train,
         policy,
-        epochs=cfg.bc.epochs,
+        cfg.bc,
         seed=cfg.seed,
-        log_fn=log,
         eval_data=eval_data,
-        **bc_kwargs(cfg, progress),
+        egocentric=cfg.egocentric,
+        progress=progress,
+        log_fn=log,
     )
     metrics["bc_s"] = time.perf_counter() - t0
     metrics["bc_final_loss"] = hist["loss"][-1]
@@ -180,7 +127,16 @@ def train_imitation(
         log("bc/heldout_action_error", metrics["heldout_action_error_after_bc"], cfg.bc.epochs)
     if algo == "dagger":
         t0 = time.perf_counter()
-        rounds = dagger_rounds(cfg, raw_env, expert, policy, train, eval_data, out, log, progress)
+        rounds = run_dagger(
+            actors(cfg, raw_env, expert),
+            policy,
+            cfg,
+            dataset=train,
+            dataset_path=out / "dagger_dataset.npz",
+            eval_data=eval_data,
+            progress=progress,
+            log_fn=log,
+        ).rounds
         metrics["dagger_s"] = time.perf_counter() - t0
         metrics["dagger_rounds"] = rounds
         if len(held):

@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.core.features.egocentric import EgocentricParams
-from semexplore_gym.training.config import TrainConfig, is_macro
 from semexplore_gym.training.factories import make_learner_env
+from semexplore_gym.training.train_config import TrainConfig, is_macro, maskable_needs_macro
 
 
 def policy_kwargs(cfg: TrainConfig) -> dict[str, Any]:
@@ -34,9 +34,7 @@ def new_ppo(cfg: TrainConfig, vec_env: Any, tensorboard_log: str | None, algo: s
     algo_cls: Any
     if algo == "maskable_ppo":
         if not is_macro(cfg):
-            raise ValueError(
-                f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
-            )
+            raise maskable_needs_macro(cfg)
         from sb3_contrib import MaskablePPO
 
         algo_cls = MaskablePPO

@@ -207,16 +207,67 @@ def mission_objective(
     return objective
 
 
+@dataclass(frozen=True)
+class StudySettings:
+    """How :func:`tune_weights` keeps and samples its Optuna study.
+
+    Attributes:
+        seed: Seed of the TPE sampler (same seed and objective: same trials).
+        storage_path: SQLite file of the study (None: in memory); a rerun resumes it.
+        jsonl_path: One JSON line per finished trial is appended here.
+        study_name: Name of the study in the storage.
+        n_startup_trials: Random trials before TPE starts modelling.
+    """
+
+    seed: int = 0
+    storage_path: str | os.PathLike | None = None
+    jsonl_path: str | os.PathLike | None = None
+    study_name: str = "semantic-weights"
+    n_startup_trials: int = 5
+
+
+def _check_enqueued(enqueue: Sequence[Mapping[str, float]], space: SearchSpace) -> None:
+    for w in enqueue:
+        unknown = sorted(set(w) - set(space.ranges))
+        if unknown:
+            raise ValueError(
+                f"enqueued weights {unknown} are not in the search space {sorted(space.ranges)}"
+            )
+
+
+def _finished_trials(study: Any, complete: Any) -> list[tuple[int, dict[str, float], float]]:
+    """``(number, weights, value)`` of every completed trial of ``study``."""
+    return [
+        (t.number, {k: float(v) for k, v in t.params.items()}, float(t.value))
+        for t in study.trials
+        if t.state == complete and t.value is not None
+    ]
+
+
+def _open_study(optuna: Any, settings: StudySettings) -> Any:
+    """The study of ``settings``: created, or loaded from its storage to resume."""
+    storage = None
+    if settings.storage_path is not None:
+        Path(settings.storage_path).parent.mkdir(parents=True, exist_ok=True)
+        storage = f"sqlite:///{Path(settings.storage_path).resolve()}"
+    sampler = optuna.samplers.TPESampler(
+        seed=settings.seed, n_startup_trials=settings.n_startup_trials
+    )
+    return optuna.create_study(
+        study_name=settings.study_name,
+        storage=storage,
+        sampler=sampler,
+        direction="minimize",
+        load_if_exists=True,
+    )
+
+
 def tune_weights(
     objective: Objective,
     n_trials: int,
     space: SearchSpace | None = None,
-    seed: int = 0,
+    study_settings: StudySettings | None = None,
     enqueue: Sequence[Mapping[str, float]] = (),
-    storage_path: str | os.PathLike | None = None,
-    jsonl_path: str | os.PathLike | None = None,
-    study_name: str = "semantic-weights",
-    n_startup_trials: int = 5,
     on_trial: Callable[[int, dict[str, float], float], None] | None = None,
 ) -> TuningResult:
     """Minimise ``objective`` over ``space`` with Optuna's seeded TPE sampler.
@@ -225,18 +276,15 @@ def tune_weights(
         objective: Weight set -> value (lower is better), e.g. from :func:`mission_objective`.
         n_trials: Total completed trials wanted (trials already in the storage count).
         space: The search space (default: ``w_v``, ``w_p``, ``w_I``).
-        seed: Seed of the TPE sampler (same seed and objective: same trials).
+        study_settings: Seed, storage, trial log and name of the study (None: defaults).
         enqueue: Weight sets tried first (e.g. the paper's, or a deliberately bad start); keys
             missing from a set are sampled.
-        storage_path: SQLite file of the Optuna study (None: in memory).
-        jsonl_path: One JSON line per finished trial is appended here.
-        study_name: Name of the study in the storage.
-        n_startup_trials: Random trials before TPE starts modelling.
         on_trial: Called after each trial as ``on_trial(number, weights, value)``.
 
     Returns:
         The :class:`TuningResult`.
     """
+    settings = study_settings if study_settings is not None else StudySettings()
     try:
         import optuna
     except ImportError as e:  # pragma: no cover - optuna is in the rl extra
@@ -245,31 +293,15 @@ def tune_weights(
     if n_trials < 1:
         raise ValueError(f"n_trials must be >= 1, got {n_trials!r}")
     space = space or SearchSpace()
-    for w in enqueue:
-        unknown = sorted(set(w) - set(space.ranges))
-        if unknown:
-            raise ValueError(
-                f"enqueued weights {unknown} are not in the search space {sorted(space.ranges)}"
-            )
+    _check_enqueued(enqueue, space)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    storage = None
-    if storage_path is not None:
-        Path(storage_path).parent.mkdir(parents=True, exist_ok=True)
-        storage = f"sqlite:///{Path(storage_path).resolve()}"
-    sampler = optuna.samplers.TPESampler(seed=seed, n_startup_trials=n_startup_trials)
-    study = optuna.create_study(
-        study_name=study_name,
-        storage=storage,
-        sampler=sampler,
-        direction="minimize",
-        load_if_exists=True,
-    )
+    study = _open_study(optuna, settings)
     complete = optuna.trial.TrialState.COMPLETE
     n_done = sum(t.state == complete for t in study.trials)
     if n_done == 0:
         for w in enqueue:
             study.enqueue_trial({k: float(v) for k, v in w.items()})
-    jsonl = Path(jsonl_path) if jsonl_path is not None else None
+    jsonl = Path(settings.jsonl_path) if settings.jsonl_path is not None else None
     if jsonl is not None:
         jsonl.parent.mkdir(parents=True, exist_ok=True)
 
@@ -299,11 +331,7 @@ def tune_weights(
     remaining = max(0, n_trials - n_done)
     if remaining:
         study.optimize(run_trial, n_trials=remaining)
-    trials = [
-        (t.number, {k: float(v) for k, v in t.params.items()}, float(t.value))
-        for t in study.trials
-        if t.state == complete and t.value is not None
-    ]
+    trials = _finished_trials(study, complete)
     _, best_weights, best_value = min(trials, key=lambda t: t[2])
     return TuningResult(
         best_weights=best_weights,

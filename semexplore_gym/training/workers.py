@@ -22,7 +22,7 @@ import numpy as np
 
 from semexplore_gym.core.features.egocentric import EgocentricParams
 from semexplore_gym.policies.base import Policy
-from semexplore_gym.training.episodes import EpisodeRecord, rollout_episode
+from semexplore_gym.training.episodes import EpisodeRecord, EpisodeSpec, rollout_episode
 
 #: Spawn-key streams of :func:`episode_rng`: expert recording and DAgger never share numbers.
 EXPERT_STREAM = 0
@@ -92,18 +92,8 @@ class EpisodeJob:
     def run(
         self, env: Any, expert: Policy, params: EgocentricParams, learner: Any
     ) -> EpisodeRecord:
-        return rollout_episode(
-            env,
-            expert,
-            params,
-            learner,
-            self.beta,
-            episode_rng(*self.rng_key),
-            seed=self.seed,
-            max_steps=self.max_steps,
-            episode_id=self.episode_id,
-            noise_std=self.noise_std,
-        )
+        spec = EpisodeSpec(self.seed, self.max_steps, self.episode_id, self.noise_std, self.beta)
+        return rollout_episode(env, expert, params, spec, learner, episode_rng(*self.rng_key))
 
 
 def _zero_schedule(_progress: float) -> float:
@@ -205,24 +195,33 @@ def _one_torch_thread() -> Iterator[None]:
         th.set_num_threads(n)
 
 
+@dataclass(frozen=True)
+class EpisodeActors:
+    """The env and expert that episodes run with in this process, and how worker processes
+    get their own: ``make_env()`` / ``make_expert()`` when given (picklable: module-level
+    functions or ``functools.partial``), else unpickled copies of ``env`` / ``expert``."""
+
+    env: Any
+    expert: Policy
+    make_env: Callable[[], Any] | None = None
+    make_expert: Callable[[], Policy] | None = None
+
+
 def run_jobs(
     jobs: Sequence[EpisodeJob],
-    env: Any,
-    expert: Policy,
+    actors: EpisodeActors,
     params: EgocentricParams,
     learner: Any,
     pool: Any,
-    make_env: Callable[[], Any] | None,
-    make_expert: Callable[[], Policy] | None,
 ) -> Iterator[EpisodeRecord]:
     """The jobs' episode records in job order: in this process, or from ``pool`` as they finish."""
     if pool is None:
         with _one_torch_thread():
             for job in jobs:
-                yield job.run(env, expert, params, learner)
+                yield job.run(actors.env, actors.expert, params, learner)
         return
-    env_source = _Source.of(env, make_env, "env")
-    expert_source = _Source.of(expert, make_expert, "expert")
+    env_source = _Source.of(actors.env, actors.make_env, "env")
+    expert_source = _Source.of(actors.expert, actors.make_expert, "expert")
     learner_blob = (
         _policy_blob(learner) if learner is not None and any(j.beta < 1.0 for j in jobs) else None
     )

@@ -15,7 +15,7 @@ a **driver** (the scripted expert's navigation stack) steps the base env until t
 
 Layering: wrappers may not import ``policies``, so the driver is injected. Any object with the
 :class:`FrontierDriver` methods works; ``semexplore_gym.policies.expert_driver.ExpertDriver`` is the expert's, and
-the entry points in :mod:`semexplore_gym.macro_envs` build base env + driver + wrapper.
+the entry points in :mod:`semexplore_gym.expert_driven_envs` build base env + driver + wrapper.
 
 Reward of a decision: ``area_reward_per_m2 * (new mapped free area, m^2) - time_penalty_per_s *
 (simulated seconds it took)``. Episode end: terminated when the base env terminates (coverage

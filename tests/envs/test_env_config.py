@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from semexplore_gym.config import ConfigError, build_params
-from semexplore_gym.envs.config import PRESETS, EnvConfig, load_env_config
+from semexplore_gym.envs.env_config import PRESETS, EnvConfig, load_env_config
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 

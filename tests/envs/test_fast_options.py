@@ -194,3 +194,25 @@ def test_shared_map_is_a_read_only_live_view_of_the_default_map() -> None:
 def test_shared_map_option_is_named_in_the_error() -> None:
     with pytest.raises(ValueError, match="shared"):
         gym.make("SemanticExplore-v0", world="maze1", map_observation="live")
+
+
+def test_the_options_object_and_the_keywords_are_one_setting() -> None:
+    from semexplore_gym.envs.observation_options import ObservationOptions
+
+    opts = ObservationOptions(map_observation="window", map_window_cells=40)
+    a = gym.make("SemanticExplore-v0", world="maze1", observation_options=opts)
+    b = gym.make("SemanticExplore-v0", world="maze1", map_observation="window", map_window_cells=40)
+    assert a.unwrapped.observation_options == b.unwrapped.observation_options == opts
+    oa, _ = a.reset(seed=2)
+    ob, _ = b.reset(seed=2)
+    assert oa["map"].shape == (40, 40)
+    for k in oa:
+        np.testing.assert_array_equal(oa[k], ob[k])
+    # A keyword replaces the field of a given object.
+    c = gym.make("SemanticExplore-v0", world="maze1", observation_options=opts, static_info="reset")
+    assert c.unwrapped.observation_options.static_info == "reset"
+    assert c.unwrapped.observation_options.map_window_cells == 40
+    with pytest.raises(ValueError, match="map_observation must be one of"):
+        ObservationOptions(map_observation="full")
+    with pytest.raises(TypeError):
+        gym.make("SemanticExplore-v0", world="maze1", map_obs="copy")

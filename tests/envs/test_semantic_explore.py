@@ -186,7 +186,7 @@ def test_paper_config_sets_the_papers_speed_limits() -> None:
 def test_configs_dir_paper_yaml_matches_preset() -> None:
     from pathlib import Path
 
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
 
     path = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
     assert load_env_config(str(path)) == load_env_config("paper")

@@ -59,12 +59,12 @@ def test_info_pickles_and_works_in_vector_envs() -> None:
 
 
 def test_info_numbers_are_the_step_info_keys_in_order() -> None:
-    # The vector env's direct path builds info from INFO_NUMBERS and _info_values().
+    # The vector env's direct path builds info from INFO_NUMBERS and info_numbers().
     from semexplore_gym.envs.semantic_explore import INFO_NUMBERS
 
     env = gym.make("SemanticExplore-v0", world="maze1", static_info="reset")
     env.reset(seed=0)
     _, _, _, _, info = env.step(np.ones(2, np.float32))
     assert tuple(info) == (*INFO_NUMBERS, "reward_terms")
-    assert tuple(info[k] for k in INFO_NUMBERS) == env.unwrapped._info_values()
+    assert tuple(info[k] for k in INFO_NUMBERS) == env.unwrapped.info_numbers()
     env.close()

@@ -90,12 +90,12 @@ def test_direct_steps_fall_back_to_the_general_merge_for_unusual_info_values(mon
     # A number of an unusual type (here an int coverage) takes gymnasium's own merge rules.
     fast = FastSyncVectorEnv([_fn()] * 2)
     ref = SyncVectorEnv([_fn()] * 2)
-    real = SemanticExploreEnv._info_values
+    real = SemanticExploreEnv.info_numbers
 
     def int_coverage(self):
         return (int(self.sim_time_s * 10), *real(self)[1:])
 
-    monkeypatch.setattr(SemanticExploreEnv, "_info_values", int_coverage)
+    monkeypatch.setattr(SemanticExploreEnv, "info_numbers", int_coverage)
     rng = np.random.default_rng(0)
     try:
         assert _same(fast.reset(seed=1), ref.reset(seed=1))

@@ -135,3 +135,19 @@ def test_summary_with_one_pair_prints_no_p_value(tmp_path) -> None:
     p = line.strip("|").split("|")[4].strip()
     assert p == "– (1 pair)"
     assert "nan" not in text
+
+
+def test_errors_name_parameters_and_the_cli_names_flags(tmp_path) -> None:
+    from semexplore_gym.evaluation.errors import ParameterError
+    from semexplore_gym.evaluation.harness import parse_seeds
+
+    with pytest.raises(ParameterError, match="^runs must be >= 1, got 0") as info:
+        parse_seeds(0)
+    assert info.value.param == "runs"
+    assert str(info.value.for_flags({"runs": "--runs"})) == "--runs must be >= 1, got 0"
+    with pytest.raises(ParameterError, match="^policies lists 'a' twice") as info:
+        expand_tasks(["w"], ["a", "a"], [0])
+    assert info.value.named("--policies").startswith("--policies lists 'a' twice")
+    (tmp_path / "runs.csv").write_text("a,b\n1,2\n")
+    with pytest.raises(ParameterError, match=r"new output directory \(out_dir\)"):
+        run_benchmark(expand_tasks(["w"], ["p"], [0]), tmp_path, progress=False, task_fn=_fake)

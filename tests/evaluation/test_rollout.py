@@ -11,7 +11,7 @@ from semexplore_gym.policies.base import Policy, StepStats
 from semexplore_gym.policies.random_policy import RandomPolicy
 
 import semexplore_gym  # noqa: F401
-from semexplore_gym.evaluation.rollout import STAGES, run_mission, time_to_coverage
+from semexplore_gym.evaluation.rollout import STAGES, GifOptions, run_mission, time_to_coverage
 
 
 class StopAfter(Policy):
@@ -65,7 +65,9 @@ def test_max_time_and_random_policy_determinism(env):
     with pytest.raises(ValueError, match="max_time_s"):
         run_mission(env, RandomPolicy(), seed=0, max_time_s=0.0, progress=False)
     with pytest.raises(ValueError, match="rgb_array"):
-        run_mission(env, RandomPolicy(), seed=0, max_time_s=1.0, progress=False, gif_path="x.gif")
+        run_mission(
+            env, RandomPolicy(), seed=0, max_time_s=1.0, progress=False, gif=GifOptions("x.gif")
+        )
 
 
 def test_on_step_and_gif(tmp_path):
@@ -78,9 +80,8 @@ def test_on_step_and_gif(tmp_path):
         seed=0,
         max_time_s=100.0,
         progress=False,
-        gif_path=out,
-        gif_every_s=0.6,
         on_step=lambda i, *_: seen.append(i),
+        gif=GifOptions(out, every_s=0.6),
     )
     e.close()
     assert seen == list(range(1, 11))
@@ -141,3 +142,23 @@ def test_explore_gif_every_0_2_s_through_the_cli(tmp_path, capsys):
     assert main([*argv, "--gif", str(out), "--gif-every-s", "0.2"]) == 0
     with Image.open(out) as im:
         assert im.n_frames == 17  # t = 0, 0.2, ..., 3.0 and the final frame
+
+
+class CountingStop(StopAfter):
+    """Reports its own figures for benchmark rows through ``mission_metrics``."""
+
+    def mission_metrics(self):
+        return {"scored_replans": self.calls, "semantic_share": 0.25, "other": "x"}
+
+
+def test_policy_columns_come_from_mission_metrics(env):
+    from semexplore_gym.evaluation.harness import Task, mission_row
+
+    res = run_mission(env, CountingStop(3), seed=0, max_time_s=10.0, progress=False)
+    assert res.policy_metrics == {"scored_replans": 4, "semantic_share": 0.25, "other": "x"}
+    row = mission_row(Task("maze1", "counting", 0), res).to_dict()
+    assert row["scored_replans"] == 4 and row["semantic_share"] == 0.25 and "other" not in row
+    plain = run_mission(env, StopAfter(3), seed=0, max_time_s=10.0, progress=False)
+    assert plain.policy_metrics == {}
+    row = mission_row(Task("maze1", "plain", 0), plain).to_dict()
+    assert row["scored_replans"] is None and row["semantic_share"] is None

@@ -80,7 +80,7 @@ def test_changed_max_time_is_refused_on_resume(tmp_path) -> None:
         progress=False,
         task_fn=fake_task,
     )
-    with pytest.raises(ValueError, match=r"max_time_s: 5.0 -> 9.0.*new --out"):
+    with pytest.raises(ValueError, match=r"max_time_s: 5.0 -> 9.0.*new output directory"):
         run_benchmark(
             expand_tasks(["w"], ["p"], [0, 1, 2], max_time_s=9.0),
             tmp_path,

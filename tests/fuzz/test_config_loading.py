@@ -103,7 +103,7 @@ def test_config_file_and_override_bombs_are_config_errors(tmp_path) -> None:
 
 
 def test_bad_value_in_message_is_truncated() -> None:
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
 
     with pytest.raises(ConfigError) as info:
         load_env_config(None, ["robot.radius_m=" + "[" + ", ".join(["1"] * 5000) + "]"])

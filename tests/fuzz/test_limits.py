@@ -19,7 +19,7 @@ from semexplore_gym.core.worlds.build import (
     count_wall_runs,
     world_from_free_mask,
 )
-from semexplore_gym.envs.config import load_env_config
+from semexplore_gym.envs.env_config import load_env_config
 
 YAML = "image: m.png\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
 

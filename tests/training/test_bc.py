@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 from _imitation import PARAMS, ReactiveExpert, imitation_env, learner_policy
 
+from semexplore_gym.training.train_config import BCSection, ExpertSection
+from semexplore_gym.training.workers import EpisodeActors
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
@@ -16,12 +18,14 @@ def test_bc_reduces_heldout_action_error() -> None:
     from semexplore_gym.training.recording import record_expert_dataset
 
     env = imitation_env()
-    data = record_expert_dataset(env, ReactiveExpert(), None, 5, PARAMS, seed=0, max_steps=60)
+    data = record_expert_dataset(
+        EpisodeActors(env, ReactiveExpert()), None, PARAMS, ExpertSection(episodes=5, max_steps=60)
+    )
     train, held = data.split_by_episode(0.2, np.random.default_rng(0))
     assert held.n_episodes == 1
     policy = learner_policy()
     before = action_error(policy, held)
-    hist = train_bc(train, policy, epochs=12, batch_size=32, lr=1e-3, seed=0)
+    hist = train_bc(train, policy, BCSection(epochs=12, batch_size=32, lr=1e-3), seed=0)
     after = action_error(policy, held)
     assert hist["loss"][-1] < hist["loss"][0]
     assert after < 0.6 * before, (before, after)
@@ -36,7 +40,9 @@ def test_select_best_restores_the_best_epoch_and_mirroring_trains() -> None:
     params = EgocentricParams(
         crop_cells=36, crop_resolution_m=0.15, n_scan_bins=72, scan_bins_centred=True
     )
-    data = record_expert_dataset(env, ReactiveExpert(), None, 3, params, seed=0, max_steps=40)
+    data = record_expert_dataset(
+        EpisodeActors(env, ReactiveExpert()), None, params, ExpertSection(episodes=3, max_steps=40)
+    )
     train, held = data.split_by_episode(0.34, np.random.default_rng(0))
     from gymnasium import spaces
 
@@ -53,17 +59,15 @@ def test_select_best_restores_the_best_epoch_and_mirroring_trains() -> None:
     hist = train_bc(
         train,
         policy,
-        epochs=5,
-        batch_size=16,
-        lr=3e-3,
+        BCSection(
+            epochs=5, batch_size=16, lr=3e-3, select_best=True, mirror=True, lr_final_fraction=0.1
+        ),
         eval_data=held,
-        select_best=True,
-        mirror_params=params,
-        lr_final_fraction=0.1,
+        egocentric=params,
     )
     errs = hist["eval_action_error"]
     assert len(errs) == 5 and hist["best_epoch"] == [float(int(np.argmin(errs)))]
     assert action_error(policy, held) == pytest.approx(min(errs), rel=1e-6)
     with pytest.raises(ValueError, match="scan_bins_centred"):
-        train_bc(train, policy, epochs=1, mirror_params=PARAMS)
+        train_bc(train, policy, BCSection(epochs=1, mirror=True), egocentric=PARAMS)
     env.close()

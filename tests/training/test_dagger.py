@@ -25,23 +25,32 @@ def test_beta_schedule() -> None:
 def test_dagger_round_runs_and_grows_the_dataset(tmp_path: Path) -> None:
     from semexplore_gym.training.dagger import run_dagger
     from semexplore_gym.training.recording import record_expert_dataset
+    from semexplore_gym.training.train_config import (
+        BCSection,
+        DaggerSection,
+        ExpertSection,
+        TrainConfig,
+    )
+    from semexplore_gym.training.workers import EpisodeActors
 
     env = imitation_env()
-    base = record_expert_dataset(env, ReactiveExpert(), None, 1, PARAMS, seed=0, max_steps=20)
+    base = record_expert_dataset(
+        EpisodeActors(env, ReactiveExpert()), None, PARAMS, ExpertSection(episodes=1, max_steps=20)
+    )
     policy = learner_policy()
+    cfg = TrainConfig(
+        seed=3,
+        egocentric=PARAMS,
+        expert=ExpertSection(max_steps=20),
+        bc=BCSection(batch_size=16),
+        dagger=DaggerSection(rounds=2, beta=(0.5, 0.0), episodes_per_round=1, epochs_per_round=1),
+    )
     result = run_dagger(
-        env,
-        ReactiveExpert(),
+        EpisodeActors(env, ReactiveExpert()),
         policy,
-        PARAMS,
-        rounds=2,
-        beta=[0.5, 0.0],
-        episodes_per_round=1,
+        cfg,
         dataset=base,
         dataset_path=tmp_path / "agg.npz",
-        bc_kwargs={"epochs": 1, "batch_size": 16},
-        seed=3,
-        max_steps=20,
     )
     assert len(result.dataset) == len(base) + 40 and result.dataset.n_episodes == 3
     assert [r["dataset_size"] for r in result.rounds] == [len(base) + 20, len(base) + 40]

@@ -1,4 +1,4 @@
-"""Fitting the learned frontier value (``training/frontier_value.py``), with stand-in missions."""
+"""Fitting the learned frontier value (``training/frontier_value_search.py``), with stand-in missions."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
 from semexplore_gym.policies.registry import make_policy
 
-from semexplore_gym.training.frontier_value import (
+from semexplore_gym.training.frontier_value_search import (
     FrontierValueTrainConfig,
     SearchParam,
     batch_score,

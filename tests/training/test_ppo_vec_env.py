@@ -8,8 +8,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from semexplore_gym.training.config import TrainConfig, check_train_config, load_train_config
 from semexplore_gym.training.ppo import auto_vec_env, make_vec_env
+from semexplore_gym.training.train_config import TrainConfig, check_train_config, load_train_config
 
 SMALL = [
     "env.world=maze:seed=0,size_m=4",

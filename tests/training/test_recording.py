@@ -9,6 +9,8 @@ import pytest
 from _imitation import PARAMS, ConstantExpert, ReactiveExpert, imitation_env
 
 from semexplore_gym.training.dataset import ImitationDataset
+from semexplore_gym.training.train_config import ExpertSection
+from semexplore_gym.training.workers import EpisodeActors
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
@@ -18,7 +20,11 @@ def test_expert_recording_writes_labelled_episodes(tmp_path: Path) -> None:
 
     env = imitation_env()
     data = record_expert_dataset(
-        env, ReactiveExpert(), tmp_path / "e.npz", 2, PARAMS, seed=5, max_steps=15
+        EpisodeActors(env, ReactiveExpert()),
+        tmp_path / "e.npz",
+        PARAMS,
+        ExpertSection(episodes=2, max_steps=15),
+        seed=5,
     )
     back = ImitationDataset.load(tmp_path / "e.npz")
     assert len(back) == len(data) == 30 and back.n_episodes == 2
@@ -31,7 +37,7 @@ def test_expert_recording_writes_labelled_episodes(tmp_path: Path) -> None:
 
 
 def test_dart_noise_perturbs_execution_not_labels() -> None:
-    from semexplore_gym.training.episodes import rollout_episode
+    from semexplore_gym.training.episodes import EpisodeSpec, rollout_episode
 
     env = imitation_env()
 
@@ -41,10 +47,8 @@ def test_dart_noise_perturbs_execution_not_labels() -> None:
             env,
             ConstantExpert(),
             PARAMS,
+            EpisodeSpec(seed=4, max_steps=12, noise_std=noise_std),
             rng=np.random.default_rng(rng_seed),
-            seed=4,
-            max_steps=12,
-            noise_std=noise_std,
         )
         return rec.data.obs["scan"], rec.data.actions
 
@@ -60,5 +64,7 @@ def test_dart_noise_perturbs_execution_not_labels() -> None:
     np.testing.assert_array_equal(noisy_end, again_end)
     assert not np.array_equal(noisy_end, other_end)
     with pytest.raises(ValueError, match="noise_std"):
-        rollout_episode(env, ConstantExpert(), PARAMS, seed=4, max_steps=2, noise_std=-0.1)
+        rollout_episode(
+            env, ConstantExpert(), PARAMS, EpisodeSpec(seed=4, max_steps=2, noise_std=-0.1)
+        )
     env.close()

@@ -10,6 +10,7 @@ import pytest
 from semexplore_gym.training.weight_tuning import (
     PAPER_WEIGHTS,
     SearchSpace,
+    StudySettings,
     evaluate_weights,
     mission_objective,
     mission_score,
@@ -55,14 +56,19 @@ def _bowl(w: dict[str, float]) -> float:
 
 def test_tuner_improves_on_a_bad_start_and_is_seeded(tmp_path: Path) -> None:
     bad = {"cost.w_v": 10.0, "cost.w_p": 0.0, "cost.w_i": 1.0}
-    res = tune_weights(_bowl, 30, seed=3, enqueue=[bad], jsonl_path=tmp_path / "t.jsonl")
+    res = tune_weights(
+        _bowl,
+        30,
+        study_settings=StudySettings(seed=3, jsonl_path=tmp_path / "t.jsonl"),
+        enqueue=[bad],
+    )
     first_value = res.trials[0][2]
     assert res.trials[0][1] == bad and first_value == pytest.approx(_bowl(bad))
     assert res.best_value < 0.1 * first_value
     assert res.best_value == min(v for _, _, v in res.trials)
     lines = [json.loads(s) for s in (tmp_path / "t.jsonl").read_text().splitlines()]
     assert len(lines) == 30 and lines[0]["weights"] == bad
-    again = tune_weights(_bowl, 30, seed=3, enqueue=[bad])
+    again = tune_weights(_bowl, 30, study_settings=StudySettings(seed=3), enqueue=[bad])
     assert again.best_weights == res.best_weights
 
 
@@ -74,8 +80,8 @@ def test_tuner_resumes_from_sqlite(tmp_path: Path) -> None:
         calls.append(1)
         return _bowl(w)
 
-    tune_weights(counted, 4, seed=0, storage_path=db)
-    res = tune_weights(counted, 6, seed=0, storage_path=db)
+    tune_weights(counted, 4, study_settings=StudySettings(seed=0, storage_path=db))
+    res = tune_weights(counted, 6, study_settings=StudySettings(seed=0, storage_path=db))
     assert len(calls) == 6 and len(res.trials) == 6
 
 
@@ -89,7 +95,10 @@ def test_tuner_rejects_bad_arguments() -> None:
 def test_real_two_trial_tuning_run(tmp_path: Path) -> None:
     objective = mission_objective(["maze:seed=*,size_m=4"], [1], max_time_s=60.0)
     res = tune_weights(
-        objective, 2, seed=0, enqueue=[PAPER_WEIGHTS], jsonl_path=tmp_path / "t.jsonl"
+        objective,
+        2,
+        study_settings=StudySettings(seed=0, jsonl_path=tmp_path / "t.jsonl"),
+        enqueue=[PAPER_WEIGHTS],
     )
     assert len(res.trials) == 2
     rows = evaluate_weights(PAPER_WEIGHTS, ["maze:seed=*,size_m=4"], [1], max_time_s=60.0)

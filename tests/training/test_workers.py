@@ -11,7 +11,19 @@ import pytest
 from _imitation import ReactiveExpert
 
 from semexplore_gym.training.dataset import ImitationDataset
-from semexplore_gym.training.workers import DAGGER_STREAM, EXPERT_STREAM, check_workers, episode_rng
+from semexplore_gym.training.train_config import (
+    BCSection,
+    DaggerSection,
+    ExpertSection,
+    TrainConfig,
+)
+from semexplore_gym.training.workers import (
+    DAGGER_STREAM,
+    EXPERT_STREAM,
+    EpisodeActors,
+    check_workers,
+    episode_rng,
+)
 from semexplore_gym.wrappers.egocentric import EgocentricParams
 
 WORLD = "maze:size_m=5,seed=1"
@@ -88,32 +100,36 @@ def test_bad_workers_are_rejected() -> None:
     from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
+    actors = EpisodeActors(env, SteerToOpenExpert())
     with pytest.raises(ValueError, match="workers must be an integer >= 1, got 0"):
-        record_expert_dataset(env, SteerToOpenExpert(), None, 1, PARAMS, max_steps=2, workers=0)
+        record_expert_dataset(
+            actors, None, PARAMS, ExpertSection(episodes=1, max_steps=2, workers=0)
+        )
     with pytest.raises(ValueError, match="workers must be an integer >= 1, got -2"):
-        run_dagger(env, SteerToOpenExpert(), _policy(), PARAMS, rounds=1, workers=-2)
+        cfg = TrainConfig(egocentric=PARAMS, dagger=DaggerSection(rounds=1, workers=-2))
+        run_dagger(actors, _policy(), cfg)
     # More than one worker needs env and expert in a picklable form.
     with pytest.raises(ValueError, match="picklable make_env"):
         record_expert_dataset(
-            env,
-            SteerToOpenExpert(),
+            EpisodeActors(env, SteerToOpenExpert(), make_env=lambda: make_env()),
             None,
-            2,
             PARAMS,
-            max_steps=2,
-            workers=2,
-            make_env=lambda: make_env(),
+            ExpertSection(episodes=2, max_steps=2, workers=2),
         )
     env.close()
 
 
 def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
-    from semexplore_gym.training.episodes import rollout_episode
+    from semexplore_gym.training.episodes import EpisodeSpec, rollout_episode
     from semexplore_gym.training.recording import record_expert_dataset
 
     env = _env()
     data = record_expert_dataset(
-        env, SteerToOpenExpert(), None, 3, PARAMS, seed=5, max_steps=12, noise_std=0.3
+        EpisodeActors(env, SteerToOpenExpert()),
+        None,
+        PARAMS,
+        ExpertSection(episodes=3, max_steps=12, noise_std=0.3),
+        seed=5,
     )
     # Episode 2 on its own, on a new env: seed 5 + 2, noise from episode_rng(5, 2).
     alone_env = make_env()
@@ -121,11 +137,8 @@ def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
         alone_env,
         SteerToOpenExpert(),
         PARAMS,
+        EpisodeSpec(seed=7, max_steps=12, episode_id=2, noise_std=0.3),
         rng=episode_rng(5, 2),
-        seed=7,
-        max_steps=12,
-        episode_id=2,
-        noise_std=0.3,
     )
     third = data.subset(data.episode_ids == 2)
     third.meta = {}
@@ -135,10 +148,8 @@ def test_an_episode_does_not_depend_on_the_episodes_before_it() -> None:
         alone_env,
         SteerToOpenExpert(),
         PARAMS,
+        EpisodeSpec(seed=7, max_steps=12, noise_std=0.3),
         rng=episode_rng(5, 2, DAGGER_STREAM),
-        seed=7,
-        max_steps=12,
-        noise_std=0.3,
     )
     assert not np.array_equal(other.data.obs["image"], alone.data.obs["image"])
     env.close()
@@ -157,34 +168,34 @@ def test_two_workers_record_and_dagger_like_one(tmp_path: Path) -> None:
         out = tmp_path / f"w{workers}"
         # workers=2 builds the env with the factory and copies the expert by pickling.
         data = record_expert_dataset(
-            env,
-            SteerToOpenExpert(),
+            EpisodeActors(env, SteerToOpenExpert(), make_env=make_env if workers > 1 else None),
             out / "expert.npz",
-            3,
             PARAMS,
+            ExpertSection(
+                episodes=3, max_steps=10, noise_std=0.3, noise_fraction=0.67, workers=workers
+            ),
             seed=2,
-            max_steps=10,
-            noise_std=0.3,
-            noise_fraction=0.67,
-            workers=workers,
-            make_env=make_env if workers > 1 else None,
         )
         learner = _policy(seed=1)
+        cfg = TrainConfig(
+            seed=4,
+            egocentric=PARAMS,
+            expert=ExpertSection(max_steps=8),
+            bc=BCSection(batch_size=8),
+            dagger=DaggerSection(
+                rounds=2, beta=(0.5, 0.0), episodes_per_round=2, epochs_per_round=1, workers=workers
+            ),
+        )
         dagger = run_dagger(
-            env,
-            SteerToOpenExpert(),
+            EpisodeActors(
+                env,
+                SteerToOpenExpert(),
+                make_expert=functools.partial(SteerToOpenExpert) if workers > 1 else None,
+            ),
             learner,
-            PARAMS,
-            rounds=2,
-            beta=[0.5, 0.0],
-            episodes_per_round=2,
+            cfg,
             dataset=data,
             dataset_path=out / "agg.npz",
-            bc_kwargs={"epochs": 1, "batch_size": 8},
-            seed=4,
-            max_steps=8,
-            workers=workers,
-            make_expert=functools.partial(SteerToOpenExpert) if workers > 1 else None,
         )
         results[workers] = (data, dagger, learner.state_dict(), out)
     (d1, g1, w1, out1), (d2, g2, w2, out2) = results[1], results[2]

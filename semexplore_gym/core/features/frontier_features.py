@@ -4,7 +4,7 @@ The learned-value agent (:class:`semexplore_gym.policies.learned_frontier_value.
 frontier candidates of Algorithm 1 by ``C' = C + sum_k w_k * phi_k``: the paper's cost ``C``
 plus a linear value over the features below, whose weights ``w_k`` were fitted by black-box
 optimisation over missions on training worlds
-(:mod:`semexplore_gym.training.frontier_value`).
+(:mod:`semexplore_gym.training.frontier_value_search`).
 
 Per candidate (rows of :func:`frontier_value_features`, columns in :data:`FEATURE_NAMES`):
 

@@ -171,7 +171,7 @@ def _process_runner(cfg: FrontierValueTrainConfig) -> tuple[MissionRunner, Calla
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    from semexplore_gym.envs.config import load_env_config
+    from semexplore_gym.envs.env_config import load_env_config
 
     env_config = load_env_config(
         None, ["episode.random_start=true", f"episode.max_time_s={cfg.max_time_s!r}"]
@@ -192,6 +192,35 @@ def _run_one(task: Any) -> tuple[float, float]:
 
     row = run_task(task)["row"]
     return float(row["mission_time_s"]), float(row["coverage"])
+
+
+def _draw_batch(cfg: FrontierValueTrainConfig, rng: np.random.Generator) -> list[tuple[str, int]]:
+    """A generation's training missions: ``(world, seed)`` drawn from ``rng``."""
+    idx = rng.integers(0, len(cfg.worlds), size=cfg.worlds_per_generation)
+    seeds = rng.integers(cfg.train_seeds[0], cfg.train_seeds[1] + 1, size=len(idx))
+    return [(cfg.worlds[i], int(s)) for i, s in zip(idx, seeds, strict=True)]
+
+
+def _population_scores(
+    cfg: FrontierValueTrainConfig, res: list[tuple[float, float]], n: int, n_pop: int
+) -> list[float]:
+    """Each parameter set's :func:`batch_score` against the expert's missions (``res[:n]``)."""
+    ref_t = [r[0] for r in res[:n]]
+    ref_c = [r[1] for r in res[:n]]
+    scores = []
+    for j in range(n_pop):
+        part = res[n * (j + 1) : n * (j + 2)]
+        scores.append(
+            batch_score(
+                [r[0] for r in part],
+                [r[1] for r in part],
+                ref_t,
+                ref_c,
+                cfg.coverage_penalty,
+                cfg.coverage_tolerance,
+            )
+        )
+    return scores
 
 
 def train_frontier_value(
@@ -234,9 +263,7 @@ def train_frontier_value(
             if time.monotonic() - t0 > cfg.wall_budget_s:
                 log(f"wall budget reached after {gen} generations")
                 break
-            idx = rng.integers(0, len(cfg.worlds), size=cfg.worlds_per_generation)
-            seeds = rng.integers(cfg.train_seeds[0], cfg.train_seeds[1] + 1, size=len(idx))
-            batch = [(cfg.worlds[i], int(s)) for i, s in zip(idx, seeds, strict=True)]
+            batch = _draw_batch(cfg, rng)
             pop = np.vstack([mean, _sample(rng, mean, sigma, lo, hi, cfg.population - 1)])
             jobs: list[tuple[str, int, str, dict[str, float]]] = [
                 (w, s, "semantic", {}) for w, s in batch
@@ -244,23 +271,7 @@ def train_frontier_value(
             for row in pop:
                 ov = {k: float(v) for k, v in zip(keys, row, strict=True)}
                 jobs += [(w, s, "frontier-value", ov) for w, s in batch]
-            res = runner(jobs)
-            n = len(batch)
-            ref_t = [r[0] for r in res[:n]]
-            ref_c = [r[1] for r in res[:n]]
-            scores = []
-            for j in range(len(pop)):
-                part = res[n * (j + 1) : n * (j + 2)]
-                scores.append(
-                    batch_score(
-                        [r[0] for r in part],
-                        [r[1] for r in part],
-                        ref_t,
-                        ref_c,
-                        cfg.coverage_penalty,
-                        cfg.coverage_tolerance,
-                    )
-                )
+            scores = _population_scores(cfg, runner(jobs), len(batch), len(pop))
             order = np.argsort(scores)
             elite = pop[order[: cfg.elite]]
             new_mean = rank_w @ elite
@@ -303,6 +314,6 @@ def write_model(overrides: dict[str, float], path: Path, wall_s: float) -> None:
         node[parts[-1]] = round(float(value), 6)
     head = (
         "# Learned frontier value (semexplore_gym.policies.learned_frontier_value.FrontierValueParams layer), fitted by\n"
-        f"# semexplore_gym.training.frontier_value in {wall_s:.0f} s wall.\n"
+        f"# semexplore_gym.training.frontier_value_search in {wall_s:.0f} s wall.\n"
     )
     path.write_text(head + yaml.safe_dump(nested, sort_keys=True))

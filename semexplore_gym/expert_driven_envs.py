@@ -1,4 +1,4 @@
-"""Entry points of the macro-action env ids: base env + expert driver + macro wrapper.
+"""The expert-driven env ids: base env + the scripted expert as driver + a macro-action wrapper.
 
 ``SemanticExploreFrontier-v0`` (choose one of the top-K frontiers) and
 ``SemanticExploreWeights-v0`` (choose the planner weights) need the scripted expert as their

@@ -12,6 +12,7 @@ from typing import Any
 
 from semexplore_gym.config import build_params
 from semexplore_gym.core.features.egocentric import EgocentricParams
+from semexplore_gym.evaluation.errors import PARAM, ParameterError
 
 #: The base env id; any other ``env.env_id`` is a macro-action env with its own observation.
 BASE_ENV_ID = "SemanticExplore-v0"
@@ -63,7 +64,16 @@ class PolicySection:
 
 @dataclass(frozen=True)
 class BCSection:
-    """``train_bc`` settings; ``mirror`` needs ``egocentric.scan_bins_centred`` and odd beams per bin."""
+    """:func:`~semexplore_gym.training.bc.train_bc` settings.
+
+    ``epochs`` passes over the data in minibatches of ``batch_size``; Adam with rate ``lr`` and
+    weight decay ``l2_weight``; ``ent_weight`` weighs the entropy bonus (keeps the action std
+    from collapsing too early). ``mirror`` replaces each minibatch sample by its left-right
+    mirror image with probability 1/2 (the data doubled for free; needs
+    ``egocentric.scan_bins_centred`` and odd beams per bin). ``select_best`` restores the
+    weights of the epoch with the lowest held-out action error at the end. The rate decays
+    along a cosine from ``lr`` to ``lr * lr_final_fraction`` (1: constant).
+    """
 
     epochs: int = 15
     batch_size: int = 64
@@ -152,7 +162,8 @@ def is_macro(cfg: TrainConfig) -> bool:
 
 
 def check_train_config(cfg: TrainConfig, algo: str) -> None:
-    """Raise a ValueError when ``cfg`` cannot run ``algo`` (checked before any work starts)."""
+    """Raise a ValueError when ``cfg`` cannot run ``algo`` (checked before any work starts);
+    a :class:`ParameterError` naming ``algo`` when the two do not fit together."""
     for key, value in (
         ("torch_threads", cfg.torch_threads),
         ("expert.workers", cfg.expert.workers),
@@ -169,10 +180,18 @@ def check_train_config(cfg: TrainConfig, algo: str) -> None:
     if cfg.ppo.vec_env not in VEC_ENV_KINDS:
         raise ValueError(f"ppo.vec_env must be one of {VEC_ENV_KINDS}, got {cfg.ppo.vec_env!r}")
     if algo == "maskable_ppo" and not is_macro(cfg):
-        raise ValueError(
-            f"--algo maskable_ppo needs a macro-action env with action masks (env.env_id), got {cfg.env.env_id!r}"
-        )
+        raise maskable_needs_macro(cfg)
     if algo in ("bc", "dagger") and is_macro(cfg):
-        raise ValueError(
-            f"--algo {algo} trains on the egocentric env only, not env.env_id={cfg.env.env_id!r}"
+        raise ParameterError(
+            "algo",
+            f"{PARAM} {algo} trains on the egocentric env only, not env.env_id={cfg.env.env_id!r}",
         )
+
+
+def maskable_needs_macro(cfg: TrainConfig) -> ParameterError:
+    """The error of ``algo="maskable_ppo"`` on an env without action masks."""
+    return ParameterError(
+        "algo",
+        f"{PARAM} maskable_ppo needs a macro-action env with action masks (env.env_id), "
+        f"got {cfg.env.env_id!r}",
+    )

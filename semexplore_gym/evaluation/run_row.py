@@ -1,0 +1,120 @@
+"""One finished mission as a row of ``runs.csv``: the columns, typed, and their parsing.
+
+:class:`RunRow` is the schema: its fields are the CSV columns, in order. ``scored_replans`` and
+``semantic_share`` are policy-specific (a policy's ``mission_metrics()``; empty for most
+policies) and were added after the first release, so older files may lack them.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any
+
+from semexplore_gym.core.validation import short_repr
+
+
+@dataclass(frozen=True)
+class RunRow:
+    """The figures of one mission, as written to ``runs.csv`` (None: an empty cell)."""
+
+    world: str
+    policy: str
+    seed: int
+    mission_time_s: float
+    coverage: float
+    self_stopped: bool
+    stop_reason: str
+    path_length_m: float
+    collisions: int
+    T90_s: float | None
+    T99_s: float | None
+    mean_map_generation_ms: float
+    mean_global_planning_ms: float
+    wall_time_s: float
+    explored_area_m2: float
+    steps: int
+    scored_replans: int | None = None
+    semantic_share: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Column -> value, in column order."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_csv(cls, raw: dict[str, Any], where: str) -> RunRow:
+        """Parse the cells of one ``csv.DictReader`` row; ``where`` names it in errors.
+
+        Raises:
+            ValueError: a missing cell, or a cell that is not of its column's type.
+        """
+        return cls(**parse_cells(raw, where))
+
+
+#: The columns of ``runs.csv``, in order.
+CSV_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRow))
+
+#: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
+OPTIONAL_COLUMNS: frozenset[str] = frozenset({"scored_replans", "semantic_share"})
+
+_TEXT_COLUMNS = ("world", "policy", "stop_reason")
+_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans")
+
+
+def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
+    """The cells of one CSV row with numbers parsed (empty cells become None)."""
+    if None in raw or any(raw.get(k) is None for k in CSV_COLUMNS if k not in OPTIONAL_COLUMNS):
+        raise ValueError(f"{where}: expected {len(CSV_COLUMNS)} cells")
+    row: dict[str, Any] = {}
+    for k, v in raw.items():
+        if k in _TEXT_COLUMNS:
+            row[k] = v
+        elif k == "self_stopped":
+            if v not in ("True", "False"):
+                raise ValueError(
+                    f"{where}: self_stopped must be True or False, got {short_repr(v)}"
+                )
+            row[k] = v == "True"
+        elif v in ("", "None"):
+            if k in ("world", "policy", "seed"):
+                raise ValueError(f"{where}: empty {k}")
+            row[k] = None
+        else:
+            try:
+                row[k] = int(v) if k in _INT_COLUMNS else float(v)
+            except ValueError:
+                raise ValueError(f"{where}: {k} is not a number: {short_repr(v)}") from None
+    return row
+
+
+def complete_csv_bytes(path: Path) -> int:
+    """Length of ``path`` up to its last newline: a row cut by a kill has no newline yet."""
+    data = path.read_bytes()
+    return data.rfind(b"\n") + 1
+
+
+def read_runs(path: str | os.PathLike) -> list[dict[str, Any]]:
+    """Rows of a ``runs.csv`` with numbers parsed (empty cells become None).
+
+    A last line without its newline (the process was killed while writing it) is not a
+    finished mission and is ignored; any other malformed row raises a ValueError naming it.
+    """
+    p = Path(path)
+    if not p.exists():
+        return []
+    text = p.read_bytes()[: complete_csv_bytes(p)].decode("utf-8", errors="replace")
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    return [parse_cells(raw, f"{p} line {i}") for i, raw in enumerate(reader, start=2)]
+
+
+def finite_or_none(v: Any) -> float | None:
+    """``v`` as a finite float, or None (not a number, inf or nan)."""
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
