@@ -26,23 +26,9 @@ from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.cli.world_lists import check_worlds, refuse_repeats, split_list, split_worlds
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import ParameterError
-
-
-def _split(text: str) -> list[str]:
-    return [t.strip() for t in text.split(",") if t.strip()] if text else []
-
-
-def _split_worlds(text: str) -> list[str]:
-    """Split on commas that start a new world: ``maze:seed=1,size_m=6,maze2`` keeps the params."""
-    out: list[str] = []
-    for part in _split(text):
-        if out and "=" in part and ":" not in part and ":" in out[-1]:
-            out[-1] += "," + part  # a key=value of the previous world's parameters
-        else:
-            out.append(part)
-    return out
 
 
 def _split_policies(text: str) -> list[str]:
@@ -50,24 +36,6 @@ def _split_policies(text: str) -> list[str]:
     from semexplore_gym.policies.specs import split_specs
 
     return split_specs(text)
-
-
-def _check_worlds(worlds: list[str], seed: int) -> None:
-    """Build each world once before any mission starts, so a typo fails at once, not per mission.
-
-    Raises:
-        ValueError: an unknown or malformed world spelling (the message names it).
-        FileNotFoundError: a map file that does not exist.
-    """
-    from semexplore_gym.maps import make_world
-
-    for world in worlds:
-        try:
-            make_world(world.replace("seed=*", f"seed={seed}"))
-        except FileNotFoundError as e:
-            raise FileNotFoundError(f"--worlds {world!r}: {e}") from None
-        except ValueError as e:
-            raise ValueError(f"--worlds {world!r}: {e}") from None
 
 
 def _check_policies(policies: list[str]) -> None:
@@ -218,7 +186,7 @@ def _suite_tasks(
     from semexplore_gym.evaluation.suites import suite_tasks
 
     return suite_tasks(
-        _split(args.suite),
+        split_list(args.suite),
         _split_policies(args.policies),
         seeds_for,
         max_time_s=args.max_time_s,
@@ -226,16 +194,6 @@ def _suite_tasks(
         env_config=args.env_config,
         env_overrides=args.env_overrides,
     )
-
-
-def _refuse_repeats(flag: str, items: list[str]) -> None:
-    """A ValueError naming the first item ``flag`` lists twice."""
-    dup = next((x for i, x in enumerate(items) if x in items[:i]), None)
-    if dup is not None:
-        raise ValueError(
-            f"{flag} lists {short_repr(dup)} twice; each must appear once "
-            "(a repeat would count the same missions twice)"
-        )
 
 
 #: Python parameters named in the harness's errors, and the flags that set them.
@@ -259,12 +217,12 @@ def _world_tasks(
     from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import expand_tasks, parse_seeds
 
-    worlds = _split_worlds(args.worlds)
+    worlds = split_worlds(args.worlds)
     seeds = parse_seeds(args.runs or DEFAULT_RUNS, args.seed0)
     if not worlds:
         raise ValueError("--worlds is empty")
-    _refuse_repeats("--worlds", worlds)
-    _check_worlds(worlds, seeds[0])
+    refuse_repeats("--worlds", worlds)
+    check_worlds(worlds, seeds[0])
     if args.fixed_start and len(seeds) > 1:
         same = [w for w in worlds if "seed=*" not in w]
         if same:
@@ -302,7 +260,7 @@ def _run(args: argparse.Namespace) -> int:
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")
-    _refuse_repeats("--policies", policies)
+    refuse_repeats("--policies", policies)
     _check_policies(policies)
     suites: list[dict[str, Any]] = []
     if args.suite is not None:

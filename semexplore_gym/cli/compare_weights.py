@@ -90,8 +90,8 @@ def validate_args(args: argparse.Namespace) -> None:
         raise ValueError(f"--out {short_repr(args.out)} is an existing file; give a directory")
 
 
-def _split_worlds(text: str) -> list[str]:
-    from semexplore_gym.cli.benchmark import _split_worlds as split
+def split_worlds(text: str) -> list[str]:
+    from semexplore_gym.cli.world_lists import split_worlds as split
 
     return split(text)
 
@@ -325,14 +325,14 @@ def _add_scoring_and_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def _checked_worlds(flag: str, text: str, seed: int) -> list[str]:
     """The worlds ``flag`` lists, each once and each buildable (``seed=*`` with ``seed``)."""
-    from semexplore_gym.cli.benchmark import _check_worlds, _refuse_repeats
+    from semexplore_gym.cli.world_lists import check_worlds, refuse_repeats, split_worlds
 
-    worlds = _split_worlds(text)
+    worlds = split_worlds(text)
     if not worlds:
         raise ValueError(f"{flag} must name at least one world")
-    _refuse_repeats(flag, worlds)
+    refuse_repeats(flag, worlds)
     try:
-        _check_worlds(worlds, seed)
+        check_worlds(worlds, seed)
     except (ValueError, FileNotFoundError) as e:
         raise ValueError(f"{flag}: {e}") from None
     return worlds
@@ -376,13 +376,13 @@ def _check_run_args(
                 raise ValueError(f"--agents {spec!r}: {e}") from None
     labels = [*weight_sets({}), *agents]
     if args.test_suite is not None:
-        from semexplore_gym.cli.benchmark import _split
+        from semexplore_gym.cli.world_lists import split_list
         from semexplore_gym.evaluation.suites import suite_tasks
 
         seed0 = SUITE_SEED0 if args.test_seed0 is None else args.test_seed0
         try:
             tasks, suites, test_worlds = suite_tasks(
-                _split(args.test_suite),
+                split_list(args.test_suite),
                 labels,
                 lambda runs: parse_seeds(args.runs or runs, seed0),
                 max_time_s=args.max_time_s,
