@@ -6,6 +6,7 @@ Build: ``python -m sphinx -W --keep-going -b html docs docs/_build/html`` (``pip
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -41,9 +42,30 @@ myst_heading_anchors = 3
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_default_options = {"members": True, "show-inheritance": True}
+# Gymnasium's own docstrings (inherited by reset/step/render) are written for its site, not ours.
+autodoc_inherit_docstrings = False
 napoleon_google_docstring = True
 napoleon_numpy_docstring = False
+# "Attributes:" sections as fields: NamedTuple fields would otherwise be described twice.
+napoleon_use_ivar = True
 
 html_theme = "furo"
 html_title = f"SemanticExplore {release}"
 html_static_path: list[str] = []
+
+
+def _headings_to_rubrics(app, what, name, obj, options, lines: list[str]) -> None:
+    """The env docstring marks its sections Gymnasium-style (``## Action Space``): render them
+    as rubrics, with the blank line reST needs before the section's first list or table."""
+    out: list[str] = []
+    for line in lines:
+        m = re.fullmatch(r"(\s*)#{2,4} (\S.*)", line)
+        if m:
+            out += [f"{m.group(1)}.. rubric:: {m.group(2)}", ""]
+        else:
+            out.append(line)
+    lines[:] = out
+
+
+def setup(app):  # type: ignore[no-untyped-def]
+    app.connect("autodoc-process-docstring", _headings_to_rubrics)
