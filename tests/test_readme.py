@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import re
+import resource
 import runpy
 import shlex
 import shutil
@@ -106,9 +107,7 @@ def test_relative_links_are_found_in_markdown() -> None:
     assert relative_links(md) == ["docs/a.gif", "DEVELOPERS.md", "docs/f g.png", "docs/e.png"]
 
 
-@pytest.mark.parametrize(
-    "doc", ["DEVELOPERS.md", *(_rel(p) for p in doc_pages())], ids=lambda d: d
-)
+@pytest.mark.parametrize("doc", ["DEVELOPERS.md", *(_rel(p) for p in doc_pages())], ids=lambda d: d)
 def test_every_file_the_docs_link_is_tracked_by_git(doc: str) -> None:
     tracked = _tracked_files()
     if tracked is None:
@@ -164,7 +163,9 @@ class Block:
     body: str
 
 
-FENCE = re.compile(r"^(?P<mark><!-- not-run -->\n)?```(?P<info>[^\n]*)\n(?P<body>.*?)^```[ \t]*$", re.S | re.M)
+FENCE = re.compile(
+    r"^(?P<mark><!-- not-run -->\n)?```(?P<info>[^\n]*)\n(?P<body>.*?)^```[ \t]*$", re.S | re.M
+)
 
 
 def code_blocks(markdown: str, page: str = "") -> list[Block]:
@@ -229,9 +230,7 @@ def python_files(blocks: list[Block]) -> dict[str, str]:
 
 
 def all_blocks() -> list[Block]:
-    return [
-        b for p in doc_pages() for b in code_blocks(p.read_text(encoding="utf-8"), _rel(p))
-    ]
+    return [b for p in doc_pages() for b in code_blocks(p.read_text(encoding="utf-8"), _rel(p))]
 
 
 def test_code_blocks_are_found() -> None:
@@ -274,9 +273,7 @@ def test_every_code_block_is_run_or_marked() -> None:
 
 def test_commands_are_found() -> None:
     blocks = all_blocks()
-    commands = [
-        " ".join(c[:2]) for b in blocks if b.lang == "bash" for c in bash_commands(b.body)
-    ]
+    commands = [" ".join(c[:2]) for b in blocks if b.lang == "bash" for c in bash_commands(b.body)]
     assert "semexplore explore" in commands and "semexplore train" in commands
     assert "my_planner.py" in python_files(blocks)
     bench = next(
@@ -328,6 +325,19 @@ TINY_FRONTIER_VALUE = [
 ]
 
 
+#: Benchmarks skip their figures in the test (one command, the README's first, keeps them).
+NO_PLOTS = ["--no-plots"]
+
+
+def _cpu_s() -> float:
+    """CPU seconds of this process and its finished children (a load-independent clock)."""
+    own, kids = (
+        resource.getrusage(resource.RUSAGE_SELF),
+        resource.getrusage(resource.RUSAGE_CHILDREN),
+    )
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
 def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
     """The same command with a test-sized budget (flags substituted or appended)."""
     if argv[0] == "python":
@@ -349,7 +359,7 @@ def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
             worlds = ",".join(w for w in argv[i + 1].split(",") if not w.startswith("path/to/"))
             argv = [*argv[: i + 1], worlds, *argv[i + 2 :]]
         argv = _replace_or_add(_replace_or_add(argv, "--runs", "1"), "--max-time-s", "5")
-        return [*_replace_or_add(argv, "--workers", "1"), "--no-progress"]
+        return [*_replace_or_add(argv, "--workers", "1"), "--no-progress", *NO_PLOTS]
     if command == "compare-weights":
         for flag, value in (("--trials", "1"), ("--train-runs", "1"), ("--runs", "1")):
             argv = _replace_or_add(argv, flag, value)
@@ -391,7 +401,9 @@ def test_real_map_commands_are_recognised() -> None:
     assert not needs_real_maps(["semexplore", "maps", "list", "--files"])
 
 
-def _run_command(argv: list[str], work: Path, env: dict[str, str], subprocess_run: bool) -> str | None:
+def _run_command(
+    argv: list[str], work: Path, env: dict[str, str], subprocess_run: bool
+) -> str | None:
     """Run one documented command in ``work``; returns an error report, or None if it passed."""
     if subprocess_run:  # through the installed console script, exactly as a user types it
         exe = shutil.which("semexplore")
@@ -449,8 +461,9 @@ def test_every_documented_command_runs(
     monkeypatch.chdir(work)
     maps = shared_maps_present()
     seen: set[str] = set()
+    plotted = False
     failures, skipped, timings = [], [], []
-    t_all = time.perf_counter()
+    t_all, c_all = time.perf_counter(), _cpu_s()
     for block in blocks:
         where = f"{block.page}:{block.line}"
         if block.lang == "python":
@@ -462,9 +475,9 @@ def test_every_documented_command_runs(
             if not maps and ("map:" in block.body or "../shared" in block.body):
                 skipped.append(f"{where} (python snippet)")
                 continue
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), _cpu_s()
             error = _run_snippet(block)
-            timings.append((round(time.perf_counter() - t0, 1), f"python snippet {where}"))
+            timings.append((time.perf_counter() - t0, _cpu_s() - c0, f"python snippet {where}"))
             if error is not None:
                 failures.append(f"python snippet at {where}\n{error}")
             continue
@@ -482,17 +495,22 @@ def test_every_documented_command_runs(
                     continue
                 argv = [a.replace("../shared", str(SHARED)) for a in argv]
             run = shrink(argv, tiny_macro_train_args(2))
+            if run[1] == "benchmark" and not plotted and "--no-plots" not in argv:
+                run, plotted = [a for a in run if a != "--no-plots"], True  # figures once
             if shlex.join(run) in seen:
                 continue
             seen.add(shlex.join(run))
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), _cpu_s()
             error = _run_command(run, work, env, subprocess_run=not timings)
-            timings.append((round(time.perf_counter() - t0, 1), shlex.join(run)))
+            timings.append((time.perf_counter() - t0, _cpu_s() - c0, shlex.join(run)))
             if error is not None:
                 failures.append(f"{where}\n$ {shlex.join(run)}\n{error}")
-    print(f"documented commands: {len(timings)} run in {time.perf_counter() - t_all:.0f} s")
-    for t, c in timings:
-        print(f"  {t:6.1f} s  {c}")
+    print(
+        f"documented commands: {len(timings)} run in {time.perf_counter() - t_all:.0f} s wall, "
+        f"{_cpu_s() - c_all:.0f} s CPU"
+    )
+    for t, cpu, c in timings:
+        print(f"  {t:6.1f} s wall {cpu:6.1f} s CPU  {c}")
     if skipped:
         reason = "" if maps else " (no ../shared/maps: the real maps are absent)"
         print(f"skipped{reason}:", *skipped, sep="\n  ")
