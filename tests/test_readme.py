@@ -518,7 +518,7 @@ def test_every_documented_command_runs(
         if not maps:
             warnings.warn(
                 f"{len(skipped)} documented commands skipped: they need the real maps in "
-                f"{SHARED / 'maps'}, which is absent",
+                f"{SHARED / 'maps'}, which is absent (or hidden by SEMEXPLORE_TEST_HIDE_SHARED=1)",
                 stacklevel=1,
             )
     assert not failures, "documented commands failed:\n\n" + "\n\n".join(failures)
