@@ -1,0 +1,57 @@
+"""The team benchmark: ``semexplore benchmark --robots``, its columns, summary and resume."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("pettingzoo")
+
+from semexplore_gym.cli import main  # noqa: E402
+from semexplore_gym.evaluation.team_benchmark import COLUMNS  # noqa: E402
+
+
+def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
+    out = tmp_path / "team"
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze:seed=2,size_m=6",
+        "--robots",
+        "1,2",
+        "--policies",
+        "coordinated,independent",
+        "--runs",
+        "1",
+        "--max-time-s",
+        "30",
+        "--out",
+        str(out),
+        "--no-progress",
+    ]
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert tuple(rows[0]) == COLUMNS
+    assert {(r["policy"], r["n_robots"]) for r in rows} == {
+        ("team_coordinated", "1"),
+        ("team_coordinated", "2"),
+        ("team_independent", "1"),
+        ("team_independent", "2"),
+    }
+    for r in rows:
+        per_robot = [float(v) for v in r["path_per_robot_m"].split(";")]
+        assert len(per_robot) == int(r["n_robots"])
+        assert float(r["path_total_m"]) == pytest.approx(sum(per_robot), abs=0.01)
+        assert 0.0 <= float(r["overlap_ratio"]) <= 1.0
+        if r["n_robots"] == "1":
+            assert float(r["overlap_ratio"]) == 0.0
+        assert float(r["mission_time_s"]) <= 30.0 + 1e-6
+    summary = (out / "summary.md").read_text()
+    assert "T99 / 1 robot" in summary and "overlap" in summary
+    # Rerunning resumes: nothing runs again.
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        assert len(list(csv.DictReader(f))) == 4
