@@ -55,3 +55,21 @@ def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
     assert main(argv) == 0
     with (out / "runs.csv").open(newline="") as f:
         assert len(list(csv.DictReader(f))) == 4
+
+
+def test_team_mission_gif(tmp_path: Path) -> None:
+    from semexplore_gym.policies.team import make_team_policy
+
+    from semexplore_gym.envs.multi_robot import make_multi
+    from semexplore_gym.evaluation.team_benchmark import run_team_mission
+
+    env = make_multi(
+        world="maze:seed=2,size_m=6",
+        n_robots=2,
+        render_mode="rgb_array",
+        overrides=["episode.coverage_goal=1.0"],
+    )
+    gif = tmp_path / "team.gif"
+    res = run_team_mission(env, make_team_policy("coordinated"), 0, max_time_s=6.0, gif_path=gif)
+    assert gif.stat().st_size > 0
+    assert res.n_robots == 2 and res.mission_time_s == pytest.approx(6.0)
