@@ -230,32 +230,24 @@ class FrontierTeam(TeamPolicy):
                 self._idle_since[i] = min(self._idle_since[i], m.now_s)
             else:
                 self._idle_since[i] = math.inf
-                action = self._yield(i, observations[a], action)
+                active = [not t.done for t in self.members]
+                action, yielded = yield_action(
+                    i,
+                    self._poses,
+                    active,
+                    observations[a],
+                    action,
+                    self.params.yield_distance_m,
+                    self.params.yield_cone_rad,
+                )
+                if yielded:
+                    self.counters["yields"] = self.counters.get("yields", 0) + 1
             actions[a] = action
         if n and all(m.done for m in self.members):
             self.done = True
             reasons = {m.stop_reason for m in self.members}
             self.stop_reason = "no robot has a reachable frontier: " + "; ".join(sorted(reasons))
         return actions
-
-    def _yield(self, i: int, obs: dict[str, np.ndarray], action: np.ndarray) -> np.ndarray:
-        """Back off from a higher-priority teammate just ahead (module docstring)."""
-        p = self.params
-        x, y, yaw = self._poses[i][:3]
-        for j in range(i):
-            if self.members[j].done:
-                continue
-            dx, dy = self._poses[j][0] - x, self._poses[j][1] - y
-            d = math.hypot(dx, dy)
-            bearing = abs((math.atan2(dy, dx) - yaw + math.pi) % (2 * math.pi) - math.pi)
-            if d < p.yield_distance_m and bearing < p.yield_cone_rad:
-                scan = np.asarray(obs["scan"])
-                n_b = scan.shape[0]
-                back = scan[(np.arange(-n_b // 8, n_b // 8 + 1) + n_b // 2) % n_b]
-                clear = bool(np.all((back == 0) | (back > 0.3)))
-                self.counters["yields"] = self.counters.get("yields", 0) + 1
-                return np.array([-0.5 if clear else 0.0, 0.0], dtype=np.float32)
-        return action
 
     # -------------------------------------------------------- coordination
     def assign(
@@ -327,6 +319,36 @@ class FrontierTeam(TeamPolicy):
             "assignments": self.counters.get("assignments", 0),
             "yields": self.counters.get("yields", 0),
         }
+
+
+def yield_action(
+    i: int,
+    poses: list[np.ndarray],
+    active: list[bool],
+    obs: dict[str, np.ndarray],
+    action: np.ndarray,
+    distance_m: float,
+    cone_rad: float,
+) -> tuple[np.ndarray, bool]:
+    """Robot ``i``'s action after giving way: ``(action, yielded)``.
+
+    A robot yields to an active teammate of higher priority (lower index) within
+    ``distance_m`` and within ``cone_rad`` of its heading: it backs off at half speed, or
+    stands when its scan shows something within 0.3 m behind it.
+    """
+    x, y, yaw = (float(v) for v in poses[i][:3])
+    for j in range(i):
+        if not active[j]:
+            continue
+        dx, dy = float(poses[j][0]) - x, float(poses[j][1]) - y
+        bearing = abs((math.atan2(dy, dx) - yaw + math.pi) % (2 * math.pi) - math.pi)
+        if math.hypot(dx, dy) < distance_m and bearing < cone_rad:
+            scan = np.asarray(obs["scan"])
+            n_b = scan.shape[0]
+            back = scan[(np.arange(-(n_b // 8), n_b // 8 + 1) + n_b // 2) % n_b]
+            clear = bool(np.all((back == 0) | (back > 0.3)))
+            return np.array([-0.5 if clear else 0.0, 0.0], dtype=np.float32), True
+    return action, False
 
 
 def _min_distance(xy: tuple[float, float], points: list[tuple[float, ...]]) -> float:

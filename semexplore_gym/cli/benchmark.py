@@ -201,7 +201,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--robots",
         default=None,
         help="team sizes, e.g. 1,2,3: run team missions in SemanticExploreMulti-v0 with team "
-        "policies (independent, greedy, coordinated, coordinated_nobranch) instead",
+        "policies (semantic, semantic_nosem, coordinated, coordinated_nobranch, greedy, "
+        "independent) instead",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")

@@ -329,7 +329,7 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
     """``semexplore benchmark --robots N[,M...]``: the team benchmark with the benchmark's flags
     (``--worlds``, ``--policies`` as team policy names, ``--runs``, ``--seed0``, ``--out``,
     ``--max-time-s``, ``--env-config``, ``--env-set``, ``--fixed-start``)."""
-    from semexplore_gym.policies.team import TEAM_POLICIES
+    from semexplore_gym.policies.team import team_policy_names
 
     counts = [int(v) for v in str(args.robots).split(",") if v.strip()]
     if not counts or any(not 1 <= c <= 8 for c in counts):
@@ -337,12 +337,12 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
     if getattr(args, "suite", None):
         raise ValueError("--robots runs on --worlds (suites are not supported for teams yet)")
     policies = [p.strip() for p in str(args.policies).split(",") if p.strip()]
-    if any(p not in TEAM_POLICIES for p in policies):
-        # The single-robot default (semantic,frontier,nearest) means "the usual comparison".
-        if set(policies) <= {"semantic", "frontier", "nearest"}:
-            policies = ["coordinated", "independent"]
-        else:
-            raise ValueError(f"--policies with --robots: team policies {sorted(TEAM_POLICIES)}")
+    known = team_policy_names()
+    if policies == ["semantic", "frontier", "nearest"]:
+        # The single-robot default means "the usual comparison".
+        policies = ["semantic", "coordinated", "independent"]
+    if any(p not in known for p in policies):
+        raise ValueError(f"--policies with --robots takes team policies: {', '.join(known)}")
     if not worlds:
         raise ValueError("--worlds is empty")
     runs = args.runs or 5

@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("pettingzoo")
 
 from semexplore_gym.policies.navigation import NavStatus  # noqa: E402
-from semexplore_gym.policies.team import TEAM_POLICIES, make_team_policy  # noqa: E402
+from semexplore_gym.policies.team import make_team_policy, team_policy_names  # noqa: E402
 from semexplore_gym.policies.team.frontier_teams import FrontierTeam, _Candidate  # noqa: E402
 
 from semexplore_gym.core.worlds.build import world_from_segments  # noqa: E402
@@ -78,7 +78,7 @@ def _room(size_m: float = 3.0):
     return world_from_segments("room", np.array(segs, dtype=float), [(s / 2, s / 2)])
 
 
-@pytest.mark.parametrize("spec", sorted(TEAM_POLICIES))
+@pytest.mark.parametrize("spec", team_policy_names())
 def test_team_stops_when_no_robot_has_a_reachable_frontier(spec: str) -> None:
     # coverage_goal 1.0: the env does not end the episode, the team must stop itself.
     env = make_multi(world=_room(), n_robots=2, overrides=["episode.coverage_goal=1.0"])
@@ -110,3 +110,23 @@ def test_coordinated_robots_take_different_targets() -> None:
     assert len(goals) == 2 and None not in goals
     (x0, y0), (x1, y1) = goals  # type: ignore[misc]
     assert math.hypot(x1 - x0, y1 - y0) > 0.5
+
+
+@pytest.mark.parametrize("spec", ["semantic", "semantic_nosem"])
+def test_semantic_team_divides_goals(spec: str) -> None:
+    env = make_multi(world="maze1", n_robots=2)
+    obs, infos = env.reset(seed=0)
+    team = make_team_policy(spec)
+    team.reset(obs, infos, seed=0)
+    goals: list = []
+    for _ in range(60):
+        obs, _, _, _, infos = env.step(team.act(obs, infos))
+        goals = [m.goal_xy_m for m in team.members]  # type: ignore[attr-defined]
+        if all(g is not None for g in goals) and team.counters.get("assignments"):
+            break
+    assert None not in goals
+    (x0, y0), (x1, y1) = goals
+    assert math.hypot(x1 - x0, y1 - y0) > 0.5
+    if spec == "semantic_nosem":
+        cost = team.members[0].params.cost  # type: ignore[attr-defined]
+        assert cost.w_p == 0.0
