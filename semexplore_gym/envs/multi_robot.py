@@ -406,27 +406,26 @@ class SemanticExploreMultiEnv(ParallelEnv):
             self.team.map_teammates,
         )
         if self.n_robots > 1:
-            self._count_scanned(i, scan)
+            self._count_scanned(i)
         return scan
 
-    def _count_scanned(self, i: int, scan: np.ndarray) -> None:
-        """Mark the cells robot ``i``'s scan swept (bit ``i`` of ``scanned_count``'s cells), for
-        the overlap ratio: beam end points sampled at half a cell along every beam."""
+    def _count_scanned(self, i: int) -> None:
+        """Set bit ``i`` of ``scanned_count`` in every cell robot ``i``'s last scan updated in
+        the team map (its footprint, for the overlap ratio): the cells the grid stamped with
+        that scan, looked up in the box the LiDAR reaches."""
         g = self.map_geometry
-        x, y, yaw = self.lidar.sensor_pose(*(float(v) for v in self._est_poses[i]))
-        ok = scan > 0
-        r = scan[ok].astype(np.float64)
-        th = yaw + self.lidar.beam_angles_rad[ok]
-        step = 0.5 * g.resolution_m
-        n_s = int(math.ceil(self.config.lidar.max_range_m / step)) + 1
-        t = np.arange(n_s) * step
-        tt = np.minimum(t[None, :], r[:, None])
-        xs = x + tt * np.cos(th)[:, None]
-        ys = y + tt * np.sin(th)[:, None]
-        rows = np.floor((ys - g.origin_y_m) / g.resolution_m).astype(np.int64).ravel()
-        cols = np.floor((xs - g.origin_x_m) / g.resolution_m).astype(np.int64).ravel()
-        inside = (rows >= 0) & (rows < g.height) & (cols >= 0) & (cols < g.width)
-        self.scanned_count[rows[inside], cols[inside]] |= np.uint8(1 << i)
+        grid = self.grid
+        x, y, _ = self.lidar.sensor_pose(*(float(v) for v in self._est_poses[i]))
+        reach = self.config.lidar.max_range_m + g.resolution_m
+        r0 = max(0, int((y - reach - g.origin_y_m) / g.resolution_m))
+        r1 = min(g.height, int((y + reach - g.origin_y_m) / g.resolution_m) + 2)
+        c0 = max(0, int((x - reach - g.origin_x_m) / g.resolution_m))
+        c1 = min(g.width, int((x + reach - g.origin_x_m) / g.resolution_m) + 2)
+        if r0 >= r1 or c0 >= c1:
+            return
+        touched = grid._stamp[r0:r1, c0:c1] == grid._scan_id
+        block = self.scanned_count[r0:r1, c0:c1]
+        block |= touched.view(np.uint8) << np.uint8(i)
 
     def _merge_in_range(self, true_poses: list[tuple[float, float, float]]) -> None:
         xy = np.array([p[:2] for p in true_poses])

@@ -143,3 +143,14 @@ def test_render_team_frame() -> None:
     env.set_overlay("robot_1", {"goal_m": (1.0, 1.0)})
     frame = env.render()
     assert frame is not None and frame.ndim == 3 and frame.shape[2] == 3
+
+
+def test_overlap_ratio() -> None:
+    env = make_multi(world="maze1", n_robots=2)
+    env.reset(seed=0, options={"start_poses": [(0.45, 0.45, 0.0), (0.45, 1.05, 0.0)]})
+    near = env.overlap_ratio()
+    assert 0.3 < near <= 1.0  # side by side, they scan mostly the same cells
+    one = make_multi(world="maze1", n_robots=1)
+    one.reset(seed=0)
+    one.step({"robot_0": [1.0, 0.0]})
+    assert one.overlap_ratio() == 0.0
