@@ -17,8 +17,12 @@ from semexplore_gym.envs.multi_robot import SemanticExploreMultiEnv, make_multi 
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv  # noqa: E402
 
 
-def test_parallel_api() -> None:
-    parallel_api_test(make_multi(world="maze1", n_robots=3), num_cycles=30)
+@pytest.mark.parametrize(
+    ("n", "overrides"),
+    [(3, []), (1, []), (2, ["team.map_sharing=range", "team.start=spread"])],
+)
+def test_parallel_api(n: int, overrides: list[str]) -> None:
+    parallel_api_test(make_multi(world="maze1", n_robots=n, overrides=overrides), num_cycles=30)
 
 
 def test_parallel_seed() -> None:
