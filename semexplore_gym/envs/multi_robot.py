@@ -105,8 +105,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
 
     ## Episode End
     All agents terminate together when the team's coverage (the union of every scan, over the
-    reachable free space from robot 0's start) reaches ``episode.coverage_goal``, and are
-    truncated together at ``episode.max_time_s``.
+    reachable free space from robot 0's start) reaches ``episode.coverage_goal`` (unless
+    ``team.end_on_coverage`` is false), and are truncated together at ``episode.max_time_s``.
 
     ## Arguments
     ``world``, ``config``, ``render_mode`` as ``SemanticExplore-v0``; ``overrides``: its
@@ -377,7 +377,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
                 reward += team_term
             rewards[agent] = reward
             infos[agent] = self._agent_info(i, terms, True)
-        terminated = bool(self.grid.n_free_in_mask / self._n_reachable >= cfg.episode.coverage_goal)
+        coverage = self.grid.n_free_in_mask / self._n_reachable
+        terminated = bool(self.team.end_on_coverage and coverage >= cfg.episode.coverage_goal)
         truncated = bool(self.sim_time_s >= cfg.episode.max_time_s - 1e-9)
         observations = self._observations()
         terminations = {a: terminated for a in self.possible_agents}

@@ -42,6 +42,10 @@ class TeamParams:
         team_reward_weight: Weight of the ``team`` reward term, the free area the *other*
             robots added to the team map this step (m^2): 1 makes every robot's reward the
             team's whole gain; 0 leaves only its own.
+        end_on_coverage: End the episode (terminate every agent) at
+            ``episode.coverage_goal``. False: only the time limit ends it, so that a team
+            policy's own stop can be measured (``--env-set team.end_on_coverage=false`` in
+            ``semexplore benchmark --robots``).
     """
 
     n_robots: int = 2
@@ -52,6 +56,7 @@ class TeamParams:
     comm_range_m: float = 3.0
     map_teammates: bool = False
     team_reward_weight: float = 1.0
+    end_on_coverage: bool = True
 
     def __post_init__(self) -> None:
         if isinstance(self.n_robots, bool) or not 1 <= int(self.n_robots) <= MAX_ROBOTS:

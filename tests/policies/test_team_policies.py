@@ -80,8 +80,8 @@ def _room(size_m: float = 3.0):
 
 @pytest.mark.parametrize("spec", team_policy_names())
 def test_team_stops_when_no_robot_has_a_reachable_frontier(spec: str) -> None:
-    # coverage_goal 1.0: the env does not end the episode, the team must stop itself.
-    env = make_multi(world=_room(), n_robots=2, overrides=["episode.coverage_goal=1.0"])
+    # The env does not end the episode at its coverage goal: the team must stop itself.
+    env = make_multi(world=_room(), n_robots=2, overrides=["team.end_on_coverage=false"])
     obs, infos = env.reset(seed=0, options={"start_poses": [(1.0, 1.0, 0.0), (2.0, 2.0, 1.0)]})
     team = make_team_policy(spec)
     team.reset(obs, infos, seed=0)
@@ -89,8 +89,7 @@ def test_team_stops_when_no_robot_has_a_reachable_frontier(spec: str) -> None:
         actions = team.act(obs, infos)
         if team.done:
             break
-        if env.agents:  # a fully mapped room may end the episode first: the map stays final
-            obs, _, _, _, infos = env.step(actions)
+        obs, _, _, _, infos = env.step(actions)
     assert team.done
     assert team.stop_reason.startswith("no robot has a reachable frontier")
     assert infos["robot_0"]["coverage"] > 0.95
