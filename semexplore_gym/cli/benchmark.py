@@ -251,7 +251,7 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "robots", None):
         from semexplore_gym.evaluation.team_benchmark import run_team_cli
 
-        return run_team_cli(args, _split_worlds(args.worlds or ""))
+        return run_team_cli(args, _split_worlds(args.worlds or ""))  # or args.suite
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")

@@ -181,10 +181,12 @@ def run_team_benchmark(
     env_overrides: Iterable[str] = (),
     fixed_start: bool = False,
     progress: bool = True,
+    time_limits: dict[str, float | None] | None = None,
 ) -> dict[str, Any]:
     """Every (world, policy, robots, seed) team mission, appended to ``out/runs.csv``.
 
     Rerunning the same command skips the missions already in ``runs.csv`` (resumes).
+    ``time_limits`` gives some worlds their own limit (a suite's), else ``max_time_s``.
     ``episode.coverage_goal`` is set to 1 (the team, not the env, ends a mission) and
     ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides`` come last.
     """
@@ -225,7 +227,8 @@ def run_team_benchmark(
                         if key in done:
                             skipped += 1
                             continue
-                        res = run_team_mission(env, team, seed, max_time_s=max_time_s)
+                        limit = (time_limits or {}).get(world, max_time_s)
+                        res = run_team_mission(env, team, seed, max_time_s=limit)
                         writer.writerow(res.row())
                         f.flush()
                         ran += 1
@@ -334,8 +337,6 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
     counts = [int(v) for v in str(args.robots).split(",") if v.strip()]
     if not counts or any(not 1 <= c <= 8 for c in counts):
         raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}")
-    if getattr(args, "suite", None):
-        raise ValueError("--robots runs on --worlds (suites are not supported for teams yet)")
     policies = [p.strip() for p in str(args.policies).split(",") if p.strip()]
     known = team_policy_names()
     if policies == ["semantic", "frontier", "nearest"]:
@@ -343,9 +344,13 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
         policies = ["semantic", "coordinated", "independent"]
     if any(p not in known for p in policies):
         raise ValueError(f"--policies with --robots takes team policies: {', '.join(known)}")
+    time_limits: dict[str, float | None] = {}
+    runs = args.runs or 5
+    if getattr(args, "suite", None):
+        worlds, time_limits, suite_runs = _suite_worlds(args.suite, args.max_time_s)
+        runs = args.runs or suite_runs
     if not worlds:
         raise ValueError("--worlds is empty")
-    runs = args.runs or 5
     seeds = list(range(args.seed0, args.seed0 + runs))
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -361,6 +366,7 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
                 "robots": counts,
                 "seeds": seeds,
                 "max_time_s": args.max_time_s,
+                "suite": getattr(args, "suite", None),
                 "env_overrides": list(args.env_overrides),
             },
             indent=2,
@@ -377,8 +383,34 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
         env_overrides=args.env_overrides,
         fixed_start=bool(args.fixed_start),
         progress=not args.no_progress,
+        time_limits=time_limits,
     )
     summary = write_team_summary(out_dir)
     print(json.dumps(res))
     print(summary.read_text())
     return 0
+
+
+def _suite_worlds(
+    names: str, max_time_s: float | None
+) -> tuple[list[str], dict[str, float | None], int]:
+    """The worlds of comma-separated suites, each world's time limit (``max_time_s`` wins) and
+    the largest of the suites' run counts."""
+    from semexplore_gym.core.worlds import make_world
+    from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
+
+    worlds: list[str] = []
+    limits: dict[str, float | None] = {}
+    runs = 1
+    for name in [n.strip() for n in names.split(",") if n.strip()]:
+        suite = load_suite(name)
+        runs = max(runs, suite.runs)
+        for entry in suite.worlds:
+            worlds.append(entry.world)
+            if max_time_s is not None:
+                limits[entry.world] = max_time_s
+                continue
+            w = make_world(entry.world.replace("seed=*", "seed=0"))
+            area = float(w.free_mask.sum()) * w.free_geometry.resolution_m**2
+            limits[entry.world] = world_time_limit_s(suite, entry, area)
+    return worlds, limits, runs

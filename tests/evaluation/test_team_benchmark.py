@@ -73,3 +73,19 @@ def test_team_mission_gif(tmp_path: Path) -> None:
     res = run_team_mission(env, make_team_policy("coordinated"), 0, max_time_s=6.0, gif_path=gif)
     assert gif.stat().st_size > 0
     assert res.n_robots == 2 and res.mission_time_s == pytest.approx(6.0)
+
+
+def test_benchmark_robots_with_a_suite(tmp_path: Path) -> None:
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        "name: tiny\nversion: 1\nruns: 1\nmax_time_s: 8\nworlds:\n- maze:seed=3,size_m=6\n"
+    )
+    out = tmp_path / "suite"
+    argv = ["benchmark", "--suite", str(suite), "--robots", "2", "--policies", "greedy"]
+    assert main([*argv, "--out", str(out), "--no-progress"]) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["world"], r["policy"], r["n_robots"]) for r in rows] == [
+        ("maze:seed=3,size_m=6", "team_greedy", "2")
+    ]
+    assert float(rows[0]["mission_time_s"]) == pytest.approx(8.0)
