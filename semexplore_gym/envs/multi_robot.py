@@ -85,7 +85,9 @@ class SemanticExploreMultiEnv(ParallelEnv):
     teammates  (n - 1, 3)      float32  the other robots' poses, in agent order without self
     =========  ==============  =======  ==================================================
 
-    The team shares one map frame (relative start poses known). Poses are the ones the maps
+    With ``"team"`` sharing and two or more robots every agent's ``map`` is the same read-only
+    snapshot of the team map (one copy per step, not one per agent; ``np.array(...)`` gives a
+    writable copy). The team shares one map frame (relative start poses known). Poses are the ones the maps
     are built with (odometry estimates under odometry noise). Teammates' poses are always
     known (they are small messages; only maps are limited by ``comm_range_m``).
 
@@ -442,9 +444,14 @@ class SemanticExploreMultiEnv(ParallelEnv):
             [(x, y, wrap_angle_rad(yaw)) for x, y, yaw in self._est_poses], dtype=np.float32
         )
         out = {}
+        team_map = None
+        if self.n_robots > 1 and not self.own_grids:
+            # One snapshot of the team map per step, shared read-only by every agent.
+            team_map = self.grid.encoded_copy()
+            team_map.flags.writeable = False
         for i, agent in enumerate(self.possible_agents):
             out[agent] = {
-                "map": self._map_of(i).encoded_copy(),
+                "map": team_map if team_map is not None else self._map_of(i).encoded_copy(),
                 "pose": poses[i].copy(),
                 "scan": self._scans[i],
                 "teammates": np.delete(poses, i, axis=0),

@@ -1,9 +1,12 @@
-"""Rays against discs: what a LiDAR sees of other robots (numpy only)."""
+"""Rays against discs: what a LiDAR sees of other robots."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
+from numba import njit
 
 
 def cast_discs(
@@ -29,16 +32,34 @@ def cast_discs(
         that starts inside a disc meets it at its exit point (as a LiDAR inside a body
         would see its far side; it does not happen between robots that cannot overlap).
     """
+    centres = np.ascontiguousarray(centres_m, dtype=np.float64).reshape(-1, 2)
     out = np.full(cos_b.shape[0], np.inf)
-    centres = np.asarray(centres_m, dtype=np.float64).reshape(-1, 2)
-    r2 = float(radius_m) ** 2
-    for cx, cy in centres:
-        dx, dy = cx - x_m, cy - y_m
-        along = dx * cos_b + dy * sin_b  # distance to the foot of the perpendicular
-        miss2 = dx * dx + dy * dy - along * along  # squared distance of the centre from the ray
-        half = np.sqrt(np.maximum(r2 - miss2, 0.0))
-        near = along - half
-        t = np.where(near > 0.0, near, along + half)
-        hit = (miss2 <= r2) & (t > 0.0)
-        np.minimum(out, np.where(hit, t, np.inf), out=out)
+    _cast_discs(
+        float(x_m),
+        float(y_m),
+        np.ascontiguousarray(cos_b, dtype=np.float64),
+        np.ascontiguousarray(sin_b, dtype=np.float64),
+        centres,
+        float(radius_m) ** 2,
+        out,
+    )
     return out
+
+
+@njit(cache=True)
+def _cast_discs(x, y, cos_b, sin_b, centres, r2, out):  # pragma: no cover - numba
+    for k in range(centres.shape[0]):
+        dx = centres[k, 0] - x
+        dy = centres[k, 1] - y
+        dd = dx * dx + dy * dy
+        for j in range(cos_b.shape[0]):
+            along = dx * cos_b[j] + dy * sin_b[j]  # distance to the foot of the perpendicular
+            miss2 = dd - along * along  # squared distance of the centre from the ray
+            if miss2 > r2:
+                continue
+            half = math.sqrt(max(r2 - miss2, 0.0))
+            t = along - half
+            if t <= 0.0:
+                t = along + half
+            if 0.0 < t < out[j]:
+                out[j] = t
