@@ -175,6 +175,13 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="existing Ray cluster address ('auto'); default starts a local one",
     )
+    p.add_argument(
+        "--robots",
+        default=None,
+        help="team sizes, e.g. 1,2,3: run team missions in SemanticExploreMulti-v0 with team "
+        "policies (semantic, semantic_nosem, coordinated, coordinated_nobranch, greedy, "
+        "independent) instead",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
 
@@ -257,6 +264,10 @@ def _run(args: argparse.Namespace) -> int:
     from semexplore_gym.evaluation.report import write_plots, write_summary
 
     validate_args(args)
+    if getattr(args, "robots", None):
+        from semexplore_gym.evaluation.team_benchmark import run_team_cli
+
+        return run_team_cli(args, _split_worlds(args.worlds or ""))  # or args.suite
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")

@@ -1,0 +1,416 @@
+"""Team missions and the team benchmark: ``semexplore benchmark --robots 1,2,3``.
+
+A team mission runs a :class:`~semexplore_gym.policies.team.TeamPolicy` in
+``SemanticExploreMulti-v0`` until the team stops itself (no robot has a reachable frontier),
+the time limit, or complete coverage. Each seed draws robot 0's start in free space (the same
+for every team size and policy: it is the first draw of the env's RNG) and the teammates near
+it, so the rows of one seed compare teams on the same world and start.
+
+Columns of ``runs.csv`` (one row per mission):
+
+================== ==========================================================================
+world, policy      the world spelling and the team policy
+n_robots, seed     team size and seed
+coverage           team coverage at the end
+mission_time_s     simulated time until the team stopped (or the limit)
+self_stopped       the team stopped itself; ``stop_reason`` says why
+T90_s, T99_s       first simulated time at 0.90 / 0.99 coverage (empty if never)
+path_total_m       distance driven by all robots; ``path_per_robot_m`` each, ``;``-separated
+overlap_ratio      Explore-Bench: area scanned by more than one robot / area explored
+robot_collisions   robot-robot contacts begun; ``contacts`` all contacts (walls included)
+wall_time_s        wall-clock time of the mission
+================== ==========================================================================
+
+``summary.md`` has one table per world family: medians per (policy, robots), the median of
+each seed's T99 ratio to one robot's (same policy, world and seed) and, per team size, a
+paired Wilcoxon test of each policy's T99 against ``independent``'s.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+COLUMNS = (
+    "world",
+    "policy",
+    "n_robots",
+    "seed",
+    "coverage",
+    "mission_time_s",
+    "self_stopped",
+    "stop_reason",
+    "T90_s",
+    "T99_s",
+    "path_total_m",
+    "path_per_robot_m",
+    "overlap_ratio",
+    "robot_collisions",
+    "contacts",
+    "steps",
+    "wall_time_s",
+)
+
+
+@dataclass
+class TeamMissionResult:
+    """One team mission's figures (the columns of ``runs.csv``, see the module docstring)."""
+
+    world: str
+    policy: str
+    n_robots: int
+    seed: int | None
+    coverage: float
+    mission_time_s: float
+    self_stopped: bool
+    stop_reason: str
+    T90_s: float | None
+    T99_s: float | None
+    path_total_m: float
+    path_per_robot_m: list[float]
+    overlap_ratio: float
+    robot_collisions: int
+    contacts: int
+    steps: int
+    wall_time_s: float
+    coverage_trace: list[tuple[float, float]] = field(default_factory=list, repr=False)
+
+    def row(self) -> dict[str, Any]:
+        d = asdict(self)
+        d.pop("coverage_trace")
+        d["path_per_robot_m"] = ";".join(f"{v:.3f}" for v in self.path_per_robot_m)
+        for k in ("coverage", "overlap_ratio"):
+            d[k] = round(float(d[k]), 6)
+        for k in ("mission_time_s", "path_total_m", "wall_time_s"):
+            d[k] = round(float(d[k]), 3)
+        return d
+
+
+def _first_time(trace: list[tuple[float, float]], level: float) -> float | None:
+    for t, c in trace:
+        if c >= level - 1e-12:
+            return float(t)
+    return None
+
+
+def run_team_mission(
+    env: Any,
+    team: Any,
+    seed: int | None,
+    max_time_s: float | None = None,
+    gif_path: str | Path | None = None,
+    gif_every_s: float = 2.0,
+) -> TeamMissionResult:
+    """Run ``team`` in ``env`` (a ``SemanticExploreMulti-v0``) from ``reset(seed=seed)`` until
+    the team stops itself, the env ends the episode, or ``max_time_s`` of simulated time.
+
+    With ``gif_path`` (the env made with ``render_mode="rgb_array"``) a team GIF is written,
+    one frame every ``gif_every_s`` simulated seconds, goals and paths from the policy.
+    """
+    wall0 = time.perf_counter()
+    obs, infos = env.reset(seed=seed)
+    team.reset(obs, infos, seed=seed)
+    first = env.possible_agents[0]
+    trace = [(0.0, float(infos[first]["coverage"]))]
+    limit = math.inf if max_time_s is None else float(max_time_s)
+    frames: list[np.ndarray] = []
+    next_frame_s = 0.0
+    info = infos[first]
+    steps = 0
+    while env.agents:
+        actions = team.act(obs, infos)
+        if team.done:
+            break
+        obs, _, _, _, infos = env.step(actions)
+        steps += 1
+        info = infos[first]
+        trace.append((float(info["sim_time_s"]), float(info["coverage"])))
+        if gif_path is not None and info["sim_time_s"] >= next_frame_s - 1e-9:
+            for agent, overlay in team.overlays().items():
+                env.set_overlay(agent, overlay)
+            frames.append(env.render())
+            next_frame_s += gif_every_s
+        if info["sim_time_s"] >= limit - 1e-9:
+            break
+    if gif_path is not None:
+        from semexplore_gym.evaluation.rollout import save_gif
+
+        frames.append(env.render())
+        save_gif(frames, gif_path, fps=10.0)
+    paths = [float(v) for v in env.path_length_m]
+    reason = team.stop_reason if team.done else ("env ended" if not env.agents else "time limit")
+    return TeamMissionResult(
+        world=str(getattr(env.world, "name", env.world_spec)),
+        policy=team.name,
+        n_robots=len(env.possible_agents),
+        seed=seed,
+        coverage=float(info["coverage"]),
+        mission_time_s=float(info["sim_time_s"]),
+        self_stopped=bool(team.done),
+        stop_reason=reason,
+        T90_s=_first_time(trace, 0.90),
+        T99_s=_first_time(trace, 0.99),
+        path_total_m=float(sum(paths)),
+        path_per_robot_m=paths,
+        overlap_ratio=float(env.overlap_ratio()),
+        robot_collisions=int(env.sim.robot_collisions),
+        contacts=int(sum(env.sim.collisions)),
+        steps=steps,
+        wall_time_s=time.perf_counter() - wall0,
+        coverage_trace=trace,
+    )
+
+
+def run_team_benchmark(
+    worlds: Iterable[str],
+    policies: Iterable[str],
+    robot_counts: Iterable[int],
+    seeds: Iterable[int],
+    out: str | Path,
+    *,
+    max_time_s: float | None = None,
+    env_config: Any = None,
+    env_overrides: Iterable[str] = (),
+    fixed_start: bool = False,
+    progress: bool = True,
+    time_limits: dict[str, float | None] | None = None,
+) -> dict[str, Any]:
+    """Every (world, policy, robots, seed) team mission, appended to ``out/runs.csv``.
+
+    Rerunning the same command skips the missions already in ``runs.csv`` (resumes).
+    ``time_limits`` gives some worlds their own limit (a suite's), else ``max_time_s``.
+    ``episode.coverage_goal`` is set to 1 (the team, not the env, ends a mission) and
+    ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides`` come last.
+    """
+    from semexplore_gym.envs.multi_robot import make_multi
+    from semexplore_gym.policies.team import make_team_policy
+
+    out_dir = Path(out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    csv_path = out_dir / "runs.csv"
+    done: set[tuple[str, str, int, int]] = set()
+    if csv_path.exists():
+        with csv_path.open(newline="") as f:
+            for r in csv.DictReader(f):
+                done.add((r["world"], r["policy"], int(r["n_robots"]), int(r["seed"])))
+    overrides = ["episode.coverage_goal=1.0"]
+    overrides.append(f"episode.random_start={'false' if fixed_start else 'true'}")
+    if max_time_s is not None:
+        overrides.append(f"episode.max_time_s={max_time_s!r}")
+    overrides += list(env_overrides)
+    ran = skipped = 0
+    write_header = not csv_path.exists()
+    with csv_path.open("a", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        if write_header:
+            writer.writeheader()
+        for world in worlds:
+            for n in robot_counts:
+                env = None
+                for spec in policies:
+                    for seed in seeds:
+                        w = world.replace("seed=*", f"seed={seed}")
+                        team = make_team_policy(spec)
+                        if env is None or env.world_spec != w:
+                            env = make_multi(
+                                world=w, config=env_config, overrides=overrides, n_robots=n
+                            )
+                        key = (str(env.world.name), team.name, int(n), int(seed))
+                        if key in done:
+                            skipped += 1
+                            continue
+                        limit = (time_limits or {}).get(world, max_time_s)
+                        res = run_team_mission(env, team, seed, max_time_s=limit)
+                        writer.writerow(res.row())
+                        f.flush()
+                        ran += 1
+                        if progress:
+                            print(
+                                f"{res.world} {res.policy} n={n} seed={seed}: T99="
+                                f"{res.T99_s} time={res.mission_time_s:.1f} cov={res.coverage:.3f} "
+                                f"overlap={res.overlap_ratio:.2f} rr={res.robot_collisions} "
+                                f"({res.wall_time_s:.0f} s wall)",
+                                flush=True,
+                            )
+    return {"ran": ran, "skipped": skipped, "runs": str(csv_path)}
+
+
+def _float(v: str) -> float:
+    return float(v) if v not in ("", "None") else math.nan
+
+
+def _median(values: list[float]) -> float:
+    arr = np.array([v for v in values if math.isfinite(v)])
+    return float(np.median(arr)) if arr.size else math.nan
+
+
+def _fmt(v: float, digits: int = 1) -> str:
+    return "-" if not math.isfinite(v) else f"{v:.{digits}f}"
+
+
+def write_team_summary(out: str | Path) -> Path:
+    """``out/summary.md`` from ``out/runs.csv`` (module docstring)."""
+    out_dir = Path(out)
+    with (out_dir / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    t99: dict[tuple[str, str, int, int], float] = {}
+    for r in rows:
+        t99[(r["world"], r["policy"], int(r["n_robots"]), int(r["seed"]))] = _float(r["T99_s"])
+    families = sorted({r["world"].split(":")[0] for r in rows})
+    lines = ["# Team benchmark", ""]
+    for fam in families:
+        fam_rows = [r for r in rows if r["world"].split(":")[0] == fam]
+        lines += [
+            f"## {fam}",
+            "",
+            "| policy | robots | n | T90 s | T99 s | mission s | T99 / 1 robot | path total m "
+            "| path max m | overlap | robot coll. | self-stopped |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
+        cells = sorted({(r["policy"], int(r["n_robots"])) for r in fam_rows})
+        for pol, n in cells:
+            rs = [r for r in fam_rows if r["policy"] == pol and int(r["n_robots"]) == n]
+            ratios = []
+            for r in rs:
+                one = t99.get((r["world"], pol, 1, int(r["seed"])), math.nan)
+                ratios.append(_float(r["T99_s"]) / one if one > 0 else math.nan)
+            per_robot_max = [max(float(v) for v in r["path_per_robot_m"].split(";")) for r in rs]
+            lines.append(
+                f"| {pol} | {n} | {len(rs)} | {_fmt(_median([_float(r['T90_s']) for r in rs]))} "
+                f"| {_fmt(_median([_float(r['T99_s']) for r in rs]))} "
+                f"| {_fmt(_median([_float(r['mission_time_s']) for r in rs]))} "
+                f"| {_fmt(_median(ratios), 2)} "
+                f"| {_fmt(_median([_float(r['path_total_m']) for r in rs]))} "
+                f"| {_fmt(_median(per_robot_max))} "
+                f"| {_fmt(_median([_float(r['overlap_ratio']) for r in rs]), 2)} "
+                f"| {sum(int(r['robot_collisions']) for r in rs)} "
+                f"| {sum(r['self_stopped'] == 'True' for r in rs)}/{len(rs)} |"
+            )
+        lines += ["", *_paired_tests(fam_rows), ""]
+    path = out_dir / "summary.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _paired_tests(rows: list[dict[str, str]]) -> list[str]:
+    """Per team size, each policy's T99 against ``team_independent``'s on the same seeds."""
+    from scipy.stats import wilcoxon
+
+    out = []
+    by: dict[tuple[str, int], dict[tuple[str, int], float]] = {}
+    for r in rows:
+        by.setdefault((r["policy"], int(r["n_robots"])), {})[(r["world"], int(r["seed"]))] = _float(
+            r["T99_s"]
+        )
+    for (pol, n), vals in sorted(by.items()):
+        base = by.get(("team_independent", n))
+        if pol == "team_independent" or base is None:
+            continue
+        keys = [k for k in vals if k in base and math.isfinite(vals[k]) and math.isfinite(base[k])]
+        if len(keys) < 5:
+            out.append(f"- {pol} vs team_independent, {n} robots: {len(keys)} pairs, too few")
+            continue
+        a = np.array([vals[k] for k in keys])
+        b = np.array([base[k] for k in keys])
+        p = float(wilcoxon(a, b).pvalue) if np.any(a != b) else 1.0
+        out.append(
+            f"- {pol} vs team_independent, {n} robots: median T99 ratio "
+            f"{np.median(a / b):.2f} over {len(keys)} pairs, Wilcoxon p = {p:.3g}"
+        )
+    return out
+
+
+def run_team_cli(args: Any, worlds: list[str]) -> int:
+    """``semexplore benchmark --robots N[,M...]``: the team benchmark with the benchmark's flags
+    (``--worlds``, ``--policies`` as team policy names, ``--runs``, ``--seed0``, ``--out``,
+    ``--max-time-s``, ``--env-config``, ``--env-set``, ``--fixed-start``)."""
+    from semexplore_gym.policies.team import team_policy_names
+
+    counts = [int(v) for v in str(args.robots).split(",") if v.strip()]
+    if not counts or any(not 1 <= c <= 8 for c in counts):
+        raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}")
+    policies = [p.strip() for p in str(args.policies).split(",") if p.strip()]
+    known = team_policy_names()
+    if policies == ["semantic", "frontier", "nearest"]:
+        # The single-robot default means "the usual comparison".
+        policies = ["semantic", "coordinated", "independent"]
+    if any(p not in known for p in policies):
+        raise ValueError(f"--policies with --robots takes team policies: {', '.join(known)}")
+    time_limits: dict[str, float | None] = {}
+    runs = args.runs or 5
+    if getattr(args, "suite", None):
+        worlds, time_limits, suite_runs = _suite_worlds(args.suite, args.max_time_s)
+        runs = args.runs or suite_runs
+    if not worlds:
+        raise ValueError("--worlds is empty")
+    seeds = list(range(args.seed0, args.seed0 + runs))
+    out_dir = Path(args.out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    import shlex
+    import sys
+
+    (out_dir / "manifest.json").write_text(
+        json.dumps(
+            {
+                "command": " ".join(shlex.quote(a) for a in sys.argv),
+                "worlds": worlds,
+                "policies": policies,
+                "robots": counts,
+                "seeds": seeds,
+                "max_time_s": args.max_time_s,
+                "suite": getattr(args, "suite", None),
+                "env_overrides": list(args.env_overrides),
+            },
+            indent=2,
+        )
+    )
+    res = run_team_benchmark(
+        worlds,
+        policies,
+        counts,
+        seeds,
+        out_dir,
+        max_time_s=args.max_time_s,
+        env_config=args.env_config,
+        env_overrides=args.env_overrides,
+        fixed_start=bool(args.fixed_start),
+        progress=not args.no_progress,
+        time_limits=time_limits,
+    )
+    summary = write_team_summary(out_dir)
+    print(json.dumps(res))
+    print(summary.read_text())
+    return 0
+
+
+def _suite_worlds(
+    names: str, max_time_s: float | None
+) -> tuple[list[str], dict[str, float | None], int]:
+    """The worlds of comma-separated suites, each world's time limit (``max_time_s`` wins) and
+    the largest of the suites' run counts."""
+    from semexplore_gym.evaluation.suites import load_suite, world_time_limit_s
+    from semexplore_gym.maps import make_world
+
+    worlds: list[str] = []
+    limits: dict[str, float | None] = {}
+    runs = 1
+    for name in [n.strip() for n in names.split(",") if n.strip()]:
+        suite = load_suite(name)
+        runs = max(runs, suite.runs)
+        for entry in suite.worlds:
+            worlds.append(entry.world)
+            if max_time_s is not None:
+                limits[entry.world] = max_time_s
+                continue
+            w = make_world(entry.world.replace("seed=*", "seed=0"))
+            area = float(w.free_mask.sum()) * w.free_geometry.resolution_m**2
+            limits[entry.world] = world_time_limit_s(suite, entry, area)
+    return worlds, limits, runs

@@ -1,0 +1,387 @@
+"""A team of TurtleBot3s in one pymunk space, and LiDAR scans that see teammates.
+
+:class:`TeamSim` is :class:`~semexplore_gym.sim.robot.RobotSim` for ``n`` robots: the same
+walls, bodies, drive joints and substepping, with the robots added to one space so that they
+collide with the walls and with each other. With one robot it makes the same Chipmunk calls in
+the same order as :class:`RobotSim` (the multi-robot env's one-robot equivalence test relies on
+it).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pymunk
+from pymunk._chipmunk import ffi as _ffi
+from pymunk._chipmunk import lib as _cp
+
+from semexplore_gym.core.mapping.disc_cast import cast_discs
+from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
+from semexplore_gym.core.mapping.raycast import cast_scan
+from semexplore_gym.core.worlds.world import World
+from semexplore_gym.sim.lidar import Lidar
+from semexplore_gym.sim.robot import (
+    ROBOT_COLLISION_TYPE,
+    WALL_COLLISION_TYPE,
+    WALL_SKIN_M,
+    PhysicsParams,
+    RobotParams,
+)
+
+#: The full-size discs robots touch each other with (teams of two or more).
+BUMPER_COLLISION_TYPE = 3
+
+
+class TeamSim:
+    """Pymunk space holding one world's walls and ``n_robots`` robots.
+
+    Args:
+        world: The walls.
+        robot: Robot parameters (all robots alike).
+        physics: Stepping parameters.
+        n_robots: Team size, at least 1.
+
+    Attributes:
+        collisions: Per robot, contact episodes begun (with a wall or a teammate).
+        robot_collisions: Robot-robot contact episodes begun (one per touching pair).
+    """
+
+    def __init__(
+        self, world: World, robot: RobotParams, physics: PhysicsParams, n_robots: int
+    ) -> None:
+        if n_robots < 1:
+            raise ValueError(f"n_robots must be at least 1, got {n_robots!r}")
+        self.world = world
+        self.robot_params = robot
+        self.physics_params = physics
+        self.n_robots = int(n_robots)
+        self._build()
+
+    def _build(self) -> None:
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.collision_slop = self.physics_params.collision_slop_m
+        space.iterations = self.physics_params.solver_iterations
+        static = space.static_body
+        shapes = []
+        for x0, y0, x1, y1 in self.world.segments_m:
+            s = pymunk.Segment(static, (float(x0), float(y0)), (float(x1), float(y1)), WALL_SKIN_M)
+            s.friction = 0.0
+            s.elasticity = 0.0
+            s.collision_type = WALL_COLLISION_TYPE
+            s.filter = pymunk.ShapeFilter(categories=0b01)
+            shapes.append(s)
+        space.add(*shapes)
+
+        r = self.robot_params
+        self.bodies: list[pymunk.Body] = []
+        self.controls: list[pymunk.Body] = []
+        self._index_of: dict[pymunk.Shape, int] = {}
+        for i in range(self.n_robots):
+            moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
+            body = pymunk.Body(r.mass_kg, moment)
+            shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
+            shape.friction = 0.0
+            shape.elasticity = 0.0
+            shape.collision_type = ROBOT_COLLISION_TYPE
+            shape.filter = pymunk.ShapeFilter(categories=0b10)
+            control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+            pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+            pivot.max_bias = 0.0
+            pivot.max_force = r.max_drive_force_n
+            gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+            gear.error_bias = 0.0
+            gear.max_bias = 0.0
+            gear.max_force = r.max_turn_torque_nm
+            space.add(body, shape, control, pivot, gear)
+            self.bodies.append(body)
+            self.controls.append(control)
+            self._index_of[shape] = i
+            if self.n_robots > 1:
+                # The wall shape is shrunk by the walls' skin; between robots a second, full-size
+                # disc touches, so two robots meet at 2 * radius_m (what their LiDARs see).
+                shape.filter = pymunk.ShapeFilter(categories=0b10, mask=0b01)
+                bumper = pymunk.Circle(body, r.radius_m)
+                bumper.friction = 0.0
+                bumper.elasticity = 0.0
+                bumper.collision_type = BUMPER_COLLISION_TYPE
+                bumper.filter = pymunk.ShapeFilter(categories=0b100, mask=0b100)
+                space.add(bumper)
+                self._index_of[bumper] = i
+        self._wall_filter = pymunk.ShapeFilter(mask=0b01)
+        self._query_info = _ffi.new("cpPointQueryInfo *")
+        n = self.n_robots
+        self._touching = [0] * n
+        self._began = [False] * n
+        self._suppress_begin = [False] * n
+
+        def _contact_begins(i: int) -> None:
+            if self._touching[i] == 0 and not self._suppress_begin[i]:
+                self._began[i] = True
+            self._touching[i] += 1
+
+        def _begin_wall(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
+            _contact_begins(self._index_of[arbiter.shapes[0]])
+
+        def _separate_wall(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
+            i = self._index_of[arbiter.shapes[0]]
+            self._touching[i] = max(0, self._touching[i] - 1)
+
+        def _begin_robot(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
+            a, b = (self._index_of[s] for s in arbiter.shapes)
+            if not (self._suppress_begin[a] and self._suppress_begin[b]):
+                self.robot_collisions += 1
+            _contact_begins(a)
+            _contact_begins(b)
+
+        def _separate_robot(arbiter: pymunk.Arbiter, space_: pymunk.Space, data: dict) -> None:
+            for s in arbiter.shapes:
+                i = self._index_of[s]
+                self._touching[i] = max(0, self._touching[i] - 1)
+
+        space.on_collision(
+            ROBOT_COLLISION_TYPE, WALL_COLLISION_TYPE, begin=_begin_wall, separate=_separate_wall
+        )
+        space.on_collision(
+            BUMPER_COLLISION_TYPE,
+            BUMPER_COLLISION_TYPE,
+            begin=_begin_robot,
+            separate=_separate_robot,
+        )
+        self.space = space
+        self.collisions = [0] * n
+        self.robot_collisions = 0
+        self.in_contact = [False] * n
+        self._substep_dt_key = -1.0
+        self._substeps = 1
+
+    def reset(self, poses: Sequence[tuple[float, float, float]]) -> None:
+        """Place robot ``i`` at rest at ``poses[i]`` = (x_m, y_m, yaw_rad)."""
+        if len(poses) != self.n_robots:
+            raise ValueError(f"need {self.n_robots} poses, got {len(poses)}")
+        for body, control, pose in zip(self.bodies, self.controls, poses, strict=True):
+            x, y, yaw = (float(v) for v in pose)
+            for b in (body, control):
+                b.position = (x, y)
+                b.angle = yaw
+                b.velocity = (0.0, 0.0)
+                b.angular_velocity = 0.0
+            self.space.reindex_shapes_for_body(body)
+        n = self.n_robots
+        self.collisions = [0] * n
+        self.robot_collisions = 0
+        self.in_contact = [False] * n
+        self._began = [False] * n
+        self._touching = [0] * n
+
+    def pose(self, i: int) -> tuple[float, float, float]:
+        """True pose of robot ``i``."""
+        b = self.bodies[i]._body
+        p = _cp.cpBodyGetPosition(b)
+        return (p.x, p.y, _cp.cpBodyGetAngle(b))
+
+    @property
+    def poses(self) -> list[tuple[float, float, float]]:
+        return [self.pose(i) for i in range(self.n_robots)]
+
+    def step(self, commands: Sequence[tuple[float, float]], dt_s: float) -> list[bool]:
+        """Drive robot ``i`` with body-frame ``commands[i]`` = (v, omega) for ``dt_s``.
+
+        Returns, per robot, whether a new contact (wall or teammate) began. When no robot can
+        touch anything this step (no wall within radius + the step's largest travel + 1 cm of
+        any robot, no two robots within twice that, no contact going on), each moves along its
+        exact arc without the solver, as :meth:`RobotSim.step`; otherwise all robots are
+        integrated together in fixed substeps.
+        """
+        rp = self.robot_params
+        n_sub = self._substeps_for(dt_s)
+        reach = rp.radius_m + rp.max_linear_speed_mps * dt_s + 0.01
+        space_p = self.space._space
+        positions = [_cp.cpBodyGetPosition(b._body) for b in self.bodies]
+        free = all(t == 0 for t in self._touching)
+        if free:
+            for p in positions:
+                near = _cp.cpSpacePointQueryNearest(
+                    space_p, p, reach, self._wall_filter, self._query_info
+                )
+                if near != _ffi.NULL:
+                    free = False
+                    break
+        if free and self.n_robots > 1:
+            xy = np.array([(p.x, p.y) for p in positions])
+            d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+            np.fill_diagonal(d, np.inf)
+            free = bool(d.min() > 2.0 * reach)
+        if free:
+            for i, (v, w) in enumerate(commands):
+                self._drive_free(i, v, w, dt_s)
+                self.in_contact[i] = False
+            return [False] * self.n_robots
+        h = dt_s / n_sub
+        n = self.n_robots
+        self._began = [False] * n
+        for body, control, (_, w) in zip(self.bodies, self.controls, commands, strict=True):
+            control_p = control._body
+            _cp.cpBodySetPosition(control_p, _cp.cpBodyGetPosition(body._body))
+            _cp.cpBodySetAngularVelocity(control_p, w)
+        space = self.space
+        if space._bodies_to_check:
+            space.step(0.0)
+        get_angle, set_velocity, cp_step = (
+            _cp.cpBodyGetAngle,
+            _cp.cpBodySetVelocity,
+            _cp.cpSpaceStep,
+        )
+        pairs = [
+            (b._body, c._body, float(v))
+            for b, c, (v, _) in zip(self.bodies, self.controls, commands, strict=True)
+        ]
+        space._locked = True
+        try:
+            for _ in range(n_sub):
+                for body_p, control_p, v in pairs:
+                    yaw = get_angle(body_p)
+                    set_velocity(control_p, (v * math.cos(yaw), v * math.sin(yaw)))
+                cp_step(space_p, h)
+        finally:
+            space._locked = False
+        self._suppress_begin = [False] * n
+        new = list(self._began)
+        for i in range(n):
+            if new[i]:
+                self.collisions[i] += 1
+            self.in_contact[i] = self._touching[i] > 0
+        return new
+
+    def _substeps_for(self, dt_s: float) -> int:
+        if dt_s != self._substep_dt_key:
+            travel = self.robot_params.max_linear_speed_mps * dt_s
+            pp = self.physics_params
+            self._substeps = min(
+                pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m))
+            )
+            self._substep_dt_key = dt_s
+        return self._substeps
+
+    def _drive_free(self, i: int, v: float, w: float, dt_s: float) -> None:
+        # The exact arc of RobotSim._drive_free.
+        b = self.bodies[i]._body
+        p = _cp.cpBodyGetPosition(b)
+        x, y = p.x, p.y
+        yaw = _cp.cpBodyGetAngle(b)
+        if abs(w) > 1e-9:
+            yaw2 = yaw + w * dt_s
+            x += v / w * (math.sin(yaw2) - math.sin(yaw))
+            y -= v / w * (math.cos(yaw2) - math.cos(yaw))
+        else:
+            yaw2 = yaw
+            x += v * dt_s * math.cos(yaw)
+            y += v * dt_s * math.sin(yaw)
+        _cp.cpBodySetPosition(b, (x, y))
+        _cp.cpBodySetAngle(b, yaw2)
+        _cp.cpBodySetVelocity(b, (v * math.cos(yaw2), v * math.sin(yaw2)))
+        _cp.cpBodySetAngularVelocity(b, w)
+        _cp.cpSpaceReindexShapesForBody(self.space._space, b)
+
+    # Pymunk objects hold C pointers: pickle the inputs and rebuild.
+    def __getstate__(self) -> dict:
+        return {
+            "world": self.world,
+            "robot_params": self.robot_params,
+            "physics_params": self.physics_params,
+            "n_robots": self.n_robots,
+            "poses": self.poses,
+            "velocities": [tuple(b.velocity) for b in self.bodies],
+            "angular_velocities": [float(b.angular_velocity) for b in self.bodies],
+            "collisions": list(self.collisions),
+            "robot_collisions": self.robot_collisions,
+            "touching": [t > 0 for t in self._touching],
+        }
+
+    def __setstate__(self, state: dict) -> None:
+        self.world = state["world"]
+        self.robot_params = state["robot_params"]
+        self.physics_params = state["physics_params"]
+        self.n_robots = state["n_robots"]
+        self._build()
+        self.reset(state["poses"])
+        for b, v, w in zip(
+            self.bodies, state["velocities"], state["angular_velocities"], strict=True
+        ):
+            b.velocity = v
+            b.angular_velocity = w
+        self.collisions = list(state["collisions"])
+        self.robot_collisions = state["robot_collisions"]
+        # The rebuilt space re-detects contacts already counted: do not count them again.
+        self._suppress_begin = list(state["touching"])
+
+
+def sense_with_teammates(
+    lidar: Lidar,
+    true_pose: tuple[float, float, float],
+    map_pose: tuple[float, float, float] | np.ndarray,
+    grids: Sequence[OccupancyGrid],
+    rng: np.random.Generator,
+    teammates_xy_m: np.ndarray,
+    radius_m: float,
+    map_teammates: bool = False,
+) -> np.ndarray:
+    """A scan at ``true_pose`` that sees walls and teammates, fused into each of ``grids``.
+
+    Without a teammate within range (and one grid) this is :meth:`Lidar.sense_and_map`. The
+    random draws (range noise, then dropouts) are the same either way. Teammates are discs of
+    ``radius_m`` at ``teammates_xy_m`` (``(k, 2)``).
+
+    Args:
+        lidar: The robot's LiDAR.
+        true_pose: Where the scan is taken.
+        map_pose: The pose the map is built with (the odometry estimate).
+        grids: The grids to fuse the scan into (the team map, or a robot's own and the team's).
+        rng: The env's random source.
+        teammates_xy_m: ``(k, 2)`` the other robots' true positions.
+        radius_m: Robot radius.
+        map_teammates: Fuse returns from teammates as obstacles. False (default): beams that
+            end on a teammate are left out of the map (the team knows where its robots are),
+            while the returned scan still holds them.
+
+    Returns:
+        The ``(n,)`` float32 scan: 0 = invalid, ``max_range_m`` = no return.
+    """
+    p = lidar.params
+    sx, sy, syaw = lidar.sensor_pose(*true_pose)
+    near = np.zeros(0, dtype=np.float64).reshape(0, 2)
+    if len(teammates_xy_m):
+        d = np.hypot(teammates_xy_m[:, 0] - sx, teammates_xy_m[:, 1] - sy)
+        near = teammates_xy_m[d < p.max_range_m + radius_m]
+    if not len(near) and len(grids) == 1:
+        return lidar.sense_and_map(true_pose, map_pose, grids[0], rng)
+    n = p.n_beams
+    noise = rng.normal(0.0, p.range_noise_std_m, size=n) if p.range_noise_std_m > 0 else None
+    dropped = rng.random(n) < p.dropout_prob if p.dropout_prob > 0 else None
+    beams = lidar.beam_angles_rad
+    ranges = cast_scan(lidar.index, sx, sy, syaw, beams, p.max_range_m)
+    on_teammate = np.zeros(n, dtype=bool)
+    if len(near):
+        th = beams + syaw
+        disc = cast_discs(sx, sy, np.cos(th), np.sin(th), near, radius_m)
+        on_teammate = disc < ranges
+        ranges = np.where(on_teammate, disc, ranges)
+    # The sensor's post-processing, as Lidar.scan and the fused kernel do it.
+    if noise is not None:
+        finite = np.isfinite(ranges)
+        ranges = np.where(finite, ranges + noise, ranges)
+    np.minimum(ranges, p.max_range_m, out=ranges)
+    invalid = ranges < p.min_range_m
+    if dropped is not None:
+        invalid |= dropped
+    ranges[invalid] = 0.0
+    scan = ranges.astype(np.float32)
+    map_ranges = scan.astype(np.float64)
+    if not map_teammates:
+        map_ranges[on_teammate] = 0.0
+    mx, my, myaw = lidar.sensor_pose(*(float(v) for v in map_pose))
+    for grid in grids:
+        grid.integrate_scan(mx, my, myaw, beams, map_ranges, p.max_range_m)
+    return scan

@@ -1,0 +1,91 @@
+"""The team benchmark: ``semexplore benchmark --robots``, its columns, summary and resume."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("pettingzoo")
+
+from semexplore_gym.cli import main  # noqa: E402
+from semexplore_gym.evaluation.team_benchmark import COLUMNS  # noqa: E402
+
+
+def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
+    out = tmp_path / "team"
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze:seed=2,size_m=6",
+        "--robots",
+        "1,2",
+        "--policies",
+        "coordinated,independent",
+        "--runs",
+        "1",
+        "--max-time-s",
+        "30",
+        "--out",
+        str(out),
+        "--no-progress",
+    ]
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert tuple(rows[0]) == COLUMNS
+    assert {(r["policy"], r["n_robots"]) for r in rows} == {
+        ("team_coordinated", "1"),
+        ("team_coordinated", "2"),
+        ("team_independent", "1"),
+        ("team_independent", "2"),
+    }
+    for r in rows:
+        per_robot = [float(v) for v in r["path_per_robot_m"].split(";")]
+        assert len(per_robot) == int(r["n_robots"])
+        assert float(r["path_total_m"]) == pytest.approx(sum(per_robot), abs=0.01)
+        assert 0.0 <= float(r["overlap_ratio"]) <= 1.0
+        if r["n_robots"] == "1":
+            assert float(r["overlap_ratio"]) == 0.0
+        assert float(r["mission_time_s"]) <= 30.0 + 1e-6
+    summary = (out / "summary.md").read_text()
+    assert "T99 / 1 robot" in summary and "overlap" in summary
+    # Rerunning resumes: nothing runs again.
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        assert len(list(csv.DictReader(f))) == 4
+
+
+def test_team_mission_gif(tmp_path: Path) -> None:
+    from semexplore_gym.policies.team import make_team_policy
+
+    from semexplore_gym.envs.multi_robot import make_multi
+    from semexplore_gym.evaluation.team_benchmark import run_team_mission
+
+    env = make_multi(
+        world="maze:seed=2,size_m=6",
+        n_robots=2,
+        render_mode="rgb_array",
+        overrides=["episode.coverage_goal=1.0"],
+    )
+    gif = tmp_path / "team.gif"
+    res = run_team_mission(env, make_team_policy("coordinated"), 0, max_time_s=6.0, gif_path=gif)
+    assert gif.stat().st_size > 0
+    assert res.n_robots == 2 and res.mission_time_s == pytest.approx(6.0)
+
+
+def test_benchmark_robots_with_a_suite(tmp_path: Path) -> None:
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        "name: tiny\nversion: 1\nruns: 1\nmax_time_s: 8\nworlds:\n- maze:seed=3,size_m=6\n"
+    )
+    out = tmp_path / "suite"
+    argv = ["benchmark", "--suite", str(suite), "--robots", "2", "--policies", "greedy"]
+    assert main([*argv, "--out", str(out), "--no-progress"]) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["world"], r["policy"], r["n_robots"]) for r in rows] == [
+        ("maze:seed=3,size_m=6", "team_greedy", "2")
+    ]
+    assert float(rows[0]["mission_time_s"]) == pytest.approx(8.0)
