@@ -267,7 +267,7 @@ def _run(args: argparse.Namespace) -> int:
     if getattr(args, "robots", None):
         from semexplore_gym.evaluation.team_benchmark import run_team_cli
 
-        return run_team_cli(args, _split_worlds(args.worlds or ""))  # or args.suite
+        return run_team_cli(args, split_worlds(args.worlds or ""))  # or args.suite
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")
