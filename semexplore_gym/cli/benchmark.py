@@ -199,6 +199,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
+    p.add_argument(
+        "--oracle",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="also run the privileged oracle (full-knowledge tour) on every (world, seed) and "
+        "write each mission's regret against it (regret.csv, summary.md, regret_ladder.png); "
+        "default: on with --suite, off otherwise",
+    )
     add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
     add_renamed_flag(p, "--set", "use --env-set SECTION.KEY=VALUE (env config override)")
     return p
@@ -245,6 +253,11 @@ def run(args: argparse.Namespace) -> int:
     if not policies:
         raise ValueError("--policies is empty")
     _refuse_repeats("--policies", policies)
+    from semexplore_gym.evaluation.regret import ORACLE_SPEC, write_regret
+
+    with_oracle = args.oracle if args.oracle is not None else args.suite is not None
+    if with_oracle and ORACLE_SPEC not in policies:
+        policies.append(ORACLE_SPEC)
     _check_policies(policies)
     from pathlib import Path
 
@@ -313,6 +326,9 @@ def run(args: argparse.Namespace) -> int:
     )
     summary = write_summary(args.out)
     plots = [] if args.no_plots else write_plots(args.out)
+    if with_oracle:
+        regret = write_regret(args.out, plots=not args.no_plots)
+        plots += [regret["plot"]] if regret["plot"] else []
     print(
         json.dumps(
             {

@@ -58,12 +58,14 @@ class TourParams:
         viewpoint_spacing_m: Side of the blocks holding one candidate viewpoint each.
         prefer_clearance_m: Clearance cap of the candidate score (beyond it all cells tie).
         lkh_runs: LKH restarts.
+        detour_m: The cover's cost offset (:func:`travel_aware_cover`); 0 = plain greedy.
     """
 
     coverage_target: float = 0.995
     viewpoint_spacing_m: float = 0.3
     prefer_clearance_m: float = 0.6
     lkh_runs: int = 3
+    detour_m: float = 2.0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.coverage_target <= 1.0:
@@ -157,6 +159,59 @@ def greedy_cover(
         chosen.append(i)
         cov[cols] = True
         n_cov += g
+    return chosen
+
+
+def travel_aware_cover(
+    visible: sparse.csr_matrix,
+    required: int,
+    covered: np.ndarray,
+    cells_rc: np.ndarray,
+    standing: np.ndarray,
+    start_rc: tuple[int, int],
+    resolution_m: float,
+    detour_m: float,
+) -> list[int]:
+    """Greedy cover by cells per metre: each step takes the row with the most uncovered columns
+    per ``detour_m`` + path length from the nearest point chosen so far (the start first).
+
+    Plain greedy (:func:`greedy_cover`) reaches deep into every dead end for the last cells; this
+    grows the chosen set outward from the start, which keeps the tour through it short. Lazy:
+    gains only shrink and distances are exact each step, so a row's bound is its last gain over
+    its current distance.
+    """
+    n = visible.shape[0]
+    cov = np.asarray(covered, dtype=bool).copy()
+    n_cov = int(cov.sum())
+    indptr, indices = visible.indptr, visible.indices
+    gain_ub = _row_counts(~cov, indptr, indices).astype(np.float64)
+    cost = np.where(standing, resolution_m, np.inf)
+    dist, _ = distance_field(cost, start_rc)
+    cells = np.asarray(cells_rc, dtype=np.int64)
+    chosen: list[int] = []
+    taken = np.zeros(n, dtype=bool)
+    while n_cov < required:
+        d = dist[cells[:, 0], cells[:, 1]]
+        bound = np.where(taken | ~np.isfinite(d), -1.0, gain_ub / (d + detour_m))
+        order = np.argsort(-bound, kind="stable")
+        best, best_val, best_gain = -1, 0.0, 0
+        for i in order:
+            if bound[i] <= best_val:
+                break
+            cols = indices[indptr[i] : indptr[i + 1]]
+            g = int((~cov[cols]).sum())
+            gain_ub[i] = g
+            val = g / (d[i] + detour_m)
+            if val > best_val:
+                best, best_val, best_gain = int(i), val, g
+        if best < 0:
+            break
+        chosen.append(best)
+        taken[best] = True
+        cov[indices[indptr[best] : indptr[best + 1]]] = True
+        n_cov += best_gain
+        d_new, _ = distance_field(cost, (int(cells[best, 0]), int(cells[best, 1])))
+        np.minimum(dist, d_new, out=dist)
     return chosen
 
 
@@ -263,7 +318,12 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
     coverable[vis.indices] = True
     n_mask = max(1, mask_flat.size)
     required = min(int(math.ceil(prm.coverage_target * n_mask)), int(coverable.sum()))
-    chosen = greedy_cover(vis, required, covered0)
+    if prm.detour_m > 0:
+        chosen = travel_aware_cover(
+            vis, required, covered0, candidates, standing, start_rc, res, prm.detour_m
+        )
+    else:
+        chosen = greedy_cover(vis, required, covered0)
     nodes = np.vstack([np.array([start_rc], dtype=np.int64), candidates[chosen]])
     dist = geodesic_matrix(standing, geo, nodes)
     order = open_tour_order(dist, prm.lkh_runs)
