@@ -13,8 +13,8 @@
    paths over the standing mask (:func:`geodesic_matrix`, the project's grid Dijkstra);
 4. an **open tour** from the start through every viewpoint (:func:`open_tour_order`): LKH
    (Helsgaun's Lin-Kernighan heuristic, through the ``elkai`` package; optional extra
-   ``oracle``) on the distance matrix with a dummy end node that is 0 from everywhere, so the
-   closed tour through it is the open path. LKH with a fixed seed is deterministic.
+   ``oracle``) on the distance matrix with a dummy node between the path's end and the start
+   (see :func:`open_tour_order`), so the closed tour through it is the open path. LKH with a fixed seed is deterministic.
 
 The tour length is an upper bound on the shortest drive that sees the target share with this
 sensor model: set cover and TSP are both solved approximately, and the viewpoints are limited to
@@ -265,8 +265,9 @@ def _elkai() -> object:
 def open_tour_order(distances_m: np.ndarray, runs: int = 3) -> list[int]:
     """An open path from node 0 through every node, short by LKH (through ``elkai``).
 
-    A dummy node at distance 0 from all closes the path into a tour; distances go to LKH as
-    integer millimetres (LKH's weights are integers). Unreachable pairs get a large finite cost.
+    A dummy node closes the path into a tour (0 from node 0, the same large constant from every
+    other node, so the tour enters node 0 from it); distances go to LKH as integer millimetres
+    (LKH's weights are integers). Unreachable pairs get a large finite cost.
 
     Returns:
         Node indices in visiting order, starting with 0.
@@ -278,8 +279,12 @@ def open_tour_order(distances_m: np.ndarray, runs: int = 3) -> list[int]:
     finite = d[np.isfinite(d)]
     big = 10.0 * (float(finite.max()) + 1.0) * k
     mm = np.rint(np.where(np.isfinite(d), d, big) * 1000.0).astype(np.int64)
+    # The dummy is 0 from node 0 and a constant M from every other node: every tour through
+    # the edge (dummy, 0) pays M once, any other pays it twice, so node 0 is an end of the path.
     full = np.zeros((k + 1, k + 1), dtype=np.int64)
     full[:k, :k] = mm
+    m_const = int(mm.max()) * (k + 1) + 1
+    full[k, 1:k] = full[1:k, k] = m_const
     elkai = _elkai()
     cycle = elkai.DistanceMatrix(full.tolist()).solve_tsp(runs=int(runs))  # type: ignore[attr-defined]
     cycle = [int(v) for v in cycle[:-1]]
