@@ -102,6 +102,12 @@ def _oracle(arg: str, overrides: dict[str, Any]) -> Policy:
     """The privileged full-knowledge explorer (:mod:`semexplore_gym.policies.oracle`)."""
     from semexplore_gym.policies.oracle import OracleParams, OraclePolicy
 
+    from semexplore_gym.core.coverage_tour.tour import require_solver
+
+    try:
+        require_solver()
+    except ImportError as e:
+        raise ValueError(str(e)) from None
     if arg:
         raise ValueError(f"policy 'oracle' takes no argument, got 'oracle:{arg}'")
     return OraclePolicy(build_params(OracleParams, overrides.pop("params", None), overrides))

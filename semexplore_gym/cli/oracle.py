@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from typing import Any
 
 #: Keys of the ``--json`` object, in order.
 JSON_KEYS: tuple[str, ...] = (
@@ -74,9 +75,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def static_bound(
     world: str,
     start_seed: int = 0,
-    env_config: object = None,
+    env_config: Any = None,
     env_overrides: list[str] | None = None,
-) -> dict[str, object]:
+) -> dict[str, Any]:
     """The static tour of ``world`` from the start of ``env.reset(seed=start_seed)``, as the
     ``--json`` object of ``semexplore oracle``.
 
@@ -113,7 +114,10 @@ def static_bound(
 
 
 def run(args: argparse.Namespace) -> int:
-    out = static_bound(args.world, args.start_seed, args.env_config, args.env_overrides)
+    try:
+        out = static_bound(args.world, args.start_seed, args.env_config, args.env_overrides)
+    except ImportError as e:  # the optional solver: one line saying what to install
+        raise ValueError(str(e)) from None
     if args.json:
         print(json.dumps(out))
     else:

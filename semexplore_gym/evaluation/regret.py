@@ -183,6 +183,7 @@ def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Pa
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        from matplotlib.ticker import FormatStrFormatter, NullFormatter
     except ImportError as e:  # pragma: no cover - the render extra is missing
         raise ImportError(
             "the regret ladder needs matplotlib: pip install 'semexplore-gym[render]'"
@@ -210,6 +211,13 @@ def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Pa
             ax.plot([min(med, 50.0)], [y], "o", color="k" if name == "oracle" else "C0")
         ax.set_yticks(range(len(names)), names)
         ax.set_xscale("log")
+        top = max([np.percentile(v, 75) for v in by_policy.values()] + [2.0])
+        ax.set_xlim(0.9, min(50.0, float(top)) * 1.15)
+        ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xticks(
+            [t for t in (1, 1.5, 2, 3, 5, 10, 20, 50) if t <= min(50.0, float(top)) * 1.15]
+        )
         ax.axvline(1.0, color="0.7", lw=1, ls="--")
         ax.set_xlabel("T99 ÷ oracle's (median, IQR)")
         ax.set_title(fam)

@@ -254,6 +254,11 @@ def geodesic_matrix(
     return out
 
 
+def require_solver() -> None:
+    """Raise ImportError (saying how to install it) when the tour solver is missing."""
+    _elkai()
+
+
 def _elkai() -> object:
     try:
         import elkai
