@@ -61,6 +61,8 @@ class TourParams:
         prefer_clearance_m: Clearance cap of the candidate score (beyond it all cells tie).
         lkh_runs: LKH restarts.
         detour_m: The cover's cost offset (:func:`travel_aware_cover`); 0 = plain greedy.
+        max_candidates: On bigger maps the lattice is coarsened until it has at most this many
+            candidates (memory: each holds up to ``pi R^2`` visible cells).
     """
 
     coverage_target: float = 0.995
@@ -68,6 +70,7 @@ class TourParams:
     prefer_clearance_m: float = 0.6
     lkh_runs: int = 3
     detour_m: float = 2.0
+    max_candidates: int = 6000
 
     def __post_init__(self) -> None:
         if not 0.0 < self.coverage_target <= 1.0:
@@ -84,6 +87,10 @@ class TourParams:
             )
         if not (math.isfinite(self.detour_m) and self.detour_m >= 0):
             raise ValueError(f"TourParams.detour_m must be >= 0, got {self.detour_m!r}")
+        if not (isinstance(self.max_candidates, int) and self.max_candidates >= 1):
+            raise ValueError(
+                f"TourParams.max_candidates must be an integer >= 1, got {self.max_candidates!r}"
+            )
         if not (isinstance(self.lkh_runs, int) and self.lkh_runs >= 1):
             raise ValueError(f"TourParams.lkh_runs must be an integer >= 1, got {self.lkh_runs!r}")
 
@@ -323,6 +330,9 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
     index = SegmentIndex(facts.world.segments_m)
     spacing = max(1, int(round(prm.viewpoint_spacing_m / res)))
     candidates = candidate_viewpoints(standing, clearance, spacing)
+    while candidates.shape[0] > prm.max_candidates:  # big maps: a coarser lattice
+        spacing += max(1, spacing // 4)
+        candidates = candidate_viewpoints(standing, clearance, spacing)
     start_rc = nearest_allowed_cell(standing, geo, facts.start_pose[:2])
     seen_start = visible_sets(facts.world, geo, np.array([start_rc]), facts.sensor, mask, index)
     vis = visible_sets(facts.world, geo, candidates, facts.sensor, mask, index)

@@ -187,8 +187,10 @@ def visible_sets(
         half,
         consts,
     )
+    small = np.int32 if flat.size < 2**31 and indices.size < 2**31 else np.int64
     return sparse.csr_matrix(
-        (np.ones(indices.size, dtype=bool), indices, indptr), shape=(n, flat.size)
+        (np.ones(indices.size, dtype=bool), indices.astype(small), indptr.astype(small)),
+        shape=(n, flat.size),
     )
 
 
