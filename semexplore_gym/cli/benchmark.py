@@ -257,6 +257,12 @@ def run(args: argparse.Namespace) -> int:
 
     with_oracle = args.oracle if args.oracle is not None else args.suite is not None
     if with_oracle and ORACLE_SPEC not in policies:
+        from semexplore_gym.core.coverage_tour.tour import require_solver
+
+        try:
+            require_solver()
+        except ImportError as e:
+            raise ValueError(f"{e}; or leave the oracle out: --no-oracle") from None
         policies.append(ORACLE_SPEC)
     _check_policies(policies)
     from pathlib import Path

@@ -72,3 +72,28 @@ def test_write_regret_adds_a_csv_a_summary_section_and_is_idempotent(tmp_path):
     text = (tmp_path / "summary.md").read_text()
     assert text.startswith("# Benchmark") and text.count(SECTION_TITLE) == 1
     assert "### maze" in text and "### cave" in text and "### all worlds" in text
+
+
+def test_benchmark_with_the_oracle_writes_the_regret(tmp_path, capsys):
+    import json
+
+    import pytest
+
+    from semexplore_gym.cli import main
+    from semexplore_gym.evaluation.harness import read_runs
+
+    pytest.importorskip("elkai")
+    base = ["benchmark", "--worlds", "maze:seed=1,size_m=4", "--policies", "nearest", "--runs", "1"]
+    base += ["--max-time-s", "400", "--no-progress"]
+    assert main([*base, "--out", str(tmp_path / "plain")]) == 0
+    assert not (tmp_path / "plain" / "regret.csv").exists()  # off by default without --suite
+    capsys.readouterr()
+    assert main([*base, "--oracle", "--out", str(tmp_path / "with")]) == 0
+    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    assert report["failed"] == 0
+    rows = read_runs(tmp_path / "with" / "runs.csv")
+    oracle = next(r for r in rows if r["policy"] == "oracle")
+    assert oracle["coverage"] >= 0.99 and oracle["collisions"] == 0 and oracle["self_stopped"]
+    assert (tmp_path / "with" / "regret.csv").exists()
+    assert (tmp_path / "with" / "regret_ladder.png").exists()
+    assert SECTION_TITLE in (tmp_path / "with" / "summary.md").read_text()
