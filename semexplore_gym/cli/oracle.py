@@ -1,7 +1,8 @@
 """``semexplore oracle``: the full-knowledge coverage tour of a world, without driving it.
 
 Plans the oracle explorer's static tour (:func:`semexplore_gym.core.coverage_tour.plan_coverage_tour`)
-from the start pose a mission with ``--start-seed N`` would get (``env.reset(seed=N)``) and prints
+from the start pose a benchmark's seed N gets (``env.reset(seed=N)``: a random free pose, or the
+world's own with ``--fixed-start``) and prints
 its length, the time to drive it at top speed, the number of viewpoints and the share of the
 reachable area they see. PRIVILEGED: it reads the true world.
 
@@ -51,7 +52,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--start-seed",
         type=int,
         default=0,
-        help="seed of env.reset that picks the start (default: 0)",
+        help="seed of env.reset that picks the start: the start of a benchmark's seed N "
+        "(default: 0)",
+    )
+    p.add_argument(
+        "--fixed-start",
+        action="store_true",
+        help="start at the world's own start pose, as 'benchmark --fixed-start' does (default: "
+        "a random free pose drawn from --start-seed, as benchmark does)",
     )
     p.add_argument(
         "--env-config", default=None, help="env config: preset name or YAML path (default: default)"
@@ -115,7 +123,9 @@ def static_bound(
 
 def run(args: argparse.Namespace) -> int:
     try:
-        out = static_bound(args.world, args.start_seed, args.env_config, args.env_overrides)
+        start = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
+        overrides = start + args.env_overrides
+        out = static_bound(args.world, args.start_seed, args.env_config, overrides)
     except ImportError as e:  # the optional solver: one line saying what to install
         raise ValueError(str(e)) from None
     if args.json:
