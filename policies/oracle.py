@@ -50,7 +50,7 @@ from semexplore_gym.core.coverage_tour import (
     open_tour_order,
     plan_coverage_tour,
 )
-from semexplore_gym.core.coverage_tour.tour import _row_counts
+from semexplore_gym.core.coverage_tour.tour import row_counts
 from semexplore_gym.core.coverage_tour.viewpoints import (
     nearest_allowed_cell,
     visible_sets,
@@ -293,7 +293,7 @@ class OraclePolicy(Policy):
             return
         unseen = self._unseen(grid)
         sub = tour.visible[self._left]
-        gains = _row_counts(unseen, sub.indptr, sub.indices)
+        gains = row_counts(unseen, sub.indptr, sub.indices)
         if (gains >= self.params.min_gain_cells).all():
             return
         seen = ~unseen
@@ -381,7 +381,7 @@ class OraclePolicy(Policy):
         vis = visible_sets(
             self.facts.world, self.geometry, cand, self.facts.sensor, self.facts.reachable_mask
         )
-        gains = _row_counts(unseen, vis.indptr, vis.indices)
+        gains = row_counts(unseen, vis.indptr, vis.indices)
         dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
         d = dist[cand[:, 0], cand[:, 1]]
         useful = (gains >= self.params.min_gain_cells) & np.isfinite(d)

@@ -154,7 +154,7 @@ def greedy_cover(
     cov = np.zeros(m, dtype=bool) if covered is None else np.asarray(covered, dtype=bool).copy()
     n_cov = int(cov.sum())
     indptr, indices = visible.indptr, visible.indices
-    gains = _row_counts(~cov, indptr, indices)
+    gains = row_counts(~cov, indptr, indices)
     heap = [(-int(g), i) for i, g in enumerate(gains) if g > 0]
     heapq.heapify(heap)
     chosen: list[int] = []
@@ -195,7 +195,7 @@ def travel_aware_cover(
     cov = np.asarray(covered, dtype=bool).copy()
     n_cov = int(cov.sum())
     indptr, indices = visible.indptr, visible.indices
-    gain_ub = _row_counts(~cov, indptr, indices).astype(np.float64)
+    gain_ub = row_counts(~cov, indptr, indices).astype(np.float64)
     cost = np.where(standing, resolution_m, np.inf)
     dist, _ = distance_field(cost, start_rc)
     cells = np.asarray(cells_rc, dtype=np.int64)
@@ -226,7 +226,7 @@ def travel_aware_cover(
     return chosen
 
 
-def _row_counts(flags: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
+def row_counts(flags: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """Per CSR row, how many of its columns are set in ``flags`` (no sparse product, no copies
     of the matrix)."""
     n = indptr.size - 1
