@@ -3,7 +3,8 @@
 Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
 value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier"`` (ROS frontier_exploration
-baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"sb3:<model.zip>"`` (a
+baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"oracle"`` (privileged:
+reads the true world, a yardstick for benchmarks, :mod:`semexplore_gym.policies.oracle`), ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
 agent with the expert driving), ``"py:<module or file.py>:<Name>"`` (your own
 :class:`~semexplore_gym.policies.base.Policy` subclass or factory, so ``semexplore benchmark`` can compare it
@@ -100,6 +101,21 @@ def _random(arg: str, overrides: dict[str, Any]) -> Policy:
             f"policy 'random' takes no argument or parameters, got {arg!r} and {sorted(overrides)}"
         )
     return RandomPolicy()
+
+
+def _oracle(arg: str, overrides: dict[str, Any]) -> Policy:
+    """The privileged full-knowledge explorer (:mod:`semexplore_gym.policies.oracle`)."""
+    from semexplore_gym.policies.oracle import OracleParams, OraclePolicy
+
+    from semexplore_gym.core.coverage_tour.tour import require_solver
+
+    try:
+        require_solver()
+    except ImportError as e:
+        raise ValueError(str(e)) from None
+    if arg:
+        raise ValueError(f"policy 'oracle' takes no argument, got 'oracle:{arg}'")
+    return OraclePolicy(build_params(OracleParams, overrides.pop("params", None), overrides))
 
 
 def _sb3(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -225,6 +241,7 @@ def policy_factories() -> dict[str, Factory]:
         "frontier": _frontier,
         "nearest": _nearest,
         "random": _random,
+        "oracle": _oracle,
         "sb3": _sb3,
         "pretrained": _pretrained,
         "py": _python,

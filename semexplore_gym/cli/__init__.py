@@ -23,6 +23,7 @@ SUBCOMMANDS: dict[str, str] = {
     "compare-weights": "compare_weights",
     "maps": "maps",
     "pretrained": "pretrained",
+    "oracle": "oracle",
 }
 
 

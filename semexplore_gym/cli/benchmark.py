@@ -184,6 +184,14 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
+    p.add_argument(
+        "--oracle",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="also run the privileged oracle (full-knowledge tour) on every (world, seed) and "
+        "write each mission's regret against it (regret.csv, summary.md, regret_ladder.png); "
+        "default: on with --suite, off otherwise",
+    )
 
 
 def _suite_tasks(
@@ -272,6 +280,17 @@ def _run(args: argparse.Namespace) -> int:
     if not policies:
         raise ValueError("--policies is empty")
     refuse_repeats("--policies", policies)
+    from semexplore_gym.evaluation.regret import ORACLE_SPEC, write_regret
+
+    with_oracle = args.oracle if args.oracle is not None else args.suite is not None
+    if with_oracle and ORACLE_SPEC not in policies:
+        from semexplore_gym.core.coverage_tour.tour import require_solver
+
+        try:
+            require_solver()
+        except ImportError as e:
+            raise ValueError(f"{e}; or leave the oracle out: --no-oracle") from None
+        policies.append(ORACLE_SPEC)
     _check_policies(policies)
     suites: list[dict[str, Any]] = []
     if args.suite is not None:
@@ -311,6 +330,9 @@ def _run(args: argparse.Namespace) -> int:
     )
     summary = write_summary(args.out)
     plots = [] if args.no_plots else write_plots(args.out)
+    if with_oracle:
+        regret = write_regret(args.out, plots=not args.no_plots)
+        plots += [regret["plot"]] if regret["plot"] else []
     print(
         json.dumps(
             {

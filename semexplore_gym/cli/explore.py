@@ -46,7 +46,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--policy",
         default=None,
         help="policy spec: semantic (default), semantic-paper (the paper's method alone), "
-        "frontier, nearest, random, pretrained:NAME (see 'semexplore pretrained'), "
+        "frontier, nearest, random, oracle (PRIVILEGED: reads the true world through the env's "
+        "privileged channel; a full-knowledge yardstick, not an explorer), pretrained:NAME (see 'semexplore pretrained'), "
         "sb3:MODEL.zip, py:FILE.py:CLASS or py:package.module:CLASS (your own Policy); a bracket sets "
         "parameters, 'semantic[cost.w_v=0;cost.w_p=0]' (the spelling benchmark and "
         "compare-weights use; applied after --policy-set). sb3: and py: specs run code from "

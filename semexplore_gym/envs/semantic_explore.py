@@ -11,6 +11,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from semexplore_gym.core.coverage_tour.problem import PRIVILEGED_INFO_KEY
 from semexplore_gym.core.features.map_window import map_window, window_origin
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
@@ -155,6 +156,12 @@ class SemanticExploreEnv(gym.Env):
       ``robot``, ``lidar``, ``dt_s``) in every ``info``; ``"reset"`` puts them only in the
       ``info`` of ``reset``, so each step's ``info`` holds only what changes (cheaper to merge
       in gymnasium's vector envs, which batch every ``info`` key per step).
+    - ``privileged``: False (default). True adds the ground truth to the ``info`` of ``reset``
+      (only there): ``info["privileged_world"]``, a
+      :class:`~semexplore_gym.core.coverage_tour.problem.PrivilegedWorld` (true world, start
+      pose, reachable mask, LiDAR model). The one channel through which privileged policies (the
+      oracle explorer) read the true world; observations are unchanged. Learning code never
+      sets it.
 
     ## Info
     ``map_geometry``, ``robot``, ``lidar``, ``dt_s``, ``coverage``, ``explored_area_m2`` (free
@@ -176,9 +183,10 @@ class SemanticExploreEnv(gym.Env):
       a dict of per-field arrays.
     - v0, issue #17: the ``map_observation`` (``"window"``, ``"shared"``) and ``static_info``
       (``"reset"``) options, off by default (the default observations and ``info`` are unchanged).
-    - v0, issue #28 (no change to observations, rewards or dynamics): the speed options are
+    - v0, 0.2 (no change to observations, rewards or dynamics): the speed options are
       one :class:`ObservationOptions` (``observation_options=``); the fast path the vector env
       uses is public (:meth:`advance`, :meth:`write_obs_into`, :meth:`info_numbers`).
+    - v0, 0.2: the ``privileged`` option (off by default; nothing changes without it).
 
     ## Speed
     ``python scripts/bench_env.py`` times the step stage by stage; ``scripts/bench_vector_env.py``
@@ -205,9 +213,11 @@ class SemanticExploreEnv(gym.Env):
         overrides: list[str] | None = None,
         render_mode: str | None = None,
         observation_options: ObservationOptions | None = None,
+        privileged: bool = False,
         **option_fields: Any,
     ) -> None:
         super().__init__()
+        self.privileged = bool(privileged)
         opts = ObservationOptions.from_flags(observation_options, **option_fields)
         self.observation_options = opts
         # Read by wrappers and tools; the options object is the one source.
@@ -354,9 +364,29 @@ class SemanticExploreEnv(gym.Env):
         self._true_pose = self.sim.pose
         self._scan = self._sense_and_map(self._true_pose)
         info = self._info({"free_area_change": 0.0, "time": 0.0, "collision": 0.0}, True)
+        if self.privileged:
+            info[PRIVILEGED_INFO_KEY] = self._privileged_world(pose, reach)
         if self.render_mode == "human":
             self.render()
         return self._obs(), info
+
+    def _privileged_world(self, pose: tuple[float, float, float], reach: np.ndarray) -> Any:
+        from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld, SensorModel
+
+        cfg = self.config
+        reach = reach.copy()
+        reach.flags.writeable = False
+        return PrivilegedWorld(
+            world=self.world,
+            geometry=self.map_geometry,
+            start_pose=pose,
+            radius_m=cfg.robot.radius_m,
+            clearance_m=cfg.robot.radius_m + 0.01,
+            reachable_mask=reach,
+            sensor=SensorModel(cfg.lidar.n_beams, cfg.lidar.max_range_m, cfg.lidar.min_range_m),
+            max_linear_speed_mps=cfg.robot.max_linear_speed_mps,
+            coverage_goal=cfg.episode.coverage_goal,
+        )
 
     def step(
         self, action: np.ndarray

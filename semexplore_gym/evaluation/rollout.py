@@ -163,9 +163,11 @@ def map_observation_for(policy: Any) -> dict[str, Any]:
     that point (successive observations share the map). Any other policy gets the default
     fresh copy per step.
     """
+    # A privileged policy (the oracle) gets the true world in reset's info; no other does.
+    privileged = {"privileged": True} if getattr(policy, "privileged", False) else {}
     if getattr(policy, "reads_map_in_step_only", False):
-        return {"map_observation": "shared", "disable_env_checker": True}
-    return {}
+        return {"map_observation": "shared", "disable_env_checker": True, **privileged}
+    return privileged
 
 
 def time_to_coverage(trace: list[tuple[float, float, float]], level: float) -> float | None:

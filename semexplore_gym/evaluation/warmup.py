@@ -83,11 +83,17 @@ def warm_up(
         f"episode.max_time_s={WARMUP_TIME_S!r}",
     ]
     with event.install_listener("numba:compile", _OnCompile()):
+        policy = make_policy()
+        # A privileged policy (the oracle) needs the true world in reset's info.
+        privileged = {"privileged": True} if getattr(policy, "privileged", False) else {}
         env = gym.make(
-            "SemanticExplore-v0", world=WARMUP_WORLD, config=config, overrides=env_overrides
+            "SemanticExplore-v0",
+            world=WARMUP_WORLD,
+            config=config,
+            overrides=env_overrides,
+            **privileged,
         )
         try:
-            policy = make_policy()
             obs, info = env.reset(seed=0)
             policy.reset(obs, info, seed=0)
             while True:

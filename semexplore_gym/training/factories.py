@@ -50,6 +50,9 @@ def make_learner_env(cfg: TrainConfig, max_episode_steps: int | None = None) -> 
 
 def make_expert(cfg: TrainConfig) -> Any:
     """The labelling expert ``cfg.expert.spec`` (a ``semexplore_gym.policies.registry`` spec)."""
+    from semexplore_gym.policies.oracle import refuse_privileged
     from semexplore_gym.policies.registry import make_policy
 
-    return make_policy(cfg.expert.spec)
+    expert = make_policy(cfg.expert.spec)
+    refuse_privileged(expert, "training expert")
+    return expert

@@ -1,0 +1,480 @@
+"""The oracle explorer: a full-knowledge coverage tour, driven by the expert's navigation stack.
+
+**Privileged.** Unlike every other policy, the oracle reads the true world: the
+:class:`~semexplore_gym.core.coverage_tour.problem.PrivilegedWorld` that an env made with
+``privileged=True`` puts in the ``info`` of ``reset`` (``info["privileged_world"]``; the mission
+runners ask for it through :func:`semexplore_gym.evaluation.rollout.map_observation_for`, which
+reads :attr:`OraclePolicy.privileged`). Any other env makes :meth:`OraclePolicy.reset` raise, so
+the oracle cannot slip into learning code (training envs are never privileged, and
+``make_expert`` refuses it). It is a yardstick, not an explorer: its times are what a robot
+that knew the building could do with this sensor and this navigation stack.
+
+At ``reset`` it plans the static tour of :func:`~semexplore_gym.core.coverage_tour.plan_coverage_tour`
+(viewpoints that see 99.5 % of the reachable mask, an open LKH tour from the start). While it
+drives:
+
+* every ``check_period_s`` it counts, for each viewpoint left, the cells of its visible set the
+  live map (``obs["map"]``) has not mapped FREE yet. When some viewpoint is no longer needed,
+  it reruns the greedy cover over the viewpoints left on what is still unseen and reorders the
+  survivors by LKH from where the robot is (distances: the stored geodesic matrix plus one
+  Dijkstra from the robot);
+* it drives to each viewpoint along a shortest path on the true standing mask that keeps off
+  the walls, followed by the semantic expert's modified potential field
+  (:func:`~semexplore_gym.core.planning.potential_field.potential_field_command`, the expert's
+  parameters) with the expert's stuck recovery (:class:`~semexplore_gym.policies.navigation.BackoffRecovery`,
+  :class:`~semexplore_gym.policies.navigation.ProgressWatch`); a viewpoint not reached within
+  its time budget is dropped;
+* when the tour runs out below the goal it drives to the nearest standing cell near a cell
+  still unseen; it stops once ``info["coverage"]`` reaches the env's coverage goal, or nothing
+  is left to see.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
+from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
+
+from semexplore_gym.core.coverage_tour import (
+    PRIVILEGED_INFO_KEY,
+    CoverageTour,
+    PrivilegedWorld,
+    TourParams,
+    greedy_cover,
+    open_tour_order,
+    plan_coverage_tour,
+)
+from semexplore_gym.core.coverage_tour.tour import row_counts
+from semexplore_gym.core.coverage_tour.viewpoints import (
+    nearest_allowed_cell,
+    visible_sets,
+    wall_clearance_m,
+)
+from semexplore_gym.core.grid import FREE
+from semexplore_gym.core.planning.grid_scan import known_cell_count
+from semexplore_gym.core.planning.grid_search import distance_field, shortest_path_cells
+from semexplore_gym.core.planning.potential_field import (
+    PotentialFieldParams,
+    RobotLimits,
+    beam_angles_rad,
+    potential_field_command,
+    resample_polyline,
+)
+
+__all__ = ["OracleParams", "OraclePolicy", "PrivilegedPolicyError", "refuse_privileged"]
+
+_NOT_PRIVILEGED = (
+    "the oracle is a privileged policy: it needs the true world, which only an env made with "
+    "privileged=True hands out (info['privileged_world'] at reset); the mission runners "
+    "(semexplore explore/benchmark) do that for it, learning code never does"
+)
+
+
+class PrivilegedPolicyError(ValueError):
+    """A privileged policy was used where only honest policies belong."""
+
+
+def refuse_privileged(policy: Any, where: str) -> None:
+    """Raise :class:`PrivilegedPolicyError` when ``policy`` reads ground truth (learning code)."""
+    if getattr(policy, "privileged", False):
+        raise PrivilegedPolicyError(
+            f"{where}: policy {getattr(policy, 'name', policy)!r} is privileged (reads the true "
+            "world) and cannot be used here"
+        )
+
+
+@dataclass(frozen=True)
+class OracleParams:
+    """Parameters of :class:`OraclePolicy`.
+
+    Attributes:
+        tour: The static tour's settings.
+        potential_field: The path follower (the expert's defaults).
+        goal_reached_radius_m: A viewpoint within this distance is reached.
+        check_period_s: How often the viewpoints left are checked against the live map.
+        min_gain_cells: A viewpoint that would add fewer unseen cells is not needed.
+        path_prefer_clearance_m: Paths keep this far from walls where they can ...
+        path_wall_cost: ... at up to this extra cost per metre nearer.
+        goal_time_factor: Time budget of a viewpoint: this times its path at top speed ...
+        min_goal_time_s: ... and at least this.
+        stuck_timeout_s: The expert's stuck watch (no motion, no map growth).
+        stuck_radius_m: See ``stuck_timeout_s``.
+        backoff_duration_s: The expert's back-off manoeuvre.
+        backoff_speed_fraction: See ``backoff_duration_s``.
+        max_fallback_goals: Goals beyond the tour (see :meth:`OraclePolicy._fallback_cell`)
+            before the oracle gives up.
+    """
+
+    tour: TourParams = field(default_factory=TourParams)
+    potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
+    goal_reached_radius_m: float = 0.3
+    check_period_s: float = 1.0
+    min_gain_cells: int = 1
+    path_prefer_clearance_m: float = 0.35
+    path_wall_cost: float = 4.0
+    goal_time_factor: float = 3.0
+    min_goal_time_s: float = 20.0
+    stuck_timeout_s: float = 8.0
+    stuck_radius_m: float = 0.25
+    backoff_duration_s: float = 1.5
+    backoff_speed_fraction: float = 0.5
+    max_fallback_goals: int = 30
+
+
+class OraclePolicy(Policy):
+    """PRIVILEGED full-knowledge explorer (see the module docstring): reads the true world from
+    ``info["privileged_world"]`` of a ``privileged=True`` env and drives a precomputed coverage
+    tour with the expert's navigation stack. A benchmark yardstick, never a learner's teacher.
+
+    Args:
+        params: Parameters (default :class:`OracleParams`).
+    """
+
+    name = "oracle"
+    #: Reads ground truth: runners make its env with ``privileged=True``; learning code refuses it.
+    privileged = True
+    reads_map_in_step_only = True
+
+    def __init__(self, params: OracleParams | None = None) -> None:
+        super().__init__()
+        self.params = params if params is not None else OracleParams()
+        self.tour: CoverageTour | None = None
+        self.counters: dict[str, int] = {}
+
+    # ------------------------------------------------------------------ lifecycle
+    def reset(
+        self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
+    ) -> None:
+        super().reset(obs, info, seed=seed)
+        facts = info.get(PRIVILEGED_INFO_KEY)
+        if not isinstance(facts, PrivilegedWorld):
+            raise PrivilegedPolicyError(_NOT_PRIVILEGED)
+        env = read_env_facts(info, type(self).__name__)
+        prm = self.params
+        self.facts = facts
+        self.geometry = env.geometry
+        self.dt_s = env.dt_s
+        self.limits = RobotLimits(
+            radius_m=env.radius_m,
+            max_linear_speed_mps=env.max_linear_speed_mps,
+            max_angular_speed_radps=env.max_angular_speed_radps,
+            max_range_m=env.max_range_m,
+        )
+        t0 = time.perf_counter()
+        self.tour = tour = plan_coverage_tour(facts, prm.tour)
+        self.planning_s = time.perf_counter() - t0
+        res = self.geometry.resolution_m
+        clearance = wall_clearance_m(facts.world, self.geometry, prm.path_prefer_clearance_m)
+        pref = np.clip(1.0 - clearance / prm.path_prefer_clearance_m, 0.0, 1.0)
+        self._drive_cost = np.where(tour.standing, res * (1.0 + prm.path_wall_cost * pref), np.inf)
+        self._geo_cost = np.where(tour.standing, res, np.inf)
+        self._left: list[int] = list(range(tour.n_viewpoints))
+        self._tried: set[tuple[int, int]] = set()
+        self._goal_xy: tuple[float, float] | None = None
+        self._goal_rc: tuple[int, int] | None = None
+        self._goal_kind = ""
+        self._path: np.ndarray | None = None
+        self._progress = 0
+        self._time_s = 0.0
+        self._next_check_s = 0.0
+        self._goal_since_s = 0.0
+        self._goal_budget_s = math.inf
+        self._angles: np.ndarray | None = None
+        self._n_mask = max(1, tour.mask_flat.size)
+        self.counters = {
+            "viewpoints": tour.n_viewpoints,
+            "reached": 0,
+            "skipped": 0,
+            "timeouts": 0,
+            "reorders": 0,
+            "recoveries": 0,
+            "fallback_goals": 0,
+        }
+        self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
+        self._watch = ProgressWatch(
+            prm.stuck_timeout_s, radius_m=prm.stuck_radius_m, min_new_cells=20
+        )
+        self._watch.reset(
+            0.0, (float(obs["pose"][0]), float(obs["pose"][1])), known_cell_count(obs["map"])
+        )
+
+    def mission_metrics(self) -> dict[str, Any]:
+        t = self.tour
+        return {
+            "oracle_tour_m": None if t is None else round(t.length_m, 3),
+            "oracle_viewpoints": None if t is None else t.n_viewpoints,
+        }
+
+    # ------------------------------------------------------------------ stepping
+    def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
+        t_start = time.perf_counter()
+        stats = StepStats()
+        self.last_stats = stats
+        if self.done:
+            return np.zeros(2, dtype=np.float32)
+        grid = obs["map"]
+        p = obs["pose"]
+        pose = (float(p[0]), float(p[1]), float(p[2]))
+        scan = np.asarray(obs["scan"], dtype=np.float64)
+        if self._angles is None or len(self._angles) != len(scan):
+            self._angles = beam_angles_rad(len(scan))
+        if float(info.get("coverage", 0.0)) >= self.facts.coverage_goal:
+            return self._stop("coverage_goal")
+        if self._backoff.active(self._time_s):
+            v, w = self._backoff_command(grid, pose, scan)
+        else:
+            if self._backoff.finish():
+                self._path = None  # replan the way to the goal from here
+            t_plan = time.perf_counter()
+            self._update_goal(grid, pose)
+            stats.global_planning_ms = (time.perf_counter() - t_plan) * 1e3
+            if self.done:
+                return np.zeros(2, dtype=np.float32)
+            v, w = self._follow(grid, pose, scan)
+            self._watch_progress(grid, pose)
+            if self._backoff.active(self._time_s):
+                v, w = self._backoff_command(grid, pose, scan)
+        self._time_s += self.dt_s
+        stats.local_planning_ms = max(
+            0.0, (time.perf_counter() - t_start) * 1e3 - stats.global_planning_ms
+        )
+        lim = self.limits
+        return np.array(
+            [
+                np.clip(v / lim.max_linear_speed_mps, -1, 1),
+                np.clip(w / lim.max_angular_speed_radps, -1, 1),
+            ],
+            dtype=np.float32,
+        )
+
+    def _stop(self, reason: str) -> np.ndarray:
+        self.done = True
+        self.stop_reason = reason
+        return np.zeros(2, dtype=np.float32)
+
+    # ------------------------------------------------------------------ goals
+    def _unseen(self, grid: np.ndarray) -> np.ndarray:
+        """Per reachable-mask cell (``tour.mask_flat`` order): not yet mapped FREE."""
+        assert self.tour is not None
+        return np.asarray(grid).reshape(-1)[self.tour.mask_flat] != FREE
+
+    def _update_goal(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        prm = self.params
+        if self._goal_xy is not None:
+            d = math.hypot(pose[0] - self._goal_xy[0], pose[1] - self._goal_xy[1])
+            if d <= prm.goal_reached_radius_m:
+                self.counters["reached"] += 1
+                self._drop_goal()
+            elif self._time_s - self._goal_since_s > self._goal_budget_s:
+                self.counters["timeouts"] += 1
+                self._drop_goal()
+        if self._goal_xy is None or self._time_s >= self._next_check_s - 1e-9:
+            self._next_check_s = self._time_s + prm.check_period_s
+            self._prune(grid, pose)
+        if self._goal_xy is None:
+            self._next_goal(grid, pose)
+
+    def _drop_goal(self) -> None:
+        if self._goal_kind == "tour" and self._left:
+            self._left.pop(0)
+        self._goal_xy = self._goal_rc = None
+        self._path = None
+
+    def _prune(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        """Drop the viewpoints the live map has made unnecessary; reorder the rest."""
+        tour = self.tour
+        if tour is None or not self._left:
+            return
+        unseen = self._unseen(grid)
+        sub = tour.visible[self._left]
+        gains = row_counts(unseen, sub.indptr, sub.indices)
+        if (gains >= self.params.min_gain_cells).all():
+            return
+        seen = ~unseen
+        # Drop only what the others make redundant: the live map lags the static prediction
+        # (the robot passes near a viewpoint, not on it), so no margin is given away here.
+        coverable = seen.copy()
+        coverable[sub.indices] = True
+        keep = sorted(greedy_cover(sub, int(coverable.sum()), seen))
+        kept = [self._left[i] for i in keep]
+        self.counters["skipped"] += len(self._left) - len(kept)
+        self._left = self._order_from(pose, kept)
+        self.counters["reorders"] += 1
+        if self._goal_kind == "tour" and (
+            not self._left or self._goal_rc != self._rc(self._left[0])
+        ):
+            self._goal_xy = self._goal_rc = None
+            self._path = None
+
+    def _rc(self, vp: int) -> tuple[int, int]:
+        assert self.tour is not None
+        r, c = self.tour.viewpoints_rc[vp]
+        return int(r), int(c)
+
+    def _order_from(self, pose: tuple[float, float, float], vps: list[int]) -> list[int]:
+        """``vps`` as an open LKH tour from the robot's position."""
+        assert self.tour is not None
+        if len(vps) <= 1:
+            return list(vps)
+        here = self._robot_cell(pose)
+        dist, _ = distance_field(self._geo_cost, here)
+        cells = self.tour.viewpoints_rc[vps]
+        d0 = dist[cells[:, 0], cells[:, 1]]
+        k = len(vps)
+        m = np.zeros((k + 1, k + 1))
+        m[0, 1:] = m[1:, 0] = d0
+        m[1:, 1:] = self.tour.distances_m[np.ix_(vps, vps)]
+        order = open_tour_order(m, self.params.tour.lkh_runs)
+        return [vps[i - 1] for i in order[1:]]
+
+    def _robot_cell(self, pose: tuple[float, float, float]) -> tuple[int, int]:
+        assert self.tour is not None
+        try:
+            return nearest_allowed_cell(self.tour.standing, self.geometry, pose[:2])
+        except ValueError:
+            r, c = (int(v) for v in self.geometry.world_to_grid(pose[0], pose[1]))
+            return r, c
+
+    def _next_goal(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        tour = self.tour
+        assert tour is not None
+        while self._left:
+            rc = self._rc(self._left[0])
+            if self._set_goal(rc, "tour", pose):
+                return
+            self._left.pop(0)
+            self.counters["skipped"] += 1
+        rc_fb = self._fallback_cell(grid, pose)
+        if rc_fb is None or not self._set_goal(rc_fb, "fallback", pose):
+            self._stop("nothing_left_to_see")
+            return
+        self.counters["fallback_goals"] += 1
+
+    def _fallback_cell(
+        self, grid: np.ndarray, pose: tuple[float, float, float]
+    ) -> tuple[int, int] | None:
+        """The candidate viewpoint that would see the most still-unseen reachable cells per
+        metre of path (never one tried before), or None when none would see any."""
+        tour = self.tour
+        assert tour is not None
+        unseen = self._unseen(grid)
+        if not unseen.any() or self.counters["fallback_goals"] >= self.params.max_fallback_goals:
+            return None
+        h, w = self.geometry.shape
+        flat = np.zeros(h * w, dtype=bool)
+        flat[tour.mask_flat[unseen]] = True
+        res = self.geometry.resolution_m
+        reach_m = self.facts.sensor.max_range_m
+        near = ndimage.distance_transform_edt(~flat.reshape(h, w)) * res <= reach_m
+        cand = tour.candidates_rc
+        ok = near[cand[:, 0], cand[:, 1]]
+        ok &= np.array([(int(r), int(c)) not in self._tried for r, c in cand], dtype=bool)
+        cand = cand[ok]
+        if cand.shape[0] == 0:
+            return None
+        vis = visible_sets(
+            self.facts.world, self.geometry, cand, self.facts.sensor, self.facts.reachable_mask
+        )
+        gains = row_counts(unseen, vis.indptr, vis.indices)
+        dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
+        d = dist[cand[:, 0], cand[:, 1]]
+        useful = (gains >= self.params.min_gain_cells) & np.isfinite(d)
+        # The nearest one that would reach the goal on its own, else the most cells per metre.
+        needed = math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum())
+        enough = useful & (gains >= needed)
+        score = np.where(enough, 1e9 - d, np.where(useful, gains / (d + 1.0), -1.0))
+        k = int(np.argmax(score))
+        if score[k] < 0:
+            return None
+        rc = (int(cand[k, 0]), int(cand[k, 1]))
+        self._tried.add(rc)
+        return rc
+
+    def _set_goal(self, rc: tuple[int, int], kind: str, pose: tuple[float, float, float]) -> bool:
+        path = self._plan_path(rc, pose)
+        if path is None:
+            return False
+        x, y = self.geometry.grid_to_world(rc[0], rc[1])
+        self._goal_xy, self._goal_rc, self._goal_kind = (float(x), float(y)), rc, kind
+        self._goal_since_s = self._time_s
+        length = float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
+        self._goal_budget_s = max(
+            self.params.min_goal_time_s,
+            self.params.goal_time_factor * length / self.limits.max_linear_speed_mps,
+        )
+        return True
+
+    def _plan_path(
+        self, rc: tuple[int, int], pose: tuple[float, float, float]
+    ) -> np.ndarray | None:
+        here = self._robot_cell(pose)
+        found = shortest_path_cells(self._drive_cost, here, rc)
+        if found is None:
+            return None
+        cells, _ = found
+        xs, ys = self.geometry.grid_to_world(cells[:, 0], cells[:, 1])
+        pts = np.vstack([[pose[0], pose[1]], np.column_stack([xs, ys])])
+        self._path = resample_polyline(pts, self.geometry.resolution_m)
+        self._progress = 0
+        return self._path
+
+    # ------------------------------------------------------------------ driving
+    def _follow(
+        self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
+    ) -> tuple[float, float]:
+        if self._path is None:
+            assert self._goal_rc is not None
+            if self._plan_path(self._goal_rc, pose) is None:
+                self._drop_goal()
+                return 0.0, 0.0
+        path = self._path
+        assert path is not None
+        cmd = potential_field_command(
+            scan,
+            pose,
+            path,
+            grid,
+            self.geometry,
+            self.limits,
+            self.params.potential_field,
+            start_index=self._progress,
+        )
+        lo = self._progress
+        hi = min(len(path), lo + int(math.ceil(1.5 / self.geometry.resolution_m)) + 1)
+        d = np.hypot(path[lo:hi, 0] - pose[0], path[lo:hi, 1] - pose[1])
+        i = int(np.argmin(d))
+        if d[i] <= 0.5:
+            self._progress = lo + i
+        else:
+            self._path = None  # far off the path: plan again from here next step
+        return cmd.v_mps, cmd.omega_radps
+
+    def _watch_progress(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        if self._watch.update(self._time_s, (pose[0], pose[1]), known_cell_count(grid)):
+            self.counters["recoveries"] += 1
+            self._backoff.start(self._time_s, self.rng)
+            self._watch.hold(self._time_s + self.params.backoff_duration_s, known_cell_count(grid))
+
+    def _backoff_command(
+        self, grid: np.ndarray, pose: tuple[float, float, float], scan: np.ndarray
+    ) -> tuple[float, float]:
+        assert self._angles is not None
+        return self._backoff.command(
+            grid, self.geometry, pose, scan, self._angles, self.limits, self.params.potential_field
+        )
+
+    def overlay(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"text": f"oracle (privileged): {len(self._left)} viewpoint(s) left"}
+        if self._goal_xy is not None:
+            out["goal_m"] = self._goal_xy
+        if self._path is not None:
+            out["paths_m"] = [self._path]
+        if self.tour is not None and self._left:
+            out["frontiers_m"] = [tuple(self.tour.viewpoints_xy_m[i]) for i in self._left]
+        return out

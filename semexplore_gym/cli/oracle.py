@@ -1,0 +1,139 @@
+"""``semexplore oracle``: the full-knowledge coverage tour of a world, without driving it.
+
+Plans the oracle explorer's static tour (:func:`semexplore_gym.core.coverage_tour.plan_coverage_tour`)
+from the start pose a benchmark's seed N gets (``env.reset(seed=N)``: a random free pose, or the
+world's own with ``--fixed-start``) and prints
+its length, the time to drive it at top speed, the number of viewpoints and the share of the
+reachable area they see. PRIVILEGED: it reads the true world.
+
+The tour is an upper bound on the shortest drive that sees that share with the env's LiDAR: the
+set cover (greedy) and the tour (LKH) are solved approximately, on a lattice of viewpoints; the
+time ignores turning, so it is a lower bound on driving this tour.
+
+Example::
+
+    semexplore oracle 'office:seed=1,size_m=20' --start-seed 0 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from typing import Any
+
+#: Keys of the ``--json`` object, in order.
+JSON_KEYS: tuple[str, ...] = (
+    "world",
+    "start_seed",
+    "start_pose",
+    "tour_length_m",
+    "time_at_top_speed_s",
+    "n_viewpoints",
+    "covered_share",
+    "coverable_share",
+    "n_candidates",
+    "planning_s",
+)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    from semexplore_gym.cli import describe
+
+    p = sub.add_parser(
+        "oracle",
+        help="the full-knowledge coverage tour of a world (privileged static bound): length, "
+        "time at top speed, viewpoints, covered share",
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("world", help="a world spelling ('maze:seed=3,size_m=10', maze1, a map file)")
+    p.add_argument(
+        "--start-seed",
+        type=int,
+        default=0,
+        help="seed of env.reset that picks the start: the start of a benchmark's seed N "
+        "(default: 0)",
+    )
+    p.add_argument(
+        "--fixed-start",
+        action="store_true",
+        help="start at the world's own start pose, as 'benchmark --fixed-start' does (default: "
+        "a random free pose drawn from --start-seed, as benchmark does)",
+    )
+    p.add_argument(
+        "--env-config", default=None, help="env config: preset name or YAML path (default: default)"
+    )
+    p.add_argument(
+        "--env-set",
+        dest="env_overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="env config override, e.g. lidar.max_range_m=5 (repeatable)",
+    )
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
+    )
+    return p
+
+
+def static_bound(
+    world: str,
+    start_seed: int = 0,
+    env_config: Any = None,
+    env_overrides: list[str] | None = None,
+) -> dict[str, Any]:
+    """The static tour of ``world`` from the start of ``env.reset(seed=start_seed)``, as the
+    ``--json`` object of ``semexplore oracle``.
+
+    Raises:
+        ValueError: an unknown world, or a start the robot cannot stand at.
+        ImportError: the tour solver (``elkai``) is missing.
+    """
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, plan_coverage_tour
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    if not 0 <= start_seed <= 2**32 - 1:
+        raise ValueError(f"--start-seed must be in 0..2**32-1, got {start_seed}")
+    env = SemanticExploreEnv(world, config=env_config, overrides=env_overrides, privileged=True)
+    try:
+        _, info = env.reset(seed=start_seed)
+    finally:
+        env.close()
+    facts = info[PRIVILEGED_INFO_KEY]
+    t0 = time.perf_counter()
+    tour = plan_coverage_tour(facts)
+    planning_s = time.perf_counter() - t0
+    return {
+        "world": str(world),
+        "start_seed": start_seed,
+        "start_pose": [round(float(v), 4) for v in facts.start_pose],
+        "tour_length_m": round(tour.length_m, 3),
+        "time_at_top_speed_s": round(tour.length_m / facts.max_linear_speed_mps, 2),
+        "n_viewpoints": tour.n_viewpoints,
+        "covered_share": round(tour.covered_share, 5),
+        "coverable_share": round(tour.coverable_share, 5),
+        "n_candidates": tour.n_candidates,
+        "planning_s": round(planning_s, 2),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        start = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
+        overrides = start + args.env_overrides
+        out = static_bound(args.world, args.start_seed, args.env_config, overrides)
+    except ImportError as e:  # the optional solver: one line saying what to install
+        raise ValueError(str(e)) from None
+    if args.json:
+        print(json.dumps(out))
+    else:
+        print(
+            f"{out['world']} (start seed {out['start_seed']}): tour {out['tour_length_m']} m, "
+            f"{out['time_at_top_speed_s']} s at top speed, {out['n_viewpoints']} viewpoints, "
+            f"covered {float(out['covered_share']):.2%} (planned in {out['planning_s']} s)"
+        )
+    return 0

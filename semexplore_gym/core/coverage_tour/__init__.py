@@ -1,0 +1,35 @@
+"""Full-knowledge coverage tours: the oracle explorer's planner (privileged: true map).
+
+* :mod:`.problem`: :class:`PrivilegedWorld` (the ground truth a privileged env hands out) and
+  :class:`SensorModel`;
+* :mod:`.viewpoints`: standing mask, candidate viewpoints, visible sets (the env's LiDAR model);
+* :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`.
+"""
+
+from semexplore_gym.core.coverage_tour.problem import (
+    PRIVILEGED_INFO_KEY,
+    PrivilegedWorld,
+    SensorModel,
+)
+from semexplore_gym.core.coverage_tour.tour import (
+    SOLVER_HINT,
+    CoverageTour,
+    TourParams,
+    geodesic_matrix,
+    greedy_cover,
+    open_tour_order,
+    plan_coverage_tour,
+)
+
+__all__ = [
+    "PRIVILEGED_INFO_KEY",
+    "SOLVER_HINT",
+    "CoverageTour",
+    "PrivilegedWorld",
+    "SensorModel",
+    "TourParams",
+    "geodesic_matrix",
+    "greedy_cover",
+    "open_tour_order",
+    "plan_coverage_tour",
+]

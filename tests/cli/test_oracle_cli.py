@@ -1,0 +1,47 @@
+"""``semexplore oracle``: the static bound's JSON keys and one clear line for bad input."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from semexplore_gym.cli import main
+from semexplore_gym.cli.oracle import JSON_KEYS
+
+pytest.importorskip("elkai")
+
+
+def test_oracle_json_prints_the_documented_keys(capsys):
+    assert main(["oracle", "maze:seed=1,size_m=5", "--start-seed", "3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert tuple(out) == JSON_KEYS
+    assert out["start_seed"] == 3 and out["n_viewpoints"] >= 1
+    assert out["covered_share"] >= 0.995
+    assert out["time_at_top_speed_s"] == pytest.approx(out["tour_length_m"] / 0.22, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["oracle", "nosuch:seed=1"], "unknown world"),
+        (["oracle", "maze1", "--env-set", "episode.start_pose=[0.0,0.0,0.0]"], "start pose"),
+    ],
+)
+def test_bad_input_gets_one_clear_line(argv, words, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and words in err[0]
+
+
+def test_a_missing_solver_is_one_line_saying_what_to_install(monkeypatch, capsys):
+    import sys
+
+    from semexplore_gym.policies.registry import make_policy
+
+    monkeypatch.setitem(sys.modules, "elkai", None)  # import elkai now raises ImportError
+    assert main(["oracle", "maze:seed=1,size_m=5"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pip install" in err[0] and "elkai" in err[0]
+    with pytest.raises(ValueError, match="elkai"):
+        make_policy("oracle")

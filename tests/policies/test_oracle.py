@@ -1,0 +1,89 @@
+"""The oracle explorer: privileged channel, determinism, and short missions on small worlds."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from semexplore_gym.policies.oracle import OraclePolicy, PrivilegedPolicyError, refuse_privileged
+from semexplore_gym.policies.registry import make_policy
+
+import semexplore_gym  # noqa: F401  (registers the env)
+from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, PrivilegedWorld
+from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
+
+pytest.importorskip("elkai")
+
+
+def _env(world: str, privileged: bool) -> gym.Env:
+    return gym.make(
+        "SemanticExplore-v0",
+        world=world,
+        overrides=["episode.max_time_s=900", "episode.random_start=true"],
+        privileged=privileged,
+    )
+
+
+def test_only_a_privileged_env_hands_out_the_true_world():
+    env = _env("maze:seed=0,size_m=4", privileged=False)
+    _, info = env.reset(seed=0)
+    assert PRIVILEGED_INFO_KEY not in info
+    with pytest.raises(PrivilegedPolicyError, match="privileged"):
+        make_policy("oracle").reset(*env.reset(seed=0), seed=0)
+    env = _env("maze:seed=0,size_m=4", privileged=True)
+    obs, info = env.reset(seed=0)
+    facts = info[PRIVILEGED_INFO_KEY]
+    assert isinstance(facts, PrivilegedWorld)
+    assert PRIVILEGED_INFO_KEY not in obs
+    # The env's own coverage denominator, read-only.
+    assert facts.reachable_mask.sum() == env.unwrapped._n_reachable
+    assert not facts.reachable_mask.flags.writeable
+    _, _, _, _, step_info = env.step(np.zeros(2, dtype=np.float32))
+    assert PRIVILEGED_INFO_KEY not in step_info
+
+
+def test_runners_ask_for_the_channel_and_learning_code_refuses_the_oracle():
+    oracle = make_policy("oracle")
+    assert isinstance(oracle, OraclePolicy) and oracle.privileged
+    assert map_observation_for(oracle)["privileged"] is True
+    assert "privileged" not in map_observation_for(make_policy("semantic"))
+    with pytest.raises(PrivilegedPolicyError, match="training expert"):
+        refuse_privileged(oracle, "training expert")
+    refuse_privileged(make_policy("nearest"), "training expert")  # honest: no error
+
+
+def test_make_expert_refuses_the_oracle():
+    from types import SimpleNamespace
+
+    from semexplore_gym.training.factories import make_expert
+
+    with pytest.raises(PrivilegedPolicyError):
+        make_expert(SimpleNamespace(expert=SimpleNamespace(spec="oracle")))  # type: ignore[arg-type]
+
+
+def _mission(world: str, spec: str, seed: int):
+    policy = make_policy(spec)
+    env = gym.make(
+        "SemanticExplore-v0",
+        world=world,
+        overrides=["episode.max_time_s=900", "episode.random_start=true"],
+        **map_observation_for(policy),
+    )
+    return run_mission(env, policy, seed=seed, ignore_terminated=True)
+
+
+@pytest.mark.parametrize("world", ["maze:seed=3,size_m=5", "cave:seed=1,size_m=6"])
+def test_an_oracle_mission_stops_itself_at_the_goal_before_the_expert(world):
+    res = _mission(world, "oracle", seed=1)
+    assert res.self_stopped and res.stop_reason == "coverage_goal"
+    assert res.coverage >= 0.99 and res.collisions == 0
+    expert = _mission(world, "semantic", seed=1)
+    assert res.t99_s is not None
+    assert expert.t99_s is None or res.t99_s <= expert.t99_s
+
+
+def test_the_oracle_is_deterministic_for_a_fixed_seed():
+    a = _mission("maze:seed=3,size_m=4", "oracle", seed=2)
+    b = _mission("maze:seed=3,size_m=4", "oracle", seed=2)
+    assert a.mission_time_s == b.mission_time_s
+    assert np.array_equal(a.trajectory, b.trajectory)
