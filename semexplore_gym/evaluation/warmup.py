@@ -16,7 +16,8 @@ Why not ahead-of-time compilation: numba's AOT (``numba.pycc``) is deprecated, n
 signatures for every kernel and a compiler at install time, and its extension modules would
 replace the ``@njit`` functions the tests and callers use; the disk cache gives the same
 steady state after one run. ``tests/evaluation/test_warmup_first_row.py`` checks, on an empty
-cache, that the first benchmark row's per-call times match the second's.
+cache, that no kernel compiles inside a benchmark's missions and that the first row's per-call
+times are those of the rows after it.
 """
 
 from __future__ import annotations
@@ -42,8 +43,9 @@ FAMILY_WORLDS = (
 #: A world whose map has intersections: segmenting it joins legs at their centres, which the
 #: 3 m maze never does.
 SEGMENTED_WORLD = "maze1"
-#: How long compiling every kernel takes (about 290 kernels, one core busy): 40-60 s measured on
-#: an idle machine, 2.5-4 min on one shared by ~8 jobs; the warm-up prints the real figure.
+#: How long compiling every kernel takes: 296 kernels in 64 s of CPU time, one core (measured
+#: for the semantic expert on an empty cache), so about a minute when that core is free; 3-6 min
+#: of wall time on a 2-core machine shared by ~8 jobs. The warm-up prints the real figure.
 COMPILE_ESTIMATE = "about 1 min on an idle machine, more under load"
 COMPILE_MESSAGE = f"compiling numba kernels (first run only, {COMPILE_ESTIMATE})..."
 #: Keys of the warm-ups this process has done (a process loads a kernel once; the set only
