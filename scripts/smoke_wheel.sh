@@ -36,7 +36,7 @@ step "install it in a fresh venv"
 VPY="$WORK/venv/bin/python"
 "$VPY" -m pip install -q --disable-pip-version-check "$WHEEL"
 export PATH="$WORK/venv/bin:$PATH"
-export PYTHONPATH=  # nothing of the checkout
+unset PYTHONPATH  # nothing of the checkout
 RUN="$WORK/run"
 mkdir "$RUN"
 cd "$RUN"
@@ -50,6 +50,12 @@ assert importlib.util.find_spec("policies") is None
 from semexplore_gym import load_suite, make_policy  # the public API
 from semexplore_gym.core.resources import configs_dir
 assert "site-packages" in str(configs_dir()), configs_dir()
+# Every reproduce line's config is a shipped file (the torch-free one also runs below).
+from semexplore_gym import pretrained_models
+from semexplore_gym.core.resources import resolve_config_path
+for m in pretrained_models():
+    path = resolve_config_path(m.config)
+    assert path.is_file() and "site-packages" in str(path), (m.name, path)
 print(semexplore_gym.__version__, load_suite("paper").worlds[0].world, make_policy("semantic").name)
 EOF
 semexplore --version
