@@ -1,14 +1,29 @@
 """SemanticExplore: semantic topometric exploration with a simulated TurtleBot3.
 
-``import semexplore_gym`` registers the Gymnasium env ``SemanticExplore-v0``::
+``import semexplore_gym`` registers the Gymnasium env ``SemanticExplore-v0`` (and the
+macro-action ids) and stays light: the public API below is imported on first use::
 
     import gymnasium as gym
     import semexplore_gym
     env = gym.make("SemanticExplore-v0", world="maze1")
+    venv = gym.make_vec("SemanticExplore-v0", num_envs=4)      # FastSyncVectorEnv
+
+    from semexplore_gym import make_mission_env, make_policy, run_mission
+    policy = make_policy("semantic")
+    env = make_mission_env("maze1", "paper")
+    result = run_mission(env, policy, seed=0, max_time_s=600)
+    print(result.coverage, result.mission_time_s)
+
+The public names: :func:`make_policy` (policy specs, as ``--policy`` spells them),
+:func:`run_mission` and :func:`make_mission_env`, :func:`record_expert_dataset` with
+:class:`EgocentricParams`, :func:`make_world` and :func:`list_world_names`, :func:`load_suite`
+and :func:`list_suites`, :func:`load_env_config` and :class:`EnvConfig`,
+:func:`pretrained_models`, :class:`FastSyncVectorEnv`, :func:`warm_up`.
 """
 
 from __future__ import annotations
 
+import importlib
 import importlib.machinery
 import importlib.util
 import sys
@@ -16,8 +31,53 @@ from pathlib import Path
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 
-__version__ = "0.1.0"
-__all__ = ["FREE", "OCCUPIED", "UNKNOWN", "GridGeometry", "register_envs", "__version__"]
+__version__ = "0.2.0"
+
+#: The public API served by :func:`__getattr__`: name -> the module that defines it. Imported on
+#: first use, so that ``import semexplore_gym`` (which every ``semexplore_gym.*`` import runs)
+#: pulls in neither gymnasium nor the env, the policies or the runners, and so that the package
+#: root, low in the layer order (tests/test_layers.py), names the layers above it only as data.
+PUBLIC_API: dict[str, str] = {
+    "make_policy": "semexplore_gym.policies.registry",
+    "run_mission": "semexplore_gym.evaluation.rollout",
+    "make_mission_env": "semexplore_gym.evaluation.rollout",
+    "MissionResult": "semexplore_gym.evaluation.rollout",
+    "record_expert_dataset": "semexplore_gym.training.recording",
+    "EgocentricParams": "semexplore_gym.core.features.egocentric",
+    "make_world": "semexplore_gym.core.worlds",
+    "list_world_names": "semexplore_gym.core.worlds",
+    "load_suite": "semexplore_gym.evaluation.suites",
+    "list_suites": "semexplore_gym.evaluation.suites",
+    "load_env_config": "semexplore_gym.envs.config",
+    "EnvConfig": "semexplore_gym.envs.config",
+    "pretrained_models": "semexplore_gym.policies.pretrained",
+    "FastSyncVectorEnv": "semexplore_gym.envs.vector",
+    "warm_up": "semexplore_gym.evaluation.warmup",
+}
+
+__all__ = [
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
+    "GridGeometry",
+    "register_envs",
+    "__version__",
+    *PUBLIC_API,
+]
+
+
+def __getattr__(name: str) -> object:
+    """The public API (:data:`PUBLIC_API`), imported when first asked for."""
+    module = PUBLIC_API.get(name)
+    if module is None:
+        raise AttributeError(f"module 'semexplore_gym' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *PUBLIC_API})
 
 
 def register_envs() -> None:
@@ -29,9 +89,12 @@ def register_envs() -> None:
         "SemanticExploreFrontier-v0": "semexplore_gym.expert_driven_envs:make_frontier_choice_env",
         "SemanticExploreWeights-v0": "semexplore_gym.expert_driven_envs:make_planner_weights_env",
     }
+    # gym.make_vec("SemanticExplore-v0", num_envs=n) builds the batched FastSyncVectorEnv
+    # (vectorization_mode="sync" still gives gymnasium's SyncVectorEnv).
+    vector = {"SemanticExplore-v0": "semexplore_gym.envs.vector:make_vector_env"}
     for env_id, entry_point in ids.items():
         if env_id not in registry:
-            register(id=env_id, entry_point=entry_point)
+            register(id=env_id, entry_point=entry_point, vector_entry_point=vector.get(env_id))
 
 
 class _CheckoutPolicies(importlib.machinery.PathFinder):

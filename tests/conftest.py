@@ -2,9 +2,37 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
+
+#: ``SEMEXPLORE_TEST_HIDE_SHARED=1`` runs the tests as on a clean clone, without ``../shared``
+#: beside the repository: tests marked ``shared_maps`` skip, and ``tests/test_readme.py`` skips
+#: the commands that need the real maps (``.ci/run`` runs it so once more).
+HIDE_SHARED_ENV = "SEMEXPLORE_TEST_HIDE_SHARED"
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
+
+def shared_hidden() -> bool:
+    """Whether ``../shared`` is hidden from the tests (see :data:`HIDE_SHARED_ENV`)."""
+    return os.environ.get(HIDE_SHARED_ENV) == "1"
+
+
+@pytest.fixture(scope="session")
+def shared_dir() -> Path | None:
+    """``../shared`` beside the repository, or None when it is absent or hidden."""
+    return None if shared_hidden() or not SHARED.is_dir() else SHARED
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if not shared_hidden():
+        return
+    skip = pytest.mark.skip(reason=f"../shared hidden ({HIDE_SHARED_ENV}=1)")
+    for item in items:
+        if item.get_closest_marker("shared_maps") is not None:
+            item.add_marker(skip)
 
 
 @pytest.fixture(scope="session")

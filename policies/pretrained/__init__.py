@@ -5,7 +5,7 @@ Each model lives in its own folder here, ``<name>/model.zip`` (an SB3 model) or
 beside the resolved ``config.yaml`` of the ``semexplore train`` run that produced it (a
 macro-action agent reads its settings from it). ``index.yaml`` describes them: what each was trained on, the command and
 config that reproduce it, and its measured results. ``semexplore pretrained`` lists them, one
-line each starting with the policy spec::
+short line each starting with the policy spec (``--details`` for everything else)::
 
     from semexplore_gym.policies.registry import make_policy
     policy = make_policy("pretrained:dagger_maze")
@@ -27,7 +27,16 @@ INDEX_PATH = PRETRAINED_DIR / "index.yaml"
 #: Largest model file shipped (bytes); a test holds every model to it.
 MAX_MODEL_BYTES = 5 * 1024 * 1024
 
-_FIELDS = ("name", "description", "trained_on", "command", "config", "training_time", "results")
+_FIELDS = (
+    "name",
+    "summary",
+    "description",
+    "trained_on",
+    "command",
+    "config",
+    "training_time",
+    "results",
+)
 
 
 @dataclass(frozen=True)
@@ -36,15 +45,18 @@ class PretrainedModel:
 
     Attributes:
         name: Its name: the policy spec is ``pretrained:<name>``.
+        summary: What it is and how it did, in a few words (its line in ``semexplore pretrained``).
         description: What the agent is, in one sentence.
         trained_on: The worlds and the amount of experience it was trained on.
-        command: The ``semexplore train`` command that reproduces it (from a checkout).
-        config: The training config of that command (a path in the repository).
+        command: The ``semexplore train`` command that reproduces it (from any directory: its
+            ``configs/...`` path is found among the shipped configs).
+        config: The training config of that command (``configs/agents/...``, shipped).
         training_time: Wall time of the training run and the machine it ran on.
         results: Its measured results on unseen worlds, and how they were measured.
     """
 
     name: str
+    summary: str
     description: str
     trained_on: str
     command: str
@@ -68,12 +80,21 @@ class PretrainedModel:
         return folder / "model.zip"
 
     def summary_line(self) -> str:
-        """One line: the spec first, then description, training data, command, results."""
-        return (
-            f"{self.spec}  {self.description} Trained on {self.trained_on} "
-            f"(training: {self.training_time}). Reproduce: {self.command} (config {self.config}). "
-            f"Results: {self.results}"
-        )
+        """One short line: the spec, then the summary."""
+        return f"{self.spec:<31} {self.summary}"
+
+    def detail_lines(self) -> list[str]:
+        """Every field of the index, one line each (the command kept whole, to copy)."""
+        rows = [
+            ("what", self.description),
+            ("trained on", self.trained_on),
+            ("training", self.training_time),
+            ("reproduce", self.command),
+            ("config", self.config),
+            ("results", self.results),
+            ("model", str(self.model_path)),
+        ]
+        return [self.spec] + [f"  {k + ':':<12}{v}" for k, v in rows]
 
     def to_dict(self) -> dict[str, Any]:
         """The index fields plus ``spec``, ``model_path`` and ``size_bytes``."""

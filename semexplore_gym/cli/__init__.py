@@ -54,7 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # subcommand not part of this build
             raise
         p = module.add_parser(sub)
-        p.set_defaults(_run=module.run)
+        # _prog names the command in error lines; a subcommand's own sub-parsers (maps get)
+        # set theirs the same way, and theirs win.
+        p.set_defaults(_run=module.run, _prog=p.prog)
     return parser
 
 
@@ -80,8 +82,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         text = one_line(str(e), 600) or type(e).__name__
         if isinstance(e, (RecursionError, MemoryError)):
             text = f"{type(e).__name__}: input too large or too deeply nested ({text})"
-        print(f"semexplore {args.command}: error: {text}", file=sys.stderr)
+        print(f"{error_prefix(args)} {text}", file=sys.stderr)
         return 2
+
+
+def error_prefix(args: argparse.Namespace) -> str:
+    """``semexplore maps get: error:``: the one style of every error line of the command."""
+    return f"{getattr(args, '_prog', None) or f'semexplore {args.command}'}: error:"
 
 
 if __name__ == "__main__":  # pragma: no cover

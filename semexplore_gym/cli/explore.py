@@ -16,6 +16,7 @@ import sys
 from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag, check_output_flag
+from semexplore_gym.evaluation.warmup import COMPILE_ESTIMATE
 
 #: Keys of the ``--json`` object, in order.
 JSON_KEYS: tuple[str, ...] = (
@@ -34,13 +35,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "explore",
         help="run one exploration mission and print coverage, mission time, path length, collisions",
         description="Run one exploration mission of a policy (default: the semantic expert) and "
-        "print its metrics. The first run of a fresh clone compiles the numba kernels (~2 min, "
-        "said on stderr); reported times never include it.",
+        "print its metrics. The first run after installing compiles the numba kernels ("
+        + COMPILE_ESTIMATE
+        + ", said on stderr); reported times never include it.",
     )
     p.add_argument(
         "--world",
         default="maze1",
-        help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json (default: maze1)",
+        help="maze1, maze2, a procedural family with parameters ('maze:seed=3,size_m=10', "
+        "'office:...', 'cave:...', 'forest:...'), a catalogue map 'map:NAME' (semexplore maps "
+        "list), a ROS map .yaml or a HouseExpo .json (default: maze1)",
     )
     p.add_argument(
         "--policy",
@@ -181,6 +185,8 @@ def run(args: argparse.Namespace) -> int:
         env.close()
 
     summary = result.summary()
+    # The spec as given: a policy's own name may shorten it (sb3:model.zip for sb3:runs/x/model.zip).
+    summary["policy"] = spec
     if args.json:
         print(json.dumps({k: summary[k] for k in JSON_KEYS}))
     else:
@@ -203,10 +209,19 @@ def format_result(summary: dict[str, Any]) -> str:
         f"collisions       {summary['collisions']}",
         f"T90_s / T99_s    {_fmt_t(summary['T90_s'])} / {_fmt_t(summary['T99_s'])}",
         f"wall_time_s      {summary['wall_time_s']:.2f}  ({_speedup(summary)}x faster than simulated time)",
-        f"map generation   {summary['mean_map_generation_ms']:.2f} ms mean per call",
-        f"global planning  {summary['mean_global_planning_ms']:.2f} ms mean per replan ({summary['n_replans']} replans)",
-        "stage split (s)  " + ", ".join(f"{k} {v:.3f}" for k, v in summary["stage_time_s"].items()),
     ]
+    # Only the stages the policy has: a learned policy builds no map representation and never
+    # replans, so 0.00 ms would only mislead.
+    stages = summary["stage_time_s"]
+    if stages.get("map_generation", 1.0) > 0:
+        lines.append(f"map generation   {summary['mean_map_generation_ms']:.2f} ms mean per call")
+    if summary["n_replans"] > 0:
+        lines.append(
+            f"global planning  {summary['mean_global_planning_ms']:.2f} ms mean per replan "
+            f"({summary['n_replans']} replans)"
+        )
+    used = {k: v for k, v in stages.items() if v > 0}
+    lines.append("stage split (s)  " + ", ".join(f"{k} {v:.3f}" for k, v in used.items()))
     return "\n".join(lines)
 
 

@@ -64,6 +64,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     path.add_argument("name", nargs="?", default=None, metavar="NAME")
     p.set_defaults(_maps_parser=p)
+    for action in (lst, get, path):
+        action.set_defaults(_prog=action.prog)  # errors read "semexplore maps get: error: ..."
     return p
 
 
@@ -109,7 +111,9 @@ def _get(args: argparse.Namespace) -> int:
                     timeout_s=args.timeout_s,
                 )
         except MapFetchError as e:
-            print(f"semexplore maps get: error: {e}", file=sys.stderr)
+            from semexplore_gym.cli import error_prefix
+
+            print(f"{error_prefix(args)} {e}", file=sys.stderr)
             return 1
         print(f"{name}: {world}")
     return 0

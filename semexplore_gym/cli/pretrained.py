@@ -1,11 +1,13 @@
 """``semexplore pretrained``: the agents shipped inside the package, ready to run.
 
-Each line starts with the policy spec that runs the model (``pretrained:NAME``), then what it
-is, what it was trained on, the command and config that reproduce it, and its measured results.
+One short line per model: the policy spec that runs it (``pretrained:NAME``) and what it is.
+``--details`` adds what it was trained on, the command and config that reproduce it (they run
+from any directory: the ``configs/...`` files ship with the package) and its measured results.
 
 Example::
 
     semexplore pretrained
+    semexplore pretrained --details
     semexplore pretrained --json
     semexplore explore --world maze1 --policy pretrained:dagger_maze
     semexplore benchmark --worlds 'maze:size_m=6,seed=*' --policies semantic,pretrained:frontier_choice_maze --runs 5 --out runs/bench
@@ -29,6 +31,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--json", action="store_true", help="a JSON list (with each model's path and size)"
     )
+    p.add_argument(
+        "--details",
+        action="store_true",
+        help="every field of each model: training data, reproduce command, config, results",
+    )
     return p
 
 
@@ -39,6 +46,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps([m.to_dict() for m in models], indent=2))
         return 0
-    for m in models:
-        print(m.summary_line())
+    for i, m in enumerate(models):
+        if args.details:
+            print(("\n" if i else "") + "\n".join(m.detail_lines()))
+        else:
+            print(m.summary_line())
     return 0

@@ -1,4 +1,4 @@
-"""``semexplore train --algo bc|dagger|ppo|frontier_value --train-config FILE --out DIR``: train an agent.
+"""``semexplore train --algo bc|dagger|ppo|maskable_ppo|frontier_value --train-config FILE --out DIR``: train an agent.
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
@@ -9,14 +9,26 @@ observation instead (``env.macro`` holds its ``MacroParams`` fields, ``env.exper
 the driving expert's parameters). Every run directory gets ``model.zip``, the resolved
 ``config.yaml``, ``args.json`` (arguments and command line), TensorBoard logs (CSV when
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
-``frontier_value`` fits a learned frontier value for the expert
-(:mod:`semexplore_gym.training.frontier_value_search`, no torch needed) and writes ``model.yaml``,
-``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
+``frontier_value`` fits a learned frontier value for the expert (no torch needed) and writes
+``model.yaml``, ``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
+
+The shipped configs (``configs/agents/*.yml``: bc_maze, dagger_maze, ppo_maze,
+frontier_choice_maze, planner_weights_maze, frontier_value) work from any directory.
+
+Example::
+
+    semexplore train --algo dagger --train-config configs/agents/dagger_maze.yml --out runs/dagger
+    semexplore train --algo bc --train-config configs/agents/bc_maze.yml --train-set bc.epochs=2 --out runs/bc
 
 This module parses the arguments and writes the run directory; the configuration
 (:mod:`semexplore_gym.training.train_config`) and the runs (:mod:`semexplore_gym.training.imitation`,
-:mod:`semexplore_gym.training.ppo`) live in ``semexplore_gym.training``.
+:mod:`semexplore_gym.training.ppo`, :mod:`semexplore_gym.training.frontier_value_search`) live in
+``semexplore_gym.training``.
 """
+
+# This module parses the arguments and writes the run directory; the configuration
+# (semexplore_gym.training.config) and the runs (training.imitation, training.ppo,
+# training.frontier_value) live in semexplore_gym.training.
 
 from __future__ import annotations
 
@@ -42,7 +54,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "train",
-        help="train a learning agent (behaviour cloning, DAgger or PPO)",
+        help="train a learning agent (BC, DAgger, PPO, MaskablePPO or a learned frontier value)",
         description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -53,7 +65,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="bc, dagger, ppo, maskable_ppo (macro-action envs) or frontier_value (a learned "
         "frontier value for the expert, fitted by a cross-entropy method over missions)",
     )
-    p.add_argument("--train-config", default=None, help="agent config YAML (configs/agents/*.yml)")
+    p.add_argument(
+        "--train-config",
+        default=None,
+        help="agent config YAML: yours, or a shipped one (configs/agents/NAME.yml)",
+    )
     p.add_argument("--out", required=True, help="run directory (created)")
     p.add_argument(
         "--train-set",

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from semexplore_gym.config.loading import UnsafeInputError, load_yaml_file, load_yaml_text
+from semexplore_gym.config.resources import resolve_config_path
 from semexplore_gym.core.validation import short_repr
 
 T = TypeVar("T")
@@ -311,8 +312,11 @@ _MISSING = object()
 
 
 def load_yaml(path: str | os.PathLike) -> dict[str, Any]:
-    """Read a YAML mapping with ``safe_load``; clear errors for a missing or malformed file."""
-    p = Path(path)
+    """Read a YAML mapping with ``safe_load``; clear errors for a missing or malformed file.
+
+    ``configs/...`` paths that do not exist here are the shipped ones
+    (:func:`~semexplore_gym.config.resources.resolve_config_path`)."""
+    p = resolve_config_path(path)
     if not p.is_file():
         raise FileNotFoundError(f"config file not found: {short_repr(str(p), 200)}")
     try:

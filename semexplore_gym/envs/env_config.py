@@ -17,6 +17,10 @@ from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 #: Largest reward weight magnitude: beyond it sums of terms lose precision or overflow.
 MAX_REWARD_WEIGHT = 1e6
 
+#: Longest LiDAR range the env accepts: far beyond any real 2D LiDAR (the LDS-01 reaches 3.5 m),
+#: and the scan observation's float32 bound must hold it.
+MAX_LIDAR_RANGE_M = 1000.0
+
 #: Largest travel per physics substep near walls that keeps wall penetration under 1 cm (the
 #: no-penetration promise) with the solver's own slack on top; measured, see tests/fuzz.
 MAX_SUBSTEP_TRAVEL_M = 0.005
@@ -97,6 +101,11 @@ class EnvConfig:
     episode: EpisodeParams = field(default_factory=EpisodeParams)
 
     def __post_init__(self) -> None:
+        if not self.lidar.max_range_m <= MAX_LIDAR_RANGE_M:
+            raise ValueError(
+                f"lidar.max_range_m must be at most {MAX_LIDAR_RANGE_M:g} m, got "
+                f"{self.lidar.max_range_m!r}"
+            )
         # Substeps per control step are ceil(speed * dt / max_substep_travel_m), capped at
         # max_substeps; past the cap each substep travels further and the robot can sink into
         # (or pass) a wall. Refuse such combinations instead of silently capping.

@@ -447,7 +447,7 @@ class SemanticExploreEnv(gym.Env):
                 if raw.dtype.kind not in "fiubO" or np.iscomplexobj(action):
                     raise TypeError(f"dtype {raw.dtype}")
                 a = raw.astype(np.float64).reshape(-1)
-            except (TypeError, ValueError) as e:
+            except (TypeError, ValueError, OverflowError) as e:  # Overflow: a huge Python int
                 raise ValueError(
                     f"action must be 2 numbers [v, omega] in [-1, 1], got {short_repr(action)}"
                 ) from e

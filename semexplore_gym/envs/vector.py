@@ -412,3 +412,42 @@ class FastSyncVectorEnv(SyncVectorEnv):
         if self.copy:
             return {key: batch[key].copy() for key in keys}
         return batch
+
+
+def make_vector_env(
+    num_envs: int = 1,
+    *,
+    copy: bool = True,
+    autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+    max_episode_steps: int | None = None,
+    env_id: str = "SemanticExplore-v0",
+    **env_kwargs: Any,
+) -> FastSyncVectorEnv:
+    """``gym.make_vec("SemanticExplore-v0", num_envs=4, ...)``: the registered vector entry point.
+
+    ``num_envs`` copies of ``gym.make(env_id, **env_kwargs)`` in a :class:`FastSyncVectorEnv`.
+    ``world`` may be a list: env ``i`` gets ``world[i % len(world)]`` (mixed worlds in one
+    batch; their maps must have the same shape, as every batch's). A procedural spelling without
+    ``seed=`` (``"maze:size_m=6"``) already gives each env its own world, drawn from its reset
+    seed. gymnasium's vector options come as keywords here (``make_vec`` refuses
+    ``vector_kwargs`` and ``wrappers`` for a vector entry point): ``copy`` and
+    ``autoreset_mode``. For wrappers per env, use ``vectorization_mode="sync"`` (gymnasium's
+    ``SyncVectorEnv``) or build ``FastSyncVectorEnv([...])`` yourself.
+    """
+    if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
+        raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+    worlds = env_kwargs.pop("world", None)
+    if isinstance(worlds, (list, tuple)):
+        if not worlds:
+            raise ValueError("world: an empty list of worlds")
+        per_env = [worlds[i % len(worlds)] for i in range(num_envs)]
+    else:
+        per_env = [worlds] * num_envs
+    if max_episode_steps is not None:
+        env_kwargs["max_episode_steps"] = max_episode_steps
+
+    def maker(world: Any) -> Any:
+        kwargs = env_kwargs if world is None else {**env_kwargs, "world": world}
+        return lambda: gym.make(env_id, **kwargs)
+
+    return FastSyncVectorEnv([maker(w) for w in per_env], copy=copy, autoreset_mode=autoreset_mode)

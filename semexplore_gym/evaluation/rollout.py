@@ -442,11 +442,10 @@ def _drive(
         if bar is not None:
             bar.update(dt_s)
             if log.steps % 25 == 0:
-                bar.set_postfix(
-                    coverage=f"{info['coverage']:.3f}",
-                    mode=str(st.extra.get("mode", "")),
-                    refresh=False,
-                )
+                shown = {"coverage": f"{info['coverage']:.3f}"}
+                if st.extra.get("mode"):  # only policies that have modes report one
+                    shown["mode"] = str(st.extra["mode"])
+                bar.set_postfix(shown, refresh=False)
         if (terminated and not ignore_terminated) or truncated or sim_t >= limit_s - 1e-9:
             break
     if gif is not None:

@@ -28,12 +28,13 @@ from typing import Any
 
 import yaml
 
+from semexplore_gym.config.resources import configs_dir, resolve_config_path
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import PARAM, ParameterError
 
-#: Where named suites live (the repository's ``configs/suites``), unless
+#: Where named suites live (the shipped ``configs/suites``: in the wheel or the checkout), unless
 #: ``SEMEXPLORE_SUITES_DIR`` names another directory.
-SUITES_DIR = Path(__file__).resolve().parents[2] / "configs" / "suites"
+SUITES_DIR = configs_dir() / "suites"
 
 _KEYS = {
     "name",
@@ -176,7 +177,7 @@ def load_suite(name_or_path: str | os.PathLike) -> Suite:
         ValueError: a malformed suite (the message names the file and the key).
     """
     text = str(name_or_path)
-    path = Path(text)
+    path = resolve_config_path(text)
     if not (text.endswith((".yaml", ".yml")) or path.is_file()):
         d = Path(os.environ.get("SEMEXPLORE_SUITES_DIR") or SUITES_DIR)
         path = d / f"{text}.yaml"

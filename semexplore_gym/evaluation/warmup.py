@@ -4,15 +4,20 @@ Every hot loop is ``@njit(cache=True)``: the first run of a checkout compiles th
 two on 2 cores) and writes them to ``__pycache__``; later processes load them from there (a
 second or two). Either cost lands in whatever calls a kernel first. :func:`warm_up` pays it up
 front, so that a mission's reported wall time and per-call timings are the planners' own: it
-runs a short mission of a fresh policy, then loads every other kernel the disk cache holds for
-the modules now imported, and says on stderr what is going on when numba really compiles
-(numba's ``numba:compile`` event fires only on a cache miss).
+runs a short mission of a fresh policy, then reaches the kernels a short mission may miss
+(every world family's generator and loader, the segmentation of a map with intersections),
+then loads every other kernel the disk cache holds for the modules now imported, and says on
+stderr what is going on when numba really compiles (numba's ``numba:compile`` event fires only
+on a cache miss). The warm-up env gives the policy the same map observation as the real
+mission (:func:`~semexplore_gym.evaluation.rollout.map_observation_for`): numba compiles a
+kernel per argument type, and a read-only array is another type than a writable one.
 
 Why not ahead-of-time compilation: numba's AOT (``numba.pycc``) is deprecated, needs explicit
 signatures for every kernel and a compiler at install time, and its extension modules would
 replace the ``@njit`` functions the tests and callers use; the disk cache gives the same
-steady state after one run. Kernels a warm-up mission does not reach (rare branches) still
-compile lazily on a fresh clone, once.
+steady state after one run. ``tests/evaluation/test_warmup_first_row.py`` checks, on an empty
+cache, that no kernel compiles inside a benchmark's missions and that the first row's per-call
+times are those of the rows after it.
 """
 
 from __future__ import annotations
@@ -27,7 +32,22 @@ from typing import Any, TextIO, cast
 WARMUP_WORLD = "maze:seed=0,size_m=3"
 #: Simulated seconds of the warm-up mission at most (it stops when the policy is done).
 WARMUP_TIME_S = 60.0
-COMPILE_MESSAGE = "compiling numba kernels (first run only, ~2 min on 2 cores)..."
+#: One small world per procedural family: their generators' kernels (rasterising, dropping
+#: small free components) compile here rather than in a mission's reset.
+FAMILY_WORLDS = (
+    "maze:seed=0,size_m=3",
+    "office:seed=0,size_m=8",
+    "cave:seed=0,size_m=6",
+    "forest:seed=0,size_m=6",
+)
+#: A world whose map has intersections: segmenting it joins legs at their centres, which the
+#: 3 m maze never does.
+SEGMENTED_WORLD = "maze1"
+#: How long compiling every kernel takes: 296 kernels in 64 s of CPU time, one core (measured
+#: for the semantic expert on an empty cache), so about a minute when that core is free; 3-6 min
+#: of wall time on a 2-core machine shared by ~8 jobs. The warm-up prints the real figure.
+COMPILE_ESTIMATE = "about 1 min on an idle machine, more under load"
+COMPILE_MESSAGE = f"compiling numba kernels (first run only, {COMPILE_ESTIMATE})..."
 #: Keys of the warm-ups this process has done (a process loads a kernel once; the set only
 #: saves repeating the warm-up mission, it changes no result).
 _WARMED_UP: set[Hashable] = set()
@@ -40,6 +60,7 @@ def warm_up(
     *,
     key: Hashable | None = None,
     stream: TextIO | None = None,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> dict[str, float]:
     """Run a short throw-away mission so the kernels of the env and the policy are loaded.
 
@@ -51,6 +72,9 @@ def warm_up(
         key: Skip the warm-up when this process already did one with the same key (e.g. the
             policy spec and env config of every mission of a benchmark).
         stream: Where the compile message goes (default: ``sys.stderr``).
+        env_kwargs: The real mission env's map observation arguments (``map_observation``,
+            ...); default: :func:`~semexplore_gym.evaluation.rollout.map_observation_for` the
+            policy, as the CLI and the benchmark harness make their envs.
 
     Returns:
         ``{"wall_s": ..., "compiled": n, "loaded": n}``: the warm-up's wall time, the number
@@ -61,6 +85,7 @@ def warm_up(
     from numba.core import event
 
     import semexplore_gym  # noqa: F401  (registers the env)
+    from semexplore_gym.evaluation.rollout import map_observation_for
 
     if key is not None and key in _WARMED_UP:
         return {"wall_s": 0.0, "compiled": 0.0, "loaded": 0.0}
@@ -84,14 +109,14 @@ def warm_up(
     ]
     with event.install_listener("numba:compile", _OnCompile()):
         policy = make_policy()
-        # A privileged policy (the oracle) needs the true world in reset's info.
-        privileged = {"privileged": True} if getattr(policy, "privileged", False) else {}
+        # The map observation the real mission gives this policy (a read-only shared map for
+        # the scripted ones): kernels are compiled per argument type, read-only arrays included.
         env = gym.make(
             "SemanticExplore-v0",
             world=WARMUP_WORLD,
             config=config,
             overrides=env_overrides,
-            **privileged,
+            **(map_observation_for(policy) if env_kwargs is None else env_kwargs),
         )
         try:
             obs, info = env.reset(seed=0)
@@ -105,6 +130,7 @@ def warm_up(
                     break
         finally:
             env.close()
+        reach_rare_kernels()
     loaded = load_cached_kernels()
     if key is not None:
         _WARMED_UP.add(key)
@@ -116,6 +142,45 @@ def warm_up(
             flush=True,
         )
     return {"wall_s": wall_s, "compiled": float(compiled), "loaded": float(loaded)}
+
+
+def reach_rare_kernels() -> None:
+    """Run the kernels a short mission may not reach: each procedural family's generator, a
+    ROS map and a HouseExpo plan loaded from files, and the segmentation (of a read-only map, as
+    the expert sees it) of :data:`SEGMENTED_WORLD`'s ground truth."""
+    import json
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+    from PIL import Image
+
+    from semexplore_gym.core.grid import FREE, OCCUPIED
+    from semexplore_gym.core.topometric import segment_map
+    from semexplore_gym.maps import make_world
+
+    for spec in FAMILY_WORLDS:
+        make_world(spec)
+    with tempfile.TemporaryDirectory(prefix="semexplore-warmup-") as tmp:
+        d = Path(tmp)
+        pixels = np.full((24, 24), 254, np.uint8)
+        pixels[[0, -1], :] = 0
+        pixels[:, [0, -1]] = 0
+        pixels[8:16, 10:12] = 0
+        Image.fromarray(pixels).save(d / "map.pgm")
+        (d / "map.yaml").write_text(
+            "image: map.pgm\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+        )
+        make_world(d / "map.yaml")
+        house = [[0, 0], [0, 3], [4, 3], [4, 0], [2.05, 0], [2.05, 2], [1.95, 2], [1.95, 0]]
+        plan = {"id": "0" * 32, "room_num": 1, "bbox": {"min": [0, 0], "max": [4, 3]}}
+        (d / "plan.json").write_text(json.dumps({**plan, "verts": house}))
+        make_world(d / "plan.json")
+    world = make_world(SEGMENTED_WORLD)
+    grid = np.where(world.free_mask, FREE, OCCUPIED).astype(np.uint8)
+    grid.setflags(write=False)
+    segment_map(grid, world.free_geometry, clearance_m=0.2)
 
 
 def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym",)) -> int:

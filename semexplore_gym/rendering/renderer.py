@@ -19,6 +19,8 @@ Overlay keys (all optional), set with ``env.unwrapped.set_overlay(policy.overlay
 from __future__ import annotations
 
 import math
+import os
+import sys
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -184,6 +186,7 @@ class Renderer:
 
     def show(self, frame: np.ndarray, fps: float) -> None:
         """Show a frame in a pygame window (``human`` render mode)."""
+        os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
         try:
             import pygame
         except ImportError as e:  # pragma: no cover - depends on the optional extra
@@ -193,7 +196,13 @@ class Renderer:
                 'render_mode="human" needs pygame: pip install "semexplore-gym[render]"'
             ) from e
         if self._window is None:
-            pygame.init()
+            # The display alone (pygame.init() would open the audio device too: ALSA errors on
+            # a machine without sound). Without X11 or Wayland there is nothing to show the
+            # window on: SDL's dummy driver draws it quietly (its fall-backs print XDG errors).
+            if sys.platform.startswith("linux") and not (
+                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+            ):
+                os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
             pygame.display.init()
             self._window = pygame.display.set_mode((frame.shape[1], frame.shape[0]))
             pygame.display.set_caption("SemanticExplore")

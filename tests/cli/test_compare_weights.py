@@ -11,7 +11,14 @@ import pytest
 from scipy.stats import mannwhitneyu
 
 from semexplore_gym.cli import main
-from semexplore_gym.cli.compare_weights import PAPER, TUNED, summarise, weight_sets
+from semexplore_gym.cli.compare_weights import (
+    PAPER,
+    TUNED,
+    TUNED_IS_PAPER_NOTE,
+    summarise,
+    tuned_is_paper,
+    weight_sets,
+)
 
 
 def _rows(label: str, times: list[float], cov: float = 0.99) -> list[dict]:
@@ -49,6 +56,11 @@ def test_summarise_medians_completion_and_p_values() -> None:
     assert ablated["mean_coverage"] == pytest.approx(0.87)
     assert ablated["completed_fraction"] == 0.0
     assert ablated["mean_score"] == pytest.approx(115.0 + 60.0)
+
+
+def test_tuned_is_paper_only_when_no_trial_beat_the_paper() -> None:
+    assert tuned_is_paper(weight_sets({}))
+    assert not tuned_is_paper(weight_sets({"cost.w_v": 1.0}))
 
 
 def test_weight_sets_ablate_the_paper_terms() -> None:
@@ -101,6 +113,7 @@ def test_compare_weights_writes_table_and_plot(tmp_path: Path) -> None:
     assert (out / "tuning" / "study.sqlite").exists()
     sets = json.loads((out / "weights.json").read_text())["sets"]
     assert sets[TUNED] == sets[PAPER]  # one trial: the enqueued paper weights
+    assert TUNED_IS_PAPER_NOTE in (out / "compare.md").read_text()  # and the table says so
     with (out / "test" / "runs.csv").open() as f:
         runs = list(csv.DictReader(f))
     assert sorted(r["policy"] for r in runs) == sorted(weight_sets({}))

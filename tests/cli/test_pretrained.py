@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -20,8 +21,35 @@ def test_lists_each_model_on_one_line_starting_with_its_spec(
     assert len(lines) == len(models) >= 2
     for line, model in zip(lines, models, strict=True):
         assert line.startswith(f"pretrained:{model.name} ")
-        for part in ("Trained on", model.command, model.config, "Results:", model.results):
-            assert part in line
+        assert model.summary in line and len(line) <= 160, line
+
+
+def test_details_give_every_field_with_the_reproduce_command_whole(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["pretrained", "--details"]) == 0
+    out = capsys.readouterr().out
+    for model in pretrained_models():
+        assert f"\n{model.spec}\n" in f"\n{out}"
+        for part in (model.trained_on, model.command, model.config, model.results):
+            assert part in out
+
+
+def test_reproduce_commands_find_their_config_from_any_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The printed commands say configs/agents/...: from a directory without configs/ (as after
+    a pip install) that path is the shipped file and the command's parser accepts it."""
+    from semexplore_gym.cli import build_parser
+    from semexplore_gym.config.resources import resolve_config_path
+
+    monkeypatch.chdir(tmp_path)
+    for model in pretrained_models():
+        argv = shlex.split(model.command)
+        assert argv[0] == "semexplore" and f"--train-config {model.config}" in model.command
+        args = build_parser().parse_args(argv[1:])
+        assert args.train_config == model.config
+        assert resolve_config_path(model.config).is_file(), model.config
 
 
 def test_json_lists_paths_and_sizes(capsys: pytest.CaptureFixture[str]) -> None:

@@ -31,7 +31,8 @@ def _kernel_calls() -> dict[int, int]:
 
 def test_after_warm_up_a_mission_loads_and_compiles_no_kernel() -> None:
     out = io.StringIO()
-    warm_up(lambda: make_policy("semantic"), stream=out)
+    # The warm-up's env as the mission's: a fresh map copy per step (gym.make's default).
+    warm_up(lambda: make_policy("semantic"), stream=out, env_kwargs={})
     before = _kernel_calls()
     env = gym.make("SemanticExplore-v0", world="maze2")
     try:
