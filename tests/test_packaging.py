@@ -144,11 +144,11 @@ def test_a_users_own_configs_folder_wins(tmp_path: Path, monkeypatch: pytest.Mon
 def test_every_reader_of_a_config_finds_the_shipped_one_from_elsewhere(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from semexplore_gym.envs.config import load_env_config
     from semexplore_gym.policies.specs import load_policy_config
-    from semexplore_gym.training.config import load_train_config
 
+    from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.suites import list_suites, load_suite
+    from semexplore_gym.training.train_config import load_train_config
 
     monkeypatch.chdir(tmp_path)
     assert {"paper", "mazes", "real"} <= set(list_suites())

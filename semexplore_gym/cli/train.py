@@ -19,16 +19,11 @@ Example::
 
     semexplore train --algo dagger --train-config configs/agents/dagger_maze.yml --out runs/dagger
     semexplore train --algo bc --train-config configs/agents/bc_maze.yml --train-set bc.epochs=2 --out runs/bc
-
-This module parses the arguments and writes the run directory; the configuration
-(:mod:`semexplore_gym.training.train_config`) and the runs (:mod:`semexplore_gym.training.imitation`,
-:mod:`semexplore_gym.training.ppo`, :mod:`semexplore_gym.training.frontier_value_search`) live in
-``semexplore_gym.training``.
 """
 
 # This module parses the arguments and writes the run directory; the configuration
-# (semexplore_gym.training.config) and the runs (training.imitation, training.ppo,
-# training.frontier_value) live in semexplore_gym.training.
+# (semexplore_gym.training.train_config) and the runs (training.imitation, training.ppo,
+# training.frontier_value_search) live in semexplore_gym.training.
 
 from __future__ import annotations
 

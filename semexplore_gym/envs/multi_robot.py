@@ -29,7 +29,7 @@ from semexplore_gym.core.mapping.raycast import SegmentIndex
 from semexplore_gym.core.worlds.geometry import segment_distance_field
 from semexplore_gym.core.worlds.start import reachable_free_mask
 from semexplore_gym.core.worlds.world import World
-from semexplore_gym.envs.config import EnvConfig, load_env_config
+from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.multi_robot_config import (
     TeamParams,
     load_team_params,
