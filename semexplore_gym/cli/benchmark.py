@@ -265,6 +265,23 @@ def run(args: argparse.Namespace) -> int:
         raise e.for_flags(FLAGS) from None
 
 
+def _add_oracle(args: argparse.Namespace, policies: list[str]) -> bool:
+    """Whether the run includes the oracle (``--oracle``; by default with ``--suite``); appends
+    its spec to ``policies`` when asked for and not listed."""
+    from semexplore_gym.evaluation.regret import ORACLE_SPEC
+
+    with_oracle = args.oracle if args.oracle is not None else args.suite is not None
+    if with_oracle and ORACLE_SPEC not in policies:
+        from semexplore_gym.core.coverage_tour.tour import require_solver
+
+        try:
+            require_solver()
+        except ImportError as e:
+            raise ValueError(f"{e}; or leave the oracle out: --no-oracle") from None
+        policies.append(ORACLE_SPEC)
+    return bool(with_oracle)
+
+
 def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -280,17 +297,7 @@ def _run(args: argparse.Namespace) -> int:
     if not policies:
         raise ValueError("--policies is empty")
     refuse_repeats("--policies", policies)
-    from semexplore_gym.evaluation.regret import ORACLE_SPEC, write_regret
-
-    with_oracle = args.oracle if args.oracle is not None else args.suite is not None
-    if with_oracle and ORACLE_SPEC not in policies:
-        from semexplore_gym.core.coverage_tour.tour import require_solver
-
-        try:
-            require_solver()
-        except ImportError as e:
-            raise ValueError(f"{e}; or leave the oracle out: --no-oracle") from None
-        policies.append(ORACLE_SPEC)
+    with_oracle = _add_oracle(args, policies)
     _check_policies(policies)
     suites: list[dict[str, Any]] = []
     if args.suite is not None:
@@ -331,6 +338,8 @@ def _run(args: argparse.Namespace) -> int:
     summary = write_summary(args.out)
     plots = [] if args.no_plots else write_plots(args.out)
     if with_oracle:
+        from semexplore_gym.evaluation.regret import write_regret
+
         regret = write_regret(args.out, plots=not args.no_plots)
         plots += [regret["plot"]] if regret["plot"] else []
     print(

@@ -81,7 +81,6 @@ def warm_up(
         of kernels numba compiled (0 when the on-disk cache had them all) and the number of
         further cached kernels loaded.
     """
-    import gymnasium as gym
     from numba.core import event
 
     import semexplore_gym  # noqa: F401  (registers the env)
@@ -111,25 +110,12 @@ def warm_up(
         policy = make_policy()
         # The map observation the real mission gives this policy (a read-only shared map for
         # the scripted ones): kernels are compiled per argument type, read-only arrays included.
-        env = gym.make(
-            "SemanticExplore-v0",
-            world=WARMUP_WORLD,
-            config=config,
-            overrides=env_overrides,
-            **(map_observation_for(policy) if env_kwargs is None else env_kwargs),
+        run_warmup_mission(
+            policy,
+            config,
+            env_overrides,
+            map_observation_for(policy) if env_kwargs is None else env_kwargs,
         )
-        try:
-            obs, info = env.reset(seed=0)
-            policy.reset(obs, info, seed=0)
-            while True:
-                action = policy.act(obs, info)
-                if policy.done:
-                    break
-                obs, _, terminated, truncated, info = env.step(action)
-                if terminated or truncated:
-                    break
-        finally:
-            env.close()
         reach_rare_kernels()
     loaded = load_cached_kernels()
     if key is not None:
@@ -142,6 +128,29 @@ def warm_up(
             flush=True,
         )
     return {"wall_s": wall_s, "compiled": float(compiled), "loaded": float(loaded)}
+
+
+def run_warmup_mission(
+    policy: Any, config: Any, overrides: list[str], env_kwargs: dict[str, Any]
+) -> None:
+    """Drive ``policy`` in :data:`WARMUP_WORLD` until it stops or the episode ends."""
+    import gymnasium as gym
+
+    env = gym.make(
+        "SemanticExplore-v0", world=WARMUP_WORLD, config=config, overrides=overrides, **env_kwargs
+    )
+    try:
+        obs, info = env.reset(seed=0)
+        policy.reset(obs, info, seed=0)
+        while True:
+            action = policy.act(obs, info)
+            if policy.done:
+                break
+            obs, _, terminated, truncated, info = env.step(action)
+            if terminated or truncated:
+                break
+    finally:
+        env.close()
 
 
 def reach_rare_kernels() -> None:
