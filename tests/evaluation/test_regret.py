@@ -97,3 +97,26 @@ def test_benchmark_with_the_oracle_writes_the_regret(tmp_path, capsys):
     assert (tmp_path / "with" / "regret.csv").exists()
     assert (tmp_path / "with" / "regret_ladder.png").exists()
     assert SECTION_TITLE in (tmp_path / "with" / "summary.md").read_text()
+
+
+def test_a_suite_runs_the_oracle_by_default(tmp_path, capsys):
+    """With --suite the oracle is on unless --no-oracle: its missions are in runs.csv and the
+    regret files are written (the suite's tasks get the oracle, not only the manifest)."""
+    import pytest
+
+    from semexplore_gym.cli import main
+    from semexplore_gym.evaluation.harness import read_runs
+
+    pytest.importorskip("elkai")
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        "name: tiny\nversion: 1\ndescription: one small maze\nruns: 1\nrandom_start: true\n"
+        "max_time_s: 400.0\nworlds:\n- maze:seed=1,size_m=4\n"
+    )
+    base = ["benchmark", "--suite", str(suite), "--policies", "nearest", "--no-progress"]
+    assert main([*base, "--no-plots", "--out", str(tmp_path / "on")]) == 0
+    assert {r["policy"] for r in read_runs(tmp_path / "on" / "runs.csv")} == {"nearest", "oracle"}
+    assert (tmp_path / "on" / "regret.csv").exists()
+    assert main([*base, "--no-plots", "--no-oracle", "--out", str(tmp_path / "off")]) == 0
+    assert {r["policy"] for r in read_runs(tmp_path / "off" / "runs.csv")} == {"nearest"}
+    assert not (tmp_path / "off" / "regret.csv").exists()
