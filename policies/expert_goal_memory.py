@@ -1,5 +1,5 @@
 """The semantic expert's goal memory: drops, reaches, retries, revivals, the trail, the commanded
-goal and the stop reason (issue #13: never give up on a reachable frontier).
+goal and the stop reason (the rule: never give up on a reachable frontier).
 
 :class:`GoalMemory` is a part the expert owns. It decides what happens when the approach to a
 goal fails (retry it another way, or drop it), when a goal is reached without clearing its

@@ -6,18 +6,18 @@ path. At each replan the expert asks its :class:`PlanSource` objects in order
 source passes the expert waits a step and, after ``stop_confirmations`` such replans, stops.
 The default order (:data:`DEFAULT_PLAN_SOURCES`; :func:`insert_plan_source` adds one):
 
-=====================  ======================================================================
-source                 proposes
-=====================  ======================================================================
-``commanded``          the goal commanded from outside (``drive_to``), over a grid route
-``retry``              another approach to a goal whose approach failed (a grid route, then
-                       another side of its frontier), or drops it
-``semantic``           Algorithm 1's chosen frontier along the topometric map (the paper)
-``committed_fallback`` the grid fallback's goal of the last plan, while it lasts
-``nearest_fallback``   the nearest frontier a clearance-aware grid search reaches
-``pocket_escape``      out of a pocket of the usable map, then to a frontier outside it
-``look``               close to a frontier too narrow to reach, to look again
-=====================  ======================================================================
+======================  ======================================================================
+source                  proposes
+======================  ======================================================================
+``commanded``           the goal commanded from outside (``drive_to``), over a grid route
+``retry``               another approach to a goal whose approach failed (a grid route, then
+                        another side of its frontier), or drops it
+``semantic``            Algorithm 1's chosen frontier along the topometric map (the paper)
+``committed_fallback``  the grid fallback's goal of the last plan, while it lasts
+``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
+``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
+``look``                close to a frontier too narrow to reach, to look again
+======================  ======================================================================
 
 Every source reads what it needs from a :class:`PlanContext` and keeps no state of its own (the
 goal memory and the counters are the expert's), so one instance serves every expert. A source

@@ -175,13 +175,13 @@ class SemanticExploreEnv(gym.Env):
     ## Version History
     - v0: initial version. (The ``new_area`` reward term was renamed ``free_area_change``, and
       its weight ``reward.free_area_change_weight``, to say what it is; values unchanged.)
-    - v0, issue #17 (no change to observations, rewards or dynamics): ``info["map_geometry"]``,
+    - v0, 0.1 (no change to observations, rewards or dynamics): ``info["map_geometry"]``,
       ``info["robot"]`` and ``info["lidar"]`` are read-only mappings (:class:`FrozenInfo`)
       built once per env and shared by every step, instead of fresh dicts each step. Same
       keys and values; mutating them raises ``TypeError`` (take ``dict(...)`` for a copy).
       In gymnasium vector envs each is collected as an object array of mappings rather than
       a dict of per-field arrays.
-    - v0, issue #17: the ``map_observation`` (``"window"``, ``"shared"``) and ``static_info``
+    - v0, 0.1: the ``map_observation`` (``"window"``, ``"shared"``) and ``static_info``
       (``"reset"``) options, off by default (the default observations and ``info`` are unchanged).
     - v0, 0.2 (no change to observations, rewards or dynamics): the speed options are
       one :class:`ObservationOptions` (``observation_options=``); the fast path the vector env
