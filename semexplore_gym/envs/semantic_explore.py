@@ -36,7 +36,8 @@ PROCEDURAL_FAMILIES = ("maze", "office", "cave")
 INFO_NUMBERS = ("coverage", "explored_area_m2", "collisions", "sim_time_s", "path_length_m")
 
 
-def _is_unseeded_procedural(spec: Any) -> bool:
+def is_unseeded_procedural(spec: Any) -> bool:
+    """Whether ``spec`` names a procedural family without ``seed=`` (a new world per reset)."""
     if not isinstance(spec, str):
         return False
     family, _, params = spec.partition(":")
@@ -222,7 +223,7 @@ class SemanticExploreEnv(gym.Env):
         self.config: EnvConfig = load_env_config(config, overrides)
         cfg = self.config
         self.world_spec = world
-        self._randomise_world = _is_unseeded_procedural(world)
+        self._randomise_world = is_unseeded_procedural(world)
         self.world: World = (
             world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
         )
