@@ -240,10 +240,10 @@ class SemanticExploreMultiEnv(ParallelEnv):
 
     def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         # Robot 0's start is the single-robot env's, by the same code.
-        return SemanticExploreEnv._choose_start(self, options)  # type: ignore[arg-type]
+        return SemanticExploreEnv.choose_start(self, options)  # type: ignore[arg-type]
 
     def _scale_action(self, action: Any) -> tuple[float, float]:
-        return SemanticExploreEnv._scale_action(self, action)  # type: ignore[arg-type]
+        return SemanticExploreEnv.scale_action(self, action)  # type: ignore[arg-type]
 
     def _teammate_starts(
         self, first: tuple[float, float, float], reach: np.ndarray
@@ -431,7 +431,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         c1 = min(g.width, int((x + reach - g.origin_x_m) / g.resolution_m) + 2)
         if r0 >= r1 or c0 >= c1:
             return
-        touched = grid._stamp[r0:r1, c0:c1] == grid._scan_id
+        touched = grid.touched_by_last_scan(slice(r0, r1), slice(c0, c1))
         block = self.scanned_count[r0:r1, c0:c1]
         block |= touched.view(np.uint8) << np.uint8(i)
 
