@@ -116,7 +116,7 @@ class _Candidate:
 
 class _Member(NearestFrontierPolicy):
     """One robot of a frontier team: the nearest-frontier robot whose target choice is the
-    team's (``_select`` asks the team)."""
+    team's (``select_target`` asks the team)."""
 
     name = "team_member"
 
@@ -129,8 +129,8 @@ class _Member(NearestFrontierPolicy):
     def candidates(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> list[_Candidate]:
         """Every frontier's nearest cell by path, with its path length (blacklist excluded)."""
         assert self.nav is not None
-        self.frontiers = self._detect(grid, pose)
-        self._blacklist_hits = 0
+        self.frontiers = self.detect(grid, pose)
+        self.blacklist_hits = 0
         if not self.frontiers:
             return []
         costmap = inflate_costmap(grid, self.geometry.resolution_m, self.nav.costmap_params)
@@ -149,18 +149,18 @@ class _Member(NearestFrontierPolicy):
             cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
             x, y = self.geometry.grid_to_world(*cell)
             if (float(x), float(y)) in self.blacklist:
-                self._blacklist_hits += 1
+                self.blacklist_hits += 1
                 continue
             out.append(_Candidate(cell, (float(x), float(y)), float(d[i])))
         return out
 
-    def _select(
+    def select_target(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
     ) -> tuple[float, float] | None:
         self.counters["selections"] += 1
         choice = self.team.assign(self.index, grid, pose, stats)
-        self._target_cell = choice.cell if choice is not None else None
-        self.goal_cell = self._target_cell
+        self.target_cell = choice.cell if choice is not None else None
+        self.goal_cell = self.target_cell
         if choice is None:
             return None
         self.path_length_m = choice.path_m
@@ -219,9 +219,7 @@ class FrontierTeam(TeamPolicy):
                 continue
             if m.done and m.now_s - self._idle_since[i] >= self.params.idle_recheck_s:
                 # Teammates may have opened new frontiers since: look again.
-                m.done = False
-                m.stop_reason = ""
-                m._no_frontier_count = 0
+                m.resume()
             if m.done and not math.isfinite(self._idle_since[i]):
                 self._idle_since[i] = m.now_s
             action = m.act(observations[a], infos[a])

@@ -57,7 +57,7 @@ def test_robots_pass_in_a_corridor_two_robots_wide() -> None:
     team.goals = [(6.5, 1.6), (0.5, 0.4)]  # each robot to the far room: they meet inside
     team.reset(obs, infos, seed=0)
     for m in team.members:
-        m._target_still_frontier = lambda grid: True  # type: ignore[method-assign]
+        m.target_still_frontier = lambda grid: True  # type: ignore[method-assign]
     arrived = False
     for _ in range(1500):
         obs, _, _, _, infos = env.step(team.act(obs, infos))
