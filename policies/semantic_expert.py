@@ -342,6 +342,16 @@ class SemanticExpertPolicy(Policy):
         """Replan (segmentation and goal selection) at the next ``act``."""
         self._next_replan_s = self._time_s
 
+    def resume(self) -> None:
+        """Restart a stopped expert (e.g. when teammates opened new frontiers): clears ``done``,
+        ``stop_reason`` and the run of empty replans, sets the mode to idle and replans at the
+        next ``act``."""
+        self.done = False
+        self.stop_reason = ""
+        self.mode = ExpertMode.IDLE
+        self._empty_replans = 0
+        self.request_replan()
+
     @property
     def commanded_goal_xy_m(self) -> tuple[float, float] | None:
         """The goal commanded by :meth:`drive_to`; None once reached, failed or unreachable."""
