@@ -108,7 +108,10 @@ class FrontierTeamParams:
 
 
 @dataclass
-class _Candidate:
+class FrontierTarget:
+    """A frontier one team member can reach: its nearest cell, that cell in metres, and the
+    path length to it (what the team's assignment weighs)."""
+
     cell: tuple[int, int]
     xy_m: tuple[float, float]
     path_m: float
@@ -126,7 +129,9 @@ class _Member(NearestFrontierPolicy):
         self.index = index
         self.goal_cell: tuple[int, int] | None = None
 
-    def candidates(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> list[_Candidate]:
+    def candidates(
+        self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
+    ) -> list[FrontierTarget]:
         """Every frontier's nearest cell by path, with its path length (blacklist excluded)."""
         assert self.nav is not None
         self.frontiers = self.detect(grid, pose)
@@ -140,7 +145,7 @@ class _Member(NearestFrontierPolicy):
             fmask[f.cells[:, 0], f.cells[:, 1]] = True
         traversable |= fmask & ((costmap < INSCRIBED_COST) | (costmap == NO_INFORMATION))
         dist = geodesic_distance_m(traversable, self.geometry, pose[:2])
-        out: list[_Candidate] = []
+        out: list[FrontierTarget] = []
         for f in self.frontiers:
             d = dist[f.cells[:, 0], f.cells[:, 1]]
             i = int(np.argmin(d))
@@ -151,7 +156,7 @@ class _Member(NearestFrontierPolicy):
             if (float(x), float(y)) in self.blacklist:
                 self.blacklist_hits += 1
                 continue
-            out.append(_Candidate(cell, (float(x), float(y)), float(d[i])))
+            out.append(FrontierTarget(cell, (float(x), float(y)), float(d[i])))
         return out
 
     def select_target(
@@ -250,7 +255,7 @@ class FrontierTeam(TeamPolicy):
     # -------------------------------------------------------- coordination
     def assign(
         self, i: int, grid: np.ndarray, pose: np.ndarray, stats: StepStats
-    ) -> _Candidate | None:
+    ) -> FrontierTarget | None:
         """Robot ``i``'s next target under the team's coordination (None: no reachable one)."""
         member = self.members[i]
         cands = member.candidates(grid, pose, stats)
@@ -275,8 +280,8 @@ class FrontierTeam(TeamPolicy):
         return best
 
     def _coordinated(
-        self, i: int, cands: list[_Candidate], other_goals: list[tuple[float, ...]]
-    ) -> _Candidate:
+        self, i: int, cands: list[FrontierTarget], other_goals: list[tuple[float, ...]]
+    ) -> FrontierTarget:
         p = self.params
         xy = np.array([c.xy_m for c in cands])
         utility = np.ones(len(cands))

@@ -12,7 +12,7 @@ pytest.importorskip("pettingzoo")
 
 from semexplore_gym.policies.navigation import NavStatus  # noqa: E402
 from semexplore_gym.policies.team import make_team_policy, team_policy_names  # noqa: E402
-from semexplore_gym.policies.team.frontier_teams import FrontierTeam, _Candidate  # noqa: E402
+from semexplore_gym.policies.team.frontier_teams import FrontierTarget, FrontierTeam  # noqa: E402
 
 from semexplore_gym.core.worlds.build import world_from_segments  # noqa: E402
 from semexplore_gym.envs.multi_robot import make_multi  # noqa: E402
@@ -42,7 +42,7 @@ class _ToFixedGoals(FrontierTeam):
             return None
         x, y = self.goals[i]
         cell = tuple(int(v) for v in m.geometry.world_to_grid(x, y))
-        return _Candidate(cell, (x, y), 1.0)  # type: ignore[arg-type]
+        return FrontierTarget(cell, (x, y), 1.0)  # type: ignore[arg-type]
 
 
 def test_robots_pass_in_a_corridor_two_robots_wide() -> None:
