@@ -192,11 +192,8 @@ class _FrontierBaseline(Policy):
         return np.clip(a, -1.0, 1.0)
 
     def resume(self) -> None:
-        """Restart a stopped robot (e.g. when teammates opened new frontiers): clears
-        ``done``, ``stop_reason`` and the run of selections that found no frontier."""
-        self.done = False
-        self.stop_reason = ""
-        self._no_frontier_count = 0
+        """Restart a stopped robot: clear ``done``, ``stop_reason`` and the no-frontier run."""
+        self.done, self.stop_reason, self._no_frontier_count = False, "", 0
 
     def _finish(self, reason: str) -> None:
         """End the mission: the robot stops, ``stop_reason`` says why."""
@@ -481,10 +478,6 @@ class NearestFrontierPolicy(_FrontierBaseline):
 
     Args:
         params: Parameters; ``None`` = defaults. Keyword overrides are applied on top.
-
-    Attributes:
-        target_cell: The frontier cell chased now (row, col), or None.
-        blacklist_hits: Frontiers skipped as blacklisted in the latest selection.
     """
 
     name = "nearest"
@@ -502,8 +495,8 @@ class NearestFrontierPolicy(_FrontierBaseline):
     ) -> None:
         super().reset(obs, info, seed=seed)
         self._last_search_s = -math.inf
-        self.blacklist_hits = 0
-        self.target_cell: tuple[int, int] | None = None
+        self.blacklist_hits = 0  # public: frontiers skipped as blacklisted by the last selection
+        self.target_cell: tuple[int, int] | None = None  # public: the frontier cell chased now
         self.path_length_m = math.inf
 
     def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
@@ -512,11 +505,8 @@ class NearestFrontierPolicy(_FrontierBaseline):
         prm = self.params
         if nav.status == NavStatus.ABORTED:
             self._blacklist_aborted_goal()
-        need_target = nav.status in (
-            NavStatus.IDLE,
-            NavStatus.SUCCEEDED,
-            NavStatus.ABORTED,
-        ) or not self.target_still_frontier(grid)
+        need_target = nav.status in (NavStatus.IDLE, NavStatus.SUCCEEDED, NavStatus.ABORTED)
+        need_target = need_target or not self.target_still_frontier(grid)
         due = self.now_s - self._last_search_s >= prm.replan_period_s - 1e-9
         if need_target:
             self._last_search_s = self.now_s
@@ -569,9 +559,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
     def select_target(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
     ) -> tuple[float, float] | None:
-        """Pick the next target (the plug-in point a team member overrides): detect frontiers,
-        set :attr:`frontiers`, :attr:`target_cell`, :attr:`blacklist_hits` and
-        :attr:`path_length_m`, and return the goal in metres (None: no reachable frontier)."""
+        """Next goal (m) or None; sets frontiers, target_cell, blacklist_hits, path_length_m."""
         assert self.nav is not None
         t0 = time.perf_counter()
         self.frontiers = self.detect(grid, pose)
