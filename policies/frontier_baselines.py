@@ -191,6 +191,10 @@ class _FrontierBaseline(Policy):
         a = np.array([v / self.max_v, w / self.max_w], dtype=np.float32)
         return np.clip(a, -1.0, 1.0)
 
+    def resume(self) -> None:
+        """Restart a stopped robot: clear ``done``, ``stop_reason`` and the no-frontier run."""
+        self.done, self.stop_reason, self._no_frontier_count = False, "", 0
+
     def _finish(self, reason: str) -> None:
         """End the mission: the robot stops, ``stop_reason`` says why."""
         self.done = True
@@ -491,8 +495,8 @@ class NearestFrontierPolicy(_FrontierBaseline):
     ) -> None:
         super().reset(obs, info, seed=seed)
         self._last_search_s = -math.inf
-        self._blacklist_hits = 0
-        self._target_cell: tuple[int, int] | None = None
+        self.blacklist_hits = 0  # public: frontiers skipped as blacklisted by the last selection
+        self.target_cell: tuple[int, int] | None = None  # public: the frontier cell chased now
         self.path_length_m = math.inf
 
     def _update_goal(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> None:
@@ -501,20 +505,17 @@ class NearestFrontierPolicy(_FrontierBaseline):
         prm = self.params
         if nav.status == NavStatus.ABORTED:
             self._blacklist_aborted_goal()
-        need_target = nav.status in (
-            NavStatus.IDLE,
-            NavStatus.SUCCEEDED,
-            NavStatus.ABORTED,
-        ) or not self._target_still_frontier(grid)
+        need_target = nav.status in (NavStatus.IDLE, NavStatus.SUCCEEDED, NavStatus.ABORTED)
+        need_target = need_target or not self.target_still_frontier(grid)
         due = self.now_s - self._last_search_s >= prm.replan_period_s - 1e-9
         if need_target:
             self._last_search_s = self.now_s
-            goal = self._select(grid, pose, stats)
+            goal = self.select_target(grid, pose, stats)
             if goal is None:
                 self._no_frontier_count += 1
                 nav.cancel()
                 if self._no_frontier_count > prm.no_frontier_retries:
-                    if self._blacklist_hits:
+                    if self.blacklist_hits:
                         reason = "all reachable frontiers blacklisted"
                     elif self.frontiers:
                         reason = "no reachable frontier left"
@@ -530,19 +531,21 @@ class NearestFrontierPolicy(_FrontierBaseline):
             # list current for the overlay and the timing statistics.
             self._last_search_s = self.now_s
             t0 = time.perf_counter()
-            self.frontiers = self._detect(grid, pose)
+            self.frontiers = self.detect(grid, pose)
             stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
 
-    def _detect(self, grid: np.ndarray, pose: np.ndarray) -> list[GridFrontier]:
+    def detect(self, grid: np.ndarray, pose: np.ndarray) -> list[GridFrontier]:
+        """The frontiers of ``grid`` (this policy's size and cell-convention settings)."""
         prm = self.params
         return detect_frontiers(
             grid, self.geometry, pose[:2], prm.min_frontier_cells, prm.cell_convention
         )
 
-    def _target_still_frontier(self, grid: np.ndarray) -> bool:
-        if self._target_cell is None:
+    def target_still_frontier(self, grid: np.ndarray) -> bool:
+        """Whether :attr:`target_cell` is still a frontier cell of ``grid`` (False without one)."""
+        if self.target_cell is None:
             return False
-        r, c = self._target_cell
+        r, c = self.target_cell
         own = FREE if self.params.cell_convention == "free" else UNKNOWN
         other = UNKNOWN if own == FREE else FREE
         if grid[r, c] != own:
@@ -553,15 +556,16 @@ class NearestFrontierPolicy(_FrontierBaseline):
             for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1))
         )
 
-    def _select(
+    def select_target(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
     ) -> tuple[float, float] | None:
+        """Next goal (m) or None; sets frontiers, target_cell, blacklist_hits, path_length_m."""
         assert self.nav is not None
         t0 = time.perf_counter()
-        self.frontiers = self._detect(grid, pose)
+        self.frontiers = self.detect(grid, pose)
         stats.map_generation_ms += (time.perf_counter() - t0) * 1e3
-        self._target_cell = None
-        self._blacklist_hits = 0
+        self.target_cell = None
+        self.blacklist_hits = 0
         if not self.frontiers:
             return None
         t0 = time.perf_counter()
@@ -583,7 +587,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
             cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
             x, y = self.geometry.grid_to_world(*cell)
             if (float(x), float(y)) in self.blacklist:
-                self._blacklist_hits += 1
+                self.blacklist_hits += 1
                 continue
             if best is None or d[i] < best[0]:
                 best = (float(d[i]), cell)
@@ -591,6 +595,6 @@ class NearestFrontierPolicy(_FrontierBaseline):
         if best is None:
             return None
         self.path_length_m = best[0]
-        self._target_cell = best[1]
+        self.target_cell = best[1]
         x, y = self.geometry.grid_to_world(*best[1])
         return (float(x), float(y))

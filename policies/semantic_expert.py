@@ -204,14 +204,8 @@ class SemanticExpertPolicy(Policy):
         self._known_cells = known_cell_count(obs["map"])
         self.goal_memory.reset(self.geometry, self.params.goal_memory)
         xy_m = (float(obs["pose"][0]), float(obs["pose"][1]))
-        self.follower.reset(
-            self.geometry,
-            self.limits,
-            self.dt_s,
-            xy_m,
-            self._known_cells,
-            self.params.path_following,
-        )
+        where = (self.geometry, self.limits, self.dt_s, xy_m, self._known_cells)
+        self.follower.reset(*where, self.params.path_following)
 
     # ------------------------------------------------------------------ stepping
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
@@ -341,6 +335,11 @@ class SemanticExpertPolicy(Policy):
     def request_replan(self) -> None:
         """Replan (segmentation and goal selection) at the next ``act``."""
         self._next_replan_s = self._time_s
+
+    def resume(self) -> None:
+        """Restart a stopped expert: not done, no stop reason, idle, replanning at next ``act``."""
+        self.done, self.stop_reason, self.mode, self._empty_replans = False, "", ExpertMode.IDLE, 0
+        self.request_replan()
 
     @property
     def commanded_goal_xy_m(self) -> tuple[float, float] | None:

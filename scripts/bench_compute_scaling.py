@@ -172,7 +172,7 @@ def bench_world(spec: str, args: argparse.Namespace, rng: np.random.Generator) -
     runs: dict[str, Callable[[], tuple[float, float]]] = {
         "pm": pm,
         "fe": lambda: baseline(fe, lambda st: fe._next_goal(grid, pose_arr, st)),
-        "nearest": lambda: baseline(near, lambda st: near._select(grid, pose_arr, st)),
+        "nearest": lambda: baseline(near, lambda st: near.select_target(grid, pose_arr, st)),
     }
     times: dict[str, list[float]] = {s: [] for s in STAGES}
     for rnd in range(args.repeats + 1):

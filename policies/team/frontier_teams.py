@@ -108,7 +108,10 @@ class FrontierTeamParams:
 
 
 @dataclass
-class _Candidate:
+class FrontierTarget:
+    """A frontier one team member can reach: its nearest cell, that cell in metres, and the
+    path length to it (what the team's assignment weighs)."""
+
     cell: tuple[int, int]
     xy_m: tuple[float, float]
     path_m: float
@@ -116,7 +119,7 @@ class _Candidate:
 
 class _Member(NearestFrontierPolicy):
     """One robot of a frontier team: the nearest-frontier robot whose target choice is the
-    team's (``_select`` asks the team)."""
+    team's (``select_target`` asks the team)."""
 
     name = "team_member"
 
@@ -126,11 +129,13 @@ class _Member(NearestFrontierPolicy):
         self.index = index
         self.goal_cell: tuple[int, int] | None = None
 
-    def candidates(self, grid: np.ndarray, pose: np.ndarray, stats: StepStats) -> list[_Candidate]:
+    def candidates(
+        self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
+    ) -> list[FrontierTarget]:
         """Every frontier's nearest cell by path, with its path length (blacklist excluded)."""
         assert self.nav is not None
-        self.frontiers = self._detect(grid, pose)
-        self._blacklist_hits = 0
+        self.frontiers = self.detect(grid, pose)
+        self.blacklist_hits = 0
         if not self.frontiers:
             return []
         costmap = inflate_costmap(grid, self.geometry.resolution_m, self.nav.costmap_params)
@@ -140,7 +145,7 @@ class _Member(NearestFrontierPolicy):
             fmask[f.cells[:, 0], f.cells[:, 1]] = True
         traversable |= fmask & ((costmap < INSCRIBED_COST) | (costmap == NO_INFORMATION))
         dist = geodesic_distance_m(traversable, self.geometry, pose[:2])
-        out: list[_Candidate] = []
+        out: list[FrontierTarget] = []
         for f in self.frontiers:
             d = dist[f.cells[:, 0], f.cells[:, 1]]
             i = int(np.argmin(d))
@@ -149,18 +154,18 @@ class _Member(NearestFrontierPolicy):
             cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
             x, y = self.geometry.grid_to_world(*cell)
             if (float(x), float(y)) in self.blacklist:
-                self._blacklist_hits += 1
+                self.blacklist_hits += 1
                 continue
-            out.append(_Candidate(cell, (float(x), float(y)), float(d[i])))
+            out.append(FrontierTarget(cell, (float(x), float(y)), float(d[i])))
         return out
 
-    def _select(
+    def select_target(
         self, grid: np.ndarray, pose: np.ndarray, stats: StepStats
     ) -> tuple[float, float] | None:
         self.counters["selections"] += 1
         choice = self.team.assign(self.index, grid, pose, stats)
-        self._target_cell = choice.cell if choice is not None else None
-        self.goal_cell = self._target_cell
+        self.target_cell = choice.cell if choice is not None else None
+        self.goal_cell = self.target_cell
         if choice is None:
             return None
         self.path_length_m = choice.path_m
@@ -219,9 +224,7 @@ class FrontierTeam(TeamPolicy):
                 continue
             if m.done and m.now_s - self._idle_since[i] >= self.params.idle_recheck_s:
                 # Teammates may have opened new frontiers since: look again.
-                m.done = False
-                m.stop_reason = ""
-                m._no_frontier_count = 0
+                m.resume()
             if m.done and not math.isfinite(self._idle_since[i]):
                 self._idle_since[i] = m.now_s
             action = m.act(observations[a], infos[a])
@@ -252,7 +255,7 @@ class FrontierTeam(TeamPolicy):
     # -------------------------------------------------------- coordination
     def assign(
         self, i: int, grid: np.ndarray, pose: np.ndarray, stats: StepStats
-    ) -> _Candidate | None:
+    ) -> FrontierTarget | None:
         """Robot ``i``'s next target under the team's coordination (None: no reachable one)."""
         member = self.members[i]
         cands = member.candidates(grid, pose, stats)
@@ -277,8 +280,8 @@ class FrontierTeam(TeamPolicy):
         return best
 
     def _coordinated(
-        self, i: int, cands: list[_Candidate], other_goals: list[tuple[float, ...]]
-    ) -> _Candidate:
+        self, i: int, cands: list[FrontierTarget], other_goals: list[tuple[float, ...]]
+    ) -> FrontierTarget:
         p = self.params
         xy = np.array([c.xy_m for c in cands])
         utility = np.ones(len(cands))

@@ -99,11 +99,7 @@ class _ExpertMember(SemanticExpertPolicy):
 
     def look_again(self) -> None:
         """Un-stop: the map may have new frontiers that teammates opened."""
-        self.done = False
-        self.stop_reason = ""
-        self.mode = "idle"
-        self._empty_replans = 0
-        self._next_replan_s = self._time_s
+        self.resume()
 
 
 class SemanticTeam(TeamPolicy):

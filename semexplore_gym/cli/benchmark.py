@@ -290,9 +290,9 @@ def _run(args: argparse.Namespace) -> int:
 
     validate_args(args)
     if getattr(args, "robots", None):
-        from semexplore_gym.evaluation.team_benchmark import run_team_cli
+        from semexplore_gym.evaluation.team_benchmark import run_team_study
 
-        return run_team_cli(args, split_worlds(args.worlds or ""))  # or args.suite
+        return run_team_study(team_study_request(args))
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")
@@ -355,3 +355,30 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(Path(summary).read_text())
     return 1 if res["failed"] else 0
+
+
+def team_study_request(args: argparse.Namespace) -> Any:
+    """``--robots N[,M...]`` and the benchmark's flags as a ``TeamStudyRequest``."""
+    from pathlib import Path
+
+    from semexplore_gym.evaluation.team_benchmark import TeamStudyRequest
+
+    try:
+        counts = tuple(int(v) for v in str(args.robots).split(",") if v.strip())
+    except ValueError:
+        raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}") from None
+    return TeamStudyRequest(
+        robot_counts=counts,
+        policies=tuple(p.strip() for p in str(args.policies).split(",") if p.strip()),
+        worlds=tuple(split_worlds(args.worlds or "")),
+        out=Path(args.out),
+        seed0=args.seed0,
+        runs=args.runs,
+        suite=getattr(args, "suite", None),
+        max_time_s=args.max_time_s,
+        env_config=args.env_config,
+        env_overrides=tuple(args.env_overrides),
+        fixed_start=bool(args.fixed_start),
+        progress=not args.no_progress,
+        command=" ".join(shlex.quote(a) for a in sys.argv),
+    )

@@ -38,7 +38,7 @@ from semexplore_gym.envs.multi_robot_config import (
 from semexplore_gym.envs.semantic_explore import (
     FrozenInfo,
     SemanticExploreEnv,
-    _is_unseeded_procedural,
+    is_unseeded_procedural,
 )
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
@@ -149,7 +149,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.render_mode = render_mode
         cfg = self.config
         self.world_spec = world
-        self._randomise_world = _is_unseeded_procedural(world)
+        self._randomise_world = is_unseeded_procedural(world)
         self.world: World = (
             world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
         )
@@ -160,30 +160,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.possible_agents = [f"robot_{i}" for i in range(self.n_robots)]
         self.agents: list[str] = []
         self._build_world_state()
-        h, w = self.map_geometry.shape
-        big = np.float32(1e6)
-        pose_low = np.array([-big, -big, -np.pi], dtype=np.float32)
-        pose_high = np.array([big, big, np.pi], dtype=np.float32)
-        self._observation_spaces = {
-            a: spaces.Dict(
-                {
-                    "map": spaces.Box(0, 255, shape=(h, w), dtype=np.uint8),
-                    "pose": spaces.Box(pose_low, pose_high, dtype=np.float32),
-                    "scan": spaces.Box(
-                        0.0, cfg.lidar.max_range_m, shape=(cfg.lidar.n_beams,), dtype=np.float32
-                    ),
-                    "teammates": spaces.Box(
-                        np.tile(pose_low, (self.n_robots - 1, 1)),
-                        np.tile(pose_high, (self.n_robots - 1, 1)),
-                        dtype=np.float32,
-                    ),
-                }
-            )
-            for a in self.possible_agents
-        }
-        self._action_spaces = {
-            a: spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32) for a in self.possible_agents
-        }
+        self._build_spaces()
         self._static_info: dict[str, Any] = {
             "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
             "robot": FrozenInfo(
@@ -212,6 +189,34 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self._renderer: Any = None
 
     # ----------------------------------------------------------------- set-up
+    def _build_spaces(self) -> None:
+        """Per-agent observation (map, pose, scan, teammates) and action spaces."""
+        cfg = self.config
+        h, w = self.map_geometry.shape
+        big = np.float32(1e6)
+        pose_low = np.array([-big, -big, -np.pi], dtype=np.float32)
+        pose_high = np.array([big, big, np.pi], dtype=np.float32)
+        self._observation_spaces = {
+            a: spaces.Dict(
+                {
+                    "map": spaces.Box(0, 255, shape=(h, w), dtype=np.uint8),
+                    "pose": spaces.Box(pose_low, pose_high, dtype=np.float32),
+                    "scan": spaces.Box(
+                        0.0, cfg.lidar.max_range_m, shape=(cfg.lidar.n_beams,), dtype=np.float32
+                    ),
+                    "teammates": spaces.Box(
+                        np.tile(pose_low, (self.n_robots - 1, 1)),
+                        np.tile(pose_high, (self.n_robots - 1, 1)),
+                        dtype=np.float32,
+                    ),
+                }
+            )
+            for a in self.possible_agents
+        }
+        self._action_spaces = {
+            a: spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32) for a in self.possible_agents
+        }
+
     @property
     def np_random(self) -> np.random.Generator:
         """The env's random source (seeded by ``reset(seed=...)``, as gymnasium envs)."""
@@ -235,10 +240,10 @@ class SemanticExploreMultiEnv(ParallelEnv):
 
     def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         # Robot 0's start is the single-robot env's, by the same code.
-        return SemanticExploreEnv._choose_start(self, options)  # type: ignore[arg-type]
+        return SemanticExploreEnv.choose_start(self, options)  # type: ignore[arg-type]
 
     def _scale_action(self, action: Any) -> tuple[float, float]:
-        return SemanticExploreEnv._scale_action(self, action)  # type: ignore[arg-type]
+        return SemanticExploreEnv.scale_action(self, action)  # type: ignore[arg-type]
 
     def _teammate_starts(
         self, first: tuple[float, float, float], reach: np.ndarray
@@ -426,7 +431,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         c1 = min(g.width, int((x + reach - g.origin_x_m) / g.resolution_m) + 2)
         if r0 >= r1 or c0 >= c1:
             return
-        touched = grid._stamp[r0:r1, c0:c1] == grid._scan_id
+        touched = grid.touched_by_last_scan(slice(r0, r1), slice(c0, c1))
         block = self.scanned_count[r0:r1, c0:c1]
         block |= touched.view(np.uint8) << np.uint8(i)
 

@@ -37,7 +37,8 @@ PROCEDURAL_FAMILIES = ("maze", "office", "cave")
 INFO_NUMBERS = ("coverage", "explored_area_m2", "collisions", "sim_time_s", "path_length_m")
 
 
-def _is_unseeded_procedural(spec: Any) -> bool:
+def is_unseeded_procedural(spec: Any) -> bool:
+    """Whether ``spec`` names a procedural family without ``seed=`` (a new world per reset)."""
     if not isinstance(spec, str):
         return False
     family, _, params = spec.partition(":")
@@ -232,7 +233,7 @@ class SemanticExploreEnv(gym.Env):
         self.config: EnvConfig = load_env_config(config, overrides)
         cfg = self.config
         self.world_spec = world
-        self._randomise_world = _is_unseeded_procedural(world)
+        self._randomise_world = is_unseeded_procedural(world)
         self.world: World = (
             world if isinstance(world, World) else make_world(world, rng=np.random.default_rng(0))
         )
@@ -313,7 +314,10 @@ class SemanticExploreEnv(gym.Env):
         self.odometry = OdometryDrift(cfg.odometry)
         self._odometry_noisy = not cfg.odometry.is_perfect
 
-    def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
+    def choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
+        """The start pose for a reset: ``options["start_pose"]``, else ``episode.start_pose``,
+        else the world's start (unless ``episode.random_start``), else a random free pose drawn
+        from :attr:`np_random`. Raises ``ValueError`` for a malformed or blocked pose."""
         cfg = self.config
         clearance = cfg.robot.radius_m + cfg.episode.start_clearance_margin_m
         pose = None
@@ -346,7 +350,7 @@ class SemanticExploreEnv(gym.Env):
             self.world = make_world(f"{family}:{params}")
             self._build_world_state()
         self._started = True
-        pose = self._choose_start(options)
+        pose = self.choose_start(options)
         cfg = self.config
         self.sim.reset(pose)
         reach = reachable_free_mask(
@@ -410,7 +414,7 @@ class SemanticExploreEnv(gym.Env):
         advances must read the observation with :meth:`write_obs_into` and the ``info``
         numbers with :meth:`info_numbers` before the next call.
         """
-        v_mps, w_radps = self._scale_action(action)
+        v_mps, w_radps = self.scale_action(action)
         cfg = self.config
         before = self._true_pose
         new_collision = self.sim.step(v_mps, w_radps, cfg.episode.dt_s)
@@ -437,7 +441,9 @@ class SemanticExploreEnv(gym.Env):
         truncated = bool(self.sim_time_s >= cfg.episode.max_time_s - 1e-9)
         return reward, terminated, truncated, terms
 
-    def _scale_action(self, action: Any) -> tuple[float, float]:
+    def scale_action(self, action: Any) -> tuple[float, float]:
+        """``action`` = [v, omega] in [-1, 1] as (linear m/s, angular rad/s) of the robot's
+        limits (clipped). Raises ``ValueError`` for anything but 2 real numbers."""
         if isinstance(action, np.ndarray) and action.shape == (2,) and action.dtype.kind in "fiub":
             a0, a1 = float(action[0]), float(action[1])
         else:

@@ -32,7 +32,6 @@ import csv
 import json
 import math
 import time
-from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -169,31 +168,45 @@ def run_team_mission(
     )
 
 
-def run_team_benchmark(
-    worlds: Iterable[str],
-    policies: Iterable[str],
-    robot_counts: Iterable[int],
-    seeds: Iterable[int],
-    out: str | Path,
-    *,
-    max_time_s: float | None = None,
-    env_config: Any = None,
-    env_overrides: Iterable[str] = (),
-    fixed_start: bool = False,
-    progress: bool = True,
-    time_limits: dict[str, float | None] | None = None,
-) -> dict[str, Any]:
-    """Every (world, policy, robots, seed) team mission, appended to ``out/runs.csv``.
+@dataclass(frozen=True)
+class TeamBenchmarkConfig:
+    """What :func:`run_team_benchmark` runs: every (world, policy, robots, seed) mission.
 
-    Rerunning the same command skips the missions already in ``runs.csv`` (resumes).
     ``time_limits`` gives some worlds their own limit (a suite's), else ``max_time_s``.
     ``episode.coverage_goal`` is set to 1 (the team, not the env, ends a mission) and
     ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides`` come last.
     """
+
+    worlds: tuple[str, ...]
+    policies: tuple[str, ...]
+    robot_counts: tuple[int, ...]
+    seeds: tuple[int, ...]
+    out: Path
+    max_time_s: float | None = None
+    env_config: Any = None
+    env_overrides: tuple[str, ...] = ()
+    fixed_start: bool = False
+    progress: bool = True
+    time_limits: dict[str, float | None] = field(default_factory=dict)
+
+
+def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
+    """Every mission of ``config``, appended to ``config.out/runs.csv``.
+
+    Rerunning the same command skips the missions already in ``runs.csv`` (resumes).
+    """
     from semexplore_gym.envs.multi_robot import make_multi
     from semexplore_gym.policies.team import make_team_policy
 
-    out_dir = Path(out)
+    c = config
+    worlds, policies, robot_counts, seeds = c.worlds, c.policies, c.robot_counts, c.seeds
+    max_time_s, env_config, progress, time_limits = (
+        c.max_time_s,
+        c.env_config,
+        c.progress,
+        c.time_limits,
+    )
+    out_dir = Path(c.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     csv_path = out_dir / "runs.csv"
     done: set[tuple[str, str, int, int]] = set()
@@ -202,10 +215,10 @@ def run_team_benchmark(
             for r in csv.DictReader(f):
                 done.add((r["world"], r["policy"], int(r["n_robots"]), int(r["seed"])))
     overrides = ["episode.coverage_goal=1.0"]
-    overrides.append(f"episode.random_start={'false' if fixed_start else 'true'}")
+    overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
     if max_time_s is not None:
         overrides.append(f"episode.max_time_s={max_time_s!r}")
-    overrides += list(env_overrides)
+    overrides += list(c.env_overrides)
     ran = skipped = 0
     write_header = not csv_path.exists()
     with csv_path.open("a", newline="") as f:
@@ -328,16 +341,39 @@ def _paired_tests(rows: list[dict[str, str]]) -> list[str]:
     return out
 
 
-def run_team_cli(args: Any, worlds: list[str]) -> int:
-    """``semexplore benchmark --robots N[,M...]``: the team benchmark with the benchmark's flags
-    (``--worlds``, ``--policies`` as team policy names, ``--runs``, ``--seed0``, ``--out``,
-    ``--max-time-s``, ``--env-config``, ``--env-set``, ``--fixed-start``)."""
+@dataclass(frozen=True)
+class TeamStudyRequest:
+    """``semexplore benchmark --robots N[,M...]`` as typed values (the CLI builds it).
+
+    ``policies`` are team policy names (the single-robot default list means "the usual
+    comparison": semantic, coordinated, independent); ``suite`` (comma-separated suite names)
+    replaces ``worlds`` and sets the time limits; ``runs`` of None means 5 (or the suites').
+    ``command`` is the command line written to the manifest.
+    """
+
+    robot_counts: tuple[int, ...]
+    policies: tuple[str, ...]
+    worlds: tuple[str, ...]
+    out: Path
+    seed0: int = 0
+    runs: int | None = None
+    suite: str | None = None
+    max_time_s: float | None = None
+    env_config: Any = None
+    env_overrides: tuple[str, ...] = ()
+    fixed_start: bool = False
+    progress: bool = True
+    command: str = ""
+
+
+def run_team_study(req: TeamStudyRequest) -> int:
+    """Run the team benchmark of ``req``, write ``manifest.json`` and ``summary.md``, print them."""
     from semexplore_gym.policies.team import team_policy_names
 
-    counts = [int(v) for v in str(args.robots).split(",") if v.strip()]
+    counts = list(req.robot_counts)
     if not counts or any(not 1 <= c <= 8 for c in counts):
-        raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}")
-    policies = [p.strip() for p in str(args.policies).split(",") if p.strip()]
+        raise ValueError(f"--robots must be team sizes in 1..8, got {counts!r}")
+    policies = list(req.policies)
     known = team_policy_names()
     if policies == ["semantic", "frontier", "nearest"]:
         # The single-robot default means "the usual comparison".
@@ -345,45 +381,45 @@ def run_team_cli(args: Any, worlds: list[str]) -> int:
     if any(p not in known for p in policies):
         raise ValueError(f"--policies with --robots takes team policies: {', '.join(known)}")
     time_limits: dict[str, float | None] = {}
-    runs = args.runs or 5
-    if getattr(args, "suite", None):
-        worlds, time_limits, suite_runs = _suite_worlds(args.suite, args.max_time_s)
-        runs = args.runs or suite_runs
+    runs = req.runs or 5
+    worlds = list(req.worlds)
+    if req.suite:
+        worlds, time_limits, suite_runs = _suite_worlds(req.suite, req.max_time_s)
+        runs = req.runs or suite_runs
     if not worlds:
         raise ValueError("--worlds is empty")
-    seeds = list(range(args.seed0, args.seed0 + runs))
-    out_dir = Path(args.out)
+    seeds = list(range(req.seed0, req.seed0 + runs))
+    out_dir = Path(req.out)
     out_dir.mkdir(parents=True, exist_ok=True)
-    import shlex
-    import sys
-
     (out_dir / "manifest.json").write_text(
         json.dumps(
             {
-                "command": " ".join(shlex.quote(a) for a in sys.argv),
+                "command": req.command,
                 "worlds": worlds,
                 "policies": policies,
                 "robots": counts,
                 "seeds": seeds,
-                "max_time_s": args.max_time_s,
-                "suite": getattr(args, "suite", None),
-                "env_overrides": list(args.env_overrides),
+                "max_time_s": req.max_time_s,
+                "suite": req.suite,
+                "env_overrides": list(req.env_overrides),
             },
             indent=2,
         )
     )
     res = run_team_benchmark(
-        worlds,
-        policies,
-        counts,
-        seeds,
-        out_dir,
-        max_time_s=args.max_time_s,
-        env_config=args.env_config,
-        env_overrides=args.env_overrides,
-        fixed_start=bool(args.fixed_start),
-        progress=not args.no_progress,
-        time_limits=time_limits,
+        TeamBenchmarkConfig(
+            worlds=tuple(worlds),
+            policies=tuple(policies),
+            robot_counts=tuple(counts),
+            seeds=tuple(seeds),
+            out=out_dir,
+            max_time_s=req.max_time_s,
+            env_config=req.env_config,
+            env_overrides=tuple(req.env_overrides),
+            fixed_start=req.fixed_start,
+            progress=req.progress,
+            time_limits=time_limits,
+        )
     )
     summary = write_team_summary(out_dir)
     print(json.dumps(res))

@@ -64,6 +64,28 @@ class TeamSim:
         space.gravity = (0.0, 0.0)
         space.collision_slop = self.physics_params.collision_slop_m
         space.iterations = self.physics_params.solver_iterations
+        self._add_walls(space)
+        self.bodies: list[pymunk.Body] = []
+        self.controls: list[pymunk.Body] = []
+        self._index_of: dict[pymunk.Shape, int] = {}
+        for i in range(self.n_robots):
+            self._add_robot(space, i)
+        self._wall_filter = pymunk.ShapeFilter(mask=0b01)
+        self._query_info = _ffi.new("cpPointQueryInfo *")
+        n = self.n_robots
+        self._touching = [0] * n
+        self._began = [False] * n
+        self._suppress_begin = [False] * n
+        self._add_contact_handlers(space)
+        self.space = space
+        self.collisions = [0] * n
+        self.robot_collisions = 0
+        self.in_contact = [False] * n
+        self._substep_dt_key = -1.0
+        self._substeps = 1
+
+    def _add_walls(self, space: pymunk.Space) -> None:
+        """Add the world's wall segments to ``space`` as static, skinned segments."""
         static = space.static_body
         shapes = []
         for x0, y0, x1, y1 in self.world.segments_m:
@@ -75,47 +97,42 @@ class TeamSim:
             shapes.append(s)
         space.add(*shapes)
 
+    def _add_robot(self, space: pymunk.Space, i: int) -> None:
+        """Add robot ``i``'s body, wall disc, drive joints (and bumper disc in a team)."""
         r = self.robot_params
-        self.bodies: list[pymunk.Body] = []
-        self.controls: list[pymunk.Body] = []
-        self._index_of: dict[pymunk.Shape, int] = {}
-        for i in range(self.n_robots):
-            moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
-            body = pymunk.Body(r.mass_kg, moment)
-            shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
-            shape.friction = 0.0
-            shape.elasticity = 0.0
-            shape.collision_type = ROBOT_COLLISION_TYPE
-            shape.filter = pymunk.ShapeFilter(categories=0b10)
-            control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-            pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
-            pivot.max_bias = 0.0
-            pivot.max_force = r.max_drive_force_n
-            gear = pymunk.GearJoint(control, body, 0.0, 1.0)
-            gear.error_bias = 0.0
-            gear.max_bias = 0.0
-            gear.max_force = r.max_turn_torque_nm
-            space.add(body, shape, control, pivot, gear)
-            self.bodies.append(body)
-            self.controls.append(control)
-            self._index_of[shape] = i
-            if self.n_robots > 1:
-                # The wall shape is shrunk by the walls' skin; between robots a second, full-size
-                # disc touches, so two robots meet at 2 * radius_m (what their LiDARs see).
-                shape.filter = pymunk.ShapeFilter(categories=0b10, mask=0b01)
-                bumper = pymunk.Circle(body, r.radius_m)
-                bumper.friction = 0.0
-                bumper.elasticity = 0.0
-                bumper.collision_type = BUMPER_COLLISION_TYPE
-                bumper.filter = pymunk.ShapeFilter(categories=0b100, mask=0b100)
-                space.add(bumper)
-                self._index_of[bumper] = i
-        self._wall_filter = pymunk.ShapeFilter(mask=0b01)
-        self._query_info = _ffi.new("cpPointQueryInfo *")
-        n = self.n_robots
-        self._touching = [0] * n
-        self._began = [False] * n
-        self._suppress_begin = [False] * n
+        moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
+        body = pymunk.Body(r.mass_kg, moment)
+        shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
+        shape.friction = 0.0
+        shape.elasticity = 0.0
+        shape.collision_type = ROBOT_COLLISION_TYPE
+        shape.filter = pymunk.ShapeFilter(categories=0b10)
+        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+        pivot.max_bias = 0.0
+        pivot.max_force = r.max_drive_force_n
+        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+        gear.error_bias = 0.0
+        gear.max_bias = 0.0
+        gear.max_force = r.max_turn_torque_nm
+        space.add(body, shape, control, pivot, gear)
+        self.bodies.append(body)
+        self.controls.append(control)
+        self._index_of[shape] = i
+        if self.n_robots > 1:
+            # The wall shape is shrunk by the walls' skin; between robots a second, full-size
+            # disc touches, so two robots meet at 2 * radius_m (what their LiDARs see).
+            shape.filter = pymunk.ShapeFilter(categories=0b10, mask=0b01)
+            bumper = pymunk.Circle(body, r.radius_m)
+            bumper.friction = 0.0
+            bumper.elasticity = 0.0
+            bumper.collision_type = BUMPER_COLLISION_TYPE
+            bumper.filter = pymunk.ShapeFilter(categories=0b100, mask=0b100)
+            space.add(bumper)
+            self._index_of[bumper] = i
+
+    def _add_contact_handlers(self, space: pymunk.Space) -> None:
+        """Count contact episodes: robot-wall and robot-robot (bumper-bumper) begin/separate."""
 
         def _contact_begins(i: int) -> None:
             if self._touching[i] == 0 and not self._suppress_begin[i]:
@@ -150,12 +167,6 @@ class TeamSim:
             begin=_begin_robot,
             separate=_separate_robot,
         )
-        self.space = space
-        self.collisions = [0] * n
-        self.robot_collisions = 0
-        self.in_contact = [False] * n
-        self._substep_dt_key = -1.0
-        self._substeps = 1
 
     def reset(self, poses: Sequence[tuple[float, float, float]]) -> None:
         """Place robot ``i`` at rest at ``poses[i]`` = (x_m, y_m, yaw_rad)."""

@@ -12,7 +12,7 @@ pytest.importorskip("pettingzoo")
 
 from semexplore_gym.policies.navigation import NavStatus  # noqa: E402
 from semexplore_gym.policies.team import make_team_policy, team_policy_names  # noqa: E402
-from semexplore_gym.policies.team.frontier_teams import FrontierTeam, _Candidate  # noqa: E402
+from semexplore_gym.policies.team.frontier_teams import FrontierTarget, FrontierTeam  # noqa: E402
 
 from semexplore_gym.core.worlds.build import world_from_segments  # noqa: E402
 from semexplore_gym.envs.multi_robot import make_multi  # noqa: E402
@@ -42,7 +42,7 @@ class _ToFixedGoals(FrontierTeam):
             return None
         x, y = self.goals[i]
         cell = tuple(int(v) for v in m.geometry.world_to_grid(x, y))
-        return _Candidate(cell, (x, y), 1.0)  # type: ignore[arg-type]
+        return FrontierTarget(cell, (x, y), 1.0)  # type: ignore[arg-type]
 
 
 def test_robots_pass_in_a_corridor_two_robots_wide() -> None:
@@ -57,7 +57,7 @@ def test_robots_pass_in_a_corridor_two_robots_wide() -> None:
     team.goals = [(6.5, 1.6), (0.5, 0.4)]  # each robot to the far room: they meet inside
     team.reset(obs, infos, seed=0)
     for m in team.members:
-        m._target_still_frontier = lambda grid: True  # type: ignore[method-assign]
+        m.target_still_frontier = lambda grid: True  # type: ignore[method-assign]
     arrived = False
     for _ in range(1500):
         obs, _, _, _, infos = env.step(team.act(obs, infos))

@@ -6,7 +6,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 
 
@@ -30,17 +29,8 @@ def merge_grids(grids: Sequence[OccupancyGrid]) -> None:
     shape = grids[0].geometry.shape
     if any(g.geometry.shape != shape for g in grids):
         raise ValueError("merge_grids needs grids of one shape")
-    stack = np.stack([g._log_odds for g in grids])
+    stack = np.stack([g.log_odds for g in grids])
     pick = np.argmax(np.abs(stack), axis=0)
     merged = np.take_along_axis(stack, pick[None], axis=0)[0]
-    p = grids[0].params
-    encoded = np.full(shape, UNKNOWN, dtype=np.uint8)
-    encoded[merged < p.free_threshold] = FREE
-    encoded[merged > p.occupied_threshold] = OCCUPIED
-    free = encoded == FREE
-    n_free = int(free.sum())
     for g in grids:
-        g._log_odds[...] = merged
-        g._encoded[...] = encoded
-        g.n_free_cells = n_free
-        g.n_free_in_mask = int(np.count_nonzero(free & g.count_mask))
+        g.load_log_odds(merged)

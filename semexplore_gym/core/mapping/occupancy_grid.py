@@ -308,6 +308,30 @@ class OccupancyGrid:
         self.n_free_in_mask += d_free_mask
         return int(d_free)
 
+    def touched_by_last_scan(self, rows: slice, cols: slice) -> np.ndarray:
+        """Bool mask of the cells in ``[rows, cols]`` that the latest scan updated."""
+        return self._stamp[rows, cols] == self._scan_id
+
+    def load_log_odds(self, log_odds: np.ndarray) -> None:
+        """Replace the whole map by ``log_odds`` (``(H, W)``, e.g. a merged team map), in place.
+
+        The encoded cells and both free-cell counters follow from the new log-odds (the
+        thresholds of :attr:`params`); the scan stamps are kept.
+        """
+        if log_odds.shape != self._log_odds.shape:
+            raise ValueError(
+                f"log_odds must have shape {self._log_odds.shape}, got {log_odds.shape}"
+            )
+        p = self.params
+        encoded = np.full(log_odds.shape, UNKNOWN, dtype=np.uint8)
+        encoded[log_odds < p.free_threshold] = FREE
+        encoded[log_odds > p.occupied_threshold] = OCCUPIED
+        free = encoded == FREE
+        self._log_odds[...] = log_odds
+        self._encoded[...] = encoded
+        self.n_free_cells = int(free.sum())
+        self.n_free_in_mask = int(np.count_nonzero(free & self.count_mask))
+
     def _begin_scan(self) -> int:
         """The stamp of a new scan (stamps are cleared every ``_MAX_SCAN_ID`` scans)."""
         if self._scan_id >= _MAX_SCAN_ID:
