@@ -212,7 +212,7 @@ class SemanticTeam(TeamPolicy):
                     d = (
                         np.hypot(path[1:, 0] - q[0], path[1:, 1] - q[1])
                         if len(path) > 1
-                        else [math.inf]
+                        else np.array([math.inf])
                     )
                     if float(np.min(d)) < p.branch_radius_m:
                         branch[k] = 1.0
