@@ -195,14 +195,15 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _suite_tasks(
-    args: argparse.Namespace, policies: list[str], seeds_for: Any
+    args: argparse.Namespace, seeds_for: Any, policies: list[str] | None = None
 ) -> tuple[list[Any], list[dict[str, Any]], list[str]]:
-    """Tasks of every ``--suite`` (see :func:`~semexplore_gym.evaluation.suites.suite_tasks`)."""
+    """Tasks of every ``--suite`` (see :func:`~semexplore_gym.evaluation.suites.suite_tasks`)
+    for ``policies`` (default: ``--policies``)."""
     from semexplore_gym.evaluation.suites import suite_tasks
 
     return suite_tasks(
         split_list(args.suite),
-        policies,
+        _split_policies(args.policies) if policies is None else policies,
         seeds_for,
         max_time_s=args.max_time_s,
         fixed_start=args.fixed_start,
@@ -302,7 +303,7 @@ def _run(args: argparse.Namespace) -> int:
     suites: list[dict[str, Any]] = []
     if args.suite is not None:
         tasks, suites, worlds = _suite_tasks(
-            args, policies, lambda runs: parse_seeds(args.runs or runs, args.seed0)
+            args, lambda runs: parse_seeds(args.runs or runs, args.seed0), policies
         )
         seeds = sorted({t.seed for t in tasks})
         env_config_record: Any = "per world (suite)"

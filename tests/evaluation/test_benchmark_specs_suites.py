@@ -19,8 +19,9 @@ TINY = "maze:seed=1,size_m=4"
 
 
 def _bench(out: Path, *args: str) -> list[str]:
-    # Progress bars on, as users run it.
-    return ["benchmark", "--out", str(out), "--no-plots", *args]
+    # Progress bars on, as users run it; the oracle's regret has tests of its own
+    # (tests/evaluation/test_regret.py), here the suites run without it.
+    return ["benchmark", "--out", str(out), "--no-plots", "--no-oracle", *args]
 
 
 def _start(out: Path, world: str, policy: str, seed: int) -> np.ndarray:

@@ -1,6 +1,6 @@
-"""The README's Python API snippet (section "The Python API") runs as written.
+"""The docs' Python API snippet (Getting started, "From Python") runs as written.
 
-The test reads the block from the README (the first ``python`` fence after that heading), so
+The test reads the block from docs/getting-started.md (the first ``python`` fence after that heading), so
 the two cannot drift.
 """
 
@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-DOC = Path(__file__).resolve().parents[2] / "README.md"
-HEADING = "### The Python API"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "getting-started.md"
+HEADING = "## From Python: policies, missions, datasets"
 
 
 def python_blocks(markdown: str) -> list[str]:
