@@ -45,3 +45,23 @@ def test_a_missing_solver_is_one_line_saying_what_to_install(monkeypatch, capsys
     assert len(err) == 1 and "pip install" in err[0] and "elkai" in err[0]
     with pytest.raises(ValueError, match="elkai"):
         make_policy("oracle")
+
+
+def test_a_suite_without_the_solver_runs_without_the_oracle(monkeypatch, capsys, tmp_path):
+    """The oracle is on by default with --suite: a plain install (no elkai) still runs the
+    suite and says in one line why there is no regret; --oracle asked by name is an error."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "elkai", None)
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        "name: tiny\nversion: 1\ndescription: one small maze\nruns: 1\nrandom_start: true\n"
+        "max_time_s: 30.0\nworlds:\n- maze:seed=1,size_m=4\n"
+    )
+    base = ["benchmark", "--suite", str(suite), "--policies", "nearest", "--no-progress"]
+    assert main([*base, "--no-plots", "--out", str(tmp_path / "a")]) == 0
+    err = capsys.readouterr().err
+    assert "no oracle (regret) in this run" in err and "elkai" in err
+    assert not (tmp_path / "a" / "regret.csv").exists()
+    assert main([*base, "--oracle", "--no-plots", "--out", str(tmp_path / "b")]) == 2
+    assert "elkai" in capsys.readouterr().err
