@@ -6,6 +6,7 @@ import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 #: ``SEMEXPLORE_TEST_HIDE_SHARED=1`` runs the tests as on a clean clone, without ``../shared``
@@ -72,3 +73,46 @@ def one_torch_thread() -> Iterator[None]:
     torch.set_num_threads(1)
     yield
     torch.set_num_threads(n)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> float:
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def _segments_intersect(p0, p1, q0, q1) -> bool:
+    """Closed segments p0-p1 and q0-q1 share a point (independent of the package's kernels)."""
+    p0, p1, q0, q1 = (np.asarray(v, dtype=float) for v in (p0, p1, q0, q1))
+    d1 = _cross(p1 - p0, q0 - p0)
+    d2 = _cross(p1 - p0, q1 - p0)
+    d3 = _cross(q1 - q0, p0 - q0)
+    d4 = _cross(q1 - q0, p1 - q0)
+    if (
+        ((d1 > 0) != (d2 > 0))
+        and ((d3 > 0) != (d4 > 0))
+        and d1 != 0
+        and d2 != 0
+        and d3 != 0
+        and d4 != 0
+    ):
+        return True
+
+    def on(a, b, c) -> bool:
+        return (
+            abs(_cross(b - a, c - a)) < 1e-12
+            and min(a[0], b[0]) - 1e-12 <= c[0] <= max(a[0], b[0]) + 1e-12
+            and (min(a[1], b[1]) - 1e-12 <= c[1] <= max(a[1], b[1]) + 1e-12)
+        )
+
+    return on(p0, p1, q0) or on(p0, p1, q1) or on(q0, q1, p0) or on(q0, q1, p1)
+
+
+def _blocked(segments: np.ndarray, a, b) -> bool:
+    """Some wall segment crosses the straight line from ``a`` to ``b``."""
+    return any(_segments_intersect(a, b, s[:2], s[2:]) for s in segments)
+
+
+@pytest.fixture
+def segments_block():
+    """``segments_block(segments, a, b)``: a wall segment (rows ``x0, y0, x1, y1``) crosses the
+    straight line a-b, by plain geometry independent of the package's kernels."""
+    return _blocked

@@ -13,42 +13,6 @@ from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.worlds import rasterize_free
 from semexplore_gym.maps import load_houseexpo_world, load_ros_map, make_world
 
-
-def _cross(a: np.ndarray, b: np.ndarray) -> float:
-    return float(a[0] * b[1] - a[1] * b[0])
-
-
-def _segments_intersect(p0, p1, q0, q1) -> bool:
-    """Closed segments p0-p1 and q0-q1 share a point (independent of the package's kernels)."""
-    p0, p1, q0, q1 = (np.asarray(v, dtype=float) for v in (p0, p1, q0, q1))
-    d1 = _cross(p1 - p0, q0 - p0)
-    d2 = _cross(p1 - p0, q1 - p0)
-    d3 = _cross(q1 - q0, p0 - q0)
-    d4 = _cross(q1 - q0, p1 - q0)
-    if (
-        ((d1 > 0) != (d2 > 0))
-        and ((d3 > 0) != (d4 > 0))
-        and d1 != 0
-        and d2 != 0
-        and d3 != 0
-        and d4 != 0
-    ):
-        return True
-
-    def on(a, b, c) -> bool:
-        return (
-            abs(_cross(b - a, c - a)) < 1e-12
-            and min(a[0], b[0]) - 1e-12 <= c[0] <= max(a[0], b[0]) + 1e-12
-            and (min(a[1], b[1]) - 1e-12 <= c[1] <= max(a[1], b[1]) + 1e-12)
-        )
-
-    return on(p0, p1, q0) or on(p0, p1, q1) or on(q0, q1, p0) or on(q0, q1, p1)
-
-
-def _blocked(segments: np.ndarray, a, b) -> bool:
-    return any(_segments_intersect(a, b, s[:2], s[2:]) for s in segments)
-
-
 # --------------------------------------------------------------------------- ROS map_server
 
 
@@ -204,7 +168,7 @@ SLIT_HOUSE = [
 ]
 
 
-def test_houseexpo_polygon_with_slit(tmp_path: Path) -> None:
+def test_houseexpo_polygon_with_slit(tmp_path: Path, segments_block) -> None:
     world = load_houseexpo_world(_plan(tmp_path, SLIT_HOUSE), resolution_m=0.025)
     assert world.free_space_source == "vector"
     assert world.n_segments == 8  # the collinear top vertex is merged away
@@ -217,8 +181,8 @@ def test_houseexpo_polygon_with_slit(tmp_path: Path) -> None:
     g = world.free_geometry
     rows, cols = g.world_to_grid(np.array([1.9, 2.0, 2.1]), np.full(3, 1.0))
     assert world.free_mask[rows, cols].tolist() == [True, False, True]
-    assert _blocked(world.segments_m, (1.9, 1.0), (2.1, 1.0))
-    assert not _blocked(world.segments_m, (1.9, 2.5), (2.1, 2.5))
+    assert segments_block(world.segments_m, (1.9, 1.0), (2.1, 1.0))
+    assert not segments_block(world.segments_m, (1.9, 2.5), (2.1, 2.5))
     # ... and on another grid too.
     coarse = GridGeometry(0.1, -0.3, -0.3, 36, 46)
     free = rasterize_free(world, coarse)

@@ -13,42 +13,6 @@ from semexplore_gym.core.worlds import (
 )
 from semexplore_gym.core.worlds.geometry import merge_polyline_edges
 
-
-def _cross(a: np.ndarray, b: np.ndarray) -> float:
-    return float(a[0] * b[1] - a[1] * b[0])
-
-
-def _segments_intersect(p0, p1, q0, q1) -> bool:
-    """Closed segments p0-p1 and q0-q1 share a point (independent of the package's kernels)."""
-    p0, p1, q0, q1 = (np.asarray(v, dtype=float) for v in (p0, p1, q0, q1))
-    d1 = _cross(p1 - p0, q0 - p0)
-    d2 = _cross(p1 - p0, q1 - p0)
-    d3 = _cross(q1 - q0, p0 - q0)
-    d4 = _cross(q1 - q0, p1 - q0)
-    if (
-        ((d1 > 0) != (d2 > 0))
-        and ((d3 > 0) != (d4 > 0))
-        and d1 != 0
-        and d2 != 0
-        and d3 != 0
-        and d4 != 0
-    ):
-        return True
-
-    def on(a, b, c) -> bool:
-        return (
-            abs(_cross(b - a, c - a)) < 1e-12
-            and min(a[0], b[0]) - 1e-12 <= c[0] <= max(a[0], b[0]) + 1e-12
-            and (min(a[1], b[1]) - 1e-12 <= c[1] <= max(a[1], b[1]) + 1e-12)
-        )
-
-    return on(p0, p1, q0) or on(p0, p1, q1) or on(q0, q1, p0) or on(q0, q1, p1)
-
-
-def _blocked(segments: np.ndarray, a, b) -> bool:
-    return any(_segments_intersect(a, b, s[:2], s[2:]) for s in segments)
-
-
 # --------------------------------------------------------------------------- raster -> segments
 
 WALL_ROOM = """
@@ -77,14 +41,14 @@ def test_one_pixel_wall_gives_one_merged_segment_per_side() -> None:
     assert len(segments) == 8
 
 
-def test_one_pixel_wall_blocks_a_crossing() -> None:
+def test_one_pixel_wall_blocks_a_crossing(segments_block) -> None:
     free = parse_ascii_grid(WALL_ROOM) == FREE
     geometry = GridGeometry(0.1, 0.0, 0.0, *free.shape)
     segments = raster_to_segments(free, geometry)
     # From the centre of free cell (row 2, col 5) to that of (row 4, col 5), across the wall.
-    assert _blocked(segments, (0.55, 0.25), (0.55, 0.45))
+    assert segments_block(segments, (0.55, 0.25), (0.55, 0.45))
     # Around the wall's end (column 10 is free in rows 2..4) nothing is in the way.
-    assert not _blocked(segments, (1.05, 0.25), (1.05, 0.45))
+    assert not segments_block(segments, (1.05, 0.25), (1.05, 0.45))
 
 
 def test_raster_outside_counts_as_obstacle_and_specks_are_dropped() -> None:
