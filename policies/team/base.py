@@ -37,6 +37,19 @@ class TeamPolicy(abc.ABC):
         self.agents = list(observations)
         self.counters = {}
 
+    def reset_members(
+        self,
+        members: list[Any],
+        observations: dict[str, dict[str, np.ndarray]],
+        infos: dict[str, dict[str, Any]],
+        seed: int | None,
+    ) -> None:
+        """Reset one member policy per agent (agent ``i`` seeded ``seed + i``) and note every
+        agent's start pose in ``self._poses``."""
+        for i, (m, a) in enumerate(zip(members, self.agents, strict=True)):
+            m.reset(observations[a], infos[a], seed=None if seed is None else seed + i)
+        self._poses = [np.asarray(observations[a]["pose"], dtype=np.float64) for a in self.agents]
+
     @abc.abstractmethod
     def act(
         self, observations: dict[str, dict[str, np.ndarray]], infos: dict[str, dict[str, Any]]

@@ -126,9 +126,7 @@ class SemanticTeam(TeamPolicy):
     ) -> None:
         super().reset(observations, infos, seed)
         self.members = [_ExpertMember(self, i, self.params.expert) for i in range(len(self.agents))]
-        for i, (m, a) in enumerate(zip(self.members, self.agents, strict=True)):
-            m.reset(observations[a], infos[a], seed=None if seed is None else seed + i)
-        self._poses = [np.asarray(observations[a]["pose"], dtype=np.float64) for a in self.agents]
+        self.reset_members(self.members, observations, infos, seed)
         self._clock_s = 0.0
         self._stopped_at = [math.inf] * len(self.agents)
 
