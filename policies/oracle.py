@@ -5,8 +5,9 @@
 ``privileged=True`` puts in the ``info`` of ``reset`` (``info["privileged_world"]``; the mission
 runners ask for it through :func:`semexplore_gym.evaluation.rollout.map_observation_for`, which
 reads :attr:`OraclePolicy.privileged`). Any other env makes :meth:`OraclePolicy.reset` raise, so
-the oracle cannot slip into learning code (training envs are never privileged, and
-``make_expert`` refuses it). It is a yardstick, not an explorer: its times are what a robot
+the oracle cannot slip into learning code: ``make_expert`` refuses it unless a training run
+sets ``expert.privileged_teacher=true`` by name, and then only the teacher's env is privileged
+(the learner's env never is). It is a yardstick, not an explorer: its times are what a robot
 that knew the building could do with this sensor and this navigation stack.
 
 At ``reset`` it plans the static tour of :func:`~semexplore_gym.core.coverage_tour.plan_coverage_tour`
@@ -72,7 +73,8 @@ __all__ = ["OracleParams", "OraclePolicy", "PrivilegedPolicyError", "refuse_priv
 _NOT_PRIVILEGED = (
     "the oracle is a privileged policy: it needs the true world, which only an env made with "
     "privileged=True hands out (info['privileged_world'] at reset); the mission runners "
-    "(semexplore explore/benchmark) do that for it, learning code never does"
+    "(semexplore explore/benchmark) do that for it, learning code only with "
+    "expert.privileged_teacher=true"
 )
 
 
@@ -80,12 +82,15 @@ class PrivilegedPolicyError(ValueError):
     """A privileged policy was used where only honest policies belong."""
 
 
-def refuse_privileged(policy: Any, where: str) -> None:
-    """Raise :class:`PrivilegedPolicyError` when ``policy`` reads ground truth (learning code)."""
+def refuse_privileged(policy: Any, where: str, hint: str = "") -> None:
+    """Raise :class:`PrivilegedPolicyError` when ``policy`` reads ground truth (learning code).
+
+    ``hint`` (optional) ends the message: how the caller lets it in when asked explicitly.
+    """
     if getattr(policy, "privileged", False):
         raise PrivilegedPolicyError(
             f"{where}: policy {getattr(policy, 'name', policy)!r} is privileged (reads the true "
-            "world) and cannot be used here"
+            "world) and cannot be used here" + (f"; {hint}" if hint else "")
         )
 
 
@@ -137,7 +142,8 @@ class OraclePolicy(Policy):
     """
 
     name = "oracle"
-    #: Reads ground truth: runners make its env with ``privileged=True``; learning code refuses it.
+    #: Reads ground truth: runners make its env with ``privileged=True``; learning code refuses it
+    #: unless asked (``expert.privileged_teacher``).
     privileged = True
     reads_map_in_step_only = True
 

@@ -41,6 +41,11 @@ class ExpertSection:
     ``noise_std`` > 0 records the first ``noise_fraction`` of the episodes with DART noise on
     the executed actions (labels stay clean); ``save_interval_s`` throttles dataset rewrites;
     ``workers`` > 1 records episodes in that many processes (same data as one).
+
+    ``privileged_teacher`` (False by default) is the one way to let a privileged policy (the
+    ``oracle``, which reads the true world) label the data: the run's env then hands the true
+    world to the teacher at reset (``info["privileged_world"]``), while the student still sees
+    only its egocentric features of the observation. Without it such a spec is refused.
     """
 
     spec: str = "semantic"
@@ -51,6 +56,7 @@ class ExpertSection:
     noise_fraction: float = 1.0
     save_interval_s: float = 0.0
     workers: int = 1
+    privileged_teacher: bool = False
 
 
 @dataclass(frozen=True)

@@ -52,13 +52,49 @@ def test_runners_ask_for_the_channel_and_learning_code_refuses_the_oracle():
     refuse_privileged(make_policy("nearest"), "training expert")  # honest: no error
 
 
-def test_make_expert_refuses_the_oracle():
-    from types import SimpleNamespace
+def test_make_expert_refuses_the_oracle_unless_asked_by_name():
+    from semexplore_gym.training.factories import make_expert, make_learner_env, make_raw_env
+    from semexplore_gym.training.train_config import load_train_config
 
-    from semexplore_gym.training.factories import make_expert
+    world = ["env.world=maze:seed=0,size_m=4"]
+    with pytest.raises(PrivilegedPolicyError, match="expert.privileged_teacher=true"):
+        make_expert(load_train_config(None, [*world, "expert.spec=oracle"]))
+    with pytest.raises(ValueError, match="expert.spec='semantic'"):
+        make_expert(load_train_config(None, [*world, "expert.privileged_teacher=true"]))
+    cfg = load_train_config(None, [*world, "expert.spec=oracle", "expert.privileged_teacher=true"])
+    assert isinstance(make_expert(cfg), OraclePolicy)
+    # The teacher's env hands out the true world; the learner's never does.
+    _, info = make_raw_env(cfg).reset(seed=0)
+    assert PRIVILEGED_INFO_KEY in info
+    _, info = make_learner_env(cfg).reset(seed=0)
+    assert PRIVILEGED_INFO_KEY not in info
+    _, info = make_raw_env(load_train_config(None, world)).reset(seed=0)
+    assert PRIVILEGED_INFO_KEY not in info
 
-    with pytest.raises(PrivilegedPolicyError):
-        make_expert(SimpleNamespace(expert=SimpleNamespace(spec="oracle")))  # type: ignore[arg-type]
+
+def test_the_oracle_labels_a_dataset_when_asked_and_the_student_sees_only_features(tmp_path):
+    from semexplore_gym.training.factories import make_expert, make_learner_env, make_raw_env
+    from semexplore_gym.training.imitation import record
+    from semexplore_gym.training.train_config import load_train_config
+
+    cfg = load_train_config(
+        None,
+        [
+            "env.world=maze:seed=0,size_m=4",
+            "expert.spec=oracle",
+            "expert.privileged_teacher=true",
+            "expert.episodes=1",
+            "expert.max_steps=40",
+            "expert.holdout_fraction=0",
+        ],
+    )
+    data = record(
+        cfg, make_raw_env(cfg), make_expert(cfg), tmp_path / "d.npz", lambda *a: None, False
+    )
+    assert len(data) == 40
+    assert np.abs(data.actions).sum() > 0  # the oracle drives
+    # What the student learns from: exactly its own env's egocentric features, nothing more.
+    assert set(data.obs) == set(make_learner_env(cfg).observation_space.spaces)
 
 
 def _mission(world: str, spec: str, seed: int):
@@ -87,3 +123,13 @@ def test_the_oracle_is_deterministic_for_a_fixed_seed():
     b = _mission("maze:seed=3,size_m=4", "oracle", seed=2)
     assert a.mission_time_s == b.mission_time_s
     assert np.array_equal(a.trajectory, b.trajectory)
+
+
+def test_train_cli_refuses_the_oracle_in_one_line_and_names_the_opt_in(tmp_path, capsys):
+    from semexplore_gym.cli import main
+
+    argv = ["train", "--algo", "bc", "--train-config", "configs/agents/bc_maze.yml"]
+    code = main([*argv, "--train-set", "expert.spec=oracle", "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert "privileged" in err[0] and "expert.privileged_teacher=true" in err[0]
