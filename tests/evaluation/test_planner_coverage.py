@@ -6,6 +6,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.registry import make_policy
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.config import ConfigError
@@ -18,7 +19,6 @@ from semexplore_gym.evaluation.planner_coverage import (
     coverage_at_planner_clearance,
     planner_clearance_margin_m,
 )
-from semexplore_gym.policies.registry import make_policy
 
 RES_M = 0.05
 # Two 1.5 m rooms joined by a 0.5 m long passage 0.25 m wide: wider than the env's coverage

@@ -187,8 +187,9 @@ def test_an_env_redraws_an_unseeded_noise_cave_on_one_grid() -> None:
 
 
 def test_the_semantic_expert_runs_a_short_mission_in_a_small_noise_cave() -> None:
-    from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
     from semexplore_gym.policies.registry import make_policy
+
+    from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
 
     env = make_mission_env("noisecave:seed=7,size_m=6")
     try:
