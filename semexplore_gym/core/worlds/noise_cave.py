@@ -22,7 +22,8 @@ map of a real cave.
    raster worlds (:func:`~semexplore_gym.core.worlds.build.world_from_free_mask`).
 
 The start pose is a random cell of the largest 4-connected set of cells at least
-``_START_CLEARANCE_M`` from every non-free cell, with a random heading.
+``_START_CLEARANCE_M`` (0.25 m; less only where no cell of the cave has that much) from every
+non-free cell, with a random heading.
 """
 
 from __future__ import annotations
