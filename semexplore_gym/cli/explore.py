@@ -43,7 +43,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--world",
         default="maze1",
         help="maze1, maze2, a procedural family with parameters ('maze:seed=3,size_m=10', "
-        "'office:...', 'cave:...', 'forest:...'), a catalogue map 'map:NAME' (semexplore maps "
+        "'office:...', 'cave:...', 'noisecave:...', 'forest:...'), a catalogue map 'map:NAME' (semexplore maps "
         "list), a ROS map .yaml or a HouseExpo .json (default: maze1)",
     )
     p.add_argument(

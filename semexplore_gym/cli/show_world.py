@@ -33,7 +33,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "world",
-        help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', a ROS map .yaml or a HouseExpo .json",
+        help="maze1, maze2, 'maze:seed=3', 'office:...', 'cave:...', 'noisecave:...', a ROS map "
+        ".yaml or a HouseExpo .json",
     )
     p.add_argument("--out", required=True, help="output PNG path")
     p.add_argument(
@@ -61,13 +62,11 @@ def run(args: argparse.Namespace) -> int:
     world = base.world
     # Draw the ground truth as if fully mapped, so the picture shows the whole building.
     from semexplore_gym.core.grid import FREE, OCCUPIED
-    from semexplore_gym.core.worlds.start import reachable_free_mask
+    from semexplore_gym.envs.coverage_mask import coverage_mask
 
     g = base.map_geometry
     pose = base.sim.pose
-    reach = reachable_free_mask(
-        world, g, pose[:2], base.config.robot.radius_m, base.config.robot.radius_m + 0.01
-    )
+    reach = coverage_mask(world, g, pose[:2], base.config)
     grid = np.where(reach, FREE, OCCUPIED).astype(np.uint8)
     grid[~reach] = 128
     snap = RenderSnapshot(

@@ -58,6 +58,10 @@ class EpisodeParams:
         dt_s: Control period, one LiDAR scan per step (5 Hz like the LDS-01).
         max_time_s: Simulated time after which the episode is truncated.
         coverage_goal: Coverage at which the episode terminates.
+        coverage_clearance_margin_m: Coverage counts the free cells the robot's body sweeps
+            keeping its centre at least ``robot.radius_m`` plus this from every wall (0.01 m:
+            gaps of 0.23 m and wider count for the 0.105 m robot). See
+            :func:`~semexplore_gym.envs.coverage_mask.coverage_mask`.
         start_clearance_margin_m: Margin beyond the robot radius for sampled start poses.
         start_pose: ``[x_m, y_m, yaw_rad]`` to start from, or None for the world's own start
             pose, or a pose sampled in free space when the world has none.
@@ -67,6 +71,7 @@ class EpisodeParams:
     dt_s: float = 0.2
     max_time_s: float = 1200.0
     coverage_goal: float = 0.99
+    coverage_clearance_margin_m: float = 0.01
     start_clearance_margin_m: float = 0.1
     start_pose: tuple[float, float, float] | None = None
     random_start: bool = False
@@ -80,6 +85,11 @@ class EpisodeParams:
             )
         if not (0 < self.coverage_goal <= 1):
             raise ValueError(f"episode.coverage_goal must be in (0, 1], got {self.coverage_goal!r}")
+        if not (0 <= self.coverage_clearance_margin_m <= 1.0):
+            raise ValueError(
+                "episode.coverage_clearance_margin_m must be in [0, 1] m, got "
+                f"{self.coverage_clearance_margin_m!r}"
+            )
         if not (0 <= self.start_clearance_margin_m <= 10.0):
             raise ValueError(
                 f"episode.start_clearance_margin_m must be in [0, 10] m, got {self.start_clearance_margin_m!r}"

@@ -27,8 +27,8 @@ from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
 from semexplore_gym.core.worlds.geometry import segment_distance_field
-from semexplore_gym.core.worlds.start import reachable_free_mask
 from semexplore_gym.core.worlds.world import World
+from semexplore_gym.envs.coverage_mask import coverage_mask
 from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.multi_robot_config import (
     TeamParams,
@@ -296,9 +296,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         first = (
             self._choose_start({"start_pose": given[0]}) if given else self._choose_start(options)
         )
-        reach = reachable_free_mask(
-            self.world, self.map_geometry, first[:2], cfg.robot.radius_m, cfg.robot.radius_m + 0.01
-        )
+        reach = coverage_mask(self.world, self.map_geometry, first[:2], cfg)
         if given:
             if len(given) != n:
                 raise ValueError(f"options['start_poses'] needs {n} poses, got {len(given)}")

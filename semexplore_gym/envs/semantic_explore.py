@@ -18,12 +18,9 @@ from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
 from semexplore_gym.core.validation import short_repr
-from semexplore_gym.core.worlds.start import (
-    reachable_free_mask,
-    sample_start_pose,
-    validate_start_pose,
-)
+from semexplore_gym.core.worlds.start import sample_start_pose, validate_start_pose
 from semexplore_gym.core.worlds.world import World
+from semexplore_gym.envs.coverage_mask import coverage_mask
 from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
@@ -32,7 +29,7 @@ from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
 
-PROCEDURAL_FAMILIES = ("maze", "office", "cave")
+PROCEDURAL_FAMILIES = ("maze", "office", "cave", "noisecave")
 #: The per-step numbers of ``info`` besides ``reward_terms`` (see :meth:`info_numbers`).
 INFO_NUMBERS = ("coverage", "explored_area_m2", "collisions", "sim_time_s", "path_length_m")
 
@@ -125,12 +122,15 @@ class SemanticExploreEnv(gym.Env):
     Terminated when ``coverage >= episode.coverage_goal`` (0.99). Truncated when the simulated
     time reaches ``episode.max_time_s`` (1200 s). ``coverage`` = mapped free cells inside the
     reachable mask / cells of the reachable mask, where the reachable mask is the free area the
-    robot's body can sweep from the start, less a one-cell band along walls.
+    robot's body can sweep from the start (``self.start_pose``) with its centre at least
+    ``radius + episode.coverage_clearance_margin_m`` (0.01 m) from walls, less a one-cell band
+    along walls (:func:`~semexplore_gym.envs.coverage_mask.coverage_mask`).
 
     ## Arguments
     - ``world``: ``"maze1"``, ``"maze2"``, ``"maze:seed=3,size_m=10"``, ``"office:..."``,
-      ``"cave:..."``, a ROS map ``.yaml`` or a HouseExpo ``.json``. A procedural spelling without
-      ``seed`` draws a new world from the env's RNG at every reset (same grid shape).
+      ``"cave:..."``, ``"noisecave:..."``, a ROS map ``.yaml`` or a HouseExpo ``.json``. A
+      procedural spelling without ``seed`` draws a new world from the env's RNG at every reset
+      (same grid shape).
     - ``config``: None, a preset name (``"default"``, ``"paper"``), a YAML path, a dict or an
       :class:`EnvConfig`.
     - ``overrides``: list of ``"section.key=value"`` strings applied on top of ``config``.
@@ -255,6 +255,7 @@ class SemanticExploreEnv(gym.Env):
         self._overlay: dict[str, Any] = {}
         self._renderer: Any = None
         self._started = False
+        self.start_pose: tuple[float, float, float] | None = None  # set by reset
 
     # ----------------------------------------------------------------- set-up
     def _observation_space(self) -> spaces.Dict:
@@ -353,9 +354,8 @@ class SemanticExploreEnv(gym.Env):
         pose = self.choose_start(options)
         cfg = self.config
         self.sim.reset(pose)
-        reach = reachable_free_mask(
-            self.world, self.map_geometry, pose[:2], cfg.robot.radius_m, cfg.robot.radius_m + 0.01
-        )
+        self.start_pose = pose
+        reach = coverage_mask(self.world, self.map_geometry, pose[:2], cfg)
         self._n_reachable = max(1, int(reach.sum()))
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping, count_mask=reach)
         self.odometry.reset(pose)
@@ -385,7 +385,7 @@ class SemanticExploreEnv(gym.Env):
             geometry=self.map_geometry,
             start_pose=pose,
             radius_m=cfg.robot.radius_m,
-            clearance_m=cfg.robot.radius_m + 0.01,
+            clearance_m=cfg.robot.radius_m + cfg.episode.coverage_clearance_margin_m,
             reachable_mask=reach,
             sensor=SensorModel(cfg.lidar.n_beams, cfg.lidar.max_range_m, cfg.lidar.min_range_m),
             max_linear_speed_mps=cfg.robot.max_linear_speed_mps,

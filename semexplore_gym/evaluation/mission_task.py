@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from semexplore_gym.evaluation.run_row import OPTIONAL_COLUMNS, RunRow
+from semexplore_gym.evaluation.run_row import POLICY_COLUMNS, RunRow
 from semexplore_gym.evaluation.tasks import Task
 
 
@@ -24,9 +24,11 @@ def _warm_up_config_key(env_config: Any) -> str:
     return json.dumps({k: v for k, v in d.items() if k != "episode"}, sort_keys=True, default=str)
 
 
-def mission_row(task: Task, res: Any) -> RunRow:
+def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | None = None) -> RunRow:
     """The ``runs.csv`` row of ``task`` from its :class:`~.rollout.MissionResult`; the
-    policy-specific columns come from the policy's ``mission_metrics()`` (None if absent)."""
+    policy-specific columns come from the policy's ``mission_metrics()`` (None if absent),
+    ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
+    which still holds the env)."""
     return RunRow(
         world=task.world,
         policy=task.policy,
@@ -44,12 +46,14 @@ def mission_row(task: Task, res: Any) -> RunRow:
         wall_time_s=res.wall_time_s,
         explored_area_m2=res.explored_area_m2,
         steps=res.steps,
-        **{k: res.policy_metrics.get(k) for k in sorted(OPTIONAL_COLUMNS)},
+        **{k: res.policy_metrics.get(k) for k in POLICY_COLUMNS},
+        coverage_at_planner_clearance=coverage_at_planner_clearance,
     )
 
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
+    from semexplore_gym.evaluation.planner_coverage import coverage_at_planner_clearance
     from semexplore_gym.evaluation.rollout import (
         make_mission_env,
         map_observation_for,
@@ -78,10 +82,11 @@ def run_task(task: Task) -> dict[str, Any]:
             progress=False,
             ignore_terminated=True,
         )
+        planner_coverage = coverage_at_planner_clearance(env, policy)
     finally:
         env.close()
     return {
-        "row": mission_row(task, res).to_dict(),
+        "row": mission_row(task, res, planner_coverage).to_dict(),
         "trace": np.asarray(res.coverage_trace, dtype=np.float64),
         "trajectory": np.asarray(res.trajectory),
     }

@@ -2,7 +2,9 @@
 
 :class:`RunRow` is the schema: its fields are the CSV columns, in order. ``scored_replans`` and
 ``semantic_share`` are policy-specific (a policy's ``mission_metrics()``; empty for most
-policies) and were added after the first release, so older files may lack them.
+policies); ``coverage_at_planner_clearance`` is the coverage of the cells reachable at the
+semantic expert's planning clearance (:mod:`.planner_coverage`; every policy). All three were
+added after the first release, so older files may lack them.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ class RunRow:
     steps: int
     scored_replans: int | None = None
     semantic_share: float | None = None
+    coverage_at_planner_clearance: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -58,8 +61,11 @@ class RunRow:
 #: The columns of ``runs.csv``, in order.
 CSV_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRow))
 
+#: Policy-specific columns: the policy's ``mission_metrics()`` fills them (None if absent).
+POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
+
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
-OPTIONAL_COLUMNS: frozenset[str] = frozenset({"scored_replans", "semantic_share"})
+OPTIONAL_COLUMNS: frozenset[str] = frozenset({*POLICY_COLUMNS, "coverage_at_planner_clearance"})
 
 _TEXT_COLUMNS = ("world", "policy", "stop_reason")
 _INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans")

@@ -59,7 +59,8 @@ class PrivilegedWorld:
         start_pose: The true start pose ``(x_m, y_m, yaw_rad)``.
         radius_m: Robot radius.
         clearance_m: The wall clearance that defines where the robot can stand in the
-            reachable mask (``radius_m + 0.01``, as the env computes it).
+            reachable mask (``radius_m + episode.coverage_clearance_margin_m``, 0.01 m by
+            default, as the env computes it).
         reachable_mask: ``geometry.shape`` bool: the env's coverage denominator (read-only).
         sensor: The env's LiDAR.
         max_linear_speed_mps: Top forward speed.

@@ -1,7 +1,7 @@
 """Worlds: wall geometry, bounds, start pose and ground-truth free space.
 
 Build a fixed or procedural one with :func:`make_procedural_world` (``"maze1"``,
-``"office:seed=3,size_m=20"``); worlds from map files (a ROS map ``.yaml``, a HouseExpo
+``"office:seed=3,size_m=20"``, ``"noisecave:seed=1,threshold=0.44"``); worlds from map files (a ROS map ``.yaml``, a HouseExpo
 ``.json``, ``"map:NAME"``) and ``make_world``, which takes any spec, are in
 :mod:`semexplore_gym.maps`. A :class:`World` holds wall segments in metres and a native
 ground-truth free mask; :func:`rasterize_free` puts that free space on any other grid,
@@ -14,6 +14,7 @@ from semexplore_gym.core.worlds.cave import CaveParams, generate_cave
 from semexplore_gym.core.worlds.fixed_mazes import make_maze1, make_maze2
 from semexplore_gym.core.worlds.geometry import distance_to_segments_m, segment_distance_field
 from semexplore_gym.core.worlds.grid_maze import MazeParams, generate_maze
+from semexplore_gym.core.worlds.noise_cave import NoiseCaveParams, generate_noise_cave
 from semexplore_gym.core.worlds.office import OfficeParams, generate_office
 from semexplore_gym.core.worlds.procedural import (
     list_world_names,
@@ -32,11 +33,13 @@ from semexplore_gym.core.worlds.world import World
 __all__ = [
     "CaveParams",
     "MazeParams",
+    "NoiseCaveParams",
     "OfficeParams",
     "World",
     "distance_to_segments_m",
     "generate_cave",
     "generate_maze",
+    "generate_noise_cave",
     "generate_office",
     "list_world_names",
     "make_maze1",

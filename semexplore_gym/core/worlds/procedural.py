@@ -16,6 +16,7 @@ from semexplore_gym.core.worlds.cave import CaveParams, generate_cave
 from semexplore_gym.core.worlds.fixed_mazes import make_maze1, make_maze2
 from semexplore_gym.core.worlds.forest import ForestParams, generate_forest
 from semexplore_gym.core.worlds.grid_maze import MazeParams, generate_maze
+from semexplore_gym.core.worlds.noise_cave import NoiseCaveParams, generate_noise_cave
 from semexplore_gym.core.worlds.office import OfficeParams, generate_office
 from semexplore_gym.core.worlds.world import World
 
@@ -25,6 +26,7 @@ _FAMILIES: dict[str, tuple[type, Callable[..., World]]] = {
     "office": (OfficeParams, generate_office),
     "cave": (CaveParams, generate_cave),
     "forest": (ForestParams, generate_forest),
+    "noisecave": (NoiseCaveParams, generate_noise_cave),
 }
 
 
@@ -96,7 +98,8 @@ def make_procedural_world(spec: str, rng: np.random.Generator | None = None) -> 
 
     - ``"maze1"``, ``"maze2"``: the fixed test mazes (:mod:`.fixed_mazes`).
     - ``"maze:seed=3,size_m=10,corridor_width_m=0.8,braid=0.3"``, ``"office:seed=3,size_m=20"``,
-      ``"cave:seed=1,size_m=15"``, ``"forest:seed=1,size_m=12,density=8"``: procedural
+      ``"cave:seed=1,size_m=15"``, ``"forest:seed=1,size_m=12,density=8"``,
+      ``"noisecave:seed=1,size_m=12,threshold=0.44"``: procedural
       families; any parameter may be left out (see :func:`world_family_parameters` for the
       defaults). Without ``seed=`` the seed is drawn from ``rng``, so an env's RNG makes the
       world reproducible; with neither, seed 0 is used. ``World.metadata["spec"]`` is the fully

@@ -42,7 +42,7 @@ def _touches_border(mask: np.ndarray) -> bool:
 
 
 def test_list_world_names() -> None:
-    assert list_world_names() == ["cave", "forest", "maze", "maze1", "maze2", "office"]
+    assert list_world_names() == ["cave", "forest", "maze", "maze1", "maze2", "noisecave", "office"]
 
 
 def test_parse_world_spec() -> None:
