@@ -15,7 +15,12 @@ import numpy as np
 
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import PARAM, ParameterError
-from semexplore_gym.evaluation.run_row import CSV_COLUMNS, RunRow, complete_csv_bytes
+from semexplore_gym.evaluation.run_row import (
+    CSV_COLUMNS,
+    OPTIONAL_COLUMNS,
+    RunRow,
+    complete_csv_bytes,
+)
 
 
 def file_slug(text: str) -> str:
@@ -28,8 +33,37 @@ def task_stem(world: str, policy: str, seed: int) -> str:
     return f"{file_slug(world)}__{file_slug(policy)}__{seed}"
 
 
+def _only_lacks_optional(header: list[str]) -> bool:
+    """True when ``header`` is today's columns less some optional ones (a run of an older
+    version): its rows are still valid, the new columns just stay empty."""
+    missing = [c for c in CSV_COLUMNS if c not in header]
+    return (
+        bool(missing)
+        and all(c in OPTIONAL_COLUMNS for c in missing)
+        and [c for c in CSV_COLUMNS if c in header] == header
+    )
+
+
+def _upgrade_columns(csv_path: Path, header: list[str]) -> None:
+    """Rewrite ``csv_path`` with today's columns, the ones it lacks left empty (atomically)."""
+    with csv_path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    tmp = csv_path.with_suffix(".csv.tmp")
+    with tmp.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS))
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: row.get(k, "") or "" for k in CSV_COLUMNS})
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, csv_path)
+
+
 class ResultWriter:
     """Appends finished missions to ``runs.csv`` (flushed per row) and their traces.
+
+    A ``runs.csv`` written by an older version that only lacks optional columns (added since)
+    is upgraded in place, those cells left empty, so an old run resumes.
 
     Raises:
         ParameterError: ``out_dir`` holds a ``runs.csv`` with other columns.
@@ -50,7 +84,9 @@ class ResultWriter:
         if not new:
             with self.csv_path.open(newline="") as f:
                 header = next(csv.reader(f), [])
-            if tuple(header) != CSV_COLUMNS:
+            if tuple(header) != CSV_COLUMNS and _only_lacks_optional(header):
+                _upgrade_columns(self.csv_path, header)
+            elif tuple(header) != CSV_COLUMNS:
                 raise ParameterError(
                     "out_dir",
                     f"{self.csv_path} has columns {short_repr(header)}, expected "

@@ -127,6 +127,34 @@ def test_csv_with_other_columns_is_refused(tmp_path) -> None:
         )
 
 
+def test_a_run_of_an_older_version_resumes_its_new_optional_columns_left_empty(tmp_path) -> None:
+    import csv
+
+    from semexplore_gym.evaluation.run_row import CSV_COLUMNS, OPTIONAL_COLUMNS
+
+    tasks = expand_tasks(["maze1"], ["semantic", "frontier"], [0])
+    run_benchmark(tasks[:1], tmp_path, progress=False, task_fn=_fake)
+    # Rewrite runs.csv as an older version wrote it: without the optional columns.
+    path = tmp_path / "runs.csv"
+    rows = list(csv.DictReader(path.open(newline="")))
+    old = [c for c in CSV_COLUMNS if c not in OPTIONAL_COLUMNS]
+    with path.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=old, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    ran = []
+
+    def counting(task):
+        ran.append(task)
+        return _fake(task)
+
+    run_benchmark(tasks, tmp_path, progress=False, task_fn=counting)
+    assert len(ran) == 1  # the old row was kept, only the new mission ran
+    header, *body = list(csv.reader(path.open(newline="")))
+    assert tuple(header) == CSV_COLUMNS and len(body) == 2
+    assert body[0][header.index("mission_time_s")] == rows[0]["mission_time_s"]
+
+
 def test_summary_with_one_pair_prints_no_p_value(tmp_path) -> None:
     tasks = expand_tasks(["maze1"], ["semantic", "frontier"], [0])
     run_benchmark(tasks, tmp_path, progress=False, task_fn=_fake)
