@@ -1,0 +1,336 @@
+"""The oracle as a teacher: at a decision point, a label for every current frontier.
+
+**Training code only.** The labels read the true world, the
+:class:`~semexplore_gym.core.coverage_tour.PrivilegedWorld` that only an env made with
+``privileged=True`` hands out (``info["privileged_world"]`` at reset). A student policy never
+reads it: policies cannot import this module (``policies`` sits below ``training`` in the layer
+order, ``tests/test_layers.py``), and the mission runners make a privileged env only for a
+policy that declares ``privileged`` (the oracle). Training code builds an
+:class:`OracleTeacher` from reset's ``info`` and asks it for labels on the student's own
+states (DAgger); the student learns from the labels and the observation alone.
+
+What a label says, given the robot's pose and the live map (``obs["map"]``):
+
+1. **the re-optimised tour**: the candidate viewpoints (the oracle's lattice on the true
+   standing mask) that see the reachable cells the map has not mapped FREE yet, chosen by the
+   oracle's travel-aware greedy cover grown from the robot, ordered as an open LKH tour from
+   the robot (:mod:`semexplore_gym.core.coverage_tour`);
+2. **which frontier each viewpoint explores**: every still-unseen true free cell belongs to the
+   frontier nearest it along true free space (one multi-source Dijkstra from the frontier
+   cells); a viewpoint belongs to the frontier owning most of the unseen cells it sees;
+3. ``first``: the frontier of the tour's first viewpoint, the one the oracle would head for;
+4. ``cost_to_go_m[f]``: the length of the oracle's tour when it must head for frontier ``f``
+   first: path to ``f``'s viewpoint nearest the robot (or, for a frontier that owns no
+   viewpoint, to the standing cell nearest the frontier), then an open LKH tour from there
+   through every other viewpoint. The smallest equals the re-optimised tour up to LKH's
+   heuristic; like the oracle's tour it is an upper bound on the best drive.
+
+Lengths are metres of 8-connected grid path on the true standing mask (the oracle's metric).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import sparse
+
+from semexplore_gym.core.coverage_tour import (
+    PRIVILEGED_INFO_KEY,
+    PrivilegedWorld,
+    TourParams,
+    geodesic_matrix,
+    open_tour_order,
+)
+from semexplore_gym.core.coverage_tour.tour import require_solver, travel_aware_cover
+from semexplore_gym.core.coverage_tour.viewpoints import (
+    candidate_viewpoints,
+    nearest_allowed_cell,
+    standing_mask,
+    visible_sets,
+    wall_clearance_m,
+)
+from semexplore_gym.core.frontiers.detection import detect_frontiers
+from semexplore_gym.core.grid import FREE
+from semexplore_gym.core.planning.grid_search import distance_field
+from semexplore_gym.core.worlds.raster import rasterize_free
+
+__all__ = ["FrontierLabels", "NotPrivilegedError", "OracleTeacher", "TeacherParams"]
+
+
+class NotPrivilegedError(ValueError):
+    """The teacher was given no true world (``info`` of an env made without ``privileged``)."""
+
+
+@dataclass(frozen=True)
+class TeacherParams:
+    """Settings of :class:`OracleTeacher`.
+
+    Attributes:
+        tour: The oracle's viewpoint lattice, cover target and LKH restarts.
+        min_frontier_cells: Frontier groups detected with fewer cells are ignored (when the
+            caller passes no frontiers of its own).
+    """
+
+    tour: TourParams = field(default_factory=TourParams)
+    min_frontier_cells: int = 3
+
+
+@dataclass(frozen=True)
+class FrontierLabels:
+    """The teacher's labels at one decision point (see the module docstring).
+
+    Attributes:
+        frontier_cells: The frontiers labelled, each ``(K, 2)`` ``(row, col)`` map cells.
+        first: Index of the frontier the re-optimised tour visits first; -1 when nothing is
+            left to see.
+        cost_to_go_m: ``(F,)`` oracle tour length when heading for each frontier first.
+        tour_length_m: Length of the re-optimised tour from the robot.
+        tour_frontiers: Frontier index of each tour viewpoint, in tour order (-1: none).
+        viewpoints_rc: ``(V, 2)`` the tour's viewpoints in tour order.
+        unseen_cells: ``(F,)`` still-unseen reachable cells each frontier owns.
+    """
+
+    frontier_cells: tuple[np.ndarray, ...]
+    first: int
+    cost_to_go_m: np.ndarray
+    tour_length_m: float
+    tour_frontiers: np.ndarray
+    viewpoints_rc: np.ndarray
+    unseen_cells: np.ndarray
+
+    @property
+    def n_frontiers(self) -> int:
+        return len(self.frontier_cells)
+
+
+class OracleTeacher:
+    """Labels frontiers from the true world of one episode (training code only).
+
+    Build it from the ``info`` of a privileged env's ``reset`` (:meth:`from_reset_info`); the
+    static part (standing mask, candidate viewpoints, what each sees) is computed once here.
+
+    Args:
+        facts: The episode's true world.
+        params: :class:`TeacherParams`.
+
+    Raises:
+        NotPrivilegedError: ``facts`` is not a :class:`PrivilegedWorld`.
+        ImportError: the tour solver (``elkai``) is missing.
+    """
+
+    def __init__(self, facts: PrivilegedWorld, params: TeacherParams | None = None) -> None:
+        if not isinstance(facts, PrivilegedWorld):
+            raise NotPrivilegedError(
+                "the oracle's labels need the true world: make the training env with "
+                "privileged=True and pass reset's info (info['privileged_world']); a student "
+                "policy never gets it"
+            )
+        require_solver()
+        self.facts = facts
+        self.params = params if params is not None else TeacherParams()
+        geo = facts.geometry
+        self.geometry = geo
+        prm = self.params.tour
+        cap = max(prm.prefer_clearance_m, facts.clearance_m + geo.resolution_m)
+        clearance = wall_clearance_m(facts.world, geo, cap)
+        self.standing = standing_mask(
+            facts.world, geo, facts.start_pose[:2], facts.clearance_m, clearance
+        )
+        spacing = max(1, int(round(prm.viewpoint_spacing_m / geo.resolution_m)))
+        cand = candidate_viewpoints(self.standing, clearance, spacing)
+        while cand.shape[0] > prm.max_candidates:
+            spacing += max(1, spacing // 4)
+            cand = candidate_viewpoints(self.standing, clearance, spacing)
+        self.candidates_rc = cand
+        mask = np.asarray(facts.reachable_mask, dtype=bool)
+        self.mask_flat = np.flatnonzero(mask)
+        self.visible: sparse.csr_matrix = visible_sets(facts.world, geo, cand, facts.sensor, mask)
+        self.true_free = rasterize_free(facts.world, geo)
+        self._geo_cost = np.where(self.standing, geo.resolution_m, np.inf)
+
+    @classmethod
+    def from_reset_info(
+        cls, info: dict[str, Any], params: TeacherParams | None = None
+    ) -> OracleTeacher:
+        """The teacher of the episode whose ``reset`` returned ``info`` (privileged env)."""
+        return cls(info.get(PRIVILEGED_INFO_KEY), params)  # type: ignore[arg-type]
+
+    # ------------------------------------------------------------------ labels
+    def labels(
+        self,
+        obs: dict[str, np.ndarray],
+        frontiers: Sequence[Any] | None = None,
+    ) -> FrontierLabels:
+        """Label each frontier at the state ``obs`` (its ``map`` and ``pose``).
+
+        Args:
+            obs: The env's observation at the decision point.
+            frontiers: The frontiers the student chooses among, each a ``(K, 2)`` cell array
+                or an object with ``.cells`` (a
+                :class:`~semexplore_gym.core.frontiers.detection.GridFrontier`); default: every
+                frontier reachable from the robot (free-cell convention, at least
+                ``min_frontier_cells``).
+        """
+        grid = np.asarray(obs["map"])
+        pose = np.asarray(obs["pose"], dtype=np.float64)
+        if frontiers is None:
+            frontiers = detect_frontiers(
+                grid,
+                self.geometry,
+                pose[:2],
+                min_frontier_cells=self.params.min_frontier_cells,
+                cell_convention="free",
+            )
+        cells = tuple(
+            np.asarray(getattr(f, "cells", f), dtype=np.int64).reshape(-1, 2) for f in frontiers
+        )
+        robot = self._robot_cell(pose)
+        unseen = grid.reshape(-1)[self.mask_flat] != FREE
+        chosen = self._cover(unseen, robot)
+        owner = self._owners(grid, cells)
+        vp_owner = self._viewpoint_owners(chosen, unseen, owner)
+        nodes = np.vstack([np.array([robot], dtype=np.int64), self.candidates_rc[chosen]])
+        dist = geodesic_matrix(self.standing, self.geometry, nodes)
+        order = open_tour_order(dist, self.params.tour.lkh_runs)
+        tour = [i - 1 for i in order[1:]]
+        length = float(sum(dist[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
+        d_robot, _ = distance_field(self._geo_cost, robot)
+        cost = np.array(
+            [
+                self._cost_to_go(f, cells[f], nodes, dist, vp_owner, d_robot)
+                for f in range(len(cells))
+            ]
+        )
+        owned = owner.reshape(-1)[self.mask_flat[unseen]]
+        return FrontierLabels(
+            frontier_cells=cells,
+            first=int(vp_owner[tour[0]]) if tour else -1,
+            cost_to_go_m=cost,
+            tour_length_m=length,
+            tour_frontiers=np.array([vp_owner[i] for i in tour], dtype=np.int64),
+            viewpoints_rc=self.candidates_rc[np.asarray(chosen, dtype=np.int64)[tour]]
+            if tour
+            else np.zeros((0, 2), dtype=np.int64),
+            unseen_cells=np.bincount(owned[owned >= 0], minlength=len(cells))[: len(cells)],
+        )
+
+    def _robot_cell(self, pose: np.ndarray) -> tuple[int, int]:
+        try:
+            return nearest_allowed_cell(self.standing, self.geometry, pose[:2])
+        except ValueError:  # off the standing mask (grazing a wall): the cell it is in
+            r, c = (int(v) for v in self.geometry.world_to_grid(pose[0], pose[1]))
+            return r, c
+
+    def _cover(self, unseen: np.ndarray, robot: tuple[int, int]) -> list[int]:
+        """Viewpoints that see the cover target of the reachable cells (seen ones count)."""
+        seen = ~unseen
+        coverable = seen.copy()
+        coverable[self.visible.indices] = True
+        n = max(1, self.mask_flat.size)
+        required = min(int(math.ceil(self.params.tour.coverage_target * n)), int(coverable.sum()))
+        if int(seen.sum()) >= required:
+            return []
+        prm = self.params.tour
+        return travel_aware_cover(
+            self.visible,
+            required,
+            seen,
+            self.candidates_rc,
+            self.standing,
+            robot,
+            self.geometry.resolution_m,
+            max(prm.detour_m, 1e-6),
+        )
+
+    def _owners(self, grid: np.ndarray, cells: tuple[np.ndarray, ...]) -> np.ndarray:
+        """Per map cell, the frontier nearest along true free space (-1: none reaches it)."""
+        h, w = grid.shape
+        owner = np.full(h * w, -1, dtype=np.int64)
+        if not cells or not any(c.size for c in cells):
+            return owner.reshape(h, w)
+        src = np.vstack([c for c in cells if c.size])
+        label = np.concatenate([np.full(len(c), f, dtype=np.int64) for f, c in enumerate(cells)])
+        cost = np.where(self.true_free, self.geometry.resolution_m, np.inf)
+        dist, parent = distance_field(cost, src)
+        reached = np.isfinite(dist.reshape(-1))
+        par = parent.reshape(-1)
+        root = np.where(par >= 0, par, np.arange(h * w, dtype=np.int64))
+        while True:  # pointer jumping up to the source each cell was reached from
+            nxt = root[root]
+            if np.array_equal(nxt, root):
+                break
+            root = nxt
+        src_flat = src[:, 0] * w + src[:, 1]
+        # a cell that is the source of two frontiers keeps the first
+        first_label = {int(k): int(f) for k, f in zip(src_flat[::-1], label[::-1], strict=True)}
+        lut = np.full(h * w, -1, dtype=np.int64)
+        lut[list(first_label)] = list(first_label.values())
+        owner[reached] = lut[root[reached]]
+        return owner.reshape(h, w)
+
+    def _viewpoint_owners(
+        self, chosen: list[int], unseen: np.ndarray, owner: np.ndarray
+    ) -> np.ndarray:
+        """The frontier owning most of the unseen cells each chosen viewpoint sees."""
+        cell_owner = owner.reshape(-1)[self.mask_flat]
+        out = np.full(len(chosen), -1, dtype=np.int64)
+        for k, i in enumerate(chosen):
+            cols = self.visible.indices[self.visible.indptr[i] : self.visible.indptr[i + 1]]
+            o = cell_owner[cols[unseen[cols]]]
+            o = o[o >= 0]
+            if o.size:
+                out[k] = int(np.bincount(o).argmax())
+        return out
+
+    def _cost_to_go(
+        self,
+        f: int,
+        cells: np.ndarray,
+        nodes: np.ndarray,
+        dist: np.ndarray,
+        vp_owner: np.ndarray,
+        d_robot: np.ndarray,
+    ) -> float:
+        """Tour length from the robot when frontier ``f`` is headed for first (``nodes``: the
+        robot's cell, then the viewpoints; ``dist``: their geodesic matrix)."""
+        mine = np.flatnonzero(vp_owner == f) + 1  # node indices in ``dist``
+        if mine.size:
+            first = int(mine[np.argmin(dist[0, mine])])
+            rest = [i for i in range(1, dist.shape[0]) if i != first]
+            sub = dist[np.ix_([first, *rest], [first, *rest])]
+            head = float(dist[0, first])
+        else:
+            entry = self._entry_cell(cells, d_robot)
+            if entry is None:
+                return math.inf
+            d_entry, _ = distance_field(self._geo_cost, entry)
+            head = float(d_robot[entry])
+            sub = dist.copy()
+            sub[0, 1:] = sub[1:, 0] = d_entry[nodes[1:, 0], nodes[1:, 1]]
+        if not math.isfinite(head):
+            return math.inf
+        if sub.shape[0] <= 1:
+            return head
+        order = open_tour_order(sub, self.params.tour.lkh_runs)
+        return head + float(sum(sub[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
+
+    def _entry_cell(self, cells: np.ndarray, d: np.ndarray) -> tuple[int, int] | None:
+        """The standing cell nearest the robot (path ``d``) within 0.3 m of the frontier."""
+        if cells.size == 0:
+            return None
+        near = np.zeros_like(self.standing)
+        r = max(1, int(round(0.3 / self.geometry.resolution_m)))
+        h, w = near.shape
+        for row, col in cells:
+            near[max(0, row - r) : min(h, row + r + 1), max(0, col - r) : min(w, col + r + 1)] = (
+                True
+            )
+        ok = near & self.standing & np.isfinite(d)
+        if not ok.any():
+            return None
+        row, col = divmod(int(np.argmin(np.where(ok, d, np.inf))), w)
+        return row, col
