@@ -14,7 +14,7 @@ import numpy as np
 from semexplore_gym.core.worlds.procedural import make_procedural_world
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.maps.catalogue import resolve_map_file
-from semexplore_gym.maps.dungeon_maps import load_dungeon_map_world
+from semexplore_gym.maps.dungeon_maps import DUNGEON_M_PER_PX, load_dungeon_map_world
 from semexplore_gym.maps.houseexpo import load_houseexpo_world
 from semexplore_gym.maps.ros_map import load_ros_map_world
 
@@ -92,7 +92,9 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
         if path.suffix.lower() in _JSON_SUFFIXES:
             return load_houseexpo_world(path, name=label)
         if path.suffix.lower() in _PNG_SUFFIXES:
-            return load_dungeon_map_world(path, name=label, **options)
+            return load_dungeon_map_world(
+                path, name=label, m_per_px=options.get("m_per_px", DUNGEON_M_PER_PX)
+            )
         raise ValueError(
             f"world file {path} has an unsupported extension; use .yaml/.yml (ROS map), .json "
             "(HouseExpo) or .png (DungeonMaps)"
