@@ -6,6 +6,8 @@ baselines (nearest, FE) last:
 
 * ``n``: missions; ``coverage``: median final coverage;
 * ``T99 (s)``, ``mission time (s)``: medians (a mission that never reached 99 % has T99 = ∞);
+* ``D99 (m)``: median distance driven until 99 % coverage (from each mission's trace and
+  trajectory; the figure ARiADNE and its successors report on the DungeonMaps);
 * ``÷ expert``, ``÷ oracle``: the median over (world, seed) pairs of the policy's figure over
   the expert's (the oracle's) on the same start;
 * ``p W``: two-sided Wilcoxon signed-rank test on the pairs' log ratios to the expert (T99;
@@ -78,15 +80,41 @@ def _median_cell(rows: list[dict[str, Any]], key: str) -> str:
     return "∞" if math.isinf(med) else (f"{med:.3f}" if key == "coverage" else f"{med:.1f}")
 
 
+def distance_to_coverage_m(out_dir: Any, row: dict[str, Any], level: float = 0.99) -> float | None:
+    """Distance the robot of ``row`` drove until its coverage first reached ``level`` (inf:
+    never; None: its trace or trajectory is missing)."""
+    from pathlib import Path
+
+    from semexplore_gym.evaluation.run_writer import task_stem
+
+    stem = task_stem(row["world"], row["policy"], int(row["seed"]))
+    out = Path(out_dir)
+    try:
+        trace = np.loadtxt(out / "traces" / f"{stem}.csv", delimiter=",", skiprows=1, ndmin=2)
+        poses = np.load(out / "trajectories" / f"{stem}.npy")
+    except (OSError, ValueError):
+        return None
+    n = min(len(trace), len(poses))
+    hit = np.flatnonzero(trace[:n, 1] >= level)
+    if hit.size == 0:
+        return math.inf
+    steps = np.hypot(*np.diff(poses[: int(hit[0]) + 1, :2], axis=0).T)
+    return float(steps.sum())
+
+
 def _order(policies: list[str]) -> list[str]:
     first = [p for p in (ORACLE, EXPERT) if p in policies]
     last = [p for p in BASELINES if p in policies]
     return first + [p for p in policies if p not in first + last] + last
 
 
-def learning_table_lines(rows: list[dict[str, Any]]) -> list[str]:
-    """The "Learning benchmark" section (see the module docstring) for ``runs.csv`` rows."""
+def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> list[str]:
+    """The "Learning benchmark" section (see the module docstring) for ``runs.csv`` rows
+    (``out_dir``: the benchmark directory, for D99; without it D99 is left out)."""
     from semexplore_gym.evaluation.report import group_by_family
+
+    if out_dir is not None:
+        rows = [{**r, "D99_m": distance_to_coverage_m(out_dir, r)} for r in rows]
 
     lines = [
         SECTION_TITLE,
@@ -95,9 +123,9 @@ def learning_table_lines(rows: list[dict[str, Any]]) -> list[str]:
         f"(`{EXPERT}`) and to the oracle on the same start (< 1: faster); p W = two-sided "
         "Wilcoxon signed-rank test on the log ratios to the expert.",
         "",
-        "| family | policy | n | coverage | T99 (s) | mission time (s) | T99 ÷ expert | "
+        "| family | policy | n | coverage | T99 (s) | mission time (s) | D99 (m) | T99 ÷ expert | "
         "time ÷ expert | T99 ÷ oracle | time ÷ oracle | p W T99 | p W time |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for family, by_policy in group_by_family(rows).items():
         refs = {
@@ -108,6 +136,11 @@ def learning_table_lines(rows: list[dict[str, Any]]) -> list[str]:
             rs = by_policy[policy]
             cells = [str(len(rs)), _median_cell(rs, "coverage")]
             cells += [_median_cell(rs, "T99_s"), _median_cell(rs, "mission_time_s")]
+            cells.append(
+                _median_cell([r for r in rs if r.get("D99_m", 0) is not None], "D99_m")
+                if out_dir is not None
+                else "–"
+            )
             logs = {
                 (name, key): _paired(rs, refs[name], key)
                 if refs[name] and policy != name
@@ -129,7 +162,7 @@ def write_learning_table(out_dir: Any) -> list[str]:
     from semexplore_gym.evaluation.run_row import read_runs
 
     out = Path(out_dir)
-    lines = learning_table_lines(read_runs(out / "runs.csv"))
+    lines = learning_table_lines(read_runs(out / "runs.csv"), out)
     summary = out / "summary.md"
     text = summary.read_text() if summary.exists() else ""
     if SECTION_TITLE in text:

@@ -133,6 +133,8 @@ def test_a_split_part_runs_through_benchmark_with_the_learning_table(tmp_path, c
     body = [line for line in table if line.startswith("| maze |")]
     assert [line.split("|")[2].strip() for line in body] == ["oracle", "semantic", "nearest"]
     assert SECTION_TITLE in printed and (out / "regret.csv").is_file()
+    d99 = {line.split("|")[2].strip(): line.split("|")[7].strip() for line in body}
+    assert all(v == "∞" or float(v) > 0 for v in d99.values()) and d99["oracle"] != "∞", d99
     assert json.loads((out / "benchmark.json").read_text())["splits"] == [f"{split}:test"]
     # resumes
     assert main(argv) == 0
@@ -154,9 +156,10 @@ def test_learning_table_ratios_and_infinite_t99() -> None:
     cells = {
         line.split("|")[2].strip(): [c.strip() for c in line.split("|")[3:-1]] for line in lines
     }
-    # n, coverage, T99, time, T99/expert, time/expert, T99/oracle, time/oracle, p, p
-    assert cells["semantic"][4:8] == ["–", "–", "2.00", "2.00"]
+    # n, coverage, T99, time, D99, T99/expert, time/expert, T99/oracle, time/oracle, p, p
+    assert cells["semantic"][5:9] == ["–", "–", "2.00", "2.00"]
     assert cells["mine"][:2] == ["3", "0.990"]
-    assert cells["mine"][4:8] == ["0.80", "0.80", "1.60", "1.60"]
+    assert cells["mine"][5:9] == ["0.80", "0.80", "1.60", "1.60"]
     assert cells["mine"][2] == "80.0"  # median of 80, 80, ∞
-    assert cells["oracle"][4] == "0.50"
+    assert cells["mine"][4] == "–"  # no benchmark directory: no D99
+    assert cells["oracle"][5] == "0.50"
