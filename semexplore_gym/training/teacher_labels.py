@@ -18,12 +18,15 @@ What a label says, given the robot's pose and the live map (``obs["map"]``):
 2. **which frontier each viewpoint explores**: every still-unseen true free cell belongs to the
    frontier nearest it along true free space (one multi-source Dijkstra from the frontier
    cells); a viewpoint belongs to the frontier owning most of the unseen cells it sees;
-3. ``first``: the frontier of the tour's first viewpoint, the one the oracle would head for;
-4. ``cost_to_go_m[f]``: the length of the oracle's tour when it must head for frontier ``f``
-   first: path to ``f``'s viewpoint nearest the robot (or, for a frontier that owns no
-   viewpoint, to the standing cell nearest the frontier), then an open LKH tour from there
-   through every other viewpoint. The smallest equals the re-optimised tour up to LKH's
-   heuristic; like the oracle's tour it is an upper bound on the best drive.
+3. ``cost_to_go_m[f]``: the length of the oracle's tour when it must head for frontier ``f``
+   first: path to one of ``f``'s viewpoints (the best of the ``first_stops`` nearest the
+   robot; for a frontier that owns no viewpoint, the standing cell nearest the frontier), then
+   an open LKH tour from there through every other viewpoint; the re-optimised tour itself
+   prices the frontier it starts with. Like the oracle's tour it is an upper bound on the best
+   drive;
+4. ``first``: the frontier with the smallest cost-to-go, the one the oracle heads for (the
+   re-optimised tour's first frontier unless pricing found a shorter tour; ties: the lower
+   index).
 
 Lengths are metres of 8-connected grid path on the true standing mask (the oracle's metric).
 """
@@ -73,10 +76,13 @@ class TeacherParams:
         tour: The oracle's viewpoint lattice, cover target and LKH restarts.
         min_frontier_cells: Frontier groups detected with fewer cells are ignored (when the
             caller passes no frontiers of its own).
+        first_stops: A frontier's cost-to-go tries this many of its viewpoints nearest the
+            robot as the first stop and keeps the shortest tour.
     """
 
     tour: TourParams = field(default_factory=TourParams)
     min_frontier_cells: int = 3
+    first_stops: int = 3
 
 
 @dataclass(frozen=True)
@@ -85,8 +91,8 @@ class FrontierLabels:
 
     Attributes:
         frontier_cells: The frontiers labelled, each ``(K, 2)`` ``(row, col)`` map cells.
-        first: Index of the frontier the re-optimised tour visits first; -1 when nothing is
-            left to see.
+        first: Index of the frontier the oracle heads for (smallest cost-to-go); -1 when
+            nothing is left to see or no frontier has a finite cost.
         cost_to_go_m: ``(F,)`` oracle tour length when heading for each frontier first.
         tour_length_m: Length of the re-optimised tour from the robot.
         tour_frontiers: Frontier index of each tour viewpoint, in tour order (-1: none).
@@ -205,10 +211,13 @@ class OracleTeacher:
                 for f in range(len(cells))
             ]
         )
+        if tour and vp_owner[tour[0]] >= 0:  # the tour itself heads for that frontier first
+            f0 = int(vp_owner[tour[0]])
+            cost[f0] = min(cost[f0], length)
         owned = owner.reshape(-1)[self.mask_flat[unseen]]
         return FrontierLabels(
             frontier_cells=cells,
-            first=int(vp_owner[tour[0]]) if tour else -1,
+            first=int(np.argmin(cost)) if tour and np.isfinite(cost).any() else -1,
             cost_to_go_m=cost,
             tour_length_m=length,
             tour_frontiers=np.array([vp_owner[i] for i in tour], dtype=np.int64),
@@ -299,10 +308,9 @@ class OracleTeacher:
         robot's cell, then the viewpoints; ``dist``: their geodesic matrix)."""
         mine = np.flatnonzero(vp_owner == f) + 1  # node indices in ``dist``
         if mine.size:
-            first = int(mine[np.argmin(dist[0, mine])])
-            rest = [i for i in range(1, dist.shape[0]) if i != first]
-            sub = dist[np.ix_([first, *rest], [first, *rest])]
-            head = float(dist[0, first])
+            # The best of the frontier's few viewpoints nearest the robot as the first stop.
+            firsts = mine[np.argsort(dist[0, mine], kind="stable")[: self.params.first_stops]]
+            return min(self._tour_via(int(i), dist) for i in firsts)
         else:
             entry = self._entry_cell(cells, d_robot)
             if entry is None:
@@ -315,6 +323,16 @@ class OracleTeacher:
             return math.inf
         if sub.shape[0] <= 1:
             return head
+        order = open_tour_order(sub, self.params.tour.lkh_runs)
+        return head + float(sum(sub[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
+
+    def _tour_via(self, first: int, dist: np.ndarray) -> float:
+        """Robot -> node ``first`` -> an open LKH tour through every other viewpoint."""
+        head = float(dist[0, first])
+        rest = [i for i in range(1, dist.shape[0]) if i != first]
+        if not math.isfinite(head) or not rest:
+            return head
+        sub = dist[np.ix_([first, *rest], [first, *rest])]
         order = open_tour_order(sub, self.params.tour.lkh_runs)
         return head + float(sum(sub[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
 

@@ -117,7 +117,8 @@ def test_labels_need_the_privileged_world_of_a_privileged_env() -> None:
     labels = OracleTeacher.from_reset_info(info).labels(obs)
     assert labels.n_frontiers >= 1 and 0 <= labels.first < labels.n_frontiers
     assert np.isfinite(labels.cost_to_go_m).all()
-    assert labels.cost_to_go_m.min() <= labels.tour_length_m + 1.0
+    assert labels.cost_to_go_m[labels.first] == labels.cost_to_go_m.min()
+    assert labels.cost_to_go_m.min() <= labels.tour_length_m
 
 
 class _Spy:
