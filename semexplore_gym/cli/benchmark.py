@@ -324,6 +324,9 @@ def _run(args: argparse.Namespace) -> int:
     if getattr(args, "robots", None):
         from semexplore_gym.evaluation.team_benchmark import run_team_study
 
+        if getattr(args, "split", None):
+            raise ValueError("--robots runs --worlds or --suite; --split is for single robots")
+
         return run_team_study(team_study_request(args))
     policies = _split_policies(args.policies)
     if not policies:
