@@ -76,8 +76,9 @@ def make_world(spec: str | os.PathLike, rng: np.random.Generator | None = None) 
     """
     options: dict[str, float] = {}
     if isinstance(spec, str) and spec.strip().startswith(_CATALOGUE_PREFIX):
-        map_name, options = _map_options(spec.strip()[len(_CATALOGUE_PREFIX) :])
-        label = spec.strip()
+        rest = spec.strip()[len(_CATALOGUE_PREFIX) :]
+        map_name, options = _map_options(rest)
+        label = _CATALOGUE_PREFIX + ",".join(part.strip() for part in rest.split(","))
         spec = resolve_map_file(map_name)
         if options and Path(spec).suffix.lower() not in _PNG_SUFFIXES:
             raise ValueError(f"map:{map_name} takes no options (only DungeonMaps take m_per_px)")
