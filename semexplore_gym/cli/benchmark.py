@@ -318,7 +318,6 @@ def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from semexplore_gym.evaluation.harness import parse_seeds, run_benchmark, write_manifest
-    from semexplore_gym.evaluation.report import write_plots, write_summary
 
     validate_args(args)
     if getattr(args, "robots", None):
@@ -371,17 +370,7 @@ def _run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         suites=[{"name": r["name"], "version": r["version"]} for r in suites] or None,
     )
-    summary = write_summary(args.out)
-    plots = [] if args.no_plots else write_plots(args.out)
-    if with_oracle:
-        from semexplore_gym.evaluation.regret import write_regret
-
-        regret = write_regret(args.out, plots=not args.no_plots)
-        plots += [regret["plot"]] if regret["plot"] else []
-    if getattr(args, "split", None):
-        from semexplore_gym.evaluation.learning_table import write_learning_table
-
-        write_learning_table(args.out)
+    summary, plots = _write_reports(args, with_oracle)
     print(
         json.dumps(
             {
@@ -395,6 +384,25 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(Path(summary).read_text())
     return 1 if res["failed"] else 0
+
+
+def _write_reports(args: argparse.Namespace, with_oracle: bool) -> tuple[Any, list[Any]]:
+    """``summary.md`` and the figures; the regret outputs with the oracle; the learning table
+    with ``--split``. Returns ``(summary path, figure paths)``."""
+    from semexplore_gym.evaluation.report import write_plots, write_summary
+
+    summary = write_summary(args.out)
+    plots = [] if args.no_plots else write_plots(args.out)
+    if with_oracle:
+        from semexplore_gym.evaluation.regret import write_regret
+
+        regret = write_regret(args.out, plots=not args.no_plots)
+        plots += [regret["plot"]] if regret["plot"] else []
+    if getattr(args, "split", None):
+        from semexplore_gym.evaluation.learning_table import write_learning_table
+
+        write_learning_table(args.out)
+    return summary, plots
 
 
 def team_study_request(args: argparse.Namespace) -> Any:
