@@ -39,16 +39,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import sparse
+from numba import njit
+from scipy import ndimage, sparse
 
 from semexplore_gym.core.coverage_tour import (
     PRIVILEGED_INFO_KEY,
     PrivilegedWorld,
     TourParams,
-    geodesic_matrix,
     open_tour_order,
 )
-from semexplore_gym.core.coverage_tour.tour import require_solver, travel_aware_cover
+from semexplore_gym.core.coverage_tour.tour import require_solver
 from semexplore_gym.core.coverage_tour.viewpoints import (
     candidate_viewpoints,
     nearest_allowed_cell,
@@ -78,11 +78,14 @@ class TeacherParams:
             caller passes no frontiers of its own).
         first_stops: A frontier's cost-to-go tries this many of its viewpoints nearest the
             robot as the first stop and keeps the shortest tour.
+        pricing_lkh_runs: LKH restarts of each of those tours (the re-optimised tour itself
+            uses ``tour.lkh_runs``); the labels' cost is mostly LKH.
     """
 
     tour: TourParams = field(default_factory=TourParams)
     min_frontier_cells: int = 3
     first_stops: int = 3
+    pricing_lkh_runs: int = 1
 
 
 @dataclass(frozen=True)
@@ -157,6 +160,14 @@ class OracleTeacher:
         self.visible: sparse.csr_matrix = visible_sets(facts.world, geo, cand, facts.sensor, mask)
         self.true_free = rasterize_free(facts.world, geo)
         self._geo_cost = np.where(self.standing, geo.resolution_m, np.inf)
+        self._coverable = np.zeros(self.mask_flat.size, dtype=bool)
+        self._coverable[self.visible.indices] = True
+        # Geodesic distances between viewpoints are static: one Dijkstra per viewpoint, on the
+        # standing mask's box, the first time a cover picks it.
+        rows = np.flatnonzero(self.standing.any(axis=1))
+        cols = np.flatnonzero(self.standing.any(axis=0))
+        self._box = (int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1)
+        self._rows: dict[int, np.ndarray] = {}
 
     @classmethod
     def from_reset_info(
@@ -195,16 +206,17 @@ class OracleTeacher:
             np.asarray(getattr(f, "cells", f), dtype=np.int64).reshape(-1, 2) for f in frontiers
         )
         robot = self._robot_cell(pose)
+        d_robot, _ = distance_field(self._geo_cost, robot)
+        robot_row = d_robot[self.candidates_rc[:, 0], self.candidates_rc[:, 1]]
         unseen = grid.reshape(-1)[self.mask_flat] != FREE
-        chosen = self._cover(unseen, robot)
+        chosen = self._cover(unseen, robot_row)
         owner = self._owners(grid, cells)
         vp_owner = self._viewpoint_owners(chosen, unseen, owner)
         nodes = np.vstack([np.array([robot], dtype=np.int64), self.candidates_rc[chosen]])
-        dist = geodesic_matrix(self.standing, self.geometry, nodes)
+        dist = self._node_distances(chosen, robot_row)
         order = open_tour_order(dist, self.params.tour.lkh_runs)
         tour = [i - 1 for i in order[1:]]
         length = float(sum(dist[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
-        d_robot, _ = distance_field(self._geo_cost, robot)
         cost = np.array(
             [
                 self._cost_to_go(f, cells[f], nodes, dist, vp_owner, d_robot)
@@ -234,26 +246,82 @@ class OracleTeacher:
             r, c = (int(v) for v in self.geometry.world_to_grid(pose[0], pose[1]))
             return r, c
 
-    def _cover(self, unseen: np.ndarray, robot: tuple[int, int]) -> list[int]:
-        """Viewpoints that see the cover target of the reachable cells (seen ones count)."""
+    def _row(self, i: int) -> np.ndarray:
+        """Geodesic distances from viewpoint ``i`` to every viewpoint (cached)."""
+        row = self._rows.get(i)
+        if row is None:
+            r0, r1, c0, c1 = self._box
+            cand = self.candidates_rc
+            d, _ = distance_field(
+                self._geo_cost[r0:r1, c0:c1], (int(cand[i, 0]) - r0, int(cand[i, 1]) - c0)
+            )
+            row = d[cand[:, 0] - r0, cand[:, 1] - c0]
+            self._rows[i] = row
+        return row
+
+    def _node_distances(self, chosen: list[int], robot_row: np.ndarray) -> np.ndarray:
+        """Geodesic matrix of the robot (node 0) and the ``chosen`` viewpoints."""
+        k = len(chosen)
+        out = np.zeros((k + 1, k + 1))
+        out[0, 1:] = out[1:, 0] = robot_row[chosen]
+        for a, i in enumerate(chosen):
+            out[a + 1, 1:] = self._row(i)[chosen]
+        out = np.minimum(out, out.T)
+        np.fill_diagonal(out, 0.0)
+        return out
+
+    def _cover(self, unseen: np.ndarray, robot_row: np.ndarray) -> list[int]:
+        """Viewpoints that see the cover target of the reachable cells (seen ones count).
+
+        The rule of :func:`~semexplore_gym.core.coverage_tour.tour.travel_aware_cover` (most
+        unseen cells per ``detour_m`` + path from the nearest point chosen so far, the robot
+        first), with the viewpoints' distances cached and only the viewpoints that see an
+        unseen cell considered.
+        """
         seen = ~unseen
-        coverable = seen.copy()
-        coverable[self.visible.indices] = True
         n = max(1, self.mask_flat.size)
-        required = min(int(math.ceil(self.params.tour.coverage_target * n)), int(coverable.sum()))
-        if int(seen.sum()) >= required:
-            return []
-        prm = self.params.tour
-        return travel_aware_cover(
-            self.visible,
-            required,
-            seen,
-            self.candidates_rc,
-            self.standing,
-            robot,
-            self.geometry.resolution_m,
-            max(prm.detour_m, 1e-6),
+        required = min(
+            int(math.ceil(self.params.tour.coverage_target * n)),
+            int((seen | self._coverable).sum()),
         )
+        n_cov = int(seen.sum())
+        if n_cov >= required:
+            return []
+        # Only viewpoints within sensor range of an unseen cell can see one.
+        geo = self.geometry
+        unseen_grid = np.zeros(geo.height * geo.width, dtype=bool)
+        unseen_grid[self.mask_flat[unseen]] = True
+        far = ndimage.distance_transform_edt(~unseen_grid.reshape(geo.shape)) * geo.resolution_m
+        cand = self.candidates_rc
+        live = np.flatnonzero(far[cand[:, 0], cand[:, 1]] <= self.facts.sensor.max_range_m + 0.1)
+        indptr, indices = self.visible.indptr, self.visible.indices
+        gain_ub = _row_gains(indptr, indices, live, unseen).astype(np.float64)
+        keep = gain_ub > 0
+        live, gain_ub = live[keep], gain_ub[keep]
+        cov = seen.copy()
+        dist = robot_row[live].astype(np.float64)
+        detour = max(self.params.tour.detour_m, 1e-6)
+        taken = np.zeros(live.size, dtype=bool)
+        chosen: list[int] = []
+        while n_cov < required:
+            bound = np.where(taken | ~np.isfinite(dist), -1.0, gain_ub / (dist + detour))
+            best, best_val, best_gain = -1, 0.0, 0
+            for i in np.argsort(-bound, kind="stable"):
+                if bound[i] <= best_val:
+                    break
+                g = int(_row_gains(indptr, indices, live[i : i + 1], ~cov)[0])
+                gain_ub[i] = g
+                if g / (dist[i] + detour) > best_val:
+                    best, best_val, best_gain = int(i), g / (dist[i] + detour), g
+            if best < 0:
+                break
+            chosen.append(int(live[best]))
+            taken[best] = True
+            k = int(live[best])
+            cov[indices[indptr[k] : indptr[k + 1]]] = True
+            n_cov += best_gain
+            np.minimum(dist, self._row(int(live[best]))[live], out=dist)
+        return chosen
 
     def _owners(self, grid: np.ndarray, cells: tuple[np.ndarray, ...]) -> np.ndarray:
         """Per map cell, the frontier nearest along true free space (-1: none reaches it)."""
@@ -323,7 +391,7 @@ class OracleTeacher:
             return math.inf
         if sub.shape[0] <= 1:
             return head
-        order = open_tour_order(sub, self.params.tour.lkh_runs)
+        order = open_tour_order(sub, self.params.pricing_lkh_runs)
         return head + float(sum(sub[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
 
     def _tour_via(self, first: int, dist: np.ndarray) -> float:
@@ -333,7 +401,7 @@ class OracleTeacher:
         if not math.isfinite(head) or not rest:
             return head
         sub = dist[np.ix_([first, *rest], [first, *rest])]
-        order = open_tour_order(sub, self.params.tour.lkh_runs)
+        order = open_tour_order(sub, self.params.pricing_lkh_runs)
         return head + float(sum(sub[a, b] for a, b in zip(order[:-1], order[1:], strict=False)))
 
     def _entry_cell(self, cells: np.ndarray, d: np.ndarray) -> tuple[int, int] | None:
@@ -352,3 +420,17 @@ class OracleTeacher:
             return None
         row, col = divmod(int(np.argmin(np.where(ok, d, np.inf))), w)
         return row, col
+
+
+@njit(cache=True)
+def _row_gains(indptr, indices, rows, flags):  # pragma: no cover - numba
+    """Per row of ``rows``, how many of its CSR columns are set in ``flags``."""
+    out = np.zeros(rows.size, dtype=np.int64)
+    for k in range(rows.size):
+        r = rows[k]
+        n = 0
+        for j in range(indptr[r], indptr[r + 1]):
+            if flags[indices[j]]:
+                n += 1
+        out[k] = n
+    return out
