@@ -379,14 +379,14 @@ class OracleTeacher:
             # The best of the frontier's few viewpoints nearest the robot as the first stop.
             firsts = mine[np.argsort(dist[0, mine], kind="stable")[: self.params.first_stops]]
             return min(self._tour_via(int(i), dist) for i in firsts)
-        else:
-            entry = self._entry_cell(cells, d_robot)
-            if entry is None:
-                return math.inf
-            d_entry, _ = distance_field(self._geo_cost, entry)
-            head = float(d_robot[entry])
-            sub = dist.copy()
-            sub[0, 1:] = sub[1:, 0] = d_entry[nodes[1:, 0], nodes[1:, 1]]
+        # No viewpoint of its own: drive to the frontier, then tour every viewpoint from there.
+        entry = self._entry_cell(cells, d_robot)
+        if entry is None:
+            return math.inf
+        d_entry, _ = distance_field(self._geo_cost, entry)
+        head = float(d_robot[entry])
+        sub = dist.copy()
+        sub[0, 1:] = sub[1:, 0] = d_entry[nodes[1:, 0], nodes[1:, 1]]
         if not math.isfinite(head):
             return math.inf
         if sub.shape[0] <= 1:
