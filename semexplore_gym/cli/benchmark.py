@@ -7,10 +7,13 @@ may carry a label, ``semantic[tuned]``, or parameter overrides, ``semantic[cost.
 
     semexplore benchmark --worlds maze1,maze2 --policies semantic,frontier,nearest --runs 10 --out runs/bench
     semexplore benchmark --suite mazes,caves --policies 'semantic,semantic[cost.w_p=0],nearest' --out runs/suites
+    semexplore benchmark --split mazes:test --policies semantic,nearest,frontier,sb3:agent.zip --out runs/learn
 
 A suite (``configs/suites/NAME.yaml`` or a path to your own YAML) gives the worlds, the runs,
 the start poses and each world's time limit; its summary adds a table per world family and
-one over all worlds.
+one over all worlds. A learning split's part (``configs/splits/NAME.yaml``: ``--split mazes:test``)
+runs like a suite and adds the learning table (per family: oracle, expert, each policy,
+baselines; medians, ratios to the expert and the oracle, Wilcoxon p).
 
 Model zips (``sb3:``) and ``py:`` specs run code from the file they name, in this process and
 in every worker: use only files from sources you trust.
@@ -108,6 +111,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="comma-separated suite names (configs/suites: paper, mazes, offices, caves, open, real) "
         "or suite YAML paths; each world gets the suite's time limit, runs and start poses",
     )
+    which.add_argument(
+        "--split",
+        help="comma-separated learning split parts NAME:PART (configs/splits: mazes, offices, caves, "
+        "open, dungeon; parts train, validation, test), e.g. mazes:test; run like suites, plus "
+        "the learning table. No test world is ever used for training or model selection",
+    )
     p.add_argument(
         "--policies",
         default="semantic,frontier,nearest",
@@ -190,7 +199,7 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="also run the privileged oracle (full-knowledge tour) on every (world, seed) and "
         "write each mission's regret against it (regret.csv, summary.md, regret_ladder.png); "
-        "default: on with --suite, off otherwise",
+        "default: on with --suite or --split, off otherwise",
     )
 
 
@@ -201,8 +210,9 @@ def _suite_tasks(
     for ``policies`` (default: ``--policies``)."""
     from semexplore_gym.evaluation.suites import suite_tasks
 
+    names: list[Any] = split_list(args.suite) if args.suite is not None else _split_parts(args)
     return suite_tasks(
-        split_list(args.suite),
+        names,
         _split_policies(args.policies) if policies is None else policies,
         seeds_for,
         max_time_s=args.max_time_s,
@@ -210,6 +220,21 @@ def _suite_tasks(
         env_config=args.env_config,
         env_overrides=args.env_overrides,
     )
+
+
+def _split_parts(args: argparse.Namespace) -> list[Any]:
+    """The suites of ``--split NAME:PART[,...]``."""
+    from semexplore_gym.evaluation.splits import split_suite
+
+    out = []
+    for spec in split_list(args.split or ""):
+        try:
+            out.append(split_suite(spec))
+        except (ValueError, FileNotFoundError) as e:
+            raise ValueError(f"--split {short_repr(spec)}: {e}") from None
+    if not out:
+        raise ValueError("--split is empty")
+    return out
 
 
 #: Python parameters named in the harness's errors, and the flags that set them.
@@ -263,7 +288,8 @@ def run(args: argparse.Namespace) -> int:
         return _run(args)
     except ParameterError as e:
         # The harness names its parameters; the user typed flags.
-        raise e.for_flags(FLAGS) from None
+        flags = {**FLAGS, "names": "--split"} if getattr(args, "split", None) else FLAGS
+        raise e.for_flags(flags) from None
 
 
 def _add_oracle(args: argparse.Namespace, policies: list[str]) -> bool:
@@ -271,7 +297,8 @@ def _add_oracle(args: argparse.Namespace, policies: list[str]) -> bool:
     its spec to ``policies`` when asked for and not listed."""
     from semexplore_gym.evaluation.regret import ORACLE_SPEC
 
-    with_oracle = args.oracle if args.oracle is not None else args.suite is not None
+    suites = args.suite is not None or getattr(args, "split", None) is not None
+    with_oracle = args.oracle if args.oracle is not None else suites
     if with_oracle and ORACLE_SPEC not in policies:
         from semexplore_gym.core.coverage_tour.tour import require_solver
 
@@ -291,11 +318,13 @@ def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from semexplore_gym.evaluation.harness import parse_seeds, run_benchmark, write_manifest
-    from semexplore_gym.evaluation.report import write_plots, write_summary
 
     validate_args(args)
     if getattr(args, "robots", None):
         from semexplore_gym.evaluation.team_benchmark import run_team_study
+
+        if getattr(args, "split", None):
+            raise ValueError("--robots runs --worlds or --suite; --split is for single robots")
 
         return run_team_study(team_study_request(args))
     policies = _split_policies(args.policies)
@@ -305,7 +334,7 @@ def _run(args: argparse.Namespace) -> int:
     with_oracle = _add_oracle(args, policies)
     _check_policies(policies)
     suites: list[dict[str, Any]] = []
-    if args.suite is not None:
+    if args.suite is not None or getattr(args, "split", None) is not None:
         tasks, suites, worlds = _suite_tasks(
             args, lambda runs: parse_seeds(args.runs or runs, args.seed0), policies
         )
@@ -320,6 +349,7 @@ def _run(args: argparse.Namespace) -> int:
         {
             "command": " ".join(shlex.quote(a) for a in sys.argv),
             "suites": suites or None,
+            "splits": split_list(args.split) if getattr(args, "split", None) else None,
             "worlds": worlds,
             "policies": policies,
             "seeds": seeds,
@@ -340,13 +370,7 @@ def _run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         suites=[{"name": r["name"], "version": r["version"]} for r in suites] or None,
     )
-    summary = write_summary(args.out)
-    plots = [] if args.no_plots else write_plots(args.out)
-    if with_oracle:
-        from semexplore_gym.evaluation.regret import write_regret
-
-        regret = write_regret(args.out, plots=not args.no_plots)
-        plots += [regret["plot"]] if regret["plot"] else []
+    summary, plots = _write_reports(args, with_oracle)
     print(
         json.dumps(
             {
@@ -360,6 +384,25 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(Path(summary).read_text())
     return 1 if res["failed"] else 0
+
+
+def _write_reports(args: argparse.Namespace, with_oracle: bool) -> tuple[Any, list[Any]]:
+    """``summary.md`` and the figures; the regret outputs with the oracle; the learning table
+    with ``--split``. Returns ``(summary path, figure paths)``."""
+    from semexplore_gym.evaluation.report import write_plots, write_summary
+
+    summary = write_summary(args.out)
+    plots = [] if args.no_plots else write_plots(args.out)
+    if with_oracle:
+        from semexplore_gym.evaluation.regret import write_regret
+
+        regret = write_regret(args.out, plots=not args.no_plots)
+        plots += [regret["plot"]] if regret["plot"] else []
+    if getattr(args, "split", None):
+        from semexplore_gym.evaluation.learning_table import write_learning_table
+
+        write_learning_table(args.out)
+    return summary, plots
 
 
 def team_study_request(args: argparse.Namespace) -> Any:

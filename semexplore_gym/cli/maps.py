@@ -5,6 +5,7 @@ Example::
     semexplore maps list
     semexplore maps get tb3-world                       # into the cache, sha256-checked
     semexplore maps get tb3-world --from ../shared/maps # offline: copy from a local directory
+    semexplore maps get 'dungeon-test-*'                # a pattern: the 100 DungeonMaps test maps
     semexplore maps path tb3-world                      # where map:tb3-world is read from
     semexplore explore --world map:tb3-world
 """
@@ -36,7 +37,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     get = actions.add_parser(
         "get", help="download maps into the cache (or --dir), verifying each file's sha256"
     )
-    get.add_argument("names", nargs="+", metavar="NAME", help="catalogue map name(s)")
+    get.add_argument(
+        "names",
+        nargs="+",
+        metavar="NAME",
+        help="catalogue map name(s); a quoted pattern ('dungeon-test-*') names every match",
+    )
     get.add_argument(
         "--dir",
         default=None,
@@ -86,6 +92,24 @@ def _list(files: bool = False) -> int:
     return 0
 
 
+def _expand_patterns(names: list[str]) -> list[str]:
+    """Each name, or for a pattern with ``*``, ``?`` or ``[`` every catalogue name it matches."""
+    import fnmatch
+
+    from semexplore_gym.maps.catalogue import CATALOGUE
+
+    out: list[str] = []
+    for name in names:
+        if not any(ch in name for ch in "*?["):
+            out.append(name)
+            continue
+        matches = [n for n in CATALOGUE if fnmatch.fnmatchcase(n, name)]
+        if not matches:
+            raise ValueError(f"no catalogue map matches {name!r} (see: semexplore maps list)")
+        out += matches
+    return list(dict.fromkeys(out))
+
+
 def _get(args: argparse.Namespace) -> int:
     from semexplore_gym.maps.catalogue import (
         RAW_GITHUB_BASE,
@@ -96,6 +120,7 @@ def _get(args: argparse.Namespace) -> int:
 
     if not (args.timeout_s > 0):
         raise ValueError(f"--timeout-s must be positive, got {args.timeout_s!r}")
+    args.names = _expand_patterns(args.names)
     for name in args.names:
         get_catalogue_map(name)  # unknown names fail before anything is fetched
     root = Path(args.dir).expanduser() if args.dir else maps_cache_dir()

@@ -206,10 +206,13 @@ def save_suite(suite: Suite, path: str | os.PathLike) -> Path:
 
 
 def world_family(world: str) -> str:
-    """The family a world belongs to in a summary: ``maze``, ``office``, ..., ``real maps`` for
-    catalogue maps (``map:NAME``), or the file name of a map given by path."""
+    """The family a world belongs to in a summary: ``maze``, ``office``, ..., ``dungeon`` for
+    DungeonMaps, ``real maps`` for the other catalogue maps (``map:NAME``), or the file name of
+    a map given by path."""
     if world.lower().endswith((".yaml", ".yml", ".json")):
         return Path(world).stem
+    if world.lower().endswith(".png") or world.startswith("map:dungeon-"):
+        return "dungeon"
     name = world.partition(":")[0]
     if name == "map":
         return "real maps"
@@ -251,7 +254,7 @@ def _mission_env_config(
 
 
 def suite_tasks(
-    names: Sequence[str],
+    names: Sequence[str | Suite],
     policies: Sequence[str],
     seeds_for: Callable[[int], list[int]],
     *,
@@ -264,7 +267,7 @@ def suite_tasks(
     runs and start poses, for every policy.
 
     Args:
-        names: suite names (``configs/suites``) or YAML paths.
+        names: suite names (``configs/suites``), YAML paths or suites (a split's part).
         policies: policy specs.
         seeds_for: the seeds to run, given a suite's ``runs``.
         max_time_s: replaces every suite's time limits when given.
@@ -290,12 +293,13 @@ def suite_tasks(
     all_worlds: list[str] = []
     for name in names:
         try:
-            suite = load_suite(name)
+            suite = name if isinstance(name, Suite) else load_suite(name)
         except FileNotFoundError as e:
             raise ParameterError("names", f"{PARAM} {short_repr(name)}: {e}") from None
         if any(r["name"] == suite.name for r in records):
             raise ParameterError("names", f"{PARAM} lists suite {suite.name!r} twice")
-        records.append({"name": suite.name, "version": suite.version, "source": str(name)})
+        source = suite.source if isinstance(name, Suite) else str(name)
+        records.append({"name": suite.name, "version": suite.version, "source": source})
         seeds = seeds_for(suite.runs)
         random_start = suite.random_start and not fixed_start
         repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]

@@ -1,5 +1,8 @@
 """The map catalogue: public ROS maps of real places, pinned to a commit, with checksums.
 
+It also lists a documented sample of the DungeonMaps (``dungeon-*``, PNG world files read by
+:mod:`.dungeon_maps`; the names and checksums are in :mod:`.dungeon_catalogue`).
+
 ``world="map:NAME"`` (see :func:`~semexplore_gym.maps.world_specs.make_world`) loads a
 catalogue map from disk; this module knows what the maps are and where they live, and does no
 network I/O. Fetching them is ``semexplore maps get NAME`` (:mod:`semexplore_gym.maps.download`).
@@ -28,6 +31,8 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+
+from semexplore_gym.maps import dungeon_catalogue as _dm
 
 #: Where upstream files are fetched from; ``OWNER/REPO/COMMIT/PATH`` follows.
 RAW_GITHUB_BASE = "https://raw.githubusercontent.com"
@@ -63,7 +68,8 @@ class CatalogueMap:
         repo: Source repository, ``OWNER/NAME`` on GitHub.
         commit: The pinned commit of ``repo``.
         shared_subdir: Directory of the files in the shared collection layout.
-        files: The map's files; the world file (``.yaml`` or ``.json``) comes last.
+        files: The map's files; the world file (``.yaml``, ``.json`` or DungeonMaps ``.png``)
+            comes last.
     """
 
     name: str
@@ -76,7 +82,8 @@ class CatalogueMap:
 
     @property
     def world_file(self) -> MapFile:
-        """The file ``make_world`` loads (a map_server ``.yaml`` or a HouseExpo ``.json``)."""
+        """The file ``make_world`` loads (map_server ``.yaml``, HouseExpo ``.json``, DungeonMaps
+        ``.png``)."""
         return self.files[-1]
 
     @property
@@ -387,8 +394,32 @@ _ENTRIES: tuple[CatalogueMap, ...] = (
     ),
 )  # fmt: skip
 
+#: Catalogue names of DungeonMaps start with this (:mod:`.dungeon_catalogue`).
+DUNGEON_PREFIX = "dungeon-"
+
+
+def _dungeon(folder: str, stem: str, sha256: str, size_bytes: int) -> CatalogueMap:
+    """A DungeonMaps PNG (its world file: :mod:`.dungeon_maps` reads it, no yaml)."""
+    return CatalogueMap(
+        f"{DUNGEON_PREFIX}{folder}-{stem.replace('_', '-')}",
+        f"DungeonMaps (Chen et al. 2019) {folder}/{stem}.png, 28x21 m at 0.04375 m/px",
+        _dm.DUNGEON_LICENCE, _dm.DUNGEON_REPO, _dm.DUNGEON_COMMIT, f"DungeonMaps/{folder}",
+        (_up(f"DungeonMaps/{folder}", f"{stem}.png", sha256, size_bytes),),
+    )  # fmt: skip
+
+
+_DUNGEON_ENTRIES = tuple(
+    _dungeon(folder, *row)
+    for folder, sample in (
+        ("test", _dm.TEST_SAMPLE),
+        ("train", _dm.TRAIN_SAMPLE),
+        ("train", _dm.VALIDATION_SAMPLE),
+    )
+    for row in sample
+)
+
 #: Catalogue name -> entry.
-CATALOGUE: dict[str, CatalogueMap] = {m.name: m for m in _ENTRIES}
+CATALOGUE: dict[str, CatalogueMap] = {m.name: m for m in _ENTRIES + _DUNGEON_ENTRIES}
 
 
 def get_catalogue_map(

@@ -1,0 +1,173 @@
+"""The learning benchmark's table: per family, every policy against the expert and the oracle.
+
+Written by ``semexplore benchmark --split NAME:PART`` into ``summary.md`` (section "Learning
+benchmark") and printed. One row per (family, policy), the oracle and the expert first, the
+baselines (nearest, FE) last:
+
+* ``n``: missions; ``coverage``: median final coverage;
+* ``T99 (s)``, ``mission time (s)``: medians (a mission that never reached 99 % has T99 = ∞);
+* ``D99 (m)``: median distance driven until 99 % coverage (from each mission's trace and
+  trajectory; the figure ARiADNE and its successors report on the DungeonMaps);
+* ``÷ expert``, ``÷ oracle``: the median over (world, seed) pairs of the policy's figure over
+  the expert's (the oracle's) on the same start;
+* ``p W``: two-sided Wilcoxon signed-rank test on the pairs' log ratios to the expert (T99;
+  mission time). A pair where one side never reached 99 % counts as a very large ratio (±log
+  1e6: ranks only), a pair where neither did as a tie.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+#: The expert every row is compared with (``semexplore benchmark``'s reference policy).
+EXPERT = "semantic"
+ORACLE = "oracle"
+#: Baselines, listed last.
+BASELINES = ("nearest", "frontier")
+SECTION_TITLE = "## Learning benchmark"
+_BIG_LOG = math.log(1e6)
+
+
+def _value(r: dict[str, Any], key: str) -> float:
+    v = r.get(key)
+    return math.inf if v is None or not math.isfinite(float(v)) else float(v)
+
+
+def _paired(
+    rows: list[dict[str, Any]], ref: dict[tuple[str, int], dict[str, Any]], key: str
+) -> np.ndarray:
+    """log(policy / reference) per (world, seed) pair (ties and one-sided infinities handled)."""
+    out = []
+    for r in rows:
+        o = ref.get((r["world"], int(r["seed"])))
+        if o is None:
+            continue
+        a, b = _value(r, key), _value(o, key)
+        if math.isinf(a) and math.isinf(b):
+            out.append(0.0)
+        elif math.isinf(a) or b <= 0:
+            out.append(_BIG_LOG)
+        elif math.isinf(b) or a <= 0:
+            out.append(-_BIG_LOG)
+        else:
+            out.append(math.log(a / b))
+    return np.asarray(out, dtype=np.float64)
+
+
+def _ratio_cell(logs: np.ndarray) -> str:
+    if logs.size == 0:
+        return "–"
+    med = float(np.median(logs))
+    return "∞" if med >= _BIG_LOG else f"{math.exp(med):.2f}"
+
+
+def _p_cell(logs: np.ndarray) -> str:
+    from scipy.stats import wilcoxon
+
+    if logs.size < 2 or not np.any(logs != 0):
+        return "–"
+    return f"{wilcoxon(logs, alternative='two-sided').pvalue:.2g}"
+
+
+def _median_cell(rows: list[dict[str, Any]], key: str) -> str:
+    v = np.asarray([_value(r, key) for r in rows], dtype=np.float64)
+    if v.size == 0:
+        return "–"
+    med = float(np.percentile(v, 50, method="lower"))
+    return "∞" if math.isinf(med) else (f"{med:.3f}" if key == "coverage" else f"{med:.1f}")
+
+
+def distance_to_coverage_m(out_dir: Any, row: dict[str, Any], level: float = 0.99) -> float | None:
+    """Distance the robot of ``row`` drove until its coverage first reached ``level`` (inf:
+    never; None: its trace or trajectory is missing)."""
+    from pathlib import Path
+
+    from semexplore_gym.evaluation.run_writer import task_stem
+
+    stem = task_stem(row["world"], row["policy"], int(row["seed"]))
+    out = Path(out_dir)
+    try:
+        trace = np.loadtxt(out / "traces" / f"{stem}.csv", delimiter=",", skiprows=1, ndmin=2)
+        poses = np.load(out / "trajectories" / f"{stem}.npy")
+    except (OSError, ValueError):
+        return None
+    n = min(len(trace), len(poses))
+    hit = np.flatnonzero(trace[:n, 1] >= level)
+    if hit.size == 0:
+        return math.inf
+    steps = np.hypot(*np.diff(poses[: int(hit[0]) + 1, :2], axis=0).T)
+    return float(steps.sum())
+
+
+def _order(policies: list[str]) -> list[str]:
+    first = [p for p in (ORACLE, EXPERT) if p in policies]
+    last = [p for p in BASELINES if p in policies]
+    return first + [p for p in policies if p not in first + last] + last
+
+
+def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> list[str]:
+    """The "Learning benchmark" section (see the module docstring) for ``runs.csv`` rows
+    (``out_dir``: the benchmark directory, for D99; without it D99 is left out)."""
+    from semexplore_gym.evaluation.report import group_by_family
+
+    if out_dir is not None:
+        rows = [{**r, "D99_m": distance_to_coverage_m(out_dir, r)} for r in rows]
+
+    lines = [
+        SECTION_TITLE,
+        "",
+        f"Per family: medians, and per (world, seed) pair the median ratio to the expert "
+        f"(`{EXPERT}`) and to the oracle on the same start (< 1: faster); p W = two-sided "
+        "Wilcoxon signed-rank test on the log ratios to the expert.",
+        "",
+        "| family | policy | n | coverage | T99 (s) | mission time (s) | D99 (m) | T99 ÷ expert | "
+        "time ÷ expert | T99 ÷ oracle | time ÷ oracle | p W T99 | p W time |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for family, by_policy in group_by_family(rows).items():
+        refs = {
+            name: {(r["world"], int(r["seed"])): r for r in by_policy.get(name, [])}
+            for name in (EXPERT, ORACLE)
+        }
+        for policy in _order(list(by_policy)):
+            rs = by_policy[policy]
+            cells = [str(len(rs)), _median_cell(rs, "coverage")]
+            cells += [_median_cell(rs, "T99_s"), _median_cell(rs, "mission_time_s")]
+            cells.append(
+                _median_cell([r for r in rs if r.get("D99_m", 0) is not None], "D99_m")
+                if out_dir is not None
+                else "–"
+            )
+            logs = {
+                (name, key): _paired(rs, refs[name], key)
+                if refs[name] and policy != name
+                else np.zeros(0)
+                for name in (EXPERT, ORACLE)
+                for key in ("T99_s", "mission_time_s")
+            }
+            cells += [_ratio_cell(logs[k]) for k in logs]
+            cells += [_p_cell(logs[(EXPERT, "T99_s")]), _p_cell(logs[(EXPERT, "mission_time_s")])]
+            lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
+    lines.append("")
+    return lines
+
+
+def write_learning_table(out_dir: Any) -> list[str]:
+    """Append (or replace) the section in ``out_dir/summary.md``; returns its lines."""
+    from pathlib import Path
+
+    from semexplore_gym.evaluation.run_row import read_runs
+
+    out = Path(out_dir)
+    lines = learning_table_lines(read_runs(out / "runs.csv"), out)
+    summary = out / "summary.md"
+    text = summary.read_text() if summary.exists() else ""
+    if SECTION_TITLE in text:
+        head, _, rest = text.partition(SECTION_TITLE)
+        nxt = rest.find("\n## ")
+        text = head.rstrip() + "\n" + (rest[nxt:] if nxt >= 0 else "")
+    summary.write_text(text.rstrip() + "\n\n" + "\n".join(lines) + "\n")
+    return lines
