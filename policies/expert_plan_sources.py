@@ -19,6 +19,10 @@ source                  proposes
 ``look``                close to a frontier too narrow to reach, to look again
 ======================  ======================================================================
 
+``view`` (asked right after ``retry``) drives to a place that sees into a frontier the robot
+reached, or looked at, without its unknown side becoming known; it drops the frontier when no
+reachable place sees into it.
+
 Every source reads what it needs from a :class:`PlanContext` and keeps no state of its own (the
 goal memory and the counters are the expert's), so one instance serves every expert. A source
 switched off by the parameters passes.
@@ -45,6 +49,7 @@ from semexplore_gym.core.frontiers.reachable import (
     nearest_reachable_frontier,
     pocket_exit_path,
 )
+from semexplore_gym.core.frontiers.viewpoint import find_view_pose
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
@@ -61,6 +66,7 @@ __all__ = [
     "PocketEscape",
     "RetryFailedGoal",
     "SemanticFrontier",
+    "ViewFrontier",
     "insert_plan_source",
     "standable_prefix",
     "unknown_near",
@@ -104,6 +110,7 @@ class PlanContext:
         counts: The expert's counters.
         choose_goal: The expert's goal choice among ``candidates``.
         log: Records an event ``(name, detail)`` in the expert's event log.
+        lidar_range_m: The LiDAR's ``(min_range_m, max_range_m)``.
     """
 
     grid: np.ndarray
@@ -118,6 +125,7 @@ class PlanContext:
     counts: ExpertCounters
     choose_goal: Callable[[list[FrontierCandidate]], FrontierCandidate]
     log: Callable[[str, str], None]
+    lidar_range_m: tuple[float, float] = (0.0, 3.5)
     clearance_cache: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -230,6 +238,61 @@ class RetryFailedGoal(PlanSource):
             ctx.memory.drop(ctx.grid, goal, "grid")
             return None
         return Plan(PlanKind.RETRY, target, ctx.resampled(path), frontier_xy_m=goal)
+
+
+class ViewFrontier(PlanSource):
+    """A place that sees into a frontier reached (or looked at) without clearing it.
+
+    The goal memory asks for it (``memory.view``) instead of dropping such a frontier. The
+    place is the nearest reachable cell with a line of sight over known free cells to the
+    unknown cells next to the frontier, within the LiDAR's resolved range, away from where the
+    robot stood (:func:`~semexplore_gym.core.frontiers.viewpoint.find_view_pose`): with the
+    planner's clearance first, then with the robot radius plus ``view_clearance_margin_m``.
+    When there is none the frontier is dropped (``unseeable``).
+    """
+
+    name = "view"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        req = ctx.memory.view
+        if req is None:
+            return None
+        ctx.memory.view = None
+        prm = ctx.params
+        xy = req.frontier_xy_m
+        if not unknown_near(ctx.grid, ctx.geometry, xy, prm.goal_check_radius_m):
+            return None  # it cleared meanwhile
+        near_m = ctx.lidar_range_m[0] + prm.view_min_range_margin_m
+        far_m = max(
+            prm.view_range_fraction * ctx.lidar_range_m[1], near_m + ctx.geometry.resolution_m
+        )
+        thin_m = min(ctx.robot_radius_m + prm.view_clearance_margin_m, ctx.clearance_m)
+        for clearance_m in dict.fromkeys((ctx.clearance_m, thin_m)):
+            found = find_view_pose(
+                ctx.grid,
+                ctx.geometry,
+                ctx.xy_m,
+                xy,
+                clearance_m,
+                (near_m, far_m),
+                rim_radius_m=prm.view_rim_radius_m,
+                excluded_xy_m=(req.looked_from_xy_m, ctx.xy_m),
+                excluded_radius_m=prm.goal_reached_radius_m,
+                clearance_field=ctx.clearance_field(),
+            )
+            if found is not None:
+                ctx.counts.view_drives += 1
+                ctx.log(
+                    "view",
+                    f"frontier {tuple(round(v, 2) for v in xy)} from "
+                    f"{tuple(round(v, 2) for v in found.goal_xy_m)} "
+                    f"({found.n_visible}/{found.n_rim} unknown cells in sight)",
+                )
+                return Plan(
+                    PlanKind.VIEW, found.goal_xy_m, ctx.resampled(found.path_m), frontier_xy_m=xy
+                )
+        ctx.memory.drop(ctx.grid, xy, "unseeable")
+        return None
 
 
 class SemanticFrontier(PlanSource):
@@ -427,6 +490,7 @@ def standable_prefix(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
 DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
     CommandedGoal(),
     RetryFailedGoal(),
+    ViewFrontier(),
     SemanticFrontier(),
     CommittedFallback(),
     NearestFallback(),

@@ -198,7 +198,7 @@ class SemanticExpertPolicy(Policy):
         self.tmap, self.candidates, self.mode, self.events = None, [], ExpertMode.IDLE, []
         self.counts.clear()
         self._time_s, self._next_replan_s, self._plan = 0.0, 0.0, None
-        self._last_reason = ""
+        self._last_reason, self._min_range_m = "", facts.min_range_m
         self._seg_known_cells = self._empty_replans = 0
         self._area_types: np.ndarray | None = None
         self._known_cells = known_cell_count(obs["map"])
@@ -285,7 +285,7 @@ class SemanticExpertPolicy(Policy):
             math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
             <= self.params.goal_reached_radius_m
         ):
-            self.goal_memory.goal_reached(grid, plan)
+            self.goal_memory.goal_reached(grid, plan, (pose[0], pose[1]))
             return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
             return "path_done"
@@ -391,6 +391,9 @@ class SemanticExpertPolicy(Policy):
             or old.candidate is None
         ):
             return best
+        held = self.goal_memory.shuttle_candidate(ranked)
+        if held is not None:  # adopted again without the map growing: see it through
+            return held
         same = [
             c
             for c in ranked
@@ -467,6 +470,7 @@ class SemanticExpertPolicy(Policy):
             counts=self.counts,
             choose_goal=self.choose_goal,
             log=self._log,
+            lidar_range_m=(self._min_range_m, self.limits.max_range_m),
         )
         new_plan = None
         for source in self.plan_sources:
@@ -522,8 +526,7 @@ class SemanticExpertPolicy(Policy):
         """Every source passed: wait a step, stop after ``stop_confirmations``."""
         self._plan = None
         self._empty_replans += 1
-        # Look again at the next step before giving up.
-        self._next_replan_s = self._time_s
+        self._next_replan_s = self._time_s  # look again at the next step before giving up
         if self._empty_replans >= self.params.stop_confirmations:
             self.done = True
             self.mode = ExpertMode.DONE
@@ -544,6 +547,7 @@ class SemanticExpertPolicy(Policy):
             if old is not None:
                 self.counts.switches += 1
                 self.goal_memory.abandon(old.goal_xy_m, self._time_s)
+            self.goal_memory.adopt(new_plan.goal_xy_m, self._known_cells)
             self.follower.start_goal(new_plan, self._time_s)
             self._log("goal", f"{kind} {tuple(round(v, 2) for v in new_plan.goal_xy_m)}")
         if old is None or old.kind != new_plan.kind:
