@@ -165,6 +165,12 @@ class GoalMemory:
                     return True
         return False
 
+    def trail_near(self, xy_m: tuple[float, float], radius_m: float) -> list[tuple[float, float]]:
+        """Centres of the trail's cells within ``radius_m`` of ``xy_m``: where the robot was."""
+        c = TRAIL_CELL_M
+        pts = (((i + 0.5) * c, (j + 0.5) * c) for i, j in self.trail)
+        return [p for p in pts if math.dist(p, xy_m) <= radius_m]
+
     # ------------------------------------------------------------------ events
     def visit(self, xy_m: tuple[float, float]) -> None:
         """The robot is at ``xy_m`` (its trail)."""

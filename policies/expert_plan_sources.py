@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_goal_memory import GoalMemory
+from semexplore_gym.policies.expert_goal_memory import TRAIL_CELL_M, GoalMemory
 from semexplore_gym.policies.expert_plan import Plan, PlanKind
 from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
@@ -71,6 +71,9 @@ __all__ = [
     "standable_prefix",
     "unknown_near",
 ]
+
+#: A view place counts as reached this close (its line of sight holds from about there).
+VIEW_REACHED_M = 0.15
 
 #: Narrow frontiers checked against the trail before one is worth driving to.
 MAX_LOOK_CANDIDATES = 8
@@ -245,9 +248,10 @@ class ViewFrontier(PlanSource):
 
     The goal memory asks for it (``memory.view``) instead of dropping such a frontier. The
     place is the nearest reachable cell with a line of sight over known free cells to the
-    unknown cells next to the frontier, within the LiDAR's resolved range, away from where the
-    robot stood (:func:`~semexplore_gym.core.frontiers.viewpoint.find_view_pose`): with the
-    planner's clearance first, then with the robot radius plus ``view_clearance_margin_m``.
+    unknown cells next to the frontier, within the LiDAR's resolved range, away from every place
+    the robot has been (its trail: its LiDAR had its chance there; :func:`~semexplore_gym.core.
+    frontiers.viewpoint.find_view_pose`): with the planner's clearance first, then with the
+    robot radius plus ``view_clearance_margin_m``.
     When there is none the frontier is dropped (``unseeable``).
     """
 
@@ -267,6 +271,9 @@ class ViewFrontier(PlanSource):
             prm.view_range_fraction * ctx.lidar_range_m[1], near_m + ctx.geometry.resolution_m
         )
         thin_m = min(ctx.robot_radius_m + prm.view_clearance_margin_m, ctx.clearance_m)
+        # Where the robot has been, its LiDAR had its chance: a rim cell in sight from there on
+        # the grid is hidden in fact (a wall's face inside the cell). Look from elsewhere.
+        trail = ctx.memory.trail_near(xy, far_m + prm.view_rim_radius_m + TRAIL_CELL_M)
         for clearance_m in dict.fromkeys((ctx.clearance_m, thin_m)):
             found = find_view_pose(
                 ctx.grid,
@@ -276,8 +283,8 @@ class ViewFrontier(PlanSource):
                 clearance_m,
                 (near_m, far_m),
                 rim_radius_m=prm.view_rim_radius_m,
-                excluded_xy_m=(req.looked_from_xy_m, ctx.xy_m),
-                excluded_radius_m=prm.goal_reached_radius_m,
+                excluded_xy_m=[req.looked_from_xy_m, ctx.xy_m, *trail],
+                excluded_radius_m=TRAIL_CELL_M,
                 clearance_field=ctx.clearance_field(),
             )
             if found is not None:
@@ -288,9 +295,8 @@ class ViewFrontier(PlanSource):
                     f"{tuple(round(v, 2) for v in found.goal_xy_m)} "
                     f"({found.n_visible}/{found.n_rim} unknown cells in sight)",
                 )
-                return Plan(
-                    PlanKind.VIEW, found.goal_xy_m, ctx.resampled(found.path_m), frontier_xy_m=xy
-                )
+                path = ctx.resampled(found.path_m)
+                return Plan(PlanKind.VIEW, found.goal_xy_m, path, None, xy, VIEW_REACHED_M)
         ctx.memory.drop(ctx.grid, xy, "unseeable")
         return None
 

@@ -281,18 +281,18 @@ class SemanticExpertPolicy(Policy):
             return "no_plan"
         if self._time_s >= self._next_replan_s - 1e-9:
             return "period"
-        if (
-            math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
-            <= self.params.goal_reached_radius_m
-        ):
+        reach_m = plan.reached_within_m or self.params.goal_reached_radius_m
+        if math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1]) <= reach_m:
             self.goal_memory.goal_reached(grid, plan, (pose[0], pose[1]))
             return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
             return "path_done"
         # Goal vanished: no unknown cell is left near it (its frontier has been mapped). A
-        # commanded goal may lie in known space: it lasts until reached.
+        # commanded goal may lie in known space: it lasts until reached; a view's is its frontier.
+        view = plan.kind == PlanKind.VIEW and plan.frontier_xy_m is not None
+        watched = plan.frontier_xy_m if view and plan.frontier_xy_m else plan.goal_xy_m
         if plan.kind != PlanKind.COMMANDED and not unknown_near(
-            grid, self.geometry, plan.goal_xy_m, self.params.goal_check_radius_m
+            grid, self.geometry, watched, self.params.goal_check_radius_m
         ):
             return "goal_vanished"
         return ""

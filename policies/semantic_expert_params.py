@@ -98,9 +98,10 @@ What the paper leaves open, and how the expert handles it (parameters in
   free cells reach the unknown cells next to the frontier (its rim: the unknown cells within
   ``view_rim_radius_m`` of it with a free neighbour), at a distance the LiDAR resolves
   (beyond its minimum range plus ``view_min_range_margin_m``, within ``view_range_fraction``
-  of its maximum range), away from where it stood already
-  (:mod:`semexplore_gym.core.frontiers.viewpoint`); the planner's clearance first, then the
-  robot radius plus ``view_clearance_margin_m``. The frontier is dropped only when no such
+  of its maximum range), away from every place it has been (its trail: a rim cell in sight
+  from there on the grid, yet unknown, is hidden in fact; :mod:`semexplore_gym.core.frontiers.
+  viewpoint`); the planner's clearance first, then the robot radius plus
+  ``view_clearance_margin_m``. The frontier is dropped only when no such
   place exists, or once the robot looked from there and it stayed unknown (once per place).
 
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
