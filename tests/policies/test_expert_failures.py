@@ -179,6 +179,16 @@ def test_a_frontier_reached_but_not_cleared_is_seen_from_another_place() -> None
     pol = _reach_the_gap(prm)
     assert pol.plan_source == "view" and not pol.done
     assert pol.counters["view_drives"] == 1 and pol.counters["blacklisted"] == 0
+    view = pol.goal_xy_m
+    assert view is not None and math.dist(view, (2.43, 1.53)) > 0.25
+    # From there the LiDAR sees into the nook (mapped free, its far side unknown yet): the
+    # robot goes on into the nook instead of stopping.
+    seen = _room_and_nook()
+    seen[20:40, 51:70] = FREE
+    for _ in range(3):
+        pol.act(_obs(seen, *view), INFO)
+    assert not pol.done
+    assert pol.plan_source == "fallback" and pol.goal_xy_m[0] > 2.6  # past the gap
     # Without the view, the same frontier is dropped and the mission ends.
     off = _reach_the_gap(dataclasses.replace(prm, view_unseen_frontiers=False))
     for _ in range(3):
