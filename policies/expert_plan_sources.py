@@ -49,7 +49,7 @@ from semexplore_gym.core.frontiers.reachable import (
     nearest_reachable_frontier,
     pocket_exit_path,
 )
-from semexplore_gym.core.frontiers.viewpoint import find_view_pose
+from semexplore_gym.core.frontiers.viewpoint import ViewSearch, find_view_pose
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
@@ -274,18 +274,15 @@ class ViewFrontier(PlanSource):
         # Where the robot has been, its LiDAR had its chance: a rim cell in sight from there on
         # the grid is hidden in fact (a wall's face inside the cell). Look from elsewhere.
         trail = ctx.memory.trail_near(xy, far_m + prm.view_rim_radius_m + TRAIL_CELL_M)
+        view = ViewSearch(
+            (near_m, far_m),
+            prm.view_rim_radius_m,
+            [req.looked_from_xy_m, ctx.xy_m, *trail],
+            TRAIL_CELL_M,
+        )
         for clearance_m in dict.fromkeys((ctx.clearance_m, thin_m)):
             found = find_view_pose(
-                ctx.grid,
-                ctx.geometry,
-                ctx.xy_m,
-                xy,
-                clearance_m,
-                (near_m, far_m),
-                rim_radius_m=prm.view_rim_radius_m,
-                excluded_xy_m=[req.looked_from_xy_m, ctx.xy_m, *trail],
-                excluded_radius_m=TRAIL_CELL_M,
-                clearance_field=ctx.clearance_field(),
+                ctx.grid, ctx.geometry, ctx.xy_m, xy, clearance_m, view, ctx.clearance_field()
             )
             if found is not None:
                 ctx.counts.view_drives += 1

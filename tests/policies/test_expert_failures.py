@@ -7,9 +7,10 @@ import dataclasses
 import math
 
 import numpy as np
+import pytest
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 
-from semexplore_gym.core.frontiers.viewpoint import find_view_pose, unknown_rim
+from semexplore_gym.core.frontiers.viewpoint import ViewSearch, find_view_pose, unknown_rim
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.topometric.types import (
@@ -137,7 +138,8 @@ def test_find_view_pose_sees_the_rim_from_a_reachable_place_away_from_the_tried_
     rows, cols = unknown_rim(grid, GEOM, (2.5, 1.5), 0.5)
     assert len(rows) and (cols >= 50).all()  # the unknown cells just past the gap
     tried = (2.35, 1.5)
-    found = find_view_pose(grid, GEOM, (1.0, 1.5), (2.5, 1.5), 0.155, (0.27, 2.45), 0.5, [tried])
+    view = ViewSearch((0.27, 2.45), 0.5, [tried], 0.35)
+    found = find_view_pose(grid, GEOM, (1.0, 1.5), (2.5, 1.5), 0.155, view)
     assert found is not None and found.n_visible >= 1
     assert math.dist(found.goal_xy_m, tried) > 0.35
     rx, ry = GEOM.grid_to_world(rows, cols)
@@ -149,7 +151,9 @@ def test_find_view_pose_sees_the_rim_from_a_reachable_place_away_from_the_tried_
     # Nothing sees into a frontier behind a closed wall.
     walled = grid.copy()
     walled[24:36, 48:51] = OCCUPIED
-    assert find_view_pose(walled, GEOM, (1.0, 1.5), (2.5, 1.5), 0.155, (0.27, 2.45)) is None
+    assert find_view_pose(walled, GEOM, (1.0, 1.5), (2.5, 1.5), 0.155) is None
+    with pytest.raises(ValueError, match="range_m"):
+        ViewSearch((1.0, 0.5))
 
 
 def _reach_the_gap(params: SemanticExpertParams) -> SemanticExpertPolicy:

@@ -27,7 +27,7 @@ from semexplore_gym.core.frontiers.reachable import clearance_field_m, grid_path
 from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
-__all__ = ["ViewPose", "find_view_pose", "unknown_rim"]
+__all__ = ["ViewPose", "ViewSearch", "find_view_pose", "unknown_rim"]
 
 
 @dataclass(frozen=True)
@@ -73,24 +73,45 @@ def unknown_rim(
     return rows[inside].astype(np.int64), cols[inside].astype(np.int64)
 
 
+@dataclass(frozen=True)
+class ViewSearch:
+    """What counts as a view into a frontier (see :func:`find_view_pose`).
+
+    Attributes:
+        range_m: ``(nearest, farthest)`` distance at which a rim cell counts as seen (the
+            LiDAR's minimum range plus a margin; a share of its maximum range, where beams
+            still lie closer together than a cell).
+        rim_radius_m: Half-size of the box round the frontier's point holding the rim.
+        excluded_xy_m: Places already looked from (no view place lies near them).
+        excluded_radius_m: See ``excluded_xy_m``.
+    """
+
+    range_m: tuple[float, float] = (0.27, 2.45)
+    rim_radius_m: float = 0.5
+    excluded_xy_m: Sequence[tuple[float, float]] = ()
+    excluded_radius_m: float = 0.25
+
+    def __post_init__(self) -> None:
+        near_m, far_m = (float(v) for v in self.range_m)
+        if not (math.isfinite(far_m) and 0.0 <= near_m < far_m):
+            raise ValueError(f"need 0 <= range_m[0] < range_m[1], got {self.range_m!r}")
+
+
 def find_view_pose(
     grid: npt.ArrayLike,
     geometry: GridGeometry,
     start_xy_m: tuple[float, float],
     frontier_xy_m: tuple[float, float],
     clearance_m: float,
-    view_range_m: tuple[float, float],
-    rim_radius_m: float = 0.5,
-    excluded_xy_m: Sequence[tuple[float, float]] = (),
-    excluded_radius_m: float = 0.35,
+    view: ViewSearch = ViewSearch(),
     clearance_field: np.ndarray | None = None,
 ) -> ViewPose | None:
     """The nearest reachable cell (by path cost) that sees into the frontier at ``frontier_xy_m``.
 
     A cell sees a rim cell when the straight line between their centres crosses only FREE
-    cells and their distance lies within ``view_range_m``. Among the usable cells not within
-    ``excluded_radius_m`` of ``excluded_xy_m`` (where the robot already looked from), those
-    that see at least half as many rim cells as the best one are goals.
+    cells and their distance lies within ``view.range_m``. Among the usable cells not near
+    ``view.excluded_xy_m`` (where the robot already looked from), those that see at least half
+    as many rim cells as the best one are goals.
 
     Args:
         grid: Encoded occupancy grid (uint8).
@@ -98,12 +119,7 @@ def find_view_pose(
         start_xy_m: Robot position.
         frontier_xy_m: The frontier's point (its rim lies round it).
         clearance_m: Minimum distance from usable cells to OCCUPIED cells.
-        view_range_m: ``(nearest, farthest)`` distance at which a rim cell counts as seen (the
-            LiDAR's minimum range plus a margin; a share of its maximum range, where beams
-            still lie closer together than a cell).
-        rim_radius_m: Half-size of the box round ``frontier_xy_m`` holding the rim.
-        excluded_xy_m: Places already looked from.
-        excluded_radius_m: See ``excluded_xy_m``.
+        view: What counts as a view (ranges, rim, excluded places).
         clearance_field: A precomputed :func:`clearance_field_m` of ``grid`` (optional).
 
     Returns:
@@ -112,11 +128,10 @@ def find_view_pose(
     g = checked_encoded_grid(grid)
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
-    near_m, far_m = (float(v) for v in view_range_m)
-    if not (math.isfinite(far_m) and 0.0 <= near_m < far_m):
-        raise ValueError(f"need 0 <= view_range_m[0] < view_range_m[1], got {view_range_m!r}")
+    near_m, far_m = (float(v) for v in view.range_m)
+    excluded_xy_m, excluded_radius_m = view.excluded_xy_m, view.excluded_radius_m
     res = geometry.resolution_m
-    rim_r, rim_c = unknown_rim(g, geometry, frontier_xy_m, rim_radius_m)
+    rim_r, rim_c = unknown_rim(g, geometry, frontier_xy_m, view.rim_radius_m)
     if len(rim_r) == 0:
         return None
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
