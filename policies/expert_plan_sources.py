@@ -12,16 +12,14 @@ source                  proposes
 ``commanded``           the goal commanded from outside (``drive_to``), over a grid route
 ``retry``               another approach to a goal whose approach failed (a grid route, then
                         another side of its frontier), or drops it
+``view``                a place that sees into a frontier reached (or looked at) without its
+                        unknown side becoming known, or drops it when no reachable place does
 ``semantic``            Algorithm 1's chosen frontier along the topometric map (the paper)
 ``committed_fallback``  the grid fallback's goal of the last plan, while it lasts
 ``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
 ``look``                close to a frontier too narrow to reach, to look again
 ======================  ======================================================================
-
-``view`` (asked right after ``retry``) drives to a place that sees into a frontier the robot
-reached, or looked at, without its unknown side becoming known; it drops the frontier when no
-reachable place sees into it.
 
 Every source reads what it needs from a :class:`PlanContext` and keeps no state of its own (the
 goal memory and the counters are the expert's), so one instance serves every expert. A source

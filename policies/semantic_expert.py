@@ -21,9 +21,9 @@ The parts
 module and parameter group (a view of :class:`SemanticExpertParams`, whose flat YAML keys stay):
 
 * ``plan_sources``: an ordered tuple of :class:`~semexplore_gym.policies.expert_plan_sources.
-  PlanSource` objects (commanded goal, retry, semantic frontier, committed fallback, nearest
-  fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert_plan_sources`). At each
-  replan the first :class:`~semexplore_gym.policies.expert_plan.Plan` proposed is adopted;
+  PlanSource` objects (commanded goal, retry, view, semantic frontier, committed fallback,
+  nearest fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert_plan_sources`).
+  At each replan the first :class:`~semexplore_gym.policies.expert_plan.Plan` proposed is adopted;
   when all pass, the expert waits, and stops after ``stop_confirmations`` such replans.
 * ``goal_memory``: a :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` (drops,
   reaches, retries, revivals, the trail, the commanded goal, the stop reason).

@@ -414,6 +414,7 @@ def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
     assert names == [
         "commanded",
         "retry",
+        "view",
         "semantic",
         "committed_fallback",
         "nearest_fallback",
@@ -428,7 +429,7 @@ def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
             return Plan(PlanKind.FALLBACK, (1.0, 1.0), np.array([ctx.xy_m, (1.0, 1.0)]))
 
     sources = insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), before="semantic")
-    assert [s.name for s in sources].index("stay") == 2
+    assert [s.name for s in sources].index("stay") == 3
     with pytest.raises(ValueError, match="no plan source named"):
         insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), after="nope")
     pol = SemanticExpertPolicy(segmenter=corridor_tmap, plan_sources=sources)
