@@ -256,6 +256,9 @@ class ViewFrontier(PlanSource):
     name = "view"
 
     def propose(self, ctx: PlanContext) -> Plan | None:
+        cur = ctx.current
+        if cur is not None and cur.kind == PlanKind.VIEW and cur.frontier_xy_m is not None:
+            return self._keep(ctx, cur, cur.frontier_xy_m)
         req = ctx.memory.view
         if req is None:
             return None
@@ -294,6 +297,19 @@ class ViewFrontier(PlanSource):
                 return Plan(PlanKind.VIEW, found.goal_xy_m, path, None, xy, VIEW_REACHED_M)
         ctx.memory.drop(ctx.grid, xy, "unseeable")
         return None
+
+    @staticmethod
+    def _keep(ctx: PlanContext, cur: Plan, xy: tuple[float, float]) -> Plan | None:
+        """The view under way, until its frontier is mapped or dropped, or its path is done
+        (then the robot looked from about there: dropped as viewed)."""
+        if ctx.memory.is_blacklisted(xy) or not unknown_near(
+            ctx.grid, ctx.geometry, xy, ctx.params.goal_check_radius_m
+        ):
+            return None
+        if cur.progress >= len(cur.path_m) - 1:
+            ctx.memory.drop(ctx.grid, xy, "viewed")
+            return None
+        return cur
 
 
 class SemanticFrontier(PlanSource):

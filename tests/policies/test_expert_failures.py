@@ -181,6 +181,11 @@ def test_a_frontier_reached_but_not_cleared_is_seen_from_another_place() -> None
     assert pol.counters["view_drives"] == 1 and pol.counters["blacklisted"] == 0
     view = pol.goal_xy_m
     assert view is not None and math.dist(view, (2.43, 1.53)) > 0.25
+    # The view is kept at the next replans (the frontiers round are no reason to leave it).
+    for _ in range(2):
+        pol.request_replan()
+        pol.act(_obs(_room_and_nook(), 2.4, 1.5), INFO)
+        assert pol.plan_source == "view" and pol.goal_xy_m == view
     # From there the LiDAR sees into the nook (mapped free, its far side unknown yet): the
     # robot goes on into the nook instead of stopping.
     seen = _room_and_nook()
