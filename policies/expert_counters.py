@@ -35,6 +35,8 @@ class ExpertCounters:
         pocket_escapes: Plans that first leave a pocket of the usable map.
         goal_timeouts: Goals not reached within their time budget.
         oscillations_blocked: Switches back to a recently abandoned goal refused.
+        shuttles: Goals adopted again without the map growing (the shuttle guard commits).
+        view_drives: Drives to a place that sees into a frontier reached without clearing.
         scored_replans: Replans with at least one scored frontier (instrumentation only).
         semantic_decisive: Of those, replans where the metric cost alone would have chosen
             another frontier (instrumentation only).
@@ -58,6 +60,8 @@ class ExpertCounters:
     pocket_escapes: int = 0
     goal_timeouts: int = 0
     oscillations_blocked: int = 0
+    shuttles: int = 0
+    view_drives: int = 0
     scored_replans: int = 0
     semantic_decisive: int = 0
     replans_by_reason: dict[str, int] = field(default_factory=dict)

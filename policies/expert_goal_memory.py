@@ -12,8 +12,10 @@ fields of the same names in :class:`SemanticExpertParams`, documented in
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 from semexplore_gym.policies.expert_counters import ExpertCounters
@@ -24,7 +26,12 @@ from semexplore_gym.policies.semantic_expert_params import GoalMemoryParams
 
 from semexplore_gym.core.grid import GridGeometry
 
-__all__ = ["TRAIL_CELL_M", "GoalMemory", "Reach", "Retry"]
+if TYPE_CHECKING:
+    from semexplore_gym.core.planning.graph_search import FrontierCandidate
+
+__all__ = ["TRAIL_CELL_M", "GoalMemory", "Reach", "Retry", "ViewRequest"]
+
+_Scored = TypeVar("_Scored", bound="FrontierCandidate")
 
 #: Lattice of the robot's trail (metres per cell).
 TRAIL_CELL_M = 0.25
@@ -43,6 +50,21 @@ class Retry:
     goal_xy_m: tuple[float, float]
     failures: int
     failed_at_xy_m: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class ViewRequest:
+    """A frontier reached (or looked at) without clearing: look into it from elsewhere first.
+
+    Attributes:
+        frontier_xy_m: The frontier's point.
+        reason: The drop reason if no place sees into it (``"reached"`` or ``"looked"``).
+        looked_from_xy_m: Where the robot stood when it gave up on the frontier as it was.
+    """
+
+    frontier_xy_m: tuple[float, float]
+    reason: str
+    looked_from_xy_m: tuple[float, float]
 
 
 @dataclass
@@ -68,6 +90,10 @@ class GoalMemory:
         reaches: Goals reached without their frontier clearing.
         trail: Cells of a :data:`TRAIL_CELL_M` lattice the robot has been in.
         commanded_xy_m: The goal commanded from outside (None: the expert chooses).
+        view: The frontier to look into from elsewhere at the next replan (None: none).
+        viewed: Frontiers that had their look from elsewhere (dropped at once next time).
+        recent_goals: The last adopted goals with the map's known cells then (shuttle guard).
+        shuttle_xy_m: The goal the shuttle guard committed to (None: none).
     """
 
     def __init__(
@@ -103,6 +129,12 @@ class GoalMemory:
         # close to has had its closer look.
         self.trail: set[tuple[int, int]] = set()
         self.commanded_xy_m: tuple[float, float] | None = None
+        self.view: ViewRequest | None = None
+        self.viewed: list[tuple[float, float]] = []
+        self.recent_goals: deque[tuple[tuple[float, float], int]] = deque(
+            maxlen=max(1, int(prm.shuttle_switches))
+        )
+        self.shuttle_xy_m: tuple[float, float] | None = None
 
     # ------------------------------------------------------------------ queries
     def dropped_points(self) -> list[tuple[float, float]]:
@@ -133,10 +165,50 @@ class GoalMemory:
                     return True
         return False
 
+    def trail_near(self, xy_m: tuple[float, float], radius_m: float) -> list[tuple[float, float]]:
+        """Centres of the trail's cells within ``radius_m`` of ``xy_m``: where the robot was."""
+        c = TRAIL_CELL_M
+        pts = (((i + 0.5) * c, (j + 0.5) * c) for i, j in self.trail)
+        return [p for p in pts if math.dist(p, xy_m) <= radius_m]
+
     # ------------------------------------------------------------------ events
     def visit(self, xy_m: tuple[float, float]) -> None:
         """The robot is at ``xy_m`` (its trail)."""
         self.trail.add((int(xy_m[0] // TRAIL_CELL_M), int(xy_m[1] // TRAIL_CELL_M)))
+
+    def adopt(self, goal_xy_m: tuple[float, float], known_cells: int) -> bool:
+        """A new goal was adopted with ``known_cells`` known; with the shuttle guard on, True
+        (and :attr:`shuttle_xy_m` set) when it is a goal adopted within the last
+        ``shuttle_switches`` goals and the map gained less than ``shuttle_min_new_m2`` since."""
+        prm = self.params
+        if not prm.shuttle_guard:
+            return False
+        assert self.geometry is not None
+        min_new = prm.shuttle_min_new_m2 / self.geometry.resolution_m**2
+        again = any(
+            math.dist(goal_xy_m, xy) <= prm.shuttle_radius_m and known_cells - k < min_new
+            for xy, k in self.recent_goals
+        )
+        self.recent_goals.append((goal_xy_m, known_cells))
+        if not again:
+            if self.shuttle_xy_m is not None and not self.is_shuttle_goal(goal_xy_m):
+                self.shuttle_xy_m = None
+            return False
+        self.shuttle_xy_m = goal_xy_m
+        self.counts.shuttles += 1
+        self.log("shuttle", f"goal adopted again without progress, kept: {goal_xy_m}")
+        return True
+
+    def is_shuttle_goal(self, xy_m: tuple[float, float]) -> bool:
+        """Whether the shuttle guard committed to a goal near ``xy_m``."""
+        s = self.shuttle_xy_m
+        return s is not None and math.dist(s, xy_m) <= self.params.shuttle_radius_m
+
+    def shuttle_candidate(self, ranked: Sequence[_Scored]) -> _Scored | None:
+        """The cheapest of ``ranked`` (frontier candidates) at the goal the shuttle guard
+        committed to (None: no commitment, or that goal is no candidate now)."""
+        held = [c for c in ranked if self.is_shuttle_goal(c.goal_xy_m)]
+        return min(held, key=lambda c: c.cost) if held else None
 
     def abandon(self, goal_xy_m: tuple[float, float], now_s: float) -> None:
         """The robot switched away from ``goal_xy_m``."""
@@ -169,11 +241,13 @@ class GoalMemory:
         # A retry's target may be a point beside the goal: the goal itself is what failed.
         goal = (
             plan.frontier_xy_m
-            if plan.kind == PlanKind.RETRY and plan.frontier_xy_m
+            if plan.kind in (PlanKind.RETRY, PlanKind.VIEW) and plan.frontier_xy_m
             else plan.goal_xy_m
         )
+        if self.is_shuttle_goal(goal):
+            self.shuttle_xy_m = None
         n, failed_at = self.frontiers.record_failure(goal, robot_xy_m)
-        if n >= self.params.max_goal_attempts or plan.kind == PlanKind.LOOK:
+        if n >= self.params.max_goal_attempts or plan.kind in (PlanKind.LOOK, PlanKind.VIEW):
             self.retry = None
             self.drop(grid, goal, "attempts")
             return
@@ -181,32 +255,58 @@ class GoalMemory:
         self.counts.retries += 1
         self.log("retry", f"attempt {n + 1} at {goal}")
 
-    def goal_reached(self, grid: np.ndarray, plan: Plan) -> None:
-        """The robot reached ``plan``'s goal (the replan that follows decides what next)."""
+    def goal_reached(
+        self, grid: np.ndarray, plan: Plan, robot_xy_m: tuple[float, float] | None = None
+    ) -> None:
+        """The robot (at ``robot_xy_m``; default: the goal) reached ``plan``'s goal (the replan
+        that follows decides what next)."""
         if plan.kind == PlanKind.COMMANDED:
             self.end_command("command_reached")
             return
+        if self.is_shuttle_goal(plan.goal_xy_m):
+            self.shuttle_xy_m = None
         if plan.kind == PlanKind.RETRY:
             self.retry = None
-        if plan.kind == PlanKind.LOOK and plan.frontier_xy_m is not None:
-            # Looked from close by and the frontier is still there: the gap stays closed.
+        at = robot_xy_m if robot_xy_m is not None else plan.goal_xy_m
+        if plan.kind == PlanKind.VIEW and plan.frontier_xy_m is not None:
+            # Looked from a place that sees into it, and it stayed unknown.
+            self.drop(grid, plan.frontier_xy_m, "viewed")
+        elif plan.kind == PlanKind.LOOK and plan.frontier_xy_m is not None:
+            # Looked from close by and the frontier is still there: the gap stays closed,
+            # unless another place sees into it.
             self.counts.looks += 1
-            self.drop(grid, plan.frontier_xy_m, "looked")
+            self._give_up(grid, plan.frontier_xy_m, "looked", at)
         elif self.params.reach_blacklist:
-            self._register_reach(grid, plan.goal_xy_m)
+            self._register_reach(grid, plan.goal_xy_m, at)
 
-    def _register_reach(self, grid: np.ndarray, goal: tuple[float, float]) -> None:
+    def _register_reach(
+        self, grid: np.ndarray, goal: tuple[float, float], at: tuple[float, float]
+    ) -> None:
         r = self.params.blacklist_radius_m
         for reach in self.reaches:
             if math.hypot(goal[0] - reach.xy_m[0], goal[1] - reach.xy_m[1]) <= r:
                 reach.count += 1
                 if reach.count >= self.params.max_goal_reaches:
                     reach.count = 0
-                    self.drop(grid, reach.xy_m, "reached")
+                    self._give_up(grid, reach.xy_m, "reached", at)
                 return
         self.reaches.append(Reach((goal[0], goal[1]), 1))
         if self.params.max_goal_reaches <= 1:
-            self.drop(grid, goal, "reached")
+            self._give_up(grid, goal, "reached", at)
+
+    def _give_up(
+        self, grid: np.ndarray, xy_m: tuple[float, float], reason: str, at: tuple[float, float]
+    ) -> None:
+        """Drop the frontier at ``xy_m`` as it is, or first look into it from elsewhere (once
+        per place, with ``view_unseen_frontiers``)."""
+        r = self.params.blacklist_radius_m
+        if not self.params.view_unseen_frontiers or any(
+            math.dist(xy_m, v) <= r for v in self.viewed
+        ):
+            self.drop(grid, xy_m, reason)
+            return
+        self.viewed.append(xy_m)
+        self.view = ViewRequest(xy_m, reason, at)
 
     def revive(self, grid: np.ndarray) -> None:
         """Bring back the dropped goals round which the map changed enough."""
@@ -231,6 +331,8 @@ class GoalMemory:
             ("grid", "no grid path"),
             ("reached", f"reached {self.params.max_goal_reaches} times, not cleared"),
             ("looked", "looked at, gap closed"),
+            ("viewed", "seen from another place, still unknown"),
+            ("unseeable", "no reachable place sees into them"),
         ):
             n = self.frontiers.count(reason)
             if n:

@@ -36,6 +36,8 @@ class PlanKind(StrValueEnum):
     LOOK = "look"
     #: A goal commanded from outside (:meth:`SemanticExpertPolicy.drive_to`).
     COMMANDED = "commanded"
+    #: A place that sees into a frontier reached without clearing it.
+    VIEW = "view"
 
 
 @dataclass
@@ -47,7 +49,9 @@ class Plan:
         goal_xy_m: The goal (metres, world frame); reached within ``goal_reached_radius_m``.
         path_m: ``(K, 2)`` polyline from the robot's position when planned to the goal.
         candidate: The scored frontier (semantic plans only).
-        frontier_xy_m: The frontier served when the goal lies beside it (retry, look).
+        frontier_xy_m: The frontier served when the goal lies beside it (retry, look, view).
+        reached_within_m: The goal counts as reached within this distance (None: the expert's
+            ``goal_reached_radius_m``).
         progress: Index of the path point the robot has reached.
         arc_m: Arc length of the path at each point (computed).
     """
@@ -57,6 +61,7 @@ class Plan:
     path_m: np.ndarray
     candidate: FrontierCandidate | None = None
     frontier_xy_m: tuple[float, float] | None = None
+    reached_within_m: float | None = None
     progress: int = 0
     arc_m: np.ndarray = field(init=False, repr=False)
 
@@ -79,6 +84,7 @@ class ExpertMode(StrValueEnum):
     RETRY = "retry"
     LOOK = "look"
     COMMANDED = "commanded"
+    VIEW = "view"
     ESCAPE = "escape"
     RECOVERY = "recovery"
     WAITING = "waiting"

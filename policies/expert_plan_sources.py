@@ -12,6 +12,8 @@ source                  proposes
 ``commanded``           the goal commanded from outside (``drive_to``), over a grid route
 ``retry``               another approach to a goal whose approach failed (a grid route, then
                         another side of its frontier), or drops it
+``view``                a place that sees into a frontier reached (or looked at) without its
+                        unknown side becoming known, or drops it when no reachable place does
 ``semantic``            Algorithm 1's chosen frontier along the topometric map (the paper)
 ``committed_fallback``  the grid fallback's goal of the last plan, while it lasts
 ``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
@@ -33,7 +35,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_goal_memory import GoalMemory
+from semexplore_gym.policies.expert_goal_memory import TRAIL_CELL_M, GoalMemory
 from semexplore_gym.policies.expert_plan import Plan, PlanKind
 from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
@@ -45,6 +47,7 @@ from semexplore_gym.core.frontiers.reachable import (
     nearest_reachable_frontier,
     pocket_exit_path,
 )
+from semexplore_gym.core.frontiers.viewpoint import ViewSearch, find_view_pose
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
@@ -61,10 +64,14 @@ __all__ = [
     "PocketEscape",
     "RetryFailedGoal",
     "SemanticFrontier",
+    "ViewFrontier",
     "insert_plan_source",
     "standable_prefix",
     "unknown_near",
 ]
+
+#: A view place counts as reached this close (its line of sight holds from about there).
+VIEW_REACHED_M = 0.15
 
 #: Narrow frontiers checked against the trail before one is worth driving to.
 MAX_LOOK_CANDIDATES = 8
@@ -104,6 +111,7 @@ class PlanContext:
         counts: The expert's counters.
         choose_goal: The expert's goal choice among ``candidates``.
         log: Records an event ``(name, detail)`` in the expert's event log.
+        lidar_range_m: The LiDAR's ``(min_range_m, max_range_m)``.
     """
 
     grid: np.ndarray
@@ -118,6 +126,7 @@ class PlanContext:
     counts: ExpertCounters
     choose_goal: Callable[[list[FrontierCandidate]], FrontierCandidate]
     log: Callable[[str, str], None]
+    lidar_range_m: tuple[float, float] = (0.0, 3.5)
     clearance_cache: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -230,6 +239,77 @@ class RetryFailedGoal(PlanSource):
             ctx.memory.drop(ctx.grid, goal, "grid")
             return None
         return Plan(PlanKind.RETRY, target, ctx.resampled(path), frontier_xy_m=goal)
+
+
+class ViewFrontier(PlanSource):
+    """A place that sees into a frontier reached (or looked at) without clearing it.
+
+    The goal memory asks for it (``memory.view``) instead of dropping such a frontier. The
+    place is the nearest reachable cell with a line of sight over known free cells to the
+    unknown cells next to the frontier, within the LiDAR's resolved range, away from every place
+    the robot has been (its trail: its LiDAR had its chance there; :func:`~semexplore_gym.core.
+    frontiers.viewpoint.find_view_pose`): with the planner's clearance first, then with the
+    robot radius plus ``view_clearance_margin_m``.
+    When there is none the frontier is dropped (``unseeable``).
+    """
+
+    name = "view"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        cur = ctx.current
+        if cur is not None and cur.kind == PlanKind.VIEW and cur.frontier_xy_m is not None:
+            return self._keep(ctx, cur, cur.frontier_xy_m)
+        req = ctx.memory.view
+        if req is None:
+            return None
+        ctx.memory.view = None
+        prm = ctx.params
+        xy = req.frontier_xy_m
+        if not unknown_near(ctx.grid, ctx.geometry, xy, prm.goal_check_radius_m):
+            return None  # it cleared meanwhile
+        near_m = ctx.lidar_range_m[0] + prm.view_min_range_margin_m
+        far_m = max(
+            prm.view_range_fraction * ctx.lidar_range_m[1], near_m + ctx.geometry.resolution_m
+        )
+        thin_m = min(ctx.robot_radius_m + prm.view_clearance_margin_m, ctx.clearance_m)
+        # Where the robot has been, its LiDAR had its chance: a rim cell in sight from there on
+        # the grid is hidden in fact (a wall's face inside the cell). Look from elsewhere.
+        trail = ctx.memory.trail_near(xy, far_m + prm.view_rim_radius_m + TRAIL_CELL_M)
+        view = ViewSearch(
+            (near_m, far_m),
+            prm.view_rim_radius_m,
+            [req.looked_from_xy_m, ctx.xy_m, *trail],
+            TRAIL_CELL_M,
+        )
+        for clearance_m in dict.fromkeys((ctx.clearance_m, thin_m)):
+            found = find_view_pose(
+                ctx.grid, ctx.geometry, ctx.xy_m, xy, clearance_m, view, ctx.clearance_field()
+            )
+            if found is not None:
+                ctx.counts.view_drives += 1
+                ctx.log(
+                    "view",
+                    f"frontier {tuple(round(v, 2) for v in xy)} from "
+                    f"{tuple(round(v, 2) for v in found.goal_xy_m)} "
+                    f"({found.n_visible}/{found.n_rim} unknown cells in sight)",
+                )
+                path = ctx.resampled(found.path_m)
+                return Plan(PlanKind.VIEW, found.goal_xy_m, path, None, xy, VIEW_REACHED_M)
+        ctx.memory.drop(ctx.grid, xy, "unseeable")
+        return None
+
+    @staticmethod
+    def _keep(ctx: PlanContext, cur: Plan, xy: tuple[float, float]) -> Plan | None:
+        """The view under way, until its frontier is mapped or dropped, or its path is done
+        (then the robot looked from about there: dropped as viewed)."""
+        if ctx.memory.is_blacklisted(xy) or not unknown_near(
+            ctx.grid, ctx.geometry, xy, ctx.params.goal_check_radius_m
+        ):
+            return None
+        if cur.progress >= len(cur.path_m) - 1:
+            ctx.memory.drop(ctx.grid, xy, "viewed")
+            return None
+        return cur
 
 
 class SemanticFrontier(PlanSource):
@@ -427,6 +507,7 @@ def standable_prefix(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
 DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
     CommandedGoal(),
     RetryFailedGoal(),
+    ViewFrontier(),
     SemanticFrontier(),
     CommittedFallback(),
     NearestFallback(),

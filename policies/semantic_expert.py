@@ -21,9 +21,9 @@ The parts
 module and parameter group (a view of :class:`SemanticExpertParams`, whose flat YAML keys stay):
 
 * ``plan_sources``: an ordered tuple of :class:`~semexplore_gym.policies.expert_plan_sources.
-  PlanSource` objects (commanded goal, retry, semantic frontier, committed fallback, nearest
-  fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert_plan_sources`). At each
-  replan the first :class:`~semexplore_gym.policies.expert_plan.Plan` proposed is adopted;
+  PlanSource` objects (commanded goal, retry, view, semantic frontier, committed fallback,
+  nearest fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert_plan_sources`).
+  At each replan the first :class:`~semexplore_gym.policies.expert_plan.Plan` proposed is adopted;
   when all pass, the expert waits, and stops after ``stop_confirmations`` such replans.
 * ``goal_memory``: a :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` (drops,
   reaches, retries, revivals, the trail, the commanded goal, the stop reason).
@@ -198,7 +198,7 @@ class SemanticExpertPolicy(Policy):
         self.tmap, self.candidates, self.mode, self.events = None, [], ExpertMode.IDLE, []
         self.counts.clear()
         self._time_s, self._next_replan_s, self._plan = 0.0, 0.0, None
-        self._last_reason = ""
+        self._last_reason, self._min_range_m = "", facts.min_range_m
         self._seg_known_cells = self._empty_replans = 0
         self._area_types: np.ndarray | None = None
         self._known_cells = known_cell_count(obs["map"])
@@ -281,18 +281,18 @@ class SemanticExpertPolicy(Policy):
             return "no_plan"
         if self._time_s >= self._next_replan_s - 1e-9:
             return "period"
-        if (
-            math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1])
-            <= self.params.goal_reached_radius_m
-        ):
-            self.goal_memory.goal_reached(grid, plan)
+        reach_m = plan.reached_within_m or self.params.goal_reached_radius_m
+        if math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1]) <= reach_m:
+            self.goal_memory.goal_reached(grid, plan, (pose[0], pose[1]))
             return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
             return "path_done"
         # Goal vanished: no unknown cell is left near it (its frontier has been mapped). A
-        # commanded goal may lie in known space: it lasts until reached.
+        # commanded goal may lie in known space: it lasts until reached; a view's is its frontier.
+        view = plan.kind == PlanKind.VIEW and plan.frontier_xy_m is not None
+        watched = plan.frontier_xy_m if view and plan.frontier_xy_m else plan.goal_xy_m
         if plan.kind != PlanKind.COMMANDED and not unknown_near(
-            grid, self.geometry, plan.goal_xy_m, self.params.goal_check_radius_m
+            grid, self.geometry, watched, self.params.goal_check_radius_m
         ):
             return "goal_vanished"
         return ""
@@ -391,6 +391,9 @@ class SemanticExpertPolicy(Policy):
             or old.candidate is None
         ):
             return best
+        held = self.goal_memory.shuttle_candidate(ranked)
+        if held is not None:  # adopted again without the map growing: see it through
+            return held
         same = [
             c
             for c in ranked
@@ -467,6 +470,7 @@ class SemanticExpertPolicy(Policy):
             counts=self.counts,
             choose_goal=self.choose_goal,
             log=self._log,
+            lidar_range_m=(self._min_range_m, self.limits.max_range_m),
         )
         new_plan = None
         for source in self.plan_sources:
@@ -522,8 +526,7 @@ class SemanticExpertPolicy(Policy):
         """Every source passed: wait a step, stop after ``stop_confirmations``."""
         self._plan = None
         self._empty_replans += 1
-        # Look again at the next step before giving up.
-        self._next_replan_s = self._time_s
+        self._next_replan_s = self._time_s  # look again at the next step before giving up
         if self._empty_replans >= self.params.stop_confirmations:
             self.done = True
             self.mode = ExpertMode.DONE
@@ -544,6 +547,7 @@ class SemanticExpertPolicy(Policy):
             if old is not None:
                 self.counts.switches += 1
                 self.goal_memory.abandon(old.goal_xy_m, self._time_s)
+            self.goal_memory.adopt(new_plan.goal_xy_m, self._known_cells)
             self.follower.start_goal(new_plan, self._time_s)
             self._log("goal", f"{kind} {tuple(round(v, 2) for v in new_plan.goal_xy_m)}")
         if old is None or old.kind != new_plan.kind:

@@ -81,6 +81,29 @@ What the paper leaves open, and how the expert handles it (parameters in
   goal is still a candidate (two far frontiers whose costs trade places as the robot moves
   would otherwise keep it shuttling between them, as on open ground).
 
+* **Shuttle guard** (``shuttle_guard``, ``shuttle_switches``, ``shuttle_radius_m``,
+  ``shuttle_min_new_m2``): the oscillation guard counts seconds, and a shuttle can be slower
+  than its window (the robot circling round clutter on its way to one goal while Algorithm 1's
+  costs trade places, a switch every couple of minutes, the map not growing). The shuttle
+  guard counts goal switches instead: when the robot adopts again a goal (within
+  ``shuttle_radius_m``) that it adopted within its last ``shuttle_switches`` goals, and the map
+  gained less than ``shuttle_min_new_m2`` since, it commits to that goal: no switching away
+  until it is reached, its frontier is mapped or its approach fails (then the usual retries
+  and drops, with the goal's time budget, take over).
+* **A reached frontier that stays unknown gets another view** (``view_unseen_frontiers``,
+  ``view_rim_radius_m``, ``view_range_fraction``, ``view_min_range_margin_m``,
+  ``view_clearance_margin_m``): a frontier reached ``max_goal_reaches`` times without clearing
+  (or a narrow frontier looked at from close by without opening) is not dropped at once. The
+  robot first drives to the nearest cell it can reach from which straight lines over known
+  free cells reach the unknown cells next to the frontier (its rim: the unknown cells within
+  ``view_rim_radius_m`` of it with a free neighbour), at a distance the LiDAR resolves
+  (beyond its minimum range plus ``view_min_range_margin_m``, within ``view_range_fraction``
+  of its maximum range), away from every place it has been (its trail: a rim cell in sight
+  from there on the grid, yet unknown, is hidden in fact; :mod:`semexplore_gym.core.frontiers.
+  viewpoint`); the planner's clearance first, then the robot radius plus
+  ``view_clearance_margin_m``. The frontier is dropped only when no such
+  place exists, or once the robot looked from there and it stayed unknown (once per place).
+
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
 switches them all off: the paper's method alone).
 
@@ -144,6 +167,11 @@ class GoalMemoryParams:
     oscillation_guard: bool
     oscillation_window_s: float
     grid_fallback: bool
+    shuttle_guard: bool
+    shuttle_switches: int
+    shuttle_radius_m: float
+    shuttle_min_new_m2: float
+    view_unseen_frontiers: bool
 
 
 def _group(cls: type[_Group], params: SemanticExpertParams) -> _Group:
@@ -220,6 +248,20 @@ class SemanticExpertParams:
             drives are capped (frontiers the trail already passed close to are dropped free).
         oscillation_guard: Do not switch back to a recently abandoned goal.
         oscillation_window_s: How long an abandoned goal stays "recent".
+        shuttle_guard: Commit to a goal adopted again without the map growing (see above).
+        shuttle_switches: How many of the last adopted goals a new goal is compared with.
+        shuttle_radius_m: A goal this close to an earlier one is the same goal.
+        shuttle_min_new_m2: Known area the map must gain between two adoptions of the same goal
+            for the second not to count as a shuttle.
+        view_unseen_frontiers: Before dropping a frontier reached without clearing, drive to a
+            place that sees into it (see above; part of ``reach_blacklist`` and
+            ``look_at_narrow_frontiers``).
+        view_rim_radius_m: The unknown cells to see lie within this distance of the frontier.
+        view_range_fraction: A view place lies within this share of the LiDAR's maximum range
+            of them (farther, beams are more than a cell apart).
+        view_min_range_margin_m: ... and farther than the LiDAR's minimum range plus this.
+        view_clearance_margin_m: Without a view place at the planner's clearance, one at the
+            robot radius plus this (a smaller physical margin) is sought.
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
@@ -275,6 +317,15 @@ class SemanticExpertParams:
     max_look_drives: int = 2
     oscillation_guard: bool = True
     oscillation_window_s: float = 120.0
+    shuttle_guard: bool = True
+    shuttle_switches: int = 6
+    shuttle_radius_m: float = 1.0
+    shuttle_min_new_m2: float = 1.0
+    view_unseen_frontiers: bool = True
+    view_rim_radius_m: float = 0.5
+    view_range_fraction: float = 0.7
+    view_min_range_margin_m: float = 0.15
+    view_clearance_margin_m: float = 0.025
     entry_detour: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
@@ -320,8 +371,17 @@ class SemanticExpertParams:
             "oscillation_window_s",
             "pocket_clearance_margin_m",
             "pocket_max_share",
+            "shuttle_radius_m",
+            "shuttle_min_new_m2",
+            "view_rim_radius_m",
+            "view_min_range_margin_m",
+            "view_clearance_margin_m",
         )
         require_finite(self, nonneg, positive=False)
+        if not 0.0 < self.view_range_fraction <= 1.0:
+            raise ValueError(
+                f"view_range_fraction must be in (0, 1], got {self.view_range_fraction!r}"
+            )
         if self.pocket_max_share > 1.0:
             raise ValueError(f"pocket_max_share must be in [0, 1], got {self.pocket_max_share!r}")
         if not 0.0 <= self.backoff_speed_fraction <= 1.0:
@@ -334,6 +394,7 @@ class SemanticExpertParams:
             "progress_min_new_cells",
             "max_goal_attempts",
             "revive_min_changed_cells",
+            "shuttle_switches",
         ):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
@@ -365,6 +426,8 @@ PAPER_PURE: dict[str, object] = {
     "pocket_escape": False,
     "look_at_narrow_frontiers": False,
     "oscillation_guard": False,
+    "shuttle_guard": False,
+    "view_unseen_frontiers": False,
     "entry_detour": False,
     "goal_commitment": False,
     "local_min_escape": False,

@@ -129,16 +129,22 @@ def test_a_narrow_at_first_sight_opening_gets_a_closer_look_then_is_explored() -
     pol.request_replan()
     pol.act(wide, INFO)
     assert pol.plan_source == "fallback" and pol.goal_xy_m[0] > 2.3
-    # Had it stayed narrow, reaching the look point drops it as looked-at and the mission ends.
-    pol2 = SemanticExpertPolicy(segmenter=_empty_tmap)
-    pol2.reset(narrow, INFO, seed=0)
-    pol2.act(narrow, INFO)
-    at_goal = _obs(_two_rooms(0.2), *pol2.goal_xy_m)
-    for _ in range(5):
-        pol2.act(at_goal, INFO)
-        if pol2.done:
-            break
-    assert pol2.done and "looked at" in pol2.stop_reason
+    # Had it stayed narrow, reaching the look point drops it as looked-at and the mission ends
+    # (with the view of unseen frontiers off; on, a place that sees through the gap comes first).
+    for view in (False, True):
+        prm = SemanticExpertParams(view_unseen_frontiers=view)
+        pol2 = SemanticExpertPolicy(prm, segmenter=_empty_tmap)
+        pol2.reset(narrow, INFO, seed=0)
+        pol2.act(narrow, INFO)
+        at_goal = _obs(_two_rooms(0.2), *pol2.goal_xy_m)
+        for _ in range(5):
+            pol2.act(at_goal, INFO)
+            if pol2.done or pol2.plan_source == "view":
+                break
+        if view:
+            assert pol2.plan_source == "view" and pol2.counters["view_drives"] == 1
+        else:
+            assert pol2.done and "looked at" in pol2.stop_reason
 
 
 def test_a_failed_goal_is_retried_by_other_approaches_before_it_is_dropped() -> None:

@@ -380,7 +380,7 @@ def test_counters_keep_their_names_and_mission_metrics_follow_them():
     names = list(pol.counters)
     assert names[:3] == ["replans", "segmentations", "semantic_plans"]
     assert names[-3:] == ["scored_replans", "semantic_decisive", "replan_no_plan"]
-    assert len(names) == 19 and pol.counters["semantic_plans"] == 1
+    assert len(names) == 21 and pol.counters["semantic_plans"] == 1
     assert pol.mission_metrics() == {"scored_replans": 1, "semantic_share": 0.0}
     pol.reset(obs, INFO, seed=0)
     assert pol.mission_metrics() == {"scored_replans": 0, "semantic_share": None}
@@ -414,6 +414,7 @@ def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
     assert names == [
         "commanded",
         "retry",
+        "view",
         "semantic",
         "committed_fallback",
         "nearest_fallback",
@@ -428,7 +429,7 @@ def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
             return Plan(PlanKind.FALLBACK, (1.0, 1.0), np.array([ctx.xy_m, (1.0, 1.0)]))
 
     sources = insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), before="semantic")
-    assert [s.name for s in sources].index("stay") == 2
+    assert [s.name for s in sources].index("stay") == 3
     with pytest.raises(ValueError, match="no plan source named"):
         insert_plan_source(DEFAULT_PLAN_SOURCES, Stay(), after="nope")
     pol = SemanticExpertPolicy(segmenter=corridor_tmap, plan_sources=sources)

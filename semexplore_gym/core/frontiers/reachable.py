@@ -258,6 +258,33 @@ def grid_path_to(
     return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
 
 
+def grid_path_to_mask(
+    grid: npt.ArrayLike,
+    geometry: GridGeometry,
+    start_xy_m: tuple[float, float],
+    goal_mask: np.ndarray,
+    clearance_m: float,
+    clearance_field: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """Path over usable cells (see the module docstring) from ``start_xy_m`` to the nearest (by
+    path cost) usable cell of ``goal_mask`` (``(H, W)`` bool); ``(K, 2)`` world polyline, or
+    None if none is reachable."""
+    g = checked_encoded_grid(grid)
+    if g.shape != geometry.shape or np.shape(goal_mask) != g.shape:
+        raise ValueError(f"grid, geometry and goal_mask shapes differ: {g.shape}, {geometry.shape}")
+    dist = (
+        clearance_field
+        if clearance_field is not None
+        else clearance_field_m(g, geometry.resolution_m)
+    )
+    usable = _usable(g, dist, clearance_m)
+    goals = usable & np.asarray(goal_mask, dtype=bool)
+    if not goals.any():
+        return None
+    cost = _step_cost(dist, usable, clearance_m, WALL_COST, PREFER_EXTRA_M)
+    return _search_path(g, geometry, usable, cost, goals, start_xy_m)
+
+
 def _usable(g: np.ndarray, dist: np.ndarray, clearance_m: float) -> np.ndarray:
     """FREE cells at least ``clearance_m`` from every OCCUPIED cell (to rounding)."""
     return (g == FREE) & (dist >= clearance_m - 1e-9)
