@@ -21,7 +21,8 @@ distance, as their own costs are not computed here). ``semantic=False`` is the a
 paper's semantic terms off (``w_p = w_I = 0``: cost = ``d / L_path + w_v v``) and no
 intersection matching (the distance discount and path spreading stay).
 
-The team stops when every robot's expert has stopped (no frontier left on its map); a robot
+A goal one robot drops (it looked from close by and the gap stayed closed, or its approaches
+failed) is dropped by its teammates too. The team stops when every robot's expert has stopped (no frontier left on its map); a robot
 that stopped while teammates work looks again every ``idle_recheck_s``. Robots yield to
 higher-priority teammates in passages as in :mod:`~semexplore_gym.policies.team.frontier_teams`.
 """
@@ -129,6 +130,7 @@ class SemanticTeam(TeamPolicy):
         self.reset_members(self.members, observations, infos, seed)
         self._clock_s = 0.0
         self._stopped_at = [math.inf] * len(self.agents)
+        self._shared: set[tuple[float, float]] = set()
 
     def act(
         self, observations: dict[str, dict[str, np.ndarray]], infos: dict[str, dict[str, Any]]
@@ -162,12 +164,31 @@ class SemanticTeam(TeamPolicy):
                 if yielded:
                     self.counters["yields"] = self.counters.get("yields", 0) + 1
             actions[a] = action
+        self._share_drops(observations)
         self._clock_s += self.members[0].dt_s if self.members else 0.0
         if self.members and all(m.done for m in self.members):
             self.done = True
             reasons = sorted({m.stop_reason for m in self.members})
             self.stop_reason = "no robot has a reachable frontier: " + "; ".join(reasons)
         return actions
+
+    def _share_drops(self, observations: dict[str, dict[str, np.ndarray]]) -> None:
+        """A goal one robot dropped (looked at from close by and still closed, or its
+        approaches failed) is dropped by its teammates too, once: they would otherwise cross
+        the building to find the same gap closed. Each robot revives it by its own rule."""
+        for j, src in enumerate(self.members):
+            for xy in src.goal_memory.dropped_points():
+                key = (round(xy[0], 3), round(xy[1], 3))
+                if key in self._shared:
+                    continue
+                self._shared.add(key)
+                for i, dst in enumerate(self.members):
+                    a = self.agents[i]
+                    mem = dst.goal_memory
+                    if i == j or a not in observations or mem.geometry is None:
+                        continue
+                    if not mem.is_blacklisted(xy):
+                        mem.drop(np.asarray(observations[a]["map"]), xy, "teammate")
 
     # -------------------------------------------------------- coordination
     def choose(

@@ -6,6 +6,7 @@ Example::
     semexplore explore --world ../shared/maps/turtlebot3/world/map.yaml --json
     semexplore explore --world maze2 --policy-config configs/expert/paper.yaml --policy-set cost.w_v=2
     semexplore explore --world maze2 --policy 'semantic[cost.w_v=0]'
+    semexplore explore --world office:seed=304,size_m=8 --robots 3 --policy coordinated --gif team.gif
 """
 
 from __future__ import annotations
@@ -59,6 +60,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--seed", type=int, default=0, help="seed for env.reset and the policy (default: 0)"
+    )
+    p.add_argument(
+        "--robots",
+        type=int,
+        default=None,
+        metavar="N",
+        help="explore with a team of N robots (1 to 8; SemanticExploreMulti-v0, needs the "
+        "'multi' extra); --policy then names a team policy: semantic (default), coordinated, "
+        "coordinated_nobranch, greedy, independent, semantic_nosem; the mission ends when no "
+        "robot has a reachable frontier (or at --max-time-s); --gif draws one colour per robot",
     )
     _add_config_flags(p)
     p.add_argument(
@@ -151,6 +162,8 @@ def run(args: argparse.Namespace) -> int:
     if args.gif is not None:
         # the GIF writer creates missing parent directories
         check_output_flag("--gif", args.gif, (".gif",), parent_must_exist=False)
+    if args.robots is not None:
+        return run_team(args)
     cfg = load_policy_config(args.policy_config)
     spec = args.policy or cfg.policy or "semantic"
     policy_kwargs: dict[str, Any] = cfg.policy_kwargs(args.overrides)
@@ -191,6 +204,52 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({k: summary[k] for k in JSON_KEYS}))
     else:
         print(format_result(summary))
+    if args.gif:
+        print(f"wrote {args.gif}", file=sys.stderr)
+    return 0
+
+
+def run_team(args: argparse.Namespace) -> int:
+    """``semexplore explore --robots N``: one team mission, its metrics and optional GIF."""
+    from semexplore_gym.envs.multi_robot import make_multi
+    from semexplore_gym.envs.multi_robot_config import MAX_ROBOTS
+    from semexplore_gym.evaluation.team_benchmark import run_team_mission
+    from semexplore_gym.policies.team import make_team_policy, team_policy_names
+
+    if not 1 <= args.robots <= MAX_ROBOTS:
+        raise ValueError(f"--robots must be in 1..{MAX_ROBOTS}, got {args.robots}")
+    if args.policy_config or args.overrides:
+        raise ValueError("--policy-config and --policy-set do not apply with --robots")
+    spec = args.policy or "semantic"
+    if spec not in team_policy_names():
+        raise ValueError(
+            f"--policy with --robots takes a team policy: {', '.join(team_policy_names())}"
+        )
+    # Only the team's own stop or the time limit end the mission (as in the team benchmark).
+    overrides = [f"episode.max_time_s={args.max_time_s!r}", "team.end_on_coverage=false"]
+    env = make_multi(
+        world=args.world,
+        config=args.env_config,
+        overrides=[*overrides, *args.env_overrides],
+        n_robots=args.robots,
+        render_mode="rgb_array" if args.gif else None,
+    )
+    try:
+        res = run_team_mission(
+            env,
+            make_team_policy(spec),
+            args.seed,
+            max_time_s=args.max_time_s,
+            gif_path=args.gif,
+            gif_every_s=args.gif_every_s,
+        )
+    finally:
+        env.close()
+    row = res.row()
+    if args.json:
+        print(json.dumps(row))
+    else:
+        print("\n".join(f"{k:<17}{row[k]}" for k in row))
     if args.gif:
         print(f"wrote {args.gif}", file=sys.stderr)
     return 0

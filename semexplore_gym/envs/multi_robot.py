@@ -22,10 +22,12 @@ from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
+from semexplore_gym.core.mapping.disc_cast import DiscObstacles
 from semexplore_gym.core.mapping.map_merge import merge_grids
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.odometry import OdometryDrift
 from semexplore_gym.core.mapping.raycast import SegmentIndex
+from semexplore_gym.core.mapping.scan_fusion import ScanFootprint
 from semexplore_gym.core.worlds.geometry import segment_distance_field
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.envs.coverage_mask import coverage_mask
@@ -158,6 +160,11 @@ class SemanticExploreMultiEnv(ParallelEnv):
         )
         self.n_robots = int(self.team.n_robots)
         self.possible_agents = [f"robot_{i}" for i in range(self.n_robots)]
+        # Per robot, the indices of its teammates in agent order.
+        self._others = [
+            np.array([j for j in range(self.n_robots) if j != i], dtype=np.intp)
+            for i in range(self.n_robots)
+        ]
         self.agents: list[str] = []
         self._build_world_state()
         self._build_spaces()
@@ -320,7 +327,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.trajectories: list[list[tuple[float, float]]] = [[(p[0], p[1])] for p in poses]
         self._overlays = [{} for _ in range(n)]
         self.scanned_count = np.zeros(self.map_geometry.shape, dtype=np.uint8)
-        self._scans = [self._sense(i, poses) for i in range(n)]
+        xy = np.array(poses, dtype=np.float64)[:, :2]
+        self._scans = [self._sense(i, poses, xy) for i in range(n)]
         self.agents = list(self.possible_agents)
         zero = {"free_area_change": 0.0, "time": 0.0, "collision": 0.0, "team": 0.0}
         infos = {a: self._agent_info(i, dict(zero), True) for i, a in enumerate(self.agents)}
@@ -346,6 +354,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         before = self.sim.poses
         new_contact = self.sim.step(commands, cfg.episode.dt_s)
         after = self.sim.poses
+        after_xy = np.array(after, dtype=np.float64)[:, :2]
         self._n_steps += 1
         self.sim_time_s = round(self._n_steps * cfg.episode.dt_s, 9)
         gains: list[int] = []
@@ -359,7 +368,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
             )
             own = self._map_of(i)
             own_before, team_before = own.n_free_cells, self.grid.n_free_cells
-            self._scans[i] = self._sense(i, after)
+            self._scans[i] = self._sense(i, after, after_xy)
             gains.append(own.n_free_cells - own_before)
             team_gains.append(self.grid.n_free_cells - team_before)
         if self.own_grids:
@@ -396,42 +405,28 @@ class SemanticExploreMultiEnv(ParallelEnv):
     def _map_of(self, i: int) -> OccupancyGrid:
         return self.own_grids[i] if self.own_grids else self.grid
 
-    def _sense(self, i: int, true_poses: list[tuple[float, float, float]]) -> np.ndarray:
-        others = np.array(
-            [p[:2] for j, p in enumerate(true_poses) if j != i], dtype=np.float64
-        ).reshape(-1, 2)
+    def _sense(
+        self, i: int, true_poses: list[tuple[float, float, float]], xy: np.ndarray
+    ) -> np.ndarray:
+        """Robot ``i``'s scan (``xy``: every robot's true position), fused into its map(s);
+        with teammates, its cells are counted in ``scanned_count`` (bit ``i``: its
+        footprint, for the overlap ratio)."""
+        teammates = footprint = None
+        if self.n_robots > 1:
+            teammates = DiscObstacles(
+                xy[self._others[i]], self.config.robot.radius_m, self.team.map_teammates
+            )
+            footprint = ScanFootprint(self.scanned_count, i)
         grids = [self.own_grids[i], self.grid] if self.own_grids else [self.grid]
-        scan = sense_with_teammates(
+        return sense_with_teammates(
             self.lidar,
             true_poses[i],
             self._est_poses[i],
             grids,
             self.np_random,
-            others,
-            self.config.robot.radius_m,
-            self.team.map_teammates,
+            teammates,
+            footprint,
         )
-        if self.n_robots > 1:
-            self._count_scanned(i)
-        return scan
-
-    def _count_scanned(self, i: int) -> None:
-        """Set bit ``i`` of ``scanned_count`` in every cell robot ``i``'s last scan updated in
-        the team map (its footprint, for the overlap ratio): the cells the grid stamped with
-        that scan, looked up in the box the LiDAR reaches."""
-        g = self.map_geometry
-        grid = self.grid
-        x, y, _ = self.lidar.sensor_pose(*(float(v) for v in self._est_poses[i]))
-        reach = self.config.lidar.max_range_m + g.resolution_m
-        r0 = max(0, int((y - reach - g.origin_y_m) / g.resolution_m))
-        r1 = min(g.height, int((y + reach - g.origin_y_m) / g.resolution_m) + 2)
-        c0 = max(0, int((x - reach - g.origin_x_m) / g.resolution_m))
-        c1 = min(g.width, int((x + reach - g.origin_x_m) / g.resolution_m) + 2)
-        if r0 >= r1 or c0 >= c1:
-            return
-        touched = grid.touched_by_last_scan(slice(r0, r1), slice(c0, c1))
-        block = self.scanned_count[r0:r1, c0:c1]
-        block |= touched.view(np.uint8) << np.uint8(i)
 
     def _merge_in_range(self, true_poses: list[tuple[float, float, float]]) -> None:
         xy = np.array([p[:2] for p in true_poses])
@@ -457,7 +452,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
                 "map": team_map if team_map is not None else self._map_of(i).encoded_copy(),
                 "pose": poses[i].copy(),
                 "scan": self._scans[i],
-                "teammates": np.delete(poses, i, axis=0),
+                "teammates": poses[self._others[i]],
             }
         return out
 

@@ -1,8 +1,10 @@
 """Team missions and the team benchmark: ``semexplore benchmark --robots 1,2,3``.
 
 A team mission runs a :class:`~semexplore_gym.policies.team.TeamPolicy` in
-``SemanticExploreMulti-v0`` until the team stops itself (no robot has a reachable frontier),
-the time limit, or complete coverage. Each seed draws robot 0's start in free space (the same
+``SemanticExploreMulti-v0`` until the team stops itself (no robot has a reachable frontier)
+or the time limit: the benchmark sets ``team.end_on_coverage=false``, so that, as in the
+single-robot benchmark, the mission time is the team's own and ``self_stopped`` says whether
+the team or the clock ended it. Each seed draws robot 0's start in free space (the same
 for every team size and policy: it is the first draw of the env's RNG) and the teammates near
 it, so the rows of one seed compare teams on the same world and start.
 
@@ -13,7 +15,8 @@ world, policy      the world spelling and the team policy
 n_robots, seed     team size and seed
 coverage           team coverage at the end
 mission_time_s     simulated time until the team stopped (or the limit)
-self_stopped       the team stopped itself; ``stop_reason`` says why
+self_stopped       the team stopped itself; ``stop_reason`` says why (the team's reason, or
+                   the time limit that ended the mission)
 T90_s, T99_s       first simulated time at 0.90 / 0.99 coverage (empty if never)
 path_total_m       distance driven by all robots; ``path_per_robot_m`` each, ``;``-separated
 overlap_ratio      Explore-Bench: area scanned by more than one robot / area explored
@@ -124,11 +127,13 @@ def run_team_mission(
     next_frame_s = 0.0
     info = infos[first]
     steps = 0
+    terminated = truncated = False
     while env.agents:
         actions = team.act(obs, infos)
         if team.done:
             break
-        obs, _, _, _, infos = env.step(actions)
+        obs, _, terms, truncs, infos = env.step(actions)
+        terminated, truncated = bool(terms[first]), bool(truncs[first])
         steps += 1
         info = infos[first]
         trace.append((float(info["sim_time_s"]), float(info["coverage"])))
@@ -145,7 +150,7 @@ def run_team_mission(
         frames.append(env.render())
         save_gif(frames, gif_path, fps=10.0)
     paths = [float(v) for v in env.path_length_m]
-    reason = team.stop_reason if team.done else ("env ended" if not env.agents else "time limit")
+    reason = _stop_reason(team, terminated, truncated, max_time_s)
     return TeamMissionResult(
         world=str(getattr(env.world, "name", env.world_spec)),
         policy=team.name,
@@ -168,13 +173,25 @@ def run_team_mission(
     )
 
 
+def _stop_reason(team: Any, terminated: bool, truncated: bool, max_time_s: float | None) -> str:
+    """Why a team mission ended, in the single-robot benchmark's words."""
+    if team.done:
+        return str(team.stop_reason or "team done")
+    if terminated:
+        return "env terminated (coverage goal reached)"
+    if truncated:
+        return "env truncated (episode time limit)"
+    return f"max_time_s reached ({max_time_s} s)"
+
+
 @dataclass(frozen=True)
 class TeamBenchmarkConfig:
     """What :func:`run_team_benchmark` runs: every (world, policy, robots, seed) mission.
 
     ``time_limits`` gives some worlds their own limit (a suite's), else ``max_time_s``.
-    ``episode.coverage_goal`` is set to 1 (the team, not the env, ends a mission) and
-    ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides`` come last.
+    ``team.end_on_coverage`` is set to false (the team, not the env's coverage goal, ends a
+    mission) and ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides``
+    come last.
     """
 
     worlds: tuple[str, ...]
@@ -214,7 +231,7 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
         with csv_path.open(newline="") as f:
             for r in csv.DictReader(f):
                 done.add((r["world"], r["policy"], int(r["n_robots"]), int(r["seed"])))
-    overrides = ["episode.coverage_goal=1.0"]
+    overrides = ["episode.coverage_goal=1.0", "team.end_on_coverage=false"]
     overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
     if max_time_s is not None:
         overrides.append(f"episode.max_time_s={max_time_s!r}")

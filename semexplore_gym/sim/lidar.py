@@ -7,9 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from semexplore_gym.core.mapping.disc_cast import DiscObstacles
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
-from semexplore_gym.core.mapping.scan_fusion import ScanFuser
+from semexplore_gym.core.mapping.scan_fusion import ScanFootprint, ScanFuser
 
 
 @dataclass(frozen=True)
@@ -108,16 +109,32 @@ class Lidar:
         map_pose: tuple[float, float, float] | np.ndarray,
         grid: OccupancyGrid,
         rng: np.random.Generator,
+        discs: DiscObstacles | None = None,
+        footprint: ScanFootprint | None = None,
     ) -> np.ndarray:
         """:meth:`scan` at ``true_pose`` fused into ``grid`` from ``map_pose``, in one call.
 
         The same scan, the same random draws and the same map as :meth:`scan` followed by
-        ``grid.integrate_scan`` at the sensor pose of ``map_pose``.
+        ``grid.integrate_scan`` at the sensor pose of ``map_pose``. ``discs``: other robots
+        the beams also meet (:class:`~semexplore_gym.core.mapping.disc_cast.DiscObstacles`);
+        ``footprint``: where to record the cells the scan updates
+        (:class:`~semexplore_gym.core.mapping.scan_fusion.ScanFootprint`).
         """
         p = self.params
         n = p.n_beams
         noise = rng.normal(0.0, p.range_noise_std_m, size=n) if p.range_noise_std_m > 0 else None
         dropped = rng.random(n) < p.dropout_prob if p.dropout_prob > 0 else None
         return self._fuser.scan_and_integrate(
-            grid, self.sensor_pose(*true_pose), self.sensor_pose(*map_pose), noise, dropped
+            grid,
+            self.sensor_pose(*true_pose),
+            self.sensor_pose(*map_pose),
+            noise,
+            dropped,
+            discs,
+            footprint,
         )
+
+    @property
+    def last_map_ranges(self) -> np.ndarray:
+        """The ranges :meth:`sense_and_map` last fused into its grid (reused by the next call)."""
+        return self._fuser.last_map_ranges

@@ -17,9 +17,9 @@ import pymunk
 from pymunk._chipmunk import ffi as _ffi
 from pymunk._chipmunk import lib as _cp
 
-from semexplore_gym.core.mapping.disc_cast import cast_discs
+from semexplore_gym.core.mapping.disc_cast import DiscObstacles
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
-from semexplore_gym.core.mapping.raycast import cast_scan
+from semexplore_gym.core.mapping.scan_fusion import ScanFootprint
 from semexplore_gym.core.worlds.world import World
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import (
@@ -335,15 +335,14 @@ def sense_with_teammates(
     map_pose: tuple[float, float, float] | np.ndarray,
     grids: Sequence[OccupancyGrid],
     rng: np.random.Generator,
-    teammates_xy_m: np.ndarray,
-    radius_m: float,
-    map_teammates: bool = False,
+    teammates: DiscObstacles | None,
+    footprint: ScanFootprint | None = None,
 ) -> np.ndarray:
     """A scan at ``true_pose`` that sees walls and teammates, fused into each of ``grids``.
 
-    Without a teammate within range (and one grid) this is :meth:`Lidar.sense_and_map`. The
-    random draws (range noise, then dropouts) are the same either way. Teammates are discs of
-    ``radius_m`` at ``teammates_xy_m`` (``(k, 2)``).
+    One :meth:`Lidar.sense_and_map` call (the same random draws: range noise, then dropouts)
+    casts the walls and the teammates within range and fuses the scan into ``grids[0]``; the
+    other grids get the same map ranges.
 
     Args:
         lidar: The robot's LiDAR.
@@ -351,48 +350,22 @@ def sense_with_teammates(
         map_pose: The pose the map is built with (the odometry estimate).
         grids: The grids to fuse the scan into (the team map, or a robot's own and the team's).
         rng: The env's random source.
-        teammates_xy_m: ``(k, 2)`` the other robots' true positions.
-        radius_m: Robot radius.
-        map_teammates: Fuse returns from teammates as obstacles. False (default): beams that
-            end on a teammate are left out of the map (the team knows where its robots are),
-            while the returned scan still holds them.
+        teammates: The other robots as discs at their true positions (those within
+            ``max_range_m`` + their radius of the sensor are cast); their ``map_hits``
+            false (the default of a team): beams that end on a teammate are left out of the
+            map (the team knows where its robots are), while the returned scan still holds
+            them. None: no teammates.
+        footprint: Where to record the cells the scan updated (in ``grids[0]``; the same
+            cells in every grid).
 
     Returns:
         The ``(n,)`` float32 scan: 0 = invalid, ``max_range_m`` = no return.
     """
     p = lidar.params
-    sx, sy, syaw = lidar.sensor_pose(*true_pose)
-    near = np.zeros(0, dtype=np.float64).reshape(0, 2)
-    if len(teammates_xy_m):
-        d = np.hypot(teammates_xy_m[:, 0] - sx, teammates_xy_m[:, 1] - sy)
-        near = teammates_xy_m[d < p.max_range_m + radius_m]
-    if not len(near) and len(grids) == 1:
-        return lidar.sense_and_map(true_pose, map_pose, grids[0], rng)
-    n = p.n_beams
-    noise = rng.normal(0.0, p.range_noise_std_m, size=n) if p.range_noise_std_m > 0 else None
-    dropped = rng.random(n) < p.dropout_prob if p.dropout_prob > 0 else None
-    beams = lidar.beam_angles_rad
-    ranges = cast_scan(lidar.index, sx, sy, syaw, beams, p.max_range_m)
-    on_teammate = np.zeros(n, dtype=bool)
-    if len(near):
-        th = beams + syaw
-        disc = cast_discs(sx, sy, np.cos(th), np.sin(th), near, radius_m)
-        on_teammate = disc < ranges
-        ranges = np.where(on_teammate, disc, ranges)
-    # The sensor's post-processing, as Lidar.scan and the fused kernel do it.
-    if noise is not None:
-        finite = np.isfinite(ranges)
-        ranges = np.where(finite, ranges + noise, ranges)
-    np.minimum(ranges, p.max_range_m, out=ranges)
-    invalid = ranges < p.min_range_m
-    if dropped is not None:
-        invalid |= dropped
-    ranges[invalid] = 0.0
-    scan = ranges.astype(np.float32)
-    map_ranges = scan.astype(np.float64)
-    if not map_teammates:
-        map_ranges[on_teammate] = 0.0
-    mx, my, myaw = lidar.sensor_pose(*(float(v) for v in map_pose))
-    for grid in grids:
-        grid.integrate_scan(mx, my, myaw, beams, map_ranges, p.max_range_m)
+    scan = lidar.sense_and_map(true_pose, map_pose, grids[0], rng, teammates, footprint)
+    if len(grids) > 1:
+        mx, my, myaw = lidar.sensor_pose(*(float(v) for v in map_pose))
+        ranges = lidar.last_map_ranges.copy()
+        for grid in grids[1:]:
+            grid.integrate_scan(mx, my, myaw, lidar.beam_angles_rad, ranges, p.max_range_m)
     return scan

@@ -96,3 +96,17 @@ def test_explore_gives_the_shared_map_to_policies_that_declare_it(
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert out["mission_time_s"] > 0
     assert made[0] == want  # the mission env (a warm-up env may follow)
+
+
+def test_explore_with_a_team_writes_a_team_gif(tmp_path, capsys):
+    pytest.importorskip("pettingzoo")
+    gif = tmp_path / "team.gif"
+    argv = ["explore", "--world", "office:seed=304,size_m=8", "--robots", "2"]
+    argv += ["--policy", "coordinated", "--max-time-s", "8", "--gif", str(gif), "--json"]
+    assert main([*argv, "--no-progress"]) == 0
+    row = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert row["n_robots"] == 2 and row["policy"] == "team_coordinated"
+    assert row["mission_time_s"] == pytest.approx(8.0) and row["self_stopped"] is False
+    assert gif.stat().st_size > 0
+    assert main(["explore", "--robots", "2", "--policy", "frontier", "--no-progress"]) == 2
+    assert "team policy" in capsys.readouterr().err

@@ -89,3 +89,25 @@ def test_benchmark_robots_with_a_suite(tmp_path: Path) -> None:
         ("maze:seed=3,size_m=6", "team_greedy", "2")
     ]
     assert float(rows[0]["mission_time_s"]) == pytest.approx(8.0)
+
+
+def test_benchmark_missions_end_by_the_team_stop_rule(tmp_path: Path) -> None:
+    # The benchmark's env never ends a mission at its coverage goal: the team stops itself
+    # (no robot has a reachable frontier), and runs.csv says so; the time limit says its own.
+    out = tmp_path / "stop"
+    argv = ["benchmark", "--worlds", "office:seed=304,size_m=8", "--robots", "2"]
+    argv += ["--policies", "coordinated", "--runs", "1", "--no-progress"]
+    assert main([*argv, "--max-time-s", "200", "--out", str(out)]) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["self_stopped"] == "True"
+    assert row["stop_reason"].startswith("no robot has a reachable frontier")
+    assert float(row["coverage"]) >= 0.97 and float(row["mission_time_s"]) < 200.0
+    assert "| 1/1 |" in (out / "summary.md").read_text()
+    short = tmp_path / "short"
+    assert main([*argv, "--max-time-s", "5", "--out", str(short)]) == 0
+    with (short / "runs.csv").open(newline="") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["self_stopped"] == "False"
+    assert row["stop_reason"] == "env truncated (episode time limit)"
+    assert float(row["mission_time_s"]) == pytest.approx(5.0)

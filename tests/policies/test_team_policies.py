@@ -129,3 +129,18 @@ def test_semantic_team_divides_goals(spec: str) -> None:
     if spec == "semantic_nosem":
         cost = team.members[0].params.cost  # type: ignore[attr-defined]
         assert cost.w_p == 0.0
+
+
+def test_semantic_team_shares_dropped_goals() -> None:
+    # A goal one robot dropped (looked at, gap closed) is dropped by its teammate too, once.
+    env = make_multi(world="maze1", n_robots=2)
+    obs, infos = env.reset(seed=0)
+    team = make_team_policy("semantic")
+    team.reset(obs, infos, seed=0)
+    obs, _, _, _, infos = env.step(team.act(obs, infos))
+    gap = (1.2, 0.8)
+    a, b = team.members  # type: ignore[attr-defined]
+    a.goal_memory.drop(np.asarray(obs["robot_0"]["map"]), gap, "looked")
+    assert not b.goal_memory.is_blacklisted(gap)
+    obs, _, _, _, infos = env.step(team.act(obs, infos))
+    assert b.goal_memory.is_blacklisted(gap)

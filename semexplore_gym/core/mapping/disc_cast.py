@@ -3,10 +3,26 @@
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 from numba import njit
+
+
+class DiscObstacles(NamedTuple):
+    """Discs a scan also sees (other robots), for :class:`~.scan_fusion.ScanFuser`.
+
+    Attributes:
+        centres_m: ``(k, 2)`` float64 disc centres.
+        radius_m: Disc radius (all discs alike).
+        map_hits: Fuse returns from the discs into the map; False: such beams are left out
+            of the map (the scan still holds them).
+    """
+
+    centres_m: np.ndarray
+    radius_m: float
+    map_hits: bool
 
 
 def cast_discs(
@@ -34,7 +50,7 @@ def cast_discs(
     """
     centres = np.ascontiguousarray(centres_m, dtype=np.float64).reshape(-1, 2)
     out = np.full(cos_b.shape[0], np.inf)
-    _cast_discs(
+    cast_discs_into(
         float(x_m),
         float(y_m),
         np.ascontiguousarray(cos_b, dtype=np.float64),
@@ -47,7 +63,9 @@ def cast_discs(
 
 
 @njit(cache=True)
-def _cast_discs(x, y, cos_b, sin_b, centres, r2, out):  # pragma: no cover - numba
+def cast_discs_into(x, y, cos_b, sin_b, centres, r2, out):  # pragma: no cover - numba
+    """:func:`cast_discs`'s kernel: lowers ``out[j]`` (start it at inf) to the distance along
+    ray ``j`` to the first disc of squared radius ``r2`` ahead of ``(x, y)``."""
     for k in range(centres.shape[0]):
         dx = centres[k, 0] - x
         dy = centres[k, 1] - y

@@ -42,3 +42,54 @@ def test_merge_grids_keeps_the_more_certain_cell() -> None:
     before = a.encoded.copy()
     merge_grids([a, b])  # merging again changes nothing
     assert np.array_equal(a.encoded, before)
+
+
+@pytest.mark.parametrize("map_hits", [False, True])
+def test_fused_scan_with_discs_matches_the_separate_steps(map_hits: bool) -> None:
+    from semexplore_gym.core.mapping.disc_cast import DiscObstacles
+    from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
+    from semexplore_gym.core.mapping.scan_fusion import ScanFootprint, ScanFuser
+
+    segs = np.array([(0, 0, 4, 0), (4, 0, 4, 3), (4, 3, 0, 3), (0, 3, 0, 0)], dtype=float)
+    index = SegmentIndex(segs)
+    g = GridGeometry(origin_x_m=-0.5, origin_y_m=-0.5, resolution_m=0.05, height=80, width=100)
+    beams = np.arange(360) * (2 * np.pi / 360)
+    max_r, min_r, radius = 3.5, 0.12, 0.105
+    # One disc in sight, one beyond range + radius (it must not clip no-return beams).
+    centres = np.array([[2.0, 1.6], [-3.0, -3.0]])
+    sensor, est = (1.0, 1.2, 0.3), (1.02, 1.19, 0.31)
+    rng = np.random.default_rng(0)
+    noise, dropped = rng.normal(0, 0.01, 360), rng.random(360) < 0.05
+
+    # The reference: walls, then discs, the sensor's post-processing, then the map update.
+    ref = OccupancyGrid(g)
+    ranges = cast_scan(index, *sensor, beams, max_r)
+    th = beams + sensor[2]
+    disc = cast_discs(sensor[0], sensor[1], np.cos(th), np.sin(th), centres[:1], radius)
+    hit = disc < ranges
+    ranges = np.where(hit, disc, ranges)
+    ranges = np.where(np.isfinite(ranges), ranges + noise, ranges)
+    np.minimum(ranges, max_r, out=ranges)
+    ranges[(ranges < min_r) | dropped] = 0.0
+    scan_ref = ranges.astype(np.float32)
+    map_ranges = scan_ref.astype(np.float64)
+    if not map_hits:
+        map_ranges[hit] = 0.0
+    ref.integrate_scan(*est, beams, map_ranges, max_r)
+    touched_ref = ref._stamp == ref._scan_id
+
+    grid = OccupancyGrid(g)
+    bits = np.zeros(g.shape, dtype=np.uint8)
+    fuser = ScanFuser(index, beams, max_r, min_r)
+    scan = fuser.scan_and_integrate(
+        grid,
+        sensor,
+        est,
+        noise,
+        dropped,
+        DiscObstacles(centres, radius, map_hits),
+        ScanFootprint(bits, 2),
+    )
+    assert hit.any() and np.array_equal(scan, scan_ref)
+    assert np.array_equal(grid.encoded, ref.encoded) and grid.n_free_cells == ref.n_free_cells
+    assert np.array_equal(bits, touched_ref.astype(np.uint8) << 2)
