@@ -7,7 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from semexplore_gym.evaluation.run_row import OPTIONAL_COLUMNS, RunRow
+from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
+from semexplore_gym.evaluation.run_row import POLICY_METRIC_COLUMNS, RunRow
 from semexplore_gym.evaluation.tasks import Task
 
 
@@ -26,7 +27,10 @@ def _warm_up_config_key(env_config: Any) -> str:
 
 def mission_row(task: Task, res: Any) -> RunRow:
     """The ``runs.csv`` row of ``task`` from its :class:`~.rollout.MissionResult`; the
-    policy-specific columns come from the policy's ``mission_metrics()`` (None if absent)."""
+    policy-specific columns come from the policy's ``mission_metrics()`` (None if absent), the
+    path decomposition's from the result's (None without one)."""
+    parts = res.path_decomposition
+    decomposition = parts.columns() if parts is not None else dict.fromkeys(DECOMPOSITION_COLUMNS)
     return RunRow(
         world=task.world,
         policy=task.policy,
@@ -44,7 +48,8 @@ def mission_row(task: Task, res: Any) -> RunRow:
         wall_time_s=res.wall_time_s,
         explored_area_m2=res.explored_area_m2,
         steps=res.steps,
-        **{k: res.policy_metrics.get(k) for k in sorted(OPTIONAL_COLUMNS)},
+        **{k: res.policy_metrics.get(k) for k in POLICY_METRIC_COLUMNS},
+        **decomposition,
     )
 
 

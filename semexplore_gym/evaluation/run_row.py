@@ -2,7 +2,10 @@
 
 :class:`RunRow` is the schema: its fields are the CSV columns, in order. ``scored_replans`` and
 ``semantic_share`` are policy-specific (a policy's ``mission_metrics()``; empty for most
-policies) and were added after the first release, so older files may lack them.
+policies); the path decomposition's columns (:mod:`.path_decomposition`: the path split into
+parts that add up to ``path_length_m``, goals cleared and abandoned, the goals' detour ratio)
+come for every policy. All of these were added after the first release, so older files may
+lack them.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.core.validation import short_repr
+from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -40,6 +44,15 @@ class RunRow:
     steps: int
     scored_replans: int | None = None
     semantic_share: float | None = None
+    path_to_cleared_goals_m: float | None = None
+    path_to_abandoned_goals_m: float | None = None
+    path_looks_recoveries_m: float | None = None
+    path_without_goal_m: float | None = None
+    path_after_last_new_cell_m: float | None = None
+    goals_cleared: int | None = None
+    goals_abandoned: int | None = None
+    median_goal_detour_ratio: float | None = None
+    goal_detour_excess_m: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -59,10 +72,15 @@ class RunRow:
 CSV_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRow))
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
-OPTIONAL_COLUMNS: frozenset[str] = frozenset({"scored_replans", "semantic_share"})
+OPTIONAL_COLUMNS: frozenset[str] = frozenset(
+    {"scored_replans", "semantic_share", *DECOMPOSITION_COLUMNS}
+)
+
+#: The optional columns a policy's ``mission_metrics()`` fills.
+POLICY_METRIC_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
 _TEXT_COLUMNS = ("world", "policy", "stop_reason")
-_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans")
+_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans", "goals_cleared", "goals_abandoned")
 
 
 def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
