@@ -58,6 +58,7 @@ __all__ = [
     "LedgerParams",
     "PathDecomposition",
     "PathLedger",
+    "decomposition_table",
 ]
 
 #: The parts of the path, in metres; they add up to ``path_length_m``.
@@ -353,3 +354,71 @@ class PathLedger:
             g.shortest_m = shortest_clear_path_m(
                 mask, self.geometry, g.start_xy_m, g.end_xy_m, snap_m
             )
+
+
+_TABLE_PARTS: tuple[tuple[str, str], ...] = (
+    ("path_to_cleared_goals_m", "to cleared goals"),
+    ("path_to_abandoned_goals_m", "to abandoned goals"),
+    ("path_looks_recoveries_m", "looks + recoveries"),
+    ("path_without_goal_m", "no goal"),
+    ("path_after_last_new_cell_m", "after last new cell"),
+)
+
+
+def decomposition_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str]:
+    """``summary.md`` lines: per family and policy, the medians of the path's parts (metres, and
+    in brackets the median share of each mission's path), goal counts and detour ratios.
+
+    Args:
+        families: ``{family: {policy: [runs.csv rows]}}``.
+
+    Returns:
+        The section's lines; none when no row has the decomposition's columns.
+    """
+    if not any(
+        r.get("path_to_cleared_goals_m") is not None
+        for by_policy in families.values()
+        for rs in by_policy.values()
+        for r in rs
+    ):
+        return []
+    head = " | ".join(label for _, label in _TABLE_PARTS)
+    lines = [
+        "## Path decomposition",
+        "",
+        "Medians per family and policy of where the path went (metres; in brackets the median "
+        "share of each mission's path). Medians of parts need not add up to the median path. "
+        "Detour ratio: a cleared goal's driven path ÷ the shortest path at the robot's "
+        "clearance (median over each mission's goals, then over missions); excess: driven "
+        "minus shortest, summed over a mission's cleared goals.",
+        "",
+        f"| family | policy | n | path (m) | {head} | goals cleared | goals abandoned | "
+        "detour ratio | detour excess (m) |",
+        "|---|---|---:|---:|" + "---:|" * (len(_TABLE_PARTS) + 4),
+    ]
+    for fam, by_policy in families.items():
+        for policy, rs in by_policy.items():
+            rs = [r for r in rs if r.get("path_to_cleared_goals_m") is not None]
+            if not rs:
+                continue
+            cells = [_median_cell(rs, "path_length_m", "{:.1f}")]
+            for key, _ in _TABLE_PARTS:
+                shares = [
+                    r[key] / r["path_length_m"] for r in rs if (r.get("path_length_m") or 0) > 0
+                ]
+                share = f" ({100 * float(np.median(shares)):.0f} %)" if shares else ""
+                cells.append(_median_cell(rs, key, "{:.1f}") + share)
+            cells += [
+                _median_cell(rs, "goals_cleared", "{:.0f}"),
+                _median_cell(rs, "goals_abandoned", "{:.0f}"),
+                _median_cell(rs, "median_goal_detour_ratio", "{:.2f}"),
+                _median_cell(rs, "goal_detour_excess_m", "{:.1f}"),
+            ]
+            lines.append(f"| {fam} | {policy} | {len(rs)} | " + " | ".join(cells) + " |")
+    lines.append("")
+    return lines
+
+
+def _median_cell(rows: list[dict[str, Any]], key: str, fmt: str) -> str:
+    v = [float(r[key]) for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))]
+    return fmt.format(float(np.median(v))) if v else "–"
