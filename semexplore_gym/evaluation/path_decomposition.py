@@ -14,9 +14,11 @@ what the policy said it was doing (:meth:`Policy.drive_intent
     Before the tail, steps whose mode is ``"look"`` or ``"recovery"``.
 ``path_to_cleared_goals_m``
     Before the tail, steps driving toward a goal that was *cleared*: the robot came within
-    ``reach_m`` of it, or when the policy let it go at most ``cleared_fraction`` (half) of the
+    ``reach_m`` of it; or when the policy let it go at most ``cleared_fraction`` (half) of the
     UNKNOWN cells within ``clear_radius_m`` of it when it was set were still unknown (the
-    frontier it served had been mapped; a goal whose frontier vanished has none left).
+    frontier it served had been mapped; a goal whose frontier vanished has none left); or the
+    goal was itself a frontier point (an UNKNOWN cell among its eight neighbours when set, as
+    nearest frontier's targets are) and has been seen (no UNKNOWN neighbour left).
 ``path_to_abandoned_goals_m``
     Before the tail, steps driving toward a goal the policy dropped or switched away from,
     unreached, while most of the unknown round it still stood (a goal still open when the
@@ -119,6 +121,7 @@ class GoalRecord:
         reached: The robot came within ``reach_m`` of it.
         cleared: Reached, or the unknown round it had been mapped when it ended.
         unknown_cells: UNKNOWN cells within ``clear_radius_m`` of it when it was set.
+        frontier_point: It was itself a frontier point when set (an UNKNOWN neighbour).
         driven_m: Path driven while it was the goal (every step from first to last).
         shortest_m: Shortest path at the robot's clearance from start to end (None: none).
     """
@@ -133,6 +136,7 @@ class GoalRecord:
     driven_m: float = 0.0
     shortest_m: float | None = None
     unknown_cells: int = 0
+    frontier_point: bool = False
 
     @property
     def detour_ratio(self) -> float | None:
@@ -162,23 +166,22 @@ class PathDecomposition:
     def path_length_m(self) -> float:
         return float(sum(self.parts_m.values()))
 
+    def measured_goals(self) -> list[GoalRecord]:
+        """The cleared goals with a shortest path of at least ``min_detour_base_m``."""
+        return [
+            g
+            for g in self.goals
+            if g.cleared and g.shortest_m is not None and g.shortest_m >= self.min_detour_base_m
+        ]
+
     def detour_ratios(self) -> list[float]:
-        """Detour ratios of the cleared goals whose shortest path is long enough."""
-        out = []
-        for g in self.goals:
-            r = g.detour_ratio
-            if g.cleared and r is not None and g.shortest_m >= self.min_detour_base_m:  # type: ignore[operator]
-                out.append(r)
-        return out
+        """Detour ratios of :meth:`measured_goals`."""
+        return [g.driven_m / g.shortest_m for g in self.measured_goals() if g.shortest_m]
 
     def columns(self) -> dict[str, Any]:
         """The ``runs.csv`` cells (:data:`DECOMPOSITION_COLUMNS`)."""
         ratios = self.detour_ratios()
-        excess = [
-            g.driven_m - g.shortest_m
-            for g in self.goals
-            if g.cleared and g.shortest_m is not None and g.shortest_m >= self.min_detour_base_m
-        ]
+        excess = [g.driven_m - (g.shortest_m or 0.0) for g in self.measured_goals()]
         out: dict[str, Any] = {k: round(self.parts_m[k], 3) for k in PART_COLUMNS}
         out["goals_cleared"] = sum(1 for g in self.goals if g.cleared)
         out["goals_abandoned"] = sum(1 for g in self.goals if not g.cleared)
@@ -256,9 +259,10 @@ class PathLedger:
         if g is None and goal is not None and not looking:
             g = self._open = GoalRecord((goal[0], goal[1]), xy, step, step)
             g.unknown_cells = self._unknown_near(g.goal_xy_m)
+            g.frontier_point = self._unknown_near(g.goal_xy_m, cells=1) > 0
             self.goals.append(g)
-        if g is not None:
-            g.goal_xy_m = (float(goal[0]), float(goal[1]))  # type: ignore[index]
+        if g is not None and goal is not None:
+            g.goal_xy_m = (float(goal[0]), float(goal[1]))
             g.last_step = step
             g.reached |= math.dist(xy, g.goal_xy_m) <= self.params.reach_m
         if looking:
@@ -284,24 +288,29 @@ class PathLedger:
     def _close(self, g: GoalRecord) -> None:
         g.end_xy_m = self._xy_m
         left = self._unknown_near(g.goal_xy_m)
-        g.cleared = g.reached or left <= self.params.cleared_fraction * g.unknown_cells
+        g.cleared = (
+            g.reached
+            or left <= self.params.cleared_fraction * g.unknown_cells
+            or (g.frontier_point and self._unknown_near(g.goal_xy_m, cells=1) == 0)
+        )
         self._open = None
 
-    def _unknown_near(self, xy_m: tuple[float, float]) -> int:
-        """UNKNOWN cells within ``clear_radius_m`` of ``xy_m`` in the last map seen."""
+    def _unknown_near(self, xy_m: tuple[float, float], cells: int = 0) -> int:
+        """UNKNOWN cells within ``clear_radius_m`` of ``xy_m`` in the last map seen (within
+        ``cells`` cells, its ``2 cells + 1`` square, when ``cells > 0``)."""
         grid = self._grid
         if grid is None:
             return 0
         geo = self.geometry
         r_a, c_a = geo.world_to_grid(xy_m[0], xy_m[1])
         r, c = int(r_a), int(c_a)
-        k = int(math.ceil(self.params.clear_radius_m / geo.resolution_m))
+        k = cells if cells > 0 else int(math.ceil(self.params.clear_radius_m / geo.resolution_m))
         h, w = grid.shape
         r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
         if r0 >= r1 or c0 >= c1:
             return 0
         rr, cc = np.mgrid[r0:r1, c0:c1]
-        near = (rr - r) ** 2 + (cc - c) ** 2 <= k * k
+        near = ((rr - r) ** 2 + (cc - c) ** 2 <= k * k) | (cells > 0)
         return int(np.count_nonzero(grid[r0:r1, c0:c1][near] == UNKNOWN))
 
     def tail_start_step(self) -> int:

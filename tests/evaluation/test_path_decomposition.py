@@ -206,3 +206,28 @@ def test_the_benchmark_writes_the_decomposition_columns(tmp_path) -> None:
         assert total == pytest.approx(r["path_length_m"], abs=0.01)  # cells rounded to mm
     summary = (out / "summary.md").read_text()
     assert "## Path decomposition" in summary and "to abandoned goals" in summary
+
+
+def test_a_frontier_point_goal_is_cleared_once_it_is_seen() -> None:
+    """Nearest frontier's targets are frontier cells: seeing the cell serves the goal, though
+    the frontier (and most unknown round it) goes on."""
+    grid, geo = _room()
+    grid[40:79, 41:79] = UNKNOWN  # unknown from x = 2.05 m on
+    goal = geo.grid_to_world(60, 40)  # a FREE cell next to the unknown
+    info0 = {"map_geometry": geo.to_dict(), "robot": {"radius_m": 0.2}, "explored_area_m2": 0.0}
+    pose = np.array([0.6, 3.0, 0.0])
+    ledger = PathLedger.for_mission({"pose": pose, "map": grid}, info0)
+    for i, p in enumerate(_line((0.6, 3.0), (1.0, 3.0), 4)):
+        ledger.before_step(
+            DriveIntent((float(goal[0]), float(goal[1]))), {"pose": pose, "map": grid}
+        )
+        if i == 2:
+            grid[58:63, 41:43] = FREE  # the target's unknown neighbours are seen
+        pose = np.array([*p, 0.0])
+        ledger.after_step(
+            {"pose": pose, "map": grid}, {"path_length_m": 0.1 * (i + 1), "explored_area_m2": i}
+        )
+    ledger.before_step(DriveIntent((0.5, 0.5)), {"pose": pose, "map": grid})
+    parts = ledger.finish()
+    first = parts.goals[0]
+    assert first.frontier_point and first.cleared and not first.reached
