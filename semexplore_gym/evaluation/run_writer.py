@@ -15,7 +15,12 @@ import numpy as np
 
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import PARAM, ParameterError
-from semexplore_gym.evaluation.run_row import CSV_COLUMNS, RunRow, complete_csv_bytes
+from semexplore_gym.evaluation.run_row import (
+    CSV_COLUMNS,
+    OPTIONAL_COLUMNS,
+    RunRow,
+    complete_csv_bytes,
+)
 
 
 def file_slug(text: str) -> str:
@@ -50,7 +55,9 @@ class ResultWriter:
         if not new:
             with self.csv_path.open(newline="") as f:
                 header = next(csv.reader(f), [])
-            if tuple(header) != CSV_COLUMNS:
+            if _older_header(header):
+                _add_columns(self.csv_path)
+            elif tuple(header) != CSV_COLUMNS:
                 raise ParameterError(
                     "out_dir",
                     f"{self.csv_path} has columns {short_repr(header)}, expected "
@@ -92,3 +99,25 @@ def write_manifest(out_dir: str | os.PathLike, manifest: dict[str, Any]) -> None
     p = Path(out_dir) / "benchmark.json"
     manifest = dict(manifest, written_at=time.strftime("%Y-%m-%dT%H:%M:%S"))
     p.write_text(json.dumps(manifest, indent=2, default=str))
+
+
+def _older_header(header: list[str]) -> bool:
+    """Whether ``header`` is :data:`CSV_COLUMNS` without some columns added since (a run begun
+    by an older version, which resuming brings up to date)."""
+    return (
+        len(header) < len(CSV_COLUMNS)
+        and set(CSV_COLUMNS) - set(header) <= OPTIONAL_COLUMNS
+        and header == [c for c in CSV_COLUMNS if c in header]
+    )
+
+
+def _add_columns(path: Path) -> None:
+    """Rewrite ``path`` with every column of :data:`CSV_COLUMNS` (new ones empty)."""
+    with path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    tmp = path.with_name(path.name + ".tmp")
+    with tmp.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS), restval="")
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, path)

@@ -231,3 +231,23 @@ def test_a_frontier_point_goal_is_cleared_once_it_is_seen() -> None:
     parts = ledger.finish()
     first = parts.goals[0]
     assert first.frontier_point and first.cleared and not first.reached
+
+
+def test_resuming_a_run_from_before_the_columns_adds_them(tmp_path) -> None:
+    import csv
+
+    from semexplore_gym.evaluation.run_row import CSV_COLUMNS, read_runs
+    from semexplore_gym.evaluation.run_writer import ResultWriter
+
+    old = [c for c in CSV_COLUMNS if c not in DECOMPOSITION_COLUMNS]
+    row = dict.fromkeys(old, "1")
+    row.update(world="maze1", policy="nearest", self_stopped="True", stop_reason="done")
+    with (tmp_path / "runs.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=old)
+        w.writeheader()
+        w.writerow(row)
+    ResultWriter(tmp_path).close()
+    with (tmp_path / "runs.csv").open(newline="") as f:
+        assert tuple(next(csv.reader(f))) == CSV_COLUMNS
+    (parsed,) = read_runs(tmp_path / "runs.csv")
+    assert parsed["path_length_m"] == 1.0 and parsed["path_to_cleared_goals_m"] is None
