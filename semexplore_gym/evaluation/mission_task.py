@@ -29,7 +29,7 @@ def mission_row(task: Task, res: Any) -> RunRow:
     """The ``runs.csv`` row of ``task`` from its :class:`~.rollout.MissionResult`; the
     policy-specific columns come from the policy's ``mission_metrics()`` (None if absent), the
     path decomposition's from the result's (None without one)."""
-    parts = res.path_decomposition
+    parts = getattr(res, "path_decomposition", None)
     decomposition = parts.columns() if parts is not None else dict.fromkeys(DECOMPOSITION_COLUMNS)
     return RunRow(
         world=task.world,
