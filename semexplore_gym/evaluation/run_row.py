@@ -103,10 +103,21 @@ def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
             row[k] = None
         else:
             try:
-                row[k] = int(v) if k in _INT_COLUMNS else float(v)
+                row[k] = _count(v) if k in _INT_COLUMNS else float(v)
             except ValueError:
                 raise ValueError(f"{where}: {k} is not a number: {short_repr(v)}") from None
     return row
+
+
+def _count(v: str) -> int:
+    """An integer cell; ``"3.0"`` (a whole number written as a float) reads as 3."""
+    try:
+        return int(v)
+    except ValueError:
+        f = float(v)
+        if not f.is_integer():
+            raise
+        return int(f)
 
 
 def complete_csv_bytes(path: Path) -> int:
