@@ -28,6 +28,28 @@ class StepStats:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
+#: Modes (:attr:`DriveIntent.mode`) whose driving is a look drive or a recovery, not a drive
+#: toward the goal (the semantic expert's ``ExpertMode`` values of the same names).
+LOOK_RECOVERY_MODES: frozenset[str] = frozenset({"look", "recovery"})
+
+
+@dataclass(frozen=True)
+class DriveIntent:
+    """What a policy says it drives toward in the step it just chose (see
+    :meth:`Policy.drive_intent`; read by the benchmark's path decomposition).
+
+    Attributes:
+        goal_xy_m: The goal the robot drives toward (metres, world frame); None: no goal now.
+        mode: A short label of what it does. ``"look"`` and ``"recovery"``
+            (:data:`LOOK_RECOVERY_MODES`) count as look drives and recoveries; any other label
+            (``"goal"``, the expert's ``"semantic"``, ``"fallback"``, ...) with a goal counts as
+            driving toward that goal.
+    """
+
+    goal_xy_m: tuple[float, float] | None = None
+    mode: str = "goal"
+
+
 @dataclass(frozen=True)
 class EnvFacts:
     """The static facts of the env's ``info`` a policy may read (see :func:`read_env_facts`).
@@ -125,6 +147,19 @@ class Policy(abc.ABC):
         ``scored_replans`` and ``semantic_share``). Empty by default.
         """
         return {}
+
+    def drive_intent(self) -> DriveIntent | None:
+        """The goal and mode of the step ``act`` just chose, read once per step after ``act``.
+
+        The default reads the policy's ``goal_xy_m`` and ``mode`` read-outs when it has them
+        (the semantic expert does), else returns None: the policy does not say, and its whole
+        path counts as driven without a goal. Override it to report more cheaply or exactly.
+        """
+        goal = getattr(self, "goal_xy_m", None)
+        mode = getattr(self, "mode", None)
+        if goal is None and mode is None:
+            return None
+        return DriveIntent(goal, str(mode) if mode is not None else "goal")
 
     def overlay(self) -> dict[str, Any]:
         """Drawing hints for the renderer (see :mod:`semexplore_gym.rendering`); empty by default."""

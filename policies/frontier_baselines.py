@@ -55,7 +55,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
+from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
 from semexplore_gym.policies.navigation import (
     GoalBlacklist,
     MoveBaseParams,
@@ -187,6 +187,9 @@ class _FrontierBaseline(Policy):
             self.blacklist.add(self.nav.goal_xy_m)
             self.counters["blacklisted"] += 1
 
+    def drive_intent(self) -> DriveIntent | None:
+        return None if self.nav is None else self.nav.drive_intent()
+
     def _action(self, v: float, w: float) -> np.ndarray:
         a = np.array([v / self.max_v, w / self.max_w], dtype=np.float32)
         return np.clip(a, -1.0, 1.0)
@@ -209,9 +212,7 @@ class _FrontierBaseline(Policy):
             "frontiers_m": [f.centroid_m for f in self.frontiers],
             "points_m": list(self.blacklist),
         }
-        paths = []
-        if self.nav.path is not None:
-            paths.append(self.nav.path.points_m)
+        paths = [] if self.nav.path is None else [self.nav.path.points_m]
         if self.nav.trajectory_m.shape[0] > 1:
             paths.append(self.nav.trajectory_m)
         out["paths_m"] = paths
@@ -329,7 +330,6 @@ class FrontierExplorationPolicy(_FrontierBaseline):
             self._blacklist_aborted_goal()
             nav.cancel()
             self._moving = False
-
         due = (
             prm.frequency_hz > 0
             and self.now_s - self._last_search_s >= 1.0 / prm.frequency_hz - 1e-9

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 from scipy import ndimage
-from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
+from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
 from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
 
 from semexplore_gym.core.coverage_tour import (
@@ -216,6 +216,12 @@ class OraclePolicy(Policy):
             "oracle_tour_m": None if t is None else round(t.length_m, 3),
             "oracle_viewpoints": None if t is None else t.n_viewpoints,
         }
+
+    def drive_intent(self) -> DriveIntent:
+        """The viewpoint (or fallback cell) driven to; mode ``"recovery"`` while backing off."""
+        # act has advanced the clock: the step it chose began one period earlier.
+        backing_off = self._backoff.active(self._time_s - self.dt_s)
+        return DriveIntent(self._goal_xy, "recovery" if backing_off else "goal")
 
     # ------------------------------------------------------------------ stepping
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:

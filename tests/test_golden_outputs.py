@@ -24,15 +24,17 @@ import pytest
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.core.topometric import segment_map
 from semexplore_gym.evaluation.harness import Task, run_task
+from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
 
 GOLDEN = Path(__file__).with_name("golden_outputs.json")
 REGENERATE = os.environ.get("SEMEXPLORE_REGENERATE_GOLDEN") == "1"
 
 #: Wall-clock fields differ from run to run; everything else in a row is pinned.
 _TIMED = {"mean_map_generation_ms", "mean_global_planning_ms", "wall_time_s"}
-#: Columns added after the pins were taken: a function of the final map, which the pinned trace
-#: and trajectory already fix (tests/evaluation/test_planner_coverage.py checks it).
-_ADDED_AFTER_PINS = {"coverage_at_planner_clearance"}
+#: Columns added after the pins were taken: missions are pinned by the rest (the same trace,
+#: trajectory and figures mean the same missions); coverage at the planner's clearance
+#: (tests/evaluation/test_planner_coverage.py) and the decomposition have their own tests.
+_ADDED_AFTER_PINS = {"coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS}
 
 MISSIONS = [
     ("maze1", "semantic", 0, None),

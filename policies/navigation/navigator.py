@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.base import StepStats
+from semexplore_gym.policies.base import DriveIntent, StepStats
 from semexplore_gym.policies.navigation.progress_watch import ProgressWatch
 from semexplore_gym.policies.navigation.recovery import RotateRecovery
 
@@ -251,6 +251,13 @@ class Navigator:
             self.counters["aborts"] += 1
             self.path = None
             self.dwa.clear()
+
+    def drive_intent(self) -> DriveIntent:
+        """The goal while navigating to it (mode ``"recovery"`` during a recovery, else
+        ``"goal"``); no goal once it has succeeded, been aborted or cancelled."""
+        if self.status == NavStatus.RECOVERING:
+            return DriveIntent(self.goal_xy_m, "recovery")
+        return DriveIntent(self.goal_xy_m if self.status == NavStatus.ACTIVE else None, "goal")
 
     def cancel(self) -> None:
         self.goal_xy_m = None

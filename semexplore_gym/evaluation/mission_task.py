@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
 from semexplore_gym.evaluation.run_row import POLICY_COLUMNS, RunRow
 from semexplore_gym.evaluation.tasks import Task
 
@@ -28,7 +29,9 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     """The ``runs.csv`` row of ``task`` from its :class:`~.rollout.MissionResult`; the
     policy-specific columns come from the policy's ``mission_metrics()`` (None if absent),
     ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
-    which still holds the env)."""
+    which still holds the env), the path decomposition's from the result's (None without one)."""
+    parts = getattr(res, "path_decomposition", None)
+    decomposition = parts.columns() if parts is not None else dict.fromkeys(DECOMPOSITION_COLUMNS)
     return RunRow(
         world=task.world,
         policy=task.policy,
@@ -48,6 +51,7 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
         steps=res.steps,
         **{k: res.policy_metrics.get(k) for k in POLICY_COLUMNS},
         coverage_at_planner_clearance=coverage_at_planner_clearance,
+        **decomposition,
     )
 
 

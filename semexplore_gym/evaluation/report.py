@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from semexplore_gym.evaluation.path_decomposition import decomposition_table
 from semexplore_gym.evaluation.run_row import read_runs
 from semexplore_gym.evaluation.run_writer import file_slug, task_stem
 
@@ -248,8 +249,8 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         "",
         *_suite_lines(out),
     ]
+    families = group_by_family(rows)
     if len(groups) > 1:
-        families = group_by_family(rows)
         lines += _overview_table(families, reference)
         lines += [
             "## Per family",
@@ -268,6 +269,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         lines += [f"## All worlds ({len(groups)} worlds)", ""]
         lines += _policy_table(everything)
         lines += _comparison_table(everything, reference, "(world, seed)")
+    lines += decomposition_table(families)
     for world, by_policy in groups.items():
         lines += [f"## {world}", ""]
         lines += _policy_table(by_policy)

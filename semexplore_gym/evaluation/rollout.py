@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.evaluation.gif import GifOptions, GifStreamWriter, save_gif
+from semexplore_gym.evaluation.path_decomposition import PathDecomposition, PathLedger
 from semexplore_gym.policies.base import Policy, StepStats
 
 __all__ = [
@@ -80,6 +81,8 @@ class MissionResult:
         policy_counters: The policy's ``counters`` dict, if it has one.
         policy_metrics: The policy's ``mission_metrics()`` at the end of the mission
             (policy-specific figures for benchmark rows; empty for most policies).
+        path_decomposition: Where the path went (:mod:`.path_decomposition`; None for a
+            result built elsewhere).
     """
 
     world: str
@@ -107,6 +110,7 @@ class MissionResult:
     trajectory: np.ndarray = field(repr=False)
     policy_counters: dict[str, int] = field(default_factory=dict)
     policy_metrics: dict[str, Any] = field(default_factory=dict)
+    path_decomposition: PathDecomposition | None = field(default=None, repr=False)
 
     @property
     def speedup(self) -> float:
@@ -195,6 +199,7 @@ class _MissionLog:
         self.glob_ms: list[float] = []
         self.n_replans = 0
         self.steps = 0
+        self.ledger = PathLedger.for_mission(obs, info)
 
     def add_policy_stats(self, st: StepStats, act_s: float) -> None:
         """Split one ``act`` call of ``act_s`` wall seconds into stages by its :class:`StepStats`."""
@@ -217,6 +222,7 @@ class _MissionLog:
         sim_t = float(info["sim_time_s"])
         self.trace.append((sim_t, float(info["coverage"]), float(info["explored_area_m2"])))
         self.poses.append(np.asarray(obs["pose"], dtype=np.float64).copy())
+        self.ledger.after_step(obs, info)
         return sim_t
 
 
@@ -397,6 +403,7 @@ def _mission_result(
         trajectory=np.asarray(log.poses),
         policy_counters=dict(getattr(policy, "counters", {}) or {}),
         policy_metrics=policy_mission_metrics(policy),
+        path_decomposition=log.ledger.finish(),
     )
 
 
@@ -432,6 +439,7 @@ def _drive(
         log.add_policy_stats(st, tb - ta)
         if policy.done:
             break
+        log.ledger.before_step(_drive_intent(policy), obs)
         obs, _, terminated, truncated, info = env.step(action)
         log.stage["env_step"] += time.perf_counter() - tb
         sim_t = log.add_step(obs, info)
@@ -451,6 +459,12 @@ def _drive(
     if gif is not None:
         gif.grab()
     return info, terminated, truncated
+
+
+def _drive_intent(policy: Any) -> Any:
+    """The policy's ``drive_intent()`` (None for an object without one)."""
+    hook = getattr(policy, "drive_intent", None)
+    return hook() if callable(hook) else None
 
 
 def _world_name(env: Any) -> str:

@@ -3,8 +3,10 @@
 :class:`RunRow` is the schema: its fields are the CSV columns, in order. ``scored_replans`` and
 ``semantic_share`` are policy-specific (a policy's ``mission_metrics()``; empty for most
 policies); ``coverage_at_planner_clearance`` is the coverage of the cells reachable at the
-semantic expert's planning clearance (:mod:`.planner_coverage`; every policy). All three were
-added after the first release, so older files may lack them.
+semantic expert's planning clearance (:mod:`.planner_coverage`; every policy); the path
+decomposition's columns (:mod:`.path_decomposition`: the path split into parts that add up to
+``path_length_m``, goals cleared and abandoned, the goals' detour ratio) come for every policy.
+All of these were added after the first release, so older files may lack them.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from semexplore_gym.core.validation import short_repr
+from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,15 @@ class RunRow:
     scored_replans: int | None = None
     semantic_share: float | None = None
     coverage_at_planner_clearance: float | None = None
+    path_to_cleared_goals_m: float | None = None
+    path_to_abandoned_goals_m: float | None = None
+    path_looks_recoveries_m: float | None = None
+    path_without_goal_m: float | None = None
+    path_after_last_new_cell_m: float | None = None
+    goals_cleared: int | None = None
+    goals_abandoned: int | None = None
+    median_goal_detour_ratio: float | None = None
+    goal_detour_excess_m: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -65,10 +77,12 @@ CSV_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRow))
 POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
-OPTIONAL_COLUMNS: frozenset[str] = frozenset({*POLICY_COLUMNS, "coverage_at_planner_clearance"})
+OPTIONAL_COLUMNS: frozenset[str] = frozenset(
+    {*POLICY_COLUMNS, "coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS}
+)
 
 _TEXT_COLUMNS = ("world", "policy", "stop_reason")
-_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans")
+_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans", "goals_cleared", "goals_abandoned")
 
 
 def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
@@ -91,10 +105,21 @@ def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
             row[k] = None
         else:
             try:
-                row[k] = int(v) if k in _INT_COLUMNS else float(v)
+                row[k] = _count(v) if k in _INT_COLUMNS else float(v)
             except ValueError:
                 raise ValueError(f"{where}: {k} is not a number: {short_repr(v)}") from None
     return row
+
+
+def _count(v: str) -> int:
+    """An integer cell; ``"3.0"`` (a whole number written as a float) reads as 3."""
+    try:
+        return int(v)
+    except ValueError:
+        f = float(v)
+        if not f.is_integer():
+            raise
+        return int(f)
 
 
 def complete_csv_bytes(path: Path) -> int:

@@ -33,32 +33,6 @@ def task_stem(world: str, policy: str, seed: int) -> str:
     return f"{file_slug(world)}__{file_slug(policy)}__{seed}"
 
 
-def _only_lacks_optional(header: list[str]) -> bool:
-    """True when ``header`` is today's columns less some optional ones (a run of an older
-    version): its rows are still valid, the new columns just stay empty."""
-    missing = [c for c in CSV_COLUMNS if c not in header]
-    return (
-        bool(missing)
-        and all(c in OPTIONAL_COLUMNS for c in missing)
-        and [c for c in CSV_COLUMNS if c in header] == header
-    )
-
-
-def _upgrade_columns(csv_path: Path, header: list[str]) -> None:
-    """Rewrite ``csv_path`` with today's columns, the ones it lacks left empty (atomically)."""
-    with csv_path.open(newline="") as f:
-        rows = list(csv.DictReader(f))
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with tmp.open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS))
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: row.get(k, "") or "" for k in CSV_COLUMNS})
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, csv_path)
-
-
 class ResultWriter:
     """Appends finished missions to ``runs.csv`` (flushed per row) and their traces.
 
@@ -84,8 +58,8 @@ class ResultWriter:
         if not new:
             with self.csv_path.open(newline="") as f:
                 header = next(csv.reader(f), [])
-            if tuple(header) != CSV_COLUMNS and _only_lacks_optional(header):
-                _upgrade_columns(self.csv_path, header)
+            if _older_header(header):
+                _add_columns(self.csv_path)
             elif tuple(header) != CSV_COLUMNS:
                 raise ParameterError(
                     "out_dir",
@@ -128,3 +102,25 @@ def write_manifest(out_dir: str | os.PathLike, manifest: dict[str, Any]) -> None
     p = Path(out_dir) / "benchmark.json"
     manifest = dict(manifest, written_at=time.strftime("%Y-%m-%dT%H:%M:%S"))
     p.write_text(json.dumps(manifest, indent=2, default=str))
+
+
+def _older_header(header: list[str]) -> bool:
+    """Whether ``header`` is :data:`CSV_COLUMNS` without some columns added since (a run begun
+    by an older version, which resuming brings up to date)."""
+    return (
+        len(header) < len(CSV_COLUMNS)
+        and set(CSV_COLUMNS) - set(header) <= OPTIONAL_COLUMNS
+        and header == [c for c in CSV_COLUMNS if c in header]
+    )
+
+
+def _add_columns(path: Path) -> None:
+    """Rewrite ``path`` with every column of :data:`CSV_COLUMNS` (new ones empty)."""
+    with path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    tmp = path.with_name(path.name + ".tmp")
+    with tmp.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS), restval="")
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, path)

@@ -156,7 +156,8 @@ def run_warmup_mission(
 def reach_rare_kernels() -> None:
     """Run the kernels a short mission may not reach: each procedural family's generator, a
     ROS map and a HouseExpo plan loaded from files, and the segmentation (of a read-only map, as
-    the expert sees it) of :data:`SEGMENTED_WORLD`'s ground truth."""
+    the expert sees it) of :data:`SEGMENTED_WORLD`'s ground truth, and the path decomposition's
+    shortest path at a clearance."""
     import json
     import tempfile
     from pathlib import Path
@@ -164,7 +165,8 @@ def reach_rare_kernels() -> None:
     import numpy as np
     from PIL import Image
 
-    from semexplore_gym.core.grid import FREE, OCCUPIED
+    from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
+    from semexplore_gym.core.planning.clearance_path import clear_cells, shortest_clear_path_m
     from semexplore_gym.core.topometric import segment_map
     from semexplore_gym.maps import make_world
 
@@ -190,6 +192,11 @@ def reach_rare_kernels() -> None:
     grid = np.where(world.free_mask, FREE, OCCUPIED).astype(np.uint8)
     grid.setflags(write=False)
     segment_map(grid, world.free_geometry, clearance_m=0.2)
+    # The path decomposition's shortest paths, measured when a mission ends.
+    room = np.full((12, 12), FREE, np.uint8)
+    room[[0, -1], :] = room[:, [0, -1]] = OCCUPIED
+    geo = GridGeometry(0.1, 0.0, 0.0, 12, 12)
+    shortest_clear_path_m(clear_cells(room, geo, 0.1), geo, (0.3, 0.3), (0.85, 0.75), 0.2)
 
 
 def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym",)) -> int:
