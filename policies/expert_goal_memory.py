@@ -333,6 +333,7 @@ class GoalMemory:
             ("looked", "looked at, gap closed"),
             ("viewed", "seen from another place, still unknown"),
             ("unseeable", "no reachable place sees into them"),
+            ("sliver", "a sliver of unknown behind, not worth a view"),
         ):
             n = self.frontiers.count(reason)
             if n:

@@ -47,7 +47,12 @@ from semexplore_gym.core.frontiers.reachable import (
     nearest_reachable_frontier,
     pocket_exit_path,
 )
-from semexplore_gym.core.frontiers.viewpoint import ViewSearch, find_view_pose
+from semexplore_gym.core.frontiers.viewpoint import (
+    ViewSearch,
+    find_view_pose,
+    unknown_extent_cells,
+    unknown_rim,
+)
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
@@ -250,7 +255,8 @@ class ViewFrontier(PlanSource):
     the robot has been (its trail: its LiDAR had its chance there; :func:`~semexplore_gym.core.
     frontiers.viewpoint.find_view_pose`): with the planner's clearance first, then with the
     robot radius plus ``view_clearance_margin_m``.
-    When there is none the frontier is dropped (``unseeable``).
+    When there is none the frontier is dropped (``unseeable``); so is a frontier with less than
+    ``view_min_unknown_m2`` of unknown behind it (``sliver``).
     """
 
     name = "view"
@@ -267,6 +273,9 @@ class ViewFrontier(PlanSource):
         xy = req.frontier_xy_m
         if not unknown_near(ctx.grid, ctx.geometry, xy, prm.goal_check_radius_m):
             return None  # it cleared meanwhile
+        if self._sliver(ctx, xy):
+            ctx.memory.drop(ctx.grid, xy, "sliver")
+            return None
         near_m = ctx.lidar_range_m[0] + prm.view_min_range_margin_m
         far_m = max(
             prm.view_range_fraction * ctx.lidar_range_m[1], near_m + ctx.geometry.resolution_m
@@ -297,6 +306,15 @@ class ViewFrontier(PlanSource):
                 return Plan(PlanKind.VIEW, found.goal_xy_m, path, None, xy, VIEW_REACHED_M)
         ctx.memory.drop(ctx.grid, xy, "unseeable")
         return None
+
+    @staticmethod
+    def _sliver(ctx: PlanContext, xy: tuple[float, float]) -> bool:
+        """Whether less than ``view_min_unknown_m2`` of unknown hangs on the frontier's rim."""
+        need = math.ceil(ctx.params.view_min_unknown_m2 / ctx.geometry.resolution_m**2)
+        if need <= 0:
+            return False
+        rows, cols = unknown_rim(ctx.grid, ctx.geometry, xy, ctx.params.view_rim_radius_m)
+        return unknown_extent_cells(ctx.grid, rows, cols, need) < need
 
     @staticmethod
     def _keep(ctx: PlanContext, cur: Plan, xy: tuple[float, float]) -> Plan | None:

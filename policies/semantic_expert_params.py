@@ -92,7 +92,7 @@ What the paper leaves open, and how the expert handles it (parameters in
   and drops, with the goal's time budget, take over).
 * **A reached frontier that stays unknown gets another view** (``view_unseen_frontiers``,
   ``view_rim_radius_m``, ``view_range_fraction``, ``view_min_range_margin_m``,
-  ``view_clearance_margin_m``): a frontier reached ``max_goal_reaches`` times without clearing
+  ``view_clearance_margin_m``, ``view_min_unknown_m2``): a frontier reached ``max_goal_reaches`` times without clearing
   (or a narrow frontier looked at from close by without opening) is not dropped at once. The
   robot first drives to the nearest cell it can reach from which straight lines over known
   free cells reach the unknown cells next to the frontier (its rim: the unknown cells within
@@ -103,6 +103,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   viewpoint`); the planner's clearance first, then the robot radius plus
   ``view_clearance_margin_m``. The frontier is dropped only when no such
   place exists, or once the robot looked from there and it stayed unknown (once per place).
+  A frontier whose unknown side is a sliver (less than ``view_min_unknown_m2`` of unknown
+  connected to its rim) is dropped as before: a view drive across the map for a few cells costs
+  more time than it gains.
 
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
 switches them all off: the paper's method alone).
@@ -262,6 +265,8 @@ class SemanticExpertParams:
         view_min_range_margin_m: ... and farther than the LiDAR's minimum range plus this.
         view_clearance_margin_m: Without a view place at the planner's clearance, one at the
             robot radius plus this (a smaller physical margin) is sought.
+        view_min_unknown_m2: Unknown area connected to the frontier's rim below which it is
+            dropped without a view (a sliver; 0: view every one).
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
@@ -326,6 +331,7 @@ class SemanticExpertParams:
     view_range_fraction: float = 0.7
     view_min_range_margin_m: float = 0.15
     view_clearance_margin_m: float = 0.025
+    view_min_unknown_m2: float = 0.5
     entry_detour: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
@@ -376,6 +382,7 @@ class SemanticExpertParams:
             "view_rim_radius_m",
             "view_min_range_margin_m",
             "view_clearance_margin_m",
+            "view_min_unknown_m2",
         )
         require_finite(self, nonneg, positive=False)
         if not 0.0 < self.view_range_fraction <= 1.0:

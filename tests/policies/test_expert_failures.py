@@ -10,7 +10,12 @@ import numpy as np
 import pytest
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
 
-from semexplore_gym.core.frontiers.viewpoint import ViewSearch, find_view_pose, unknown_rim
+from semexplore_gym.core.frontiers.viewpoint import (
+    ViewSearch,
+    find_view_pose,
+    unknown_extent_cells,
+    unknown_rim,
+)
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.topometric.types import (
@@ -199,6 +204,47 @@ def test_a_frontier_reached_but_not_cleared_is_seen_from_another_place() -> None
     for _ in range(3):
         off.act(_obs(_room_and_nook(), 2.3, 1.5), INFO)
     assert off.done and "reached 1 times, not cleared" in off.stop_reason
+
+
+def _room_and_sliver() -> np.ndarray:
+    """The room and gap of :func:`_room_and_nook`, but behind the gap only a 0.6 m x 0.45 m
+    pocket of unknown (0.27 m², deep enough for the grid fallback to take it), walled in."""
+    g = _room_and_nook()
+    g[:, 50:] = np.where(g[:, 50:] == FREE, FREE, OCCUPIED)
+    g[24:36, 51:60] = UNKNOWN
+    return g
+
+
+def test_unknown_extent_counts_the_unknown_behind_a_rim_up_to_a_limit() -> None:
+    rows, cols = unknown_rim(_room_and_sliver(), GEOM, (2.5, 1.5), 0.5)
+    assert unknown_extent_cells(_room_and_sliver(), rows, cols, 10_000) == 12 * 9
+    assert unknown_extent_cells(_room_and_sliver(), rows, cols, 50) == 50  # capped
+    # Unknown that runs to the map's edge goes on beyond it: unbounded.
+    rows, cols = unknown_rim(_room_and_nook(), GEOM, (2.5, 1.5), 0.5)
+    assert unknown_extent_cells(_room_and_nook(), rows, cols, 10_000) == 10_000
+
+
+def test_a_sliver_behind_a_reached_frontier_is_dropped_without_a_view_drive() -> None:
+    def reach(prm: SemanticExpertParams) -> SemanticExpertPolicy:
+        pol = SemanticExpertPolicy(prm, segmenter=_empty_tmap)
+        grid = _room_and_sliver()
+        pol.reset(_obs(grid, 1.0, 1.5), INFO, seed=0)
+        pol.act(_obs(grid, 1.0, 1.5), INFO)
+        assert pol.plan_source == "fallback"
+        goal = pol.goal_xy_m
+        for _ in range(3):
+            pol.act(_obs(grid, *goal), INFO)
+        return pol
+
+    pol = reach(SemanticExpertParams(max_goal_reaches=1))
+    assert pol.counters["view_drives"] == 0
+    for _ in range(3):
+        pol.act(_obs(_room_and_sliver(), 2.3, 1.5), INFO)
+    assert pol.done and "a sliver of unknown behind" in pol.stop_reason
+    # With no minimum, the same frontier is worth a view (or found unseeable), never a sliver.
+    every = reach(SemanticExpertParams(max_goal_reaches=1, view_min_unknown_m2=0.0))
+    assert every.plan_source == "view" or every.counters["view_drives"] == 0
+    assert "sliver" not in every.stop_reason
 
 
 # ---------------------------------------------------------------------- never stopping

@@ -27,7 +27,7 @@ from semexplore_gym.core.frontiers.reachable import clearance_field_m, grid_path
 from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 
-__all__ = ["ViewPose", "ViewSearch", "find_view_pose", "unknown_rim"]
+__all__ = ["ViewPose", "ViewSearch", "find_view_pose", "unknown_extent_cells", "unknown_rim"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +71,29 @@ def unknown_rim(
     rows, cols = rows + a0, cols + b0
     inside = (rows >= r0) & (rows <= r1) & (cols >= c0) & (cols <= c1)
     return rows[inside].astype(np.int64), cols[inside].astype(np.int64)
+
+
+def unknown_extent_cells(
+    grid: np.ndarray, rim_rows: np.ndarray, rim_cols: np.ndarray, limit: int
+) -> int:
+    """How many UNKNOWN cells are 4-connected to the rim, counted up to ``limit``.
+
+    What a view into a frontier can gain at most: a sliver of unknown behind a wall end is a
+    few cells, a room not yet entered is thousands. A region that touches the map's edge goes
+    on beyond it, so it counts ``limit``.
+    """
+    h, w = grid.shape
+    seen = {(int(r), int(c)) for r, c in zip(rim_rows, rim_cols, strict=True)}
+    todo = list(seen)
+    while todo and len(seen) < limit:
+        r, c = todo.pop()
+        for rr, cc in ((r + 1, c), (r - 1, c), (r, c + 1), (r, c - 1)):
+            if not (0 <= rr < h and 0 <= cc < w):
+                return limit
+            if (rr, cc) not in seen and grid[rr, cc] == UNKNOWN:
+                seen.add((rr, cc))
+                todo.append((rr, cc))
+    return min(len(seen), limit)
 
 
 @dataclass(frozen=True)
