@@ -58,7 +58,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--train-config", default="configs/agents/ppo_maze.yml")
     ap.add_argument("--n-steps", type=int, default=256, help="steps per env per rollout")
     ap.add_argument(
-        "--variants", nargs="+", default=["1:dummy", "2:dummy", "4:dummy", "4:subproc"], help="N_ENVS:VEC_ENV"
+        "--variants",
+        nargs="+",
+        default=["1:dummy", "2:dummy", "4:dummy", "4:subproc"],
+        help="N_ENVS:VEC_ENV",
     )
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args(argv)

@@ -144,14 +144,38 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--families", default=",".join(FAMILIES), help="comma-separated families (default: %(default)s)")
-    ap.add_argument("--per-family", type=int, default=75, help="worlds per family (default: %(default)s)")
-    ap.add_argument("--policies", default="semantic", help="comma-separated policy specs (default: %(default)s)")
-    ap.add_argument("--seed0", type=int, default=1000, help="seed of the first world (default: %(default)s)")
-    ap.add_argument("--max-time-s", type=float, default=DEFAULT_MAX_TIME_S, help="mission time limit (default: %(default)s s)")
-    ap.add_argument("--ok-coverage", type=float, default=0.97, help="coverage a mission must reach (default: %(default)s)")
-    ap.add_argument("--workers", type=int, default=1, help="missions in parallel (default: %(default)s)")
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument(
+        "--families",
+        default=",".join(FAMILIES),
+        help="comma-separated families (default: %(default)s)",
+    )
+    ap.add_argument(
+        "--per-family", type=int, default=75, help="worlds per family (default: %(default)s)"
+    )
+    ap.add_argument(
+        "--policies", default="semantic", help="comma-separated policy specs (default: %(default)s)"
+    )
+    ap.add_argument(
+        "--seed0", type=int, default=1000, help="seed of the first world (default: %(default)s)"
+    )
+    ap.add_argument(
+        "--max-time-s",
+        type=float,
+        default=DEFAULT_MAX_TIME_S,
+        help="mission time limit (default: %(default)s s)",
+    )
+    ap.add_argument(
+        "--ok-coverage",
+        type=float,
+        default=0.97,
+        help="coverage a mission must reach (default: %(default)s)",
+    )
+    ap.add_argument(
+        "--workers", type=int, default=1, help="missions in parallel (default: %(default)s)"
+    )
     ap.add_argument("--gifs", action="store_true", help="animate every failure of the first policy")
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument("--out", required=True, help="output directory; rerunning resumes")

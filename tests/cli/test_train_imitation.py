@@ -34,7 +34,9 @@ def test_bad_workers_are_rejected_before_any_work(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], override: str, message: str
 ) -> None:
     out = tmp_path / "run"
-    rc = main(["train", "--algo", "dagger", "--out", str(out), "--no-progress", "--train-set", override])
+    rc = main(
+        ["train", "--algo", "dagger", "--out", str(out), "--no-progress", "--train-set", override]
+    )
     assert rc == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
@@ -63,7 +65,12 @@ def test_dagger_with_two_workers_records_the_same_data(tmp_path: Path) -> None:
         rc = main(
             ["train", "--algo", "dagger", "--train-config", str(CONFIGS / "dagger_maze.yml")]
             + ["--out", str(out), *tiny]
-            + ["--train-set", f"expert.workers={workers}", "--train-set", f"dagger.workers={workers}"]
+            + [
+                "--train-set",
+                f"expert.workers={workers}",
+                "--train-set",
+                f"dagger.workers={workers}",
+            ]
         )
         assert rc == 0
         metrics = json.loads((out / "metrics.json").read_text())
@@ -91,8 +98,17 @@ def test_train_cli_bc_then_ppo_then_explore(tmp_path: Path) -> None:
     except Exception:  # the expert's dependencies may not have landed yet: test the plumbing
         expert = "random"
     repo = Path(__file__).resolve().parents[2]
-    common = ["--no-progress", "--train-set", f"env.world={WORLD}", "--train-set", "egocentric.crop_cells=36"]
-    common += ["--train-set", "torch_threads=1"]  # one core: keep the shared machine's other one free
+    common = [
+        "--no-progress",
+        "--train-set",
+        f"env.world={WORLD}",
+        "--train-set",
+        "egocentric.crop_cells=36",
+    ]
+    common += [
+        "--train-set",
+        "torch_threads=1",
+    ]  # one core: keep the shared machine's other one free
     bc_out = tmp_path / "bc"
     rc = main(
         [

@@ -60,6 +60,8 @@ def test_macro_env_id_rejects_imitation_and_mask_needs_macro(tmp_path: Path) -> 
     assert main(["train", "--algo", "bc", "--train-config", cfg, "--out", str(tmp_path / "a")]) == 2
     cfg = str(CONFIGS / "ppo_maze.yml")
     assert (
-        main(["train", "--algo", "maskable_ppo", "--train-config", cfg, "--out", str(tmp_path / "b")])
+        main(
+            ["train", "--algo", "maskable_ppo", "--train-config", cfg, "--out", str(tmp_path / "b")]
+        )
         == 2
     )
