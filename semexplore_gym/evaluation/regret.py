@@ -174,6 +174,12 @@ def write_regret(
     return {"pairs": len(regret), "csv": str(csv_path), "plot": None if plot is None else str(plot)}
 
 
+def _quartile_ranks(n: int) -> list[int]:
+    """Indices of the lower quartile, median and upper quartile in a sorted sample of ``n``
+    (numpy's "lower" method: actual samples, so an infinite ratio stays infinite)."""
+    return [int(math.floor(q * (n - 1))) for q in (0.25, 0.5, 0.75)]
+
+
 def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Path:
     """``regret_ladder.png``: per family, median T99 ÷ oracle with IQR per policy (log x)."""
     from semexplore_gym.evaluation.suites import world_family
@@ -202,22 +208,25 @@ def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Pa
         squeeze=False,
     )
     for ax, (fam, by_policy) in zip(axes[0], families.items(), strict=False):
+        # Never reaching 99 % is an infinite ratio: drawn at the right edge, marked "∞".
+        finite = [x for v in by_policy.values() for x in v if math.isfinite(x)]
+        cap = min(50.0, max([2.0, *finite]) * 1.1)
         names = ["oracle", *sorted(by_policy, key=lambda p: float(np.median(by_policy[p])))]
         for y, name in enumerate(names):
             v = np.asarray(by_policy.get(name, [1.0]), dtype=np.float64)
-            q1, med, q3 = np.percentile(v, [25, 50, 75], method="lower")
-            hi = q3 if math.isfinite(q3) else 50.0
-            ax.plot([q1, hi], [y, y], color="0.5", lw=3, solid_capstyle="butt")
-            ax.plot([min(med, 50.0)], [y], "o", color="k" if name == "oracle" else "C0")
+            q1, med, q3 = (min(float(q), cap) for q in np.sort(v)[_quartile_ranks(len(v))])
+            ax.plot([q1, q3], [y, y], color="0.5", lw=3, solid_capstyle="butt")
+            if med >= cap:
+                ax.plot([cap], [y], ">", color="C3")
+                ax.annotate("∞", (cap, y), xytext=(-14, 4), textcoords="offset points")
+            else:
+                ax.plot([med], [y], "o", color="k" if name == "oracle" else "C0")
         ax.set_yticks(range(len(names)), names)
         ax.set_xscale("log")
-        top = max([np.percentile(v, 75) for v in by_policy.values()] + [2.0])
-        ax.set_xlim(0.9, min(50.0, float(top)) * 1.15)
+        ax.set_xlim(0.9, cap * 1.05)
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xticks(
-            [t for t in (1, 1.5, 2, 3, 5, 10, 20, 50) if t <= min(50.0, float(top)) * 1.15]
-        )
+        ax.set_xticks([t for t in (1, 1.5, 2, 3, 5, 10, 20, 50) if t <= cap])
         ax.axvline(1.0, color="0.7", lw=1, ls="--")
         ax.set_xlabel("T99 ÷ oracle's (median, IQR)")
         ax.set_title(fam)
