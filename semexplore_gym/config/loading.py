@@ -23,6 +23,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from semexplore_gym.core.validation import one_line, short_repr
@@ -96,6 +97,18 @@ def _check_yaml_nodes(root: yaml.Node, source: str, max_depth: int, max_nodes: i
     visit(root, 0)
 
 
+def _flow_depth(text: str) -> int:
+    """The deepest nesting of flow brackets (``[`` ``{``) in ``text``, counted over the raw
+    characters (brackets inside quoted strings count too: an upper bound)."""
+    b = np.frombuffer(text.encode("utf-8", "surrogatepass"), dtype=np.uint8)
+    step = np.isin(b, _OPEN).astype(np.int32) - np.isin(b, _CLOSE).astype(np.int32)
+    return int(np.cumsum(step).max(initial=0))
+
+
+_OPEN = np.frombuffer(b"[{", dtype=np.uint8)
+_CLOSE = np.frombuffer(b"]}", dtype=np.uint8)
+
+
 def load_yaml_text(
     text: str,
     source: str = "<yaml>",
@@ -113,6 +126,10 @@ def load_yaml_text(
         raise UnsafeInputError(
             f"{source}: {len(text)} characters is more than the {max_bytes} limit"
         )
+    if _flow_depth(text) > max_depth:
+        # Refused before the parser recurses into it (which, near a memory limit, can fail as
+        # a SystemError or MemoryError rather than a RecursionError).
+        raise UnsafeInputError(f"{source}: nested deeper than {max_depth} levels")
     try:
         loader = yaml.SafeLoader(text)
     except yaml.YAMLError as e:  # the reader refuses control characters at once
@@ -120,7 +137,7 @@ def load_yaml_text(
     try:
         try:
             node = loader.get_single_node()
-        except RecursionError:
+        except (RecursionError, SystemError, MemoryError):
             raise UnsafeInputError(f"{source}: nested too deeply") from None
         except yaml.YAMLError as e:
             raise UnsafeInputError(f"{source}: malformed YAML: {one_line(str(e))}") from None
@@ -129,7 +146,7 @@ def load_yaml_text(
         _check_yaml_nodes(node, source, max_depth, max_nodes)
         try:
             return loader.construct_document(node)
-        except RecursionError:
+        except (RecursionError, SystemError, MemoryError):
             raise UnsafeInputError(f"{source}: nested too deeply") from None
         except (yaml.YAMLError, TypeError, ValueError, OverflowError) as e:
             # e.g. an unhashable mapping key ({[1]: 2}) or a timestamp out of range
