@@ -28,10 +28,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from semexplore_gym.config.resources import configs_dir, resolve_config_path
-from semexplore_gym.evaluation.suites import Suite, suite_from_dict
+from semexplore_gym.config.resources import configs_dir
+from semexplore_gym.evaluation.suites import Suite, read_named_yaml, suite_from_dict
 
 #: Where named splits live (the shipped ``configs/splits``), unless ``SEMEXPLORE_SPLITS_DIR``
 #: names another directory.
@@ -88,23 +86,7 @@ def list_splits() -> list[str]:
 
 
 def _read(name_or_path: str) -> tuple[Any, str]:
-    path = resolve_config_path(name_or_path)
-    if not (name_or_path.endswith((".yaml", ".yml")) or path.is_file()):
-        path = _splits_dir() / f"{name_or_path}.yaml"
-        if not path.is_file():
-            known = ", ".join(list_splits()) or "none"
-            raise FileNotFoundError(
-                f"unknown split {name_or_path!r}; known splits: {known} (or a .yaml path)"
-            )
-    if not path.is_file():
-        raise FileNotFoundError(f"split file not found: {name_or_path!r}")
-    if path.stat().st_size > 1_000_000:
-        raise ValueError(f"split file {name_or_path!r} is over 1 MB")
-    try:
-        return yaml.safe_load(path.read_text(encoding="utf-8")), str(path)
-    except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as e:
-        first = str(e).splitlines()[0][:200] if str(e) else type(e).__name__
-        raise ValueError(f"split file {name_or_path!r} is not valid YAML: {first}") from None
+    return read_named_yaml(name_or_path, "split", _splits_dir(), list_splits)
 
 
 def load_split(name_or_path: str | os.PathLike) -> Split:

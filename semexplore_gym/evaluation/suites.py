@@ -28,6 +28,7 @@ from typing import Any
 
 import yaml
 
+from semexplore_gym.config.loading import UnsafeInputError, load_yaml_file
 from semexplore_gym.config.resources import configs_dir, resolve_config_path
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import PARAM, ParameterError
@@ -169,6 +170,33 @@ def suite_from_dict(data: Any, source: str = "<dict>") -> Suite:
     )
 
 
+def read_named_yaml(text: str, kind: str, directory: Path, known: Sequence[str]) -> tuple[Any, str]:
+    """A ``kind`` file (suite, split) by name in ``directory`` or by path, read with the
+    project's bounded YAML loader. Returns ``(data, path)``.
+
+    Raises:
+        FileNotFoundError: no such name (the message lists ``known()``) or file.
+        ValueError: over 1 MB, or not valid YAML (the message names the file).
+    """
+    path = resolve_config_path(text)
+    if not (text.endswith((".yaml", ".yml")) or path.is_file()):
+        path = directory / f"{text}.yaml"
+        if not path.is_file():
+            names = ", ".join(known()) or "none"
+            raise FileNotFoundError(
+                f"unknown {kind} {text!r}; known {kind}s: {names} (or a .yaml path)"
+            )
+    if not path.is_file():
+        raise FileNotFoundError(f"{kind} file not found: {text!r}")
+    if path.stat().st_size > 1_000_000:
+        raise ValueError(f"{kind} file {text!r} is over 1 MB")
+    try:
+        return load_yaml_file(path, f"{kind} file"), str(path)
+    except (UnsafeInputError, UnicodeDecodeError) as e:
+        first = str(e).splitlines()[0][:200] if str(e) else type(e).__name__
+        raise ValueError(f"{kind} file {text!r} is not valid YAML: {first}") from None
+
+
 def load_suite(name_or_path: str | os.PathLike) -> Suite:
     """A suite by name (a file in the suites directory) or by path to a YAML file.
 
@@ -177,24 +205,8 @@ def load_suite(name_or_path: str | os.PathLike) -> Suite:
         ValueError: a malformed suite (the message names the file and the key).
     """
     text = str(name_or_path)
-    path = resolve_config_path(text)
-    if not (text.endswith((".yaml", ".yml")) or path.is_file()):
-        d = Path(os.environ.get("SEMEXPLORE_SUITES_DIR") or SUITES_DIR)
-        path = d / f"{text}.yaml"
-        if not path.is_file():
-            known = ", ".join(list_suites(d)) or "none"
-            raise FileNotFoundError(
-                f"unknown suite {text!r}; known suites: {known} (or a .yaml path)"
-            )
-    if not path.is_file():
-        raise FileNotFoundError(f"suite file not found: {text!r}")
-    if path.stat().st_size > 1_000_000:
-        raise ValueError(f"suite file {text!r} is over 1 MB")
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as e:
-        first = str(e).splitlines()[0][:200] if str(e) else type(e).__name__
-        raise ValueError(f"suite file {text!r} is not valid YAML: {first}") from None
+    d = Path(os.environ.get("SEMEXPLORE_SUITES_DIR") or SUITES_DIR)
+    data, path = read_named_yaml(text, "suite", d, lambda: list_suites(d))
     return suite_from_dict(data, source=str(path))
 
 
