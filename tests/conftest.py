@@ -116,3 +116,32 @@ def segments_block():
     """``segments_block(segments, a, b)``: a wall segment (rows ``x0, y0, x1, y1``) crosses the
     straight line a-b, by plain geometry independent of the package's kernels."""
     return _blocked
+
+
+def _privileged_world(world, start, radius_m: float, range_m: float, res_m: float):
+    """The oracle's view of ``world`` from ``start``: the reachable mask at the env's coverage
+    clearance (radius + 0.01 m) and a 360-beam LiDAR of ``range_m``."""
+    from semexplore_gym.core.coverage_tour import PrivilegedWorld, SensorModel
+    from semexplore_gym.core.grid import GridGeometry
+    from semexplore_gym.core.worlds.start import reachable_free_mask
+
+    geo = GridGeometry.covering(*world.bounds_m, res_m, 0.5)
+    reach = reachable_free_mask(world, geo, start[:2], radius_m, radius_m + 0.01)
+    return PrivilegedWorld(
+        world=world,
+        geometry=geo,
+        start_pose=start,
+        radius_m=radius_m,
+        clearance_m=radius_m + 0.01,
+        reachable_mask=reach,
+        sensor=SensorModel(360, range_m, 0.12),
+        max_linear_speed_mps=0.22,
+        coverage_goal=0.99,
+    )
+
+
+@pytest.fixture
+def privileged_world():
+    """``privileged_world(world, start, radius_m, range_m, res_m)``: a ``PrivilegedWorld`` of a
+    test world, as the privileged env hands it out."""
+    return _privileged_world

@@ -12,11 +12,10 @@ import pytest
 from semexplore_gym.policies.registry import make_policy
 
 import semexplore_gym  # noqa: F401  (registers the env)
-from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, PrivilegedWorld, SensorModel
+from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, PrivilegedWorld
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.worlds.build import world_from_free_mask
 from semexplore_gym.core.worlds.raster import rasterize_free
-from semexplore_gym.core.worlds.start import reachable_free_mask
 from semexplore_gym.evaluation.rollout import make_mission_env, map_observation_for, run_mission
 from semexplore_gym.training.teacher_labels import NotPrivilegedError, OracleTeacher
 
@@ -28,26 +27,13 @@ RANGE_M = 1.0
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _corridor(start_x: float) -> PrivilegedWorld:
+def _corridor(pw, start_x: float) -> PrivilegedWorld:
     """A 12 m x 0.6 m corridor along x, the robot at ``start_x``; LiDAR range 1 m."""
     h, w = int(round(0.6 / RES)), int(round(12.0 / RES))
     world = world_from_free_mask(
         "corridor", np.ones((h, w), dtype=bool), GridGeometry(RES, 0.0, 0.0, h, w)
     )
-    start = (start_x, 0.3, 0.0)
-    geo = GridGeometry.covering(*world.bounds_m, RES, 0.5)
-    reach = reachable_free_mask(world, geo, start[:2], RADIUS, RADIUS + 0.01)
-    return PrivilegedWorld(
-        world=world,
-        geometry=geo,
-        start_pose=start,
-        radius_m=RADIUS,
-        clearance_m=RADIUS + 0.01,
-        reachable_mask=reach,
-        sensor=SensorModel(360, RANGE_M, 0.12),
-        max_linear_speed_mps=0.22,
-        coverage_goal=0.99,
-    )
+    return pw(world, (start_x, 0.3, 0.0), RADIUS, RANGE_M, RES)
 
 
 def _mapped(facts: PrivilegedWorld, x0: float, x1: float) -> np.ndarray:
@@ -61,11 +47,11 @@ def _mapped(facts: PrivilegedWorld, x0: float, x1: float) -> np.ndarray:
     return grid
 
 
-def test_corridor_short_end_first_and_costs_to_go() -> None:
+def test_corridor_short_end_first_and_costs_to_go(privileged_world) -> None:
     # Known: x in [3, 5]; the robot at x = 4. Left end 4 m away, right end 8 m away. Seeing an
     # end needs driving to within R of it: left first costs (4 - 1) + (11 - 1) = 13 m, right
     # first (11 - 4) + (11 - 1) = 17 m.
-    facts = _corridor(4.0)
+    facts = _corridor(privileged_world, 4.0)
     teacher = OracleTeacher(facts)
     obs = {"map": _mapped(facts, 3.0, 5.0), "pose": np.array([4.0, 0.3, 0.0])}
     labels = teacher.labels(obs)
@@ -87,7 +73,7 @@ def test_corridor_short_end_first_and_costs_to_go() -> None:
     assert visits == [left, right]  # all of the short end, then all of the long one
     assert labels.unseen_cells[right] > 2 * labels.unseen_cells[left] > 0
     # Mirrored (robot at x = 8, known [7, 9]): now the right end is the short one.
-    facts = _corridor(8.0)
+    facts = _corridor(privileged_world, 8.0)
     obs = {"map": _mapped(facts, 7.0, 9.0), "pose": np.array([8.0, 0.3, 0.0])}
     labels = OracleTeacher(facts).labels(obs)
     xs = [
@@ -98,8 +84,8 @@ def test_corridor_short_end_first_and_costs_to_go() -> None:
     assert labels.cost_to_go_m[labels.first] < labels.cost_to_go_m[1 - labels.first] - 2.0
 
 
-def test_a_frontier_that_owns_no_viewpoint_still_gets_a_cost() -> None:
-    facts = _corridor(4.0)
+def test_a_frontier_that_owns_no_viewpoint_still_gets_a_cost(privileged_world) -> None:
+    facts = _corridor(privileged_world, 4.0)
     teacher = OracleTeacher(facts)
     obs = {"map": _mapped(facts, 3.0, 5.0), "pose": np.array([4.0, 0.3, 0.0])}
     fake = np.array([[5, 80], [6, 80]])  # two cells mid-corridor, behind the robot's column

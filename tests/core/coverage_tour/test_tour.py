@@ -13,8 +13,6 @@ import pytest
 from scipy import sparse
 
 from semexplore_gym.core.coverage_tour import (
-    PrivilegedWorld,
-    SensorModel,
     TourParams,
     greedy_cover,
     open_tour_order,
@@ -22,7 +20,6 @@ from semexplore_gym.core.coverage_tour import (
 )
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.build import world_from_free_mask
-from semexplore_gym.core.worlds.start import reachable_free_mask
 
 pytest.importorskip("elkai")
 
@@ -31,7 +28,7 @@ RADIUS = 0.105
 RANGE_M = 1.0
 
 
-def _facts(rects: list[tuple[float, float, float, float]], size_m: tuple[float, float], start):
+def _facts(pw, rects: list[tuple[float, float, float, float]], size_m: tuple[float, float], start):
     h, w = int(round(size_m[1] / RES)), int(round(size_m[0] / RES))
     free = np.zeros((h, w), dtype=bool)
     for x0, y0, x1, y1 in rects:
@@ -39,36 +36,24 @@ def _facts(rects: list[tuple[float, float, float, float]], size_m: tuple[float, 
             int(round(y0 / RES)) : int(round(y1 / RES)), int(round(x0 / RES)) : int(round(x1 / RES))
         ] = True
     world = world_from_free_mask("test", free, GridGeometry(RES, 0.0, 0.0, h, w), start_pose=start)
-    geo = GridGeometry.covering(*world.bounds_m, RES, 0.5)
-    reach = reachable_free_mask(world, geo, start[:2], RADIUS, RADIUS + 0.01)
-    return PrivilegedWorld(
-        world=world,
-        geometry=geo,
-        start_pose=start,
-        radius_m=RADIUS,
-        clearance_m=RADIUS + 0.01,
-        reachable_mask=reach,
-        sensor=SensorModel(360, RANGE_M, 0.12),
-        max_linear_speed_mps=0.22,
-        coverage_goal=0.99,
-    )
+    return pw(world, start, RADIUS, RANGE_M, RES)
 
 
-def test_a_straight_corridor_is_driven_once_to_within_range_of_its_end():
+def test_a_straight_corridor_is_driven_once_to_within_range_of_its_end(privileged_world):
     # 8 m x 0.6 m, start 0.3 m from the left end: the optimum is 8 - 0.3 - R (= 6.7 m).
-    facts = _facts([(0.0, 0.0, 8.0, 0.6)], (8.0, 0.6), (0.3, 0.3, 0.0))
+    facts = _facts(privileged_world, [(0.0, 0.0, 8.0, 0.6)], (8.0, 0.6), (0.3, 0.3, 0.0))
     tour = plan_coverage_tour(facts)
     optimum = 8.0 - 0.3 - RANGE_M
     assert optimum - 0.6 <= tour.length_m <= optimum + 0.6
     assert tour.covered_share >= 0.995
 
 
-def test_a_tree_maze_open_tour_saves_its_longest_branch():
+def test_a_tree_maze_open_tour_saves_its_longest_branch(privileged_world):
     # A hub at (4, 4) with corridors 0.6 m wide: east 4 m, north 4 m, west 2.5 m (from the
     # hub's centre). Each branch needs its length less R driven; a closed tour drives each
     # twice, an open one drives the longest once.
     rects = [(3.7, 3.7, 8.0, 4.3), (3.7, 3.7, 4.3, 8.0), (1.5, 3.7, 4.3, 4.3)]
-    facts = _facts(rects, (8.0, 8.0), (4.0, 4.0, 0.0))
+    facts = _facts(privileged_world, rects, (8.0, 8.0), (4.0, 4.0, 0.0))
     tour = plan_coverage_tour(facts)
     depth = np.array([4.0, 4.0, 2.5]) - RANGE_M
     closed = 2.0 * depth.sum()
@@ -78,9 +63,9 @@ def test_a_tree_maze_open_tour_saves_its_longest_branch():
     assert tour.covered_share >= 0.995
 
 
-def test_the_tour_is_deterministic():
+def test_the_tour_is_deterministic(privileged_world):
     rects = [(3.7, 3.7, 8.0, 4.3), (3.7, 3.7, 4.3, 8.0), (1.5, 3.7, 4.3, 4.3)]
-    facts = _facts(rects, (8.0, 8.0), (4.0, 4.0, 0.0))
+    facts = _facts(privileged_world, rects, (8.0, 8.0), (4.0, 4.0, 0.0))
     a = plan_coverage_tour(facts, TourParams(lkh_runs=2))
     b = plan_coverage_tour(facts, TourParams(lkh_runs=2))
     assert np.array_equal(a.viewpoints_rc, b.viewpoints_rc)
