@@ -170,7 +170,9 @@ def suite_from_dict(data: Any, source: str = "<dict>") -> Suite:
     )
 
 
-def read_named_yaml(text: str, kind: str, directory: Path, known: Sequence[str]) -> tuple[Any, str]:
+def read_named_yaml(
+    text: str, kind: str, directory: Path, known: Callable[[], Sequence[str]]
+) -> tuple[Any, str]:
     """A ``kind`` file (suite, split) by name in ``directory`` or by path, read with the
     project's bounded YAML loader. Returns ``(data, path)``.
 
