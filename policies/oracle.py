@@ -60,6 +60,10 @@ from semexplore_gym.core.coverage_tour.viewpoints import (
 from semexplore_gym.core.grid import FREE
 from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.grid_search import distance_field, shortest_path_cells
+from semexplore_gym.core.planning.path_tracking import (
+    path_clearance_ahead_m,
+    tight_tracking_command,
+)
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldParams,
     RobotLimits,
@@ -114,6 +118,15 @@ class OracleParams:
         backoff_speed_fraction: See ``backoff_duration_s``.
         max_fallback_goals: Goals beyond the tour (see :meth:`OraclePolicy._fallback_cell`)
             before the oracle gives up.
+        tight_margin_m: Where the true wall clearance at the robot or along the next
+            ``tight_lookahead_m`` of its path is below ``radius + tight_margin_m``, the potential
+            field (whose walls balance and stall the robot in a gap a few centimetres wider
+            than it) gives way to exact, slow path tracking
+            (:func:`~semexplore_gym.core.planning.path_tracking.tight_tracking_command`) ...
+        tight_lookahead_m: See ``tight_margin_m``.
+        tight_speed_mps: ... at this speed ...
+        tight_track_lookahead_m: ... aiming at the path point this far ahead ...
+        tight_turn_in_place_rad: ... and turning on the spot above this heading error.
     """
 
     tour: TourParams = field(default_factory=TourParams)
@@ -130,6 +143,11 @@ class OracleParams:
     backoff_duration_s: float = 1.5
     backoff_speed_fraction: float = 0.5
     max_fallback_goals: int = 30
+    tight_margin_m: float = 0.08
+    tight_lookahead_m: float = 1.0
+    tight_speed_mps: float = 0.08
+    tight_track_lookahead_m: float = 0.15
+    tight_turn_in_place_rad: float = 0.3
 
 
 class OraclePolicy(Policy):
@@ -177,6 +195,8 @@ class OraclePolicy(Policy):
         self.planning_s = time.perf_counter() - t0
         res = self.geometry.resolution_m
         clearance = wall_clearance_m(facts.world, self.geometry, prm.path_prefer_clearance_m)
+        self._clearance_m = clearance
+        self._tight_below_m = env.radius_m + prm.tight_margin_m
         pref = np.clip(1.0 - clearance / prm.path_prefer_clearance_m, 0.0, 1.0)
         self._drive_cost = np.where(tour.standing, res * (1.0 + prm.path_wall_cost * pref), np.inf)
         self._geo_cost = np.where(tour.standing, res, np.inf)
@@ -201,6 +221,7 @@ class OraclePolicy(Policy):
             "reorders": 0,
             "recoveries": 0,
             "fallback_goals": 0,
+            "tight_steps": 0,
         }
         self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
         self._watch = ProgressWatch(
@@ -447,6 +468,19 @@ class OraclePolicy(Policy):
                 return 0.0, 0.0
         path = self._path
         assert path is not None
+        if self._in_tight_passage(pose, path):
+            self.counters["tight_steps"] += 1
+            v, w = tight_tracking_command(
+                pose,
+                path,
+                self._progress,
+                lookahead_m=self.params.tight_track_lookahead_m,
+                speed_mps=min(self.params.tight_speed_mps, self.limits.max_linear_speed_mps),
+                max_omega_radps=self.limits.max_angular_speed_radps,
+                turn_in_place_rad=self.params.tight_turn_in_place_rad,
+            )
+            self._advance_progress(pose)
+            return v, w
         cmd = potential_field_command(
             scan,
             pose,
@@ -457,6 +491,23 @@ class OraclePolicy(Policy):
             self.params.potential_field,
             start_index=self._progress,
         )
+        self._advance_progress(pose)
+        return cmd.v_mps, cmd.omega_radps
+
+    def _in_tight_passage(self, pose: tuple[float, float, float], path: np.ndarray) -> bool:
+        """The true clearance at the robot or along the next stretch of path is tight."""
+        geo = self.geometry
+        n = int(math.ceil(self.params.tight_lookahead_m / geo.resolution_m)) + 1
+        stretch = np.vstack([[pose[0], pose[1]], path[self._progress : self._progress + n]])
+        rows, cols = geo.world_to_grid(stretch[:, 0], stretch[:, 1])
+        h, w = geo.shape
+        ok = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+        ahead = path_clearance_ahead_m(self._clearance_m, rows[ok], cols[ok])
+        return ahead < self._tight_below_m
+
+    def _advance_progress(self, pose: tuple[float, float, float]) -> None:
+        path = self._path
+        assert path is not None
         lo = self._progress
         hi = min(len(path), lo + int(math.ceil(1.5 / self.geometry.resolution_m)) + 1)
         d = np.hypot(path[lo:hi, 0] - pose[0], path[lo:hi, 1] - pose[1])
@@ -465,7 +516,6 @@ class OraclePolicy(Policy):
             self._progress = lo + i
         else:
             self._path = None  # far off the path: plan again from here next step
-        return cmd.v_mps, cmd.omega_radps
 
     def _watch_progress(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
         if self._watch.update(self._time_s, (pose[0], pose[1]), known_cell_count(grid)):
