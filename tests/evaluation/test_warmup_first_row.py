@@ -1,10 +1,12 @@
 """Honest first timings on a fresh install: with an empty numba cache, the warm-up compiles
-every kernel the missions reach before their clocks start, so the first benchmark row's
-per-call times are those of the rows after it.
+every kernel the missions reach before their clocks start, so no compile lands inside a timed
+mission and the first benchmark row is timed like the rows after it.
 
 One subprocess with its own empty ``NUMBA_CACHE_DIR`` (so everything compiles, as after
 ``pip install``) runs ``semexplore benchmark`` on identical missions (one world, fixed start)
-and reports every kernel numba compiled outside a warm-up.
+and reports every kernel numba compiled outside a warm-up. The timings themselves (first row
+against the next ones) are measured by ``scripts/bench_first_row.py``, not here: a unit test
+that compares milliseconds fails on a loaded machine.
 """
 
 from __future__ import annotations
@@ -55,13 +57,10 @@ with event.install_listener("numba:compile", Compiles()):
 print("RESULT " + json.dumps({"rc": rc, "compiled": state["compiled"]}))
 """
 
-#: Later rows may be this much faster than the first by noise alone (a shared machine).
-RATIO = 1.5
-
 
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
-def test_first_benchmark_row_is_timed_like_the_next_on_an_empty_kernel_cache(
+def test_no_kernel_compiles_inside_a_mission_on_an_empty_kernel_cache(
     tmp_path: Path,
 ) -> None:
     out = tmp_path / "bench"
@@ -85,10 +84,6 @@ def test_first_benchmark_row_is_timed_like_the_next_on_an_empty_kernel_cache(
     assert "mission" not in result["compiled"], f"compiled inside a mission: {result['compiled']}"
 
     rows = list(csv.DictReader((out / "runs.csv").open()))
-    for policy in ("semantic", "frontier"):
-        mine = sorted((r for r in rows if r["policy"] == policy), key=lambda r: int(r["seed"]))
-        assert len(mine) == 3
-        for key in ("mean_map_generation_ms", "mean_global_planning_ms"):
-            first, *later = (float(r[key]) for r in mine)
-            if max(later) > 0:  # a stage the policy has
-                assert first <= RATIO * max(later), (policy, key, first, later)
+    assert sorted((r["policy"], r["seed"]) for r in rows) == sorted(
+        (p, str(k)) for p in ("semantic", "frontier") for k in range(3)
+    )
