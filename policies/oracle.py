@@ -146,8 +146,8 @@ class OracleParams:
     backoff_duration_s: float = 1.5
     backoff_speed_fraction: float = 0.5
     max_fallback_goals: int = 30
-    tight_margin_m: float = 0.08
-    tight_lookahead_m: float = 1.0
+    tight_margin_m: float = 0.04
+    tight_lookahead_m: float = 0.5
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
