@@ -33,6 +33,8 @@ class ExpertCounters:
         looks: Narrow frontiers looked at (or passed close by) and dropped.
         look_drives: Drives to a look point.
         pocket_escapes: Plans that first leave a pocket of the usable map.
+        narrow_plans: Plans through passages narrower than the planners' clearance.
+        tight_steps: Steps driven by exact tracking in such a passage.
         goal_timeouts: Goals not reached within their time budget.
         oscillations_blocked: Switches back to a recently abandoned goal refused.
         shuttles: Goals adopted again without the map growing (the shuttle guard commits).
@@ -58,6 +60,8 @@ class ExpertCounters:
     looks: int = 0
     look_drives: int = 0
     pocket_escapes: int = 0
+    narrow_plans: int = 0
+    tight_steps: int = 0
     goal_timeouts: int = 0
     oscillations_blocked: int = 0
     shuttles: int = 0

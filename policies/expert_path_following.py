@@ -21,6 +21,10 @@ from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
 from semexplore_gym.policies.semantic_expert_params import PathFollowingParams
 
 from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.planning.path_tracking import (
+    scan_centring_offset_m,
+    tight_tracking_command,
+)
 from semexplore_gym.core.planning.potential_field import (
     PotentialFieldCommand,
     PotentialFieldFollower,
@@ -49,6 +53,9 @@ PROGRESS_SNAP_M = 0.5
 
 #: A forward command below this fraction of the top speed counts as standing still.
 STILL_SPEED_FRACTION = 0.1
+
+#: A narrow plan is tracked exactly where its path is tight this far ahead of the robot (m).
+TIGHT_LOOKAHEAD_M = 0.5
 
 
 class PathFollower:
@@ -82,11 +89,14 @@ class PathFollower:
         xy_m: tuple[float, float],
         known_cells: int,
         params: PathFollowingParams | None = None,
+        min_range_m: float = 0.0,
     ) -> None:
         """Start a mission with the robot at ``xy_m`` on a map with ``known_cells`` known (with
-        ``params``, if given, from now on)."""
+        ``params``, if given, from now on; ``min_range_m``: the LiDAR's, which invalid returns
+        (0) are read as)."""
         if params is not None:
             self.params = params
+        self.min_range_m = min_range_m
         prm = self.params
         self.geometry = geometry
         self.limits = limits
@@ -138,6 +148,13 @@ class PathFollower:
     ) -> tuple[float, float, bool]:
         """One step along ``plan``: ``(v_mps, omega_radps, escaping)``."""
         prm = self.params
+        if self.tight(plan):
+            self.counts.tight_steps += 1
+            v, w = self._tight_command(plan, pose, scan)
+            self.last_command = None
+            self.advance_progress(plan, pose)
+            self._still_s = 0.0
+            return v, w, False
         escaping = now_s < self._escape_until_s
         cmd = PotentialFieldFollower(self.limits, prm.potential_field).command(
             scan,
@@ -161,6 +178,41 @@ class PathFollower:
                 self.counts.escapes += 1
                 self.log("escape", f"goal={plan.goal_xy_m}")
         return cmd.v_mps, cmd.omega_radps, escaping
+
+    def tight(self, plan: Plan) -> bool:
+        """A narrow plan (``narrow_passages``) whose next stretch has less than the planners'
+        clearance on the map."""
+        along = plan.path_clearance_m
+        if along is None or not self.params.narrow_passages:
+            return False
+        n = int(math.ceil(TIGHT_LOOKAHEAD_M / self.geometry.resolution_m)) + 1
+        ahead = along[plan.progress : plan.progress + n]
+        planners_m = self.limits.radius_m + self.params.clearance_margin_m
+        return ahead.size > 0 and float(ahead.min()) < planners_m - 1e-9
+
+    def _tight_command(
+        self, plan: Plan, pose: tuple[float, float, float], scan: np.ndarray
+    ) -> tuple[float, float]:
+        """Slow, exact tracking of ``plan``, centred between the walls the scan measures."""
+        prm = self.params
+        if self._angles is None or len(self._angles) != len(scan):
+            self._angles = beam_angles_rad(len(scan))
+        shift = scan_centring_offset_m(
+            scan,
+            self._angles,
+            min_range_m=self.min_range_m,
+            reach_m=prm.tight_centring_range_m,
+        )
+        return tight_tracking_command(
+            pose,
+            plan.path_m,
+            plan.progress,
+            lookahead_m=prm.tight_track_lookahead_m,
+            speed_mps=min(prm.tight_speed_mps, self.limits.max_linear_speed_mps),
+            max_omega_radps=self.limits.max_angular_speed_radps,
+            turn_in_place_rad=prm.tight_turn_in_place_rad,
+            lateral_shift_m=shift,
+        )
 
     def advance_progress(self, plan: Plan, pose: tuple[float, float, float]) -> None:
         """Move ``plan.progress`` to the nearest path point a short window ahead."""

@@ -52,6 +52,8 @@ class Plan:
         frontier_xy_m: The frontier served when the goal lies beside it (retry, look, view).
         reached_within_m: The goal counts as reached within this distance (None: the expert's
             ``goal_reached_radius_m``).
+        path_clearance_m: For a plan through passages narrower than the planners' clearance
+            (``narrow_passages``): the map's wall clearance at each path point, else None.
         progress: Index of the path point the robot has reached.
         arc_m: Arc length of the path at each point (computed).
     """
@@ -62,6 +64,7 @@ class Plan:
     candidate: FrontierCandidate | None = None
     frontier_xy_m: tuple[float, float] | None = None
     reached_within_m: float | None = None
+    path_clearance_m: np.ndarray | None = None
     progress: int = 0
     arc_m: np.ndarray = field(init=False, repr=False)
 

@@ -18,6 +18,8 @@ source                  proposes
 ``committed_fallback``  the grid fallback's goal of the last plan, while it lasts
 ``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
+``narrow_fallback``     the nearest frontier a grid search reaches with a thinner clearance
+                        (``narrow_passages``), through passages followed slowly and exactly
 ``look``                close to a frontier too narrow to reach, to look again
 ======================  ======================================================================
 
@@ -63,6 +65,7 @@ __all__ = [
     "CommandedGoal",
     "CommittedFallback",
     "LookAtNarrowFrontier",
+    "NarrowFallback",
     "NearestFallback",
     "PlanContext",
     "PlanSource",
@@ -80,6 +83,10 @@ VIEW_REACHED_M = 0.15
 
 #: Narrow frontiers checked against the trail before one is worth driving to.
 MAX_LOOK_CANDIDATES = 8
+
+#: A look into a narrow passage's mouth ends at least this far from the robot, somewhere its
+#: trail has not been (metres).
+NARROW_LOOK_MIN_M = 0.2
 
 
 def unknown_near(
@@ -456,6 +463,83 @@ class PocketEscape(PlanSource):
         return Plan(PlanKind.FALLBACK, found.goal_xy_m, ctx.resampled(path))
 
 
+class NarrowFallback(PlanSource):
+    """Graded clearance (``narrow_passages``): nothing is reachable at the planners' clearance,
+    so the nearest frontier a grid search with the robot radius plus
+    ``narrow_clearance_margin_m`` reaches. The plan carries the map's clearance along its path:
+    where that is below the planners' clearance the path follower tracks it slowly and exactly
+    (see :class:`~semexplore_gym.policies.expert_path_following.PathFollower`).
+    """
+
+    name = "narrow_fallback"
+
+    def propose(self, ctx: PlanContext) -> Plan | None:
+        prm = ctx.params
+        thin_m = ctx.robot_radius_m + prm.narrow_clearance_margin_m
+        if not (prm.grid_fallback and prm.narrow_passages) or thin_m >= ctx.clearance_m:
+            return None
+        clearance = ctx.clearance_field()
+        # A passage this narrow has a frontier only about as wide as itself: the fallback's
+        # minimum frontier width would hide it.
+        search = ctx.fallback_search_kwargs()
+        widest_cells = max(1, math.floor(2.0 * thin_m / ctx.geometry.resolution_m + 1e-9))
+        search["min_frontier_cells"] = min(search["min_frontier_cells"], widest_cells)
+        found = nearest_reachable_frontier(
+            ctx.grid,
+            ctx.geometry,
+            ctx.xy_m,
+            thin_m,
+            frontiers=FrontierFilter(**search),
+            clearance_field=clearance,
+        )
+        if found is not None:
+            path, goal = ctx.resampled(found.path_m), found.goal_xy_m
+        else:
+            # A passage seen only at a grazing angle is not mapped free across its width yet:
+            # drive into its mouth as far as the thin clearance holds, and look along it.
+            path = self._look_into(ctx, thin_m, clearance)
+            if path is None:
+                return None
+            goal = (float(path[-1, 0]), float(path[-1, 1]))
+        rows, cols = ctx.geometry.world_to_grid(path[:, 0], path[:, 1])
+        h, w = ctx.geometry.shape
+        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+        along = np.full(len(path), np.inf)
+        along[inside] = clearance[rows[inside], cols[inside]]
+        ctx.counts.narrow_plans += 1
+        return Plan(PlanKind.FALLBACK, goal, path, path_clearance_m=along)
+
+    @staticmethod
+    def _look_into(ctx: PlanContext, thin_m: float, clearance: np.ndarray) -> np.ndarray | None:
+        prm = ctx.params
+        res_m = ctx.geometry.resolution_m
+        found = nearest_reachable_frontier(
+            ctx.grid,
+            ctx.geometry,
+            ctx.xy_m,
+            ctx.clearance_m * prm.look_clearance_fraction,
+            FrontierFilter(
+                min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
+                min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
+                reach_m=prm.fallback_reach_m,
+                excluded_xy_m=ctx.memory.dropped_points(),
+                excluded_radius_m=prm.blacklist_radius_m,
+            ),
+            clearance_field=clearance,
+        )
+        if found is None:
+            return None
+        path = standable_prefix(ctx, found.path_m, thin_m)
+        if len(path) < 2:
+            return None
+        end = (float(path[-1, 0]), float(path[-1, 1]))
+        if math.dist(end, ctx.xy_m) < NARROW_LOOK_MIN_M or ctx.memory.been_near(
+            end, NARROW_LOOK_MIN_M
+        ):
+            return None  # looked from there already
+        return path
+
+
 class LookAtNarrowFrontier(PlanSource):
     """Before stopping: drive towards a frontier too narrow to reach, to look again.
 
@@ -510,11 +594,15 @@ class LookAtNarrowFrontier(PlanSource):
         return None
 
 
-def standable_prefix(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
-    """The part of ``path_m`` from its start on which the robot's own clearance holds."""
+def standable_prefix(
+    ctx: PlanContext, path_m: np.ndarray, clearance_m: float | None = None
+) -> np.ndarray:
+    """The part of ``path_m`` from its start on which the robot's own clearance (or
+    ``clearance_m``) holds."""
+    need_m = ctx.clearance_m if clearance_m is None else clearance_m
     dense = ctx.resampled(path_m)
     rows, cols = ctx.geometry.world_to_grid(dense[:, 0], dense[:, 1])
-    ok = ctx.clearance_field()[rows, cols] >= ctx.clearance_m - 1e-9
+    ok = ctx.clearance_field()[rows, cols] >= need_m - 1e-9
     # The robot may start closer to a wall than its clearance: skip that first stretch.
     first = int(np.argmax(ok)) if ok.any() else len(ok)
     bad = np.flatnonzero(~ok[first:])
@@ -530,6 +618,7 @@ DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
     CommittedFallback(),
     NearestFallback(),
     PocketEscape(),
+    NarrowFallback(),
     LookAtNarrowFrontier(),
 )
 

@@ -205,7 +205,7 @@ class SemanticExpertPolicy(Policy):
         self.goal_memory.reset(self.geometry, self.params.goal_memory)
         xy_m = (float(obs["pose"][0]), float(obs["pose"][1]))
         where = (self.geometry, self.limits, self.dt_s, xy_m, self._known_cells)
-        self.follower.reset(*where, self.params.path_following)
+        self.follower.reset(*where, self.params.path_following, min_range_m=self._min_range_m)
 
     # ------------------------------------------------------------------ stepping
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:
@@ -280,7 +280,10 @@ class SemanticExpertPolicy(Policy):
         if plan is None:
             return "no_plan"
         if self._time_s >= self._next_replan_s - 1e-9:
-            return "period"
+            # Inside a passage narrower than the planners' clearance, a narrow plan is kept
+            # until the robot is out: a plan from in there would hand it back to the field.
+            if not self.follower.tight(plan):
+                return "period"
         reach_m = plan.reached_within_m or self.params.goal_reached_radius_m
         if math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1]) <= reach_m:
             self.goal_memory.goal_reached(grid, plan, (pose[0], pose[1]))

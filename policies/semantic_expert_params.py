@@ -106,6 +106,18 @@ What the paper leaves open, and how the expert handles it (parameters in
   A frontier whose unknown side is a sliver (less than ``view_min_unknown_m2`` of unknown
   connected to its rim) is dropped as before: a view drive across the map for a few cells costs
   more time than it gains.
+* **Narrow passages** (``narrow_passages``, off by default while it is measured;
+  ``narrow_clearance_margin_m``, ``tight_speed_mps``, ``tight_track_lookahead_m``,
+  ``tight_turn_in_place_rad``, ``tight_centring_range_m``): a graded clearance. When nothing
+  is reachable at the planners' clearance (robot radius plus ``clearance_margin_m``), the
+  grid fallback searches once more at the radius plus ``narrow_clearance_margin_m`` (gaps
+  from about 0.25 m for the 0.105 m robot on a 5 cm map), before the stop rule's look. Where such
+  a plan's path has less than the planners' clearance on the map, the potential field (whose
+  two walls balance and stall the robot in a gap barely wider than it) gives way to slow,
+  exact tracking (:func:`~semexplore_gym.core.planning.path_tracking.tight_tracking_command`:
+  ``tight_speed_mps``, aiming ``tight_track_lookahead_m`` ahead, turning on the spot above
+  ``tight_turn_in_place_rad``), kept in the middle between the walls the scan measures on
+  both sides within ``tight_centring_range_m`` (the map places a wall only to within a cell).
 
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
 switches them all off: the paper's method alone).
@@ -150,6 +162,12 @@ class PathFollowingParams:
     backoff_speed_fraction: float
     goal_time_factor: float
     min_goal_time_s: float
+    narrow_passages: bool
+    clearance_margin_m: float
+    tight_speed_mps: float
+    tight_track_lookahead_m: float
+    tight_turn_in_place_rad: float
+    tight_centring_range_m: float
 
 
 @dataclass(frozen=True)
@@ -267,6 +285,14 @@ class SemanticExpertParams:
             robot radius plus this (a smaller physical margin) is sought.
         view_min_unknown_m2: Unknown area connected to the frontier's rim below which it is
             dropped without a view (a sliver; 0: view every one).
+        narrow_passages: The graded clearance for passages narrower than the planners'
+            clearance (see the module docstring).
+        narrow_clearance_margin_m: Its last search's clearance: the robot radius plus this.
+        tight_speed_mps: Forward speed where a narrow plan's path is tight.
+        tight_track_lookahead_m: There it aims at the path point this far ahead ...
+        tight_turn_in_place_rad: ... and turns on the spot above this heading error ...
+        tight_centring_range_m: ... centred between walls the scan sees within this on both
+            sides.
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
@@ -332,6 +358,12 @@ class SemanticExpertParams:
     view_min_range_margin_m: float = 0.15
     view_clearance_margin_m: float = 0.025
     view_min_unknown_m2: float = 0.5
+    narrow_passages: bool = False
+    narrow_clearance_margin_m: float = 0.04
+    tight_speed_mps: float = 0.08
+    tight_track_lookahead_m: float = 0.06
+    tight_turn_in_place_rad: float = 0.15
+    tight_centring_range_m: float = 0.3
     entry_detour: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
@@ -383,8 +415,19 @@ class SemanticExpertParams:
             "view_min_range_margin_m",
             "view_clearance_margin_m",
             "view_min_unknown_m2",
+            "narrow_clearance_margin_m",
         )
         require_finite(self, nonneg, positive=False)
+        require_finite(
+            self,
+            (
+                "tight_speed_mps",
+                "tight_track_lookahead_m",
+                "tight_turn_in_place_rad",
+                "tight_centring_range_m",
+            ),
+            positive=True,
+        )
         if not 0.0 < self.view_range_fraction <= 1.0:
             raise ValueError(
                 f"view_range_fraction must be in (0, 1], got {self.view_range_fraction!r}"

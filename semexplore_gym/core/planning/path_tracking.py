@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-__all__ = ["path_clearance_ahead_m", "tight_tracking_command"]
+__all__ = ["path_clearance_ahead_m", "scan_centring_offset_m", "tight_tracking_command"]
 
 
 def path_clearance_ahead_m(
@@ -39,13 +39,16 @@ def tight_tracking_command(
     max_omega_radps: float,
     turn_in_place_rad: float,
     heading_gain: float = 2.0,
+    lateral_shift_m: float = 0.0,
 ) -> tuple[float, float]:
     """One pure-pursuit step along ``path_m`` (``(n, 2)`` metres) from ``start_index``.
 
     The target is the first path point at least ``lookahead_m`` from the robot (the path's
     last point near its end). With a heading error above ``turn_in_place_rad`` the robot turns
     on the spot; otherwise it drives at ``speed_mps`` scaled by the cosine of the error and
-    steers with ``heading_gain`` times the error.
+    steers with ``heading_gain`` times the error. ``lateral_shift_m`` moves the target that far
+    to the robot's left (negative: right), e.g. by :func:`scan_centring_offset_m`, to keep it
+    centred between walls measured more exactly than the path was planned.
 
     Returns:
         ``(v_mps, omega_radps)``.
@@ -69,7 +72,8 @@ def tight_tracking_command(
     d = np.hypot(tail[:, 0] - x, tail[:, 1] - y)
     far = np.flatnonzero(d >= lookahead_m)
     target = tail[far[0]] if far.size else tail[-1]
-    dx, dy = float(target[0] - x), float(target[1] - y)
+    dx = float(target[0] - x) - lateral_shift_m * math.sin(yaw)
+    dy = float(target[1] - y) + lateral_shift_m * math.cos(yaw)
     if math.hypot(dx, dy) < 1e-9:
         return 0.0, 0.0
     err = math.atan2(dy, dx) - yaw
@@ -78,3 +82,32 @@ def tight_tracking_command(
     if abs(err) > turn_in_place_rad:
         return 0.0, omega
     return speed_mps * math.cos(err), omega
+
+
+def scan_centring_offset_m(
+    scan_m: np.ndarray,
+    angles_rad: np.ndarray,
+    *,
+    min_range_m: float,
+    reach_m: float,
+    side_halfwidth_rad: float = math.pi / 6,
+) -> float:
+    """How far (metres) the robot sits right of the middle between walls on both its sides.
+
+    The nearest return within ``side_halfwidth_rad`` of straight left (``+pi/2`` in the robot
+    frame) and of straight right is taken on each side; an invalid return (0: closer than the
+    LiDAR's minimum range) counts as ``min_range_m``. When both sides have a wall within
+    ``reach_m`` the result is half their difference (positive: move left), else 0.
+    """
+    r = np.asarray(scan_m, dtype=np.float64)
+    a = np.mod(np.asarray(angles_rad, dtype=np.float64), 2.0 * math.pi)
+    r = np.where(r <= 0.0, min_range_m, r)
+    left = np.abs(a - 0.5 * math.pi) <= side_halfwidth_rad
+    right = np.abs(a - 1.5 * math.pi) <= side_halfwidth_rad
+    if not (left.any() and right.any()):
+        return 0.0
+    d_left = float(r[left].min())
+    d_right = float(r[right].min())
+    if d_left > reach_m or d_right > reach_m:
+        return 0.0
+    return 0.5 * (d_left - d_right)
