@@ -22,6 +22,8 @@ from semexplore_gym.policies.semantic_expert_params import PathFollowingParams
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.path_tracking import (
+    front_range_m,
+    path_heading_rad,
     scan_centring_offset_m,
     tight_tracking_command,
 )
@@ -56,6 +58,10 @@ STILL_SPEED_FRACTION = 0.1
 
 #: A narrow plan is tracked exactly where its path is tight this far ahead of the robot (m).
 TIGHT_LOOKAHEAD_M = 0.5
+
+#: In a tight passage the scan must show this much room ahead of the robot beyond its radius,
+#: or it only turns (m).
+TIGHT_MIN_SPARE_M = 0.01
 
 
 class PathFollower:
@@ -197,13 +203,19 @@ class PathFollower:
         prm = self.params
         if self._angles is None or len(self._angles) != len(scan):
             self._angles = beam_angles_rad(len(scan))
+        heading = path_heading_rad(plan.path_m, plan.progress + 1)
         shift = scan_centring_offset_m(
             scan,
             self._angles,
             min_range_m=self.min_range_m,
             reach_m=prm.tight_centring_range_m,
+            left_rad=heading - pose[2] + 0.5 * math.pi,
         )
-        return tight_tracking_command(
+        # The scan corrects the map's placement of the walls (a wall hit on a cell border may
+        # mark the free cell beside it), by a cell at most.
+        cell_m = self.geometry.resolution_m
+        shift = float(np.clip(shift, -cell_m, cell_m))
+        v, w = tight_tracking_command(
             pose,
             plan.path_m,
             plan.progress,
@@ -213,6 +225,12 @@ class PathFollower:
             turn_in_place_rad=prm.tight_turn_in_place_rad,
             lateral_shift_m=shift,
         )
+        # Something within 60 degrees of ahead and nearer than the robot's radius plus a
+        # centimetre (a return under the LiDAR's minimum range reads 0): turn only.
+        ahead_m = front_range_m(scan, self._angles, min_range_m=0.0, halfwidth_rad=math.pi / 3)
+        if ahead_m < self.limits.radius_m + TIGHT_MIN_SPARE_M:
+            v = min(v, 0.0)
+        return v, w
 
     def advance_progress(self, plan: Plan, pose: tuple[float, float, float]) -> None:
         """Move ``plan.progress`` to the nearest path point a short window ahead."""

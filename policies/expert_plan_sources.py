@@ -46,6 +46,7 @@ from semexplore_gym.core.frontiers.reachable import (
     FrontierFilter,
     clearance_field_m,
     grid_path_to,
+    known_free_clearance_m,
     nearest_reachable_frontier,
     pocket_exit_path,
 )
@@ -74,6 +75,7 @@ __all__ = [
     "SemanticFrontier",
     "ViewFrontier",
     "insert_plan_source",
+    "path_clearance_along",
     "standable_prefix",
     "unknown_near",
 ]
@@ -83,6 +85,10 @@ VIEW_REACHED_M = 0.15
 
 #: Narrow frontiers checked against the trail before one is worth driving to.
 MAX_LOOK_CANDIDATES = 8
+
+#: A goal through a narrow passage counts as reached this close (metres): the expert's usual
+#: radius would count it reached from outside the passage.
+NARROW_REACHED_M = 0.1
 
 #: A look into a narrow passage's mouth ends at least this far from the robot, somewhere its
 #: trail has not been (metres).
@@ -140,6 +146,7 @@ class PlanContext:
     log: Callable[[str, str], None]
     lidar_range_m: tuple[float, float] = (0.0, 3.5)
     clearance_cache: np.ndarray | None = field(default=None, repr=False)
+    known_clearance_cache: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def xy_m(self) -> tuple[float, float]:
@@ -151,6 +158,15 @@ class PlanContext:
         if self.clearance_cache is None:
             self.clearance_cache = clearance_field_m(self.grid, self.geometry.resolution_m)
         return self.clearance_cache
+
+    def known_clearance_field(self) -> np.ndarray:
+        """Clearance to the nearest cell not mapped FREE (unseen walls count), once per replan:
+        what a passage narrower than the planners' clearance is measured with."""
+        if self.known_clearance_cache is None:
+            self.known_clearance_cache = known_free_clearance_m(
+                self.grid, self.geometry.resolution_m
+            )
+        return self.known_clearance_cache
 
     def resampled(self, path_m: np.ndarray) -> np.ndarray:
         """``path_m`` resampled at the map's resolution (what the path follower expects)."""
@@ -478,7 +494,7 @@ class NarrowFallback(PlanSource):
         thin_m = ctx.robot_radius_m + prm.narrow_clearance_margin_m
         if not (prm.grid_fallback and prm.narrow_passages) or thin_m >= ctx.clearance_m:
             return None
-        clearance = ctx.clearance_field()
+        clearance = ctx.known_clearance_field()
         # A passage this narrow has a frontier only about as wide as itself: the fallback's
         # minimum frontier width would hide it.
         search = ctx.fallback_search_kwargs()
@@ -501,13 +517,14 @@ class NarrowFallback(PlanSource):
             if path is None:
                 return None
             goal = (float(path[-1, 0]), float(path[-1, 1]))
-        rows, cols = ctx.geometry.world_to_grid(path[:, 0], path[:, 1])
-        h, w = ctx.geometry.shape
-        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
-        along = np.full(len(path), np.inf)
-        along[inside] = clearance[rows[inside], cols[inside]]
         ctx.counts.narrow_plans += 1
-        return Plan(PlanKind.FALLBACK, goal, path, path_clearance_m=along)
+        return Plan(
+            PlanKind.FALLBACK,
+            goal,
+            path,
+            reached_within_m=NARROW_REACHED_M,
+            path_clearance_m=path_clearance_along(ctx, path),
+        )
 
     @staticmethod
     def _look_into(ctx: PlanContext, thin_m: float, clearance: np.ndarray) -> np.ndarray | None:
@@ -529,7 +546,7 @@ class NarrowFallback(PlanSource):
         )
         if found is None:
             return None
-        path = standable_prefix(ctx, found.path_m, thin_m)
+        path = standable_prefix(ctx, found.path_m, thin_m, clearance)
         if len(path) < 2:
             return None
         end = (float(path[-1, 0]), float(path[-1, 1]))
@@ -594,15 +611,31 @@ class LookAtNarrowFrontier(PlanSource):
         return None
 
 
+def path_clearance_along(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
+    """The clearance to cells not mapped FREE at each point of ``path_m`` (``inf`` off the
+    map)."""
+    clearance = ctx.known_clearance_field()
+    rows, cols = ctx.geometry.world_to_grid(path_m[:, 0], path_m[:, 1])
+    h, w = ctx.geometry.shape
+    inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+    along = np.full(len(path_m), np.inf)
+    along[inside] = clearance[rows[inside], cols[inside]]
+    return along
+
+
 def standable_prefix(
-    ctx: PlanContext, path_m: np.ndarray, clearance_m: float | None = None
+    ctx: PlanContext,
+    path_m: np.ndarray,
+    clearance_m: float | None = None,
+    clearance_field: np.ndarray | None = None,
 ) -> np.ndarray:
     """The part of ``path_m`` from its start on which the robot's own clearance (or
-    ``clearance_m``) holds."""
+    ``clearance_m``, on ``clearance_field``) holds."""
     need_m = ctx.clearance_m if clearance_m is None else clearance_m
+    field_m = ctx.clearance_field() if clearance_field is None else clearance_field
     dense = ctx.resampled(path_m)
     rows, cols = ctx.geometry.world_to_grid(dense[:, 0], dense[:, 1])
-    ok = ctx.clearance_field()[rows, cols] >= need_m - 1e-9
+    ok = field_m[rows, cols] >= need_m - 1e-9
     # The robot may start closer to a wall than its clearance: skip that first stretch.
     first = int(np.argmax(ok)) if ok.any() else len(ok)
     bad = np.flatnonzero(~ok[first:])

@@ -287,7 +287,10 @@ class SemanticExpertParams:
             dropped without a view (a sliver; 0: view every one).
         narrow_passages: The graded clearance for passages narrower than the planners'
             clearance (see the module docstring).
-        narrow_clearance_margin_m: Its last search's clearance: the robot radius plus this.
+        narrow_clearance_margin_m: Its last search's clearance on the map: the robot radius
+            plus this (may be slightly negative: the map places each wall only to within a
+            cell, so a passage 0.25 m wide can show as 4 free cells, 0.1 m from the walls'
+            cells at its middle; the scan then says whether the robot fits).
         tight_speed_mps: Forward speed where a narrow plan's path is tight.
         tight_track_lookahead_m: There it aims at the path point this far ahead ...
         tight_turn_in_place_rad: ... and turns on the spot above this heading error ...
@@ -359,7 +362,7 @@ class SemanticExpertParams:
     view_clearance_margin_m: float = 0.025
     view_min_unknown_m2: float = 0.5
     narrow_passages: bool = False
-    narrow_clearance_margin_m: float = 0.04
+    narrow_clearance_margin_m: float = -0.005
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
@@ -415,9 +418,11 @@ class SemanticExpertParams:
             "view_min_range_margin_m",
             "view_clearance_margin_m",
             "view_min_unknown_m2",
-            "narrow_clearance_margin_m",
         )
         require_finite(self, nonneg, positive=False)
+        m = self.narrow_clearance_margin_m
+        if isinstance(m, bool) or not isinstance(m, (int, float)) or not -0.05 <= m <= 0.5:
+            raise ValueError(f"narrow_clearance_margin_m must be in [-0.05, 0.5] m, got {m!r}")
         require_finite(
             self,
             (

@@ -64,6 +64,14 @@ def clearance_field_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
     return wall_distance_m(np.ascontiguousarray(checked_encoded_grid(grid)), float(resolution_m))
 
 
+def known_free_clearance_m(grid: npt.ArrayLike, resolution_m: float) -> np.ndarray:
+    """Distance in metres from every FREE cell centre to the nearest cell centre that is not
+    FREE (OCCUPIED or UNKNOWN; 0 on those): the clearance a robot can count on where walls
+    may still be unseen (a passage mapped on one side only is as narrow as its known part)."""
+    g = checked_encoded_grid(grid)
+    return ndimage.distance_transform_edt(g == FREE) * float(resolution_m)
+
+
 def frontier_groups(
     grid: np.ndarray, min_frontier_cells: int, min_unknown_depth_cells: float = 0.0
 ) -> tuple[np.ndarray, int]:

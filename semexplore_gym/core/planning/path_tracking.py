@@ -14,7 +14,13 @@ import math
 
 import numpy as np
 
-__all__ = ["path_clearance_ahead_m", "scan_centring_offset_m", "tight_tracking_command"]
+__all__ = [
+    "path_heading_rad",
+    "front_range_m",
+    "path_clearance_ahead_m",
+    "scan_centring_offset_m",
+    "tight_tracking_command",
+]
 
 
 def path_clearance_ahead_m(
@@ -27,6 +33,16 @@ def path_clearance_ahead_m(
     if rows.size == 0:
         return math.inf
     return float(np.min(clearance_m[rows, cols]))
+
+
+def path_heading_rad(path_m: np.ndarray, index: int) -> float:
+    """Direction (world frame) of ``path_m`` at point ``index`` (from the point before it, or
+    to the point after it at the start); 0 for a single point."""
+    p = np.asarray(path_m, dtype=np.float64)
+    if p.shape[0] < 2:
+        return 0.0
+    i = min(max(int(index), 1), p.shape[0] - 1)
+    return math.atan2(float(p[i, 1] - p[i - 1, 1]), float(p[i, 0] - p[i - 1, 0]))
 
 
 def tight_tracking_command(
@@ -47,8 +63,8 @@ def tight_tracking_command(
     last point near its end). With a heading error above ``turn_in_place_rad`` the robot turns
     on the spot; otherwise it drives at ``speed_mps`` scaled by the cosine of the error and
     steers with ``heading_gain`` times the error. ``lateral_shift_m`` moves the target that far
-    to the robot's left (negative: right), e.g. by :func:`scan_centring_offset_m`, to keep it
-    centred between walls measured more exactly than the path was planned.
+    to the path's left (negative: right), e.g. by :func:`scan_centring_offset_m`, to keep the
+    robot centred between walls measured more exactly than the path was planned.
 
     Returns:
         ``(v_mps, omega_radps)``.
@@ -71,9 +87,11 @@ def tight_tracking_command(
     tail = path[min(max(int(start_index), 0), path.shape[0] - 1) :]
     d = np.hypot(tail[:, 0] - x, tail[:, 1] - y)
     far = np.flatnonzero(d >= lookahead_m)
-    target = tail[far[0]] if far.size else tail[-1]
-    dx = float(target[0] - x) - lateral_shift_m * math.sin(yaw)
-    dy = float(target[1] - y) + lateral_shift_m * math.cos(yaw)
+    k = int(far[0]) if far.size else tail.shape[0] - 1
+    target = tail[k]
+    heading = path_heading_rad(tail, k)
+    dx = float(target[0] - x) - lateral_shift_m * math.sin(heading)
+    dy = float(target[1] - y) + lateral_shift_m * math.cos(heading)
     if math.hypot(dx, dy) < 1e-9:
         return 0.0, 0.0
     err = math.atan2(dy, dx) - yaw
@@ -84,26 +102,33 @@ def tight_tracking_command(
     return speed_mps * math.cos(err), omega
 
 
+def _angle_within(a: np.ndarray, centre_rad: float, halfwidth_rad: float) -> np.ndarray:
+    d = np.mod(a - centre_rad + math.pi, 2.0 * math.pi) - math.pi
+    return np.abs(d) <= halfwidth_rad
+
+
 def scan_centring_offset_m(
     scan_m: np.ndarray,
     angles_rad: np.ndarray,
     *,
     min_range_m: float,
     reach_m: float,
+    left_rad: float = 0.5 * math.pi,
     side_halfwidth_rad: float = math.pi / 6,
 ) -> float:
     """How far (metres) the robot sits right of the middle between walls on both its sides.
 
-    The nearest return within ``side_halfwidth_rad`` of straight left (``+pi/2`` in the robot
-    frame) and of straight right is taken on each side; an invalid return (0: closer than the
-    LiDAR's minimum range) counts as ``min_range_m``. When both sides have a wall within
-    ``reach_m`` the result is half their difference (positive: move left), else 0.
+    ``left_rad`` is the direction (robot frame) counted as left, e.g. the left normal of the
+    path; the nearest return within ``side_halfwidth_rad`` of it and of its opposite is taken
+    on each side; an invalid return (0: closer than the LiDAR's minimum range) counts as
+    ``min_range_m``. When both sides have a wall within ``reach_m`` the result is half their
+    difference (positive: move left), else 0.
     """
     r = np.asarray(scan_m, dtype=np.float64)
-    a = np.mod(np.asarray(angles_rad, dtype=np.float64), 2.0 * math.pi)
+    a = np.asarray(angles_rad, dtype=np.float64)
     r = np.where(r <= 0.0, min_range_m, r)
-    left = np.abs(a - 0.5 * math.pi) <= side_halfwidth_rad
-    right = np.abs(a - 1.5 * math.pi) <= side_halfwidth_rad
+    left = _angle_within(a, left_rad, side_halfwidth_rad)
+    right = _angle_within(a, left_rad + math.pi, side_halfwidth_rad)
     if not (left.any() and right.any()):
         return 0.0
     d_left = float(r[left].min())
@@ -111,3 +136,25 @@ def scan_centring_offset_m(
     if d_left > reach_m or d_right > reach_m:
         return 0.0
     return 0.5 * (d_left - d_right)
+
+
+def _sides(
+    scan_m: np.ndarray, angles_rad: np.ndarray, min_range_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    r = np.asarray(scan_m, dtype=np.float64)
+    a = np.mod(np.asarray(angles_rad, dtype=np.float64), 2.0 * math.pi)
+    return np.where(r <= 0.0, min_range_m, r), a
+
+
+def front_range_m(
+    scan_m: np.ndarray,
+    angles_rad: np.ndarray,
+    *,
+    min_range_m: float,
+    halfwidth_rad: float = math.pi / 9,
+) -> float:
+    """The nearest return within ``halfwidth_rad`` of straight ahead (invalid returns, 0, count
+    as ``min_range_m``); ``inf`` when no beam points there."""
+    r, a = _sides(scan_m, angles_rad, min_range_m)
+    ahead = np.minimum(a, 2.0 * math.pi - a) <= halfwidth_rad
+    return float(r[ahead].min()) if ahead.any() else math.inf
