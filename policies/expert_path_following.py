@@ -22,8 +22,8 @@ from semexplore_gym.policies.semantic_expert_params import PathFollowingParams
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.path_tracking import (
-    front_range_m,
     path_heading_rad,
+    safe_forward_speed_mps,
     scan_centring_offset_m,
     tight_tracking_command,
 )
@@ -59,9 +59,8 @@ STILL_SPEED_FRACTION = 0.1
 #: A narrow plan is tracked exactly where its path is tight this far ahead of the robot (m).
 TIGHT_LOOKAHEAD_M = 0.5
 
-#: In a tight passage the scan must show this much room ahead of the robot beyond its radius,
-#: or it only turns (m).
-TIGHT_MIN_SPARE_M = 0.01
+#: In a tight passage no forward step brings the body nearer a scan return than this (m).
+TIGHT_MIN_SPARE_M = 0.003
 
 
 class PathFollower:
@@ -225,11 +224,17 @@ class PathFollower:
             turn_in_place_rad=prm.tight_turn_in_place_rad,
             lateral_shift_m=shift,
         )
-        # Something within 60 degrees of ahead and nearer than the robot's radius plus a
-        # centimetre (a return under the LiDAR's minimum range reads 0): turn only.
-        ahead_m = front_range_m(scan, self._angles, min_range_m=0.0, halfwidth_rad=math.pi / 3)
-        if ahead_m < self.limits.radius_m + TIGHT_MIN_SPARE_M:
-            v = min(v, 0.0)
+        # No step forward that would bring the body within a few millimetres of a return.
+        v = min(
+            v,
+            safe_forward_speed_mps(
+                scan,
+                self._angles,
+                radius_m=self.limits.radius_m,
+                dt_s=self.dt_s,
+                spare_m=TIGHT_MIN_SPARE_M,
+            ),
+        )
         return v, w
 
     def advance_progress(self, plan: Plan, pose: tuple[float, float, float]) -> None:

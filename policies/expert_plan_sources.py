@@ -183,6 +183,22 @@ class PlanContext:
             clearance_field=self.clearance_field(),
         )
 
+    def narrow_clearance_m(self) -> float:
+        """The graded clearance's thinnest: the robot radius plus ``narrow_clearance_margin_m``."""
+        return self.robot_radius_m + self.params.narrow_clearance_margin_m
+
+    def narrow_route(self, goal_xy_m: tuple[float, float]) -> np.ndarray | None:
+        """A grid path to ``goal_xy_m`` at :meth:`narrow_clearance_m` on the clearance to cells
+        not mapped FREE (None: none)."""
+        return grid_path_to(
+            self.grid,
+            self.geometry,
+            self.xy_m,
+            goal_xy_m,
+            self.narrow_clearance_m(),
+            clearance_field=self.known_clearance_field(),
+        )
+
     def fallback_search_kwargs(self) -> dict[str, Any]:
         """Which frontiers the grid fallback counts (the same for its every search)."""
         prm = self.params
@@ -261,6 +277,19 @@ class RetryFailedGoal(PlanSource):
             )
             if found is not None:
                 target, path = found
+        if path is None and ctx.params.narrow_passages and retry.failures == 1:
+            # Graded clearance: a way through passages narrower than the planners' clearance.
+            path = ctx.narrow_route(goal)
+            if path is not None:
+                dense = ctx.resampled(path)
+                return Plan(
+                    PlanKind.RETRY,
+                    goal,
+                    dense,
+                    frontier_xy_m=goal,
+                    reached_within_m=NARROW_REACHED_M,
+                    path_clearance_m=path_clearance_along(ctx, dense),
+                )
         if path is None:
             # The grid planner finds no way for the robot's disc: the goal is unreachable now.
             ctx.memory.retry = None
@@ -491,7 +520,7 @@ class NarrowFallback(PlanSource):
 
     def propose(self, ctx: PlanContext) -> Plan | None:
         prm = ctx.params
-        thin_m = ctx.robot_radius_m + prm.narrow_clearance_margin_m
+        thin_m = ctx.narrow_clearance_m()
         if not (prm.grid_fallback and prm.narrow_passages) or thin_m >= ctx.clearance_m:
             return None
         clearance = ctx.known_clearance_field()

@@ -16,6 +16,7 @@ import numpy as np
 
 __all__ = [
     "path_heading_rad",
+    "safe_forward_speed_mps",
     "front_range_m",
     "path_clearance_ahead_m",
     "scan_centring_offset_m",
@@ -158,3 +159,30 @@ def front_range_m(
     r, a = _sides(scan_m, angles_rad, min_range_m)
     ahead = np.minimum(a, 2.0 * math.pi - a) <= halfwidth_rad
     return float(r[ahead].min()) if ahead.any() else math.inf
+
+
+def safe_forward_speed_mps(
+    scan_m: np.ndarray,
+    angles_rad: np.ndarray,
+    *,
+    radius_m: float,
+    dt_s: float,
+    spare_m: float,
+    max_angle_rad: float = 7.0 * math.pi / 18.0,
+) -> float:
+    """The fastest forward speed for one step of ``dt_s`` that keeps every return within
+    ``max_angle_rad`` of ahead farther than ``radius_m + spare_m`` from the robot's centre
+    (a return at angle a comes ``s cos a`` nearer over ``s`` of travel). A return of 0 (under
+    the LiDAR's minimum range: somewhere between the body and that range) there allows none.
+    """
+    r = np.asarray(scan_m, dtype=np.float64)
+    a = np.asarray(angles_rad, dtype=np.float64)
+    c = np.cos(a)
+    ahead = c >= math.cos(max_angle_rad)
+    if not ahead.any():
+        return math.inf
+    r, c = r[ahead], c[ahead]
+    if (r <= 0.0).any():
+        return 0.0
+    room = (r - radius_m - spare_m) / c
+    return max(0.0, float(room.min()) / dt_s)
