@@ -5,7 +5,11 @@ robot and stalls there; a follower that knows its path is clear (a privileged pl
 true map, or a path planned on a clearance grid) can instead track the path's centre line
 closely and slowly. :func:`tight_tracking_command` is a pure-pursuit step with a short
 lookahead that turns on the spot (safe for a round differential-drive robot) whenever the
-heading error is large, so the body never sweeps sideways into a wall.
+heading error is large, so the body never sweeps sideways into a wall. For a follower that
+knows the walls only from a map (within a cell), :func:`scan_centring_offset_m` measures from
+the scan how far it sits off the middle between the walls on both sides of its path, and
+:func:`safe_forward_speed_mps` bounds a step so that no scan return comes within a few
+millimetres of the body.
 """
 
 from __future__ import annotations
@@ -15,10 +19,9 @@ import math
 import numpy as np
 
 __all__ = [
+    "path_clearance_ahead_m",
     "path_heading_rad",
     "safe_forward_speed_mps",
-    "front_range_m",
-    "path_clearance_ahead_m",
     "scan_centring_offset_m",
     "tight_tracking_command",
 ]
@@ -137,28 +140,6 @@ def scan_centring_offset_m(
     if d_left > reach_m or d_right > reach_m:
         return 0.0
     return 0.5 * (d_left - d_right)
-
-
-def _sides(
-    scan_m: np.ndarray, angles_rad: np.ndarray, min_range_m: float
-) -> tuple[np.ndarray, np.ndarray]:
-    r = np.asarray(scan_m, dtype=np.float64)
-    a = np.mod(np.asarray(angles_rad, dtype=np.float64), 2.0 * math.pi)
-    return np.where(r <= 0.0, min_range_m, r), a
-
-
-def front_range_m(
-    scan_m: np.ndarray,
-    angles_rad: np.ndarray,
-    *,
-    min_range_m: float,
-    halfwidth_rad: float = math.pi / 9,
-) -> float:
-    """The nearest return within ``halfwidth_rad`` of straight ahead (invalid returns, 0, count
-    as ``min_range_m``); ``inf`` when no beam points there."""
-    r, a = _sides(scan_m, angles_rad, min_range_m)
-    ahead = np.minimum(a, 2.0 * math.pi - a) <= halfwidth_rad
-    return float(r[ahead].min()) if ahead.any() else math.inf
 
 
 def safe_forward_speed_mps(
