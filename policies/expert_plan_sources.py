@@ -288,7 +288,7 @@ class RetryFailedGoal(PlanSource):
                     dense,
                     frontier_xy_m=goal,
                     reached_within_m=NARROW_REACHED_M,
-                    path_clearance_m=path_clearance_along(ctx, dense),
+                    path_clearance_m=path_clearance_along(ctx, dense, ctx.known_clearance_field()),
                 )
         if path is None:
             # The grid planner finds no way for the robot's disc: the goal is unreachable now.
@@ -524,11 +524,10 @@ class NarrowFallback(PlanSource):
         if not (prm.grid_fallback and prm.narrow_passages) or thin_m >= ctx.clearance_m:
             return None
         clearance = ctx.known_clearance_field()
-        # A passage this narrow has a frontier only about as wide as itself: the fallback's
-        # minimum frontier width would hide it.
+        # The fallback's own frontier filter: a frontier as narrow as the passage is a crack as
+        # often as a way on (cave walls are full of them); a passage leading somewhere shows a
+        # wider frontier beyond it once the robot looks along it (the look below).
         search = ctx.fallback_search_kwargs()
-        widest_cells = max(1, math.floor(2.0 * thin_m / ctx.geometry.resolution_m + 1e-9))
-        search["min_frontier_cells"] = min(search["min_frontier_cells"], widest_cells)
         found = nearest_reachable_frontier(
             ctx.grid,
             ctx.geometry,
@@ -552,7 +551,7 @@ class NarrowFallback(PlanSource):
             goal,
             path,
             reached_within_m=NARROW_REACHED_M,
-            path_clearance_m=path_clearance_along(ctx, path),
+            path_clearance_m=path_clearance_along(ctx, path, clearance),
         )
 
     @staticmethod
@@ -565,7 +564,8 @@ class NarrowFallback(PlanSource):
             ctx.xy_m,
             ctx.clearance_m * prm.look_clearance_fraction,
             FrontierFilter(
-                min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
+                # At least as wide as a passage the robot fits through shows on the map.
+                min_frontier_cells=max(1, math.floor(2.0 * thin_m / res_m + 1e-9)),
                 min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
                 reach_m=prm.fallback_reach_m,
                 excluded_xy_m=ctx.memory.dropped_points(),
@@ -640,10 +640,13 @@ class LookAtNarrowFrontier(PlanSource):
         return None
 
 
-def path_clearance_along(ctx: PlanContext, path_m: np.ndarray) -> np.ndarray:
-    """The clearance to cells not mapped FREE at each point of ``path_m`` (``inf`` off the
-    map)."""
-    clearance = ctx.known_clearance_field()
+def path_clearance_along(
+    ctx: PlanContext, path_m: np.ndarray, clearance: np.ndarray | None = None
+) -> np.ndarray:
+    """The wall clearance (``clearance``, default the map's to OCCUPIED cells) at each point
+    of ``path_m`` (``inf`` off the map)."""
+    if clearance is None:
+        clearance = ctx.clearance_field()
     rows, cols = ctx.geometry.world_to_grid(path_m[:, 0], path_m[:, 1])
     h, w = ctx.geometry.shape
     inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)

@@ -89,7 +89,6 @@ from semexplore_gym.policies.expert_plan_sources import (
     PlanContext,
     PlanSource,
     insert_plan_source,
-    path_clearance_along,
     unknown_near,
 )
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
@@ -481,8 +480,6 @@ class SemanticExpertPolicy(Policy):
             new_plan = source.propose(ctx)
             if new_plan is not None:
                 break
-        if new_plan is not None and prm.narrow_passages and new_plan.path_clearance_m is None:
-            new_plan.path_clearance_m = path_clearance_along(ctx, new_plan.path_m)
         stats.global_planning_ms = (time.perf_counter() - t1) * 1e3
         if new_plan is None:
             self._give_up_plan()
