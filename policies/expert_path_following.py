@@ -22,6 +22,7 @@ from semexplore_gym.policies.semantic_expert_params import PathFollowingParams
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.path_tracking import (
+    TightTracking,
     path_heading_rad,
     safe_forward_speed_mps,
     scan_centring_offset_m,
@@ -103,6 +104,12 @@ class PathFollower:
             self.params = params
         self.min_range_m = min_range_m
         prm = self.params
+        self._tracking = TightTracking(
+            lookahead_m=prm.tight_track_lookahead_m,
+            speed_mps=min(prm.tight_speed_mps, limits.max_linear_speed_mps),
+            max_omega_radps=limits.max_angular_speed_radps,
+            turn_in_place_rad=prm.tight_turn_in_place_rad,
+        )
         self.geometry = geometry
         self.limits = limits
         self.dt_s = dt_s
@@ -186,7 +193,8 @@ class PathFollower:
 
     def tight(self, plan: Plan) -> bool:
         """A narrow plan (``narrow_passages``) whose next stretch has less than the planners'
-        clearance on the map."""
+        clearance on the map (the expert then holds its periodic replans: a plan from inside
+        the passage would hand the robot back to the potential field)."""
         along = plan.path_clearance_m
         if along is None or not self.params.narrow_passages:
             return False
@@ -214,16 +222,7 @@ class PathFollower:
         # mark the free cell beside it), by a cell at most.
         cell_m = self.geometry.resolution_m
         shift = float(np.clip(shift, -cell_m, cell_m))
-        v, w = tight_tracking_command(
-            pose,
-            plan.path_m,
-            plan.progress,
-            lookahead_m=prm.tight_track_lookahead_m,
-            speed_mps=min(prm.tight_speed_mps, self.limits.max_linear_speed_mps),
-            max_omega_radps=self.limits.max_angular_speed_radps,
-            turn_in_place_rad=prm.tight_turn_in_place_rad,
-            lateral_shift_m=shift,
-        )
+        v, w = tight_tracking_command(pose, plan.path_m, plan.progress, self._tracking, shift)
         # No step forward that would bring the body within a few millimetres of a return.
         v = min(
             v,

@@ -61,6 +61,7 @@ from semexplore_gym.core.grid import FREE
 from semexplore_gym.core.planning.grid_scan import known_cell_count
 from semexplore_gym.core.planning.grid_search import distance_field, shortest_path_cells
 from semexplore_gym.core.planning.path_tracking import (
+    TightTracking,
     path_clearance_ahead_m,
     tight_tracking_command,
 )
@@ -200,6 +201,12 @@ class OraclePolicy(Policy):
         clearance = wall_clearance_m(facts.world, self.geometry, prm.path_prefer_clearance_m)
         self._clearance_m = clearance
         self._tight_below_m = env.radius_m + prm.tight_margin_m
+        self._tracking = TightTracking(
+            lookahead_m=prm.tight_track_lookahead_m,
+            speed_mps=min(prm.tight_speed_mps, env.max_linear_speed_mps),
+            max_omega_radps=env.max_angular_speed_radps,
+            turn_in_place_rad=prm.tight_turn_in_place_rad,
+        )
         pref = np.clip(1.0 - clearance / prm.path_prefer_clearance_m, 0.0, 1.0)
         self._drive_cost = np.where(tour.standing, res * (1.0 + prm.path_wall_cost * pref), np.inf)
         self._geo_cost = np.where(tour.standing, res, np.inf)
@@ -473,15 +480,7 @@ class OraclePolicy(Policy):
         assert path is not None
         if self._in_tight_passage(pose, path):
             self.counters["tight_steps"] += 1
-            v, w = tight_tracking_command(
-                pose,
-                path,
-                self._progress,
-                lookahead_m=self.params.tight_track_lookahead_m,
-                speed_mps=min(self.params.tight_speed_mps, self.limits.max_linear_speed_mps),
-                max_omega_radps=self.limits.max_angular_speed_radps,
-                turn_in_place_rad=self.params.tight_turn_in_place_rad,
-            )
+            v, w = tight_tracking_command(pose, path, self._progress, self._tracking)
             self._advance_progress(pose)
             return v, w
         cmd = potential_field_command(

@@ -279,11 +279,8 @@ class SemanticExpertPolicy(Policy):
         plan = self._plan
         if plan is None:
             return "no_plan"
-        if self._time_s >= self._next_replan_s - 1e-9:
-            # Inside a passage narrower than the planners' clearance, a narrow plan is kept
-            # until the robot is out: a plan from in there would hand it back to the field.
-            if not self.follower.tight(plan):
-                return "period"
+        if self._time_s >= self._next_replan_s - 1e-9 and not self.follower.tight(plan):
+            return "period"
         reach_m = plan.reached_within_m or self.params.goal_reached_radius_m
         if math.hypot(pose[0] - plan.goal_xy_m[0], pose[1] - plan.goal_xy_m[1]) <= reach_m:
             self.goal_memory.goal_reached(grid, plan, (pose[0], pose[1]))

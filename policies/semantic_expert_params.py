@@ -420,19 +420,7 @@ class SemanticExpertParams:
             "view_min_unknown_m2",
         )
         require_finite(self, nonneg, positive=False)
-        m = self.narrow_clearance_margin_m
-        if isinstance(m, bool) or not isinstance(m, (int, float)) or not -0.05 <= m <= 0.5:
-            raise ValueError(f"narrow_clearance_margin_m must be in [-0.05, 0.5] m, got {m!r}")
-        require_finite(
-            self,
-            (
-                "tight_speed_mps",
-                "tight_track_lookahead_m",
-                "tight_turn_in_place_rad",
-                "tight_centring_range_m",
-            ),
-            positive=True,
-        )
+        self._check_narrow()
         if not 0.0 < self.view_range_fraction <= 1.0:
             raise ValueError(
                 f"view_range_fraction must be in (0, 1], got {self.view_range_fraction!r}"
@@ -457,6 +445,13 @@ class SemanticExpertParams:
             raise ValueError(f"max_look_drives must be >= 0, got {self.max_look_drives!r}")
         if int(self.max_revivals) < 0:
             raise ValueError(f"max_revivals must be >= 0, got {self.max_revivals!r}")
+
+    def _check_narrow(self) -> None:
+        m = self.narrow_clearance_margin_m
+        if isinstance(m, bool) or not isinstance(m, (int, float)) or not -0.05 <= m <= 0.5:
+            raise ValueError(f"narrow_clearance_margin_m must be in [-0.05, 0.5] m, got {m!r}")
+        tight = ("tight_speed_mps", "tight_track_lookahead_m", "tight_turn_in_place_rad")
+        require_finite(self, (*tight, "tight_centring_range_m"), positive=True)
 
     @property
     def path_following(self) -> PathFollowingParams:

@@ -15,10 +15,12 @@ millimetres of the body.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
+    "TightTracking",
     "path_clearance_ahead_m",
     "path_heading_rad",
     "safe_forward_speed_mps",
@@ -49,48 +51,62 @@ def path_heading_rad(path_m: np.ndarray, index: int) -> float:
     return math.atan2(float(p[i, 1] - p[i - 1, 1]), float(p[i, 0] - p[i - 1, 0]))
 
 
+@dataclass(frozen=True)
+class TightTracking:
+    """How :func:`tight_tracking_command` tracks a path.
+
+    Attributes:
+        lookahead_m: Aim at the first path point at least this far from the robot.
+        speed_mps: Forward speed (scaled by the cosine of the heading error).
+        max_omega_radps: Turn-rate limit.
+        turn_in_place_rad: Above this heading error the robot only turns.
+        heading_gain: Turn rate per radian of heading error.
+    """
+
+    lookahead_m: float
+    speed_mps: float
+    max_omega_radps: float
+    turn_in_place_rad: float
+    heading_gain: float = 2.0
+
+    def __post_init__(self) -> None:
+        for name in ("lookahead_m", "speed_mps", "max_omega_radps", "turn_in_place_rad"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be positive, got {value!r}")
+
+
 def tight_tracking_command(
     pose: tuple[float, float, float],
     path_m: np.ndarray,
     start_index: int,
-    *,
-    lookahead_m: float,
-    speed_mps: float,
-    max_omega_radps: float,
-    turn_in_place_rad: float,
-    heading_gain: float = 2.0,
+    tracking: TightTracking,
     lateral_shift_m: float = 0.0,
 ) -> tuple[float, float]:
     """One pure-pursuit step along ``path_m`` (``(n, 2)`` metres) from ``start_index``.
 
-    The target is the first path point at least ``lookahead_m`` from the robot (the path's
-    last point near its end). With a heading error above ``turn_in_place_rad`` the robot turns
-    on the spot; otherwise it drives at ``speed_mps`` scaled by the cosine of the error and
-    steers with ``heading_gain`` times the error. ``lateral_shift_m`` moves the target that far
-    to the path's left (negative: right), e.g. by :func:`scan_centring_offset_m`, to keep the
-    robot centred between walls measured more exactly than the path was planned.
+    The target is the first path point at least ``tracking.lookahead_m`` from the robot (the
+    path's last point near its end). With a heading error above ``tracking.turn_in_place_rad``
+    the robot turns on the spot; otherwise it drives at ``tracking.speed_mps`` scaled by the
+    cosine of the error and steers with ``tracking.heading_gain`` times the error.
+    ``lateral_shift_m`` moves the target that far to the path's left (negative: right), e.g.
+    by :func:`scan_centring_offset_m`, to keep the robot centred between walls measured more
+    exactly than the path was planned.
 
     Returns:
         ``(v_mps, omega_radps)``.
 
     Raises:
-        ValueError: An empty path, or a non-positive lookahead, speed or turn rate.
+        ValueError: An empty path.
     """
     path = np.asarray(path_m, dtype=np.float64)
     if path.ndim != 2 or path.shape[0] == 0 or path.shape[1] != 2:
         raise ValueError(f"path_m must be a non-empty (n, 2) array, got shape {path.shape}")
-    for name, value in (
-        ("lookahead_m", lookahead_m),
-        ("speed_mps", speed_mps),
-        ("max_omega_radps", max_omega_radps),
-        ("turn_in_place_rad", turn_in_place_rad),
-    ):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be positive, got {value!r}")
+    t = tracking
     x, y, yaw = pose
     tail = path[min(max(int(start_index), 0), path.shape[0] - 1) :]
     d = np.hypot(tail[:, 0] - x, tail[:, 1] - y)
-    far = np.flatnonzero(d >= lookahead_m)
+    far = np.flatnonzero(d >= t.lookahead_m)
     k = int(far[0]) if far.size else tail.shape[0] - 1
     target = tail[k]
     heading = path_heading_rad(tail, k)
@@ -100,10 +116,10 @@ def tight_tracking_command(
         return 0.0, 0.0
     err = math.atan2(dy, dx) - yaw
     err = math.atan2(math.sin(err), math.cos(err))
-    omega = float(np.clip(heading_gain * err, -max_omega_radps, max_omega_radps))
-    if abs(err) > turn_in_place_rad:
+    omega = float(np.clip(t.heading_gain * err, -t.max_omega_radps, t.max_omega_radps))
+    if abs(err) > t.turn_in_place_rad:
         return 0.0, omega
-    return speed_mps * math.cos(err), omega
+    return t.speed_mps * math.cos(err), omega
 
 
 def _angle_within(a: np.ndarray, centre_rad: float, halfwidth_rad: float) -> np.ndarray:

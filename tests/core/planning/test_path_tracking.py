@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.planning.path_tracking import (
+    TightTracking,
     path_clearance_ahead_m,
     path_heading_rad,
     safe_forward_speed_mps,
@@ -19,6 +20,7 @@ from semexplore_gym.core.planning.potential_field import beam_angles_rad
 ANGLES = beam_angles_rad(360)
 STRAIGHT = np.column_stack([np.linspace(0.0, 2.0, 41), np.zeros(41)])  # along +x
 KW = {"lookahead_m": 0.06, "speed_mps": 0.08, "max_omega_radps": 2.0, "turn_in_place_rad": 0.15}
+TRACK = TightTracking(**KW)
 
 
 def corridor_scan(y_m: float, half_width_m: float, yaw_rad: float = 0.0) -> np.ndarray:
@@ -34,29 +36,29 @@ def corridor_scan(y_m: float, half_width_m: float, yaw_rad: float = 0.0) -> np.n
 
 
 def test_on_the_path_and_facing_along_it_the_robot_drives_straight_at_the_set_speed():
-    v, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, **KW)
+    v, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, TRACK)
     assert v == pytest.approx(0.08) and w == pytest.approx(0.0)
 
 
 def test_a_large_heading_error_turns_on_the_spot_towards_the_path():
-    v, w = tight_tracking_command((0.0, 0.0, -0.5), STRAIGHT, 0, **KW)
+    v, w = tight_tracking_command((0.0, 0.0, -0.5), STRAIGHT, 0, TRACK)
     assert v == 0.0 and w > 0  # turn left (counter-clockwise) back onto +x
-    v, w = tight_tracking_command((0.0, 0.0, 0.1), STRAIGHT, 0, **KW)
+    v, w = tight_tracking_command((0.0, 0.0, 0.1), STRAIGHT, 0, TRACK)
     assert v > 0 and w < 0  # small error: drive and steer right
 
 
 def test_a_lateral_shift_moves_the_target_to_the_paths_left():
-    _, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, lateral_shift_m=0.01, **KW)
+    _, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, TRACK, 0.01)
     assert w > 0
-    _, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, lateral_shift_m=-0.01, **KW)
+    _, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, TRACK, -0.01)
     assert w < 0
 
 
 def test_bad_tracking_parameters_are_refused_by_name():
     with pytest.raises(ValueError, match="speed_mps"):
-        tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, **{**KW, "speed_mps": 0.0})
+        TightTracking(**{**KW, "speed_mps": 0.0})
     with pytest.raises(ValueError, match="path_m"):
-        tight_tracking_command((0.0, 0.0, 0.0), np.zeros((0, 2)), 0, **KW)
+        tight_tracking_command((0.0, 0.0, 0.0), np.zeros((0, 2)), 0, TRACK)
 
 
 def test_the_scan_says_how_far_the_robot_sits_off_the_corridors_middle():
