@@ -47,6 +47,12 @@ def test_a_large_heading_error_turns_on_the_spot_towards_the_path():
     assert v > 0 and w < 0  # small error: drive and steer right
 
 
+def test_the_target_is_a_lookahead_ahead_from_the_progress_index():
+    # Robot beyond the path's end, progress there: it aims at the last point (behind it).
+    v, w = tight_tracking_command((2.5, 0.0, 0.0), STRAIGHT, 40, TRACK)
+    assert v == 0.0 and abs(w) > 0
+
+
 def test_a_lateral_shift_moves_the_target_to_the_paths_left():
     _, w = tight_tracking_command((0.0, 0.0, 0.0), STRAIGHT, 0, TRACK, 0.01)
     assert w > 0
