@@ -403,10 +403,10 @@ class NarrowFallback(PlanSource):
         else:
             # A passage seen only at a grazing angle is not mapped free across its width yet:
             # drive into its mouth as far as the thin clearance holds, and look along it.
-            path = self._look_into(ctx, thin_m, clearance)
-            if path is None:
+            mouth = self._look_into(ctx, thin_m, clearance)
+            if mouth is None:
                 return None
-            goal = (float(path[-1, 0]), float(path[-1, 1]))
+            path, goal = mouth, (float(mouth[-1, 0]), float(mouth[-1, 1]))
         ctx.counts.narrow_plans += 1
         return Plan(
             PlanKind.FALLBACK,
