@@ -180,6 +180,10 @@ def _quartile_ranks(n: int) -> list[int]:
     return [int(math.floor(q * (n - 1))) for q in (0.25, 0.5, 0.75)]
 
 
+#: Families per row of the ladder figure.
+LADDER_COLUMNS = 3
+
+
 def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Path:
     """``regret_ladder.png``: per family, median T99 ÷ oracle with IQR per policy (log x)."""
     from semexplore_gym.evaluation.suites import world_family
@@ -201,13 +205,20 @@ def write_ladder(out_dir: str | os.PathLike, regret: list[dict[str, Any]]) -> Pa
                 r["T99_ratio"]
             )
     n = max(1, len(families))
+    cols = min(n, LADDER_COLUMNS)  # more families wrap onto further rows
+    rows = math.ceil(n / cols)
     fig, axes = plt.subplots(
-        1,
-        n,
-        figsize=(4.2 * n, 0.5 + 0.45 * max([len(v) + 1 for v in families.values()] or [2])),
+        rows,
+        cols,
+        figsize=(
+            4.2 * cols,
+            rows * (0.5 + 0.45 * max([len(v) + 1 for v in families.values()] or [2])) + 0.3,
+        ),
         squeeze=False,
     )
-    for ax, (fam, by_policy) in zip(axes[0], families.items(), strict=False):
+    for ax in axes.flat[n:]:
+        ax.set_axis_off()
+    for ax, (fam, by_policy) in zip(axes.flat, families.items(), strict=False):
         # Never reaching 99 % is an infinite ratio: drawn at the right edge, marked "∞".
         finite = [x for v in by_policy.values() for x in v if math.isfinite(x)]
         cap = min(50.0, max([2.0, *finite]) * 1.1)
