@@ -16,6 +16,7 @@ from semexplore_gym.policies.expert_plan import Plan
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.core.frontiers.reachable import (
+    FrontierFilter,
     clearance_field_m,
     grid_path_to,
     known_free_clearance_m,
@@ -135,6 +136,18 @@ class PlanContext:
             goal_xy_m,
             self.narrow_clearance_m(),
             clearance_field=self.known_clearance_field(),
+        )
+
+    def look_filter(self, min_frontier_cells: int) -> FrontierFilter:
+        """Which frontiers the looks at narrow frontiers count: groups of at least
+        ``min_frontier_cells`` with unknown space ``look_min_unknown_depth_m`` deep, not dropped."""
+        prm = self.params
+        return FrontierFilter(
+            min_frontier_cells=min_frontier_cells,
+            min_unknown_depth_cells=prm.look_min_unknown_depth_m / self.geometry.resolution_m,
+            reach_m=prm.fallback_reach_m,
+            excluded_xy_m=self.memory.dropped_points(),
+            excluded_radius_m=prm.blacklist_radius_m,
         )
 
     def fallback_search_kwargs(self) -> dict[str, Any]:

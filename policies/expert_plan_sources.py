@@ -425,14 +425,8 @@ class NarrowFallback(PlanSource):
             ctx.geometry,
             ctx.xy_m,
             ctx.clearance_m * prm.look_clearance_fraction,
-            FrontierFilter(
-                # At least as wide as a passage the robot fits through shows on the map.
-                min_frontier_cells=max(1, math.floor(2.0 * thin_m / res_m + 1e-9)),
-                min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
-                reach_m=prm.fallback_reach_m,
-                excluded_xy_m=ctx.memory.dropped_points(),
-                excluded_radius_m=prm.blacklist_radius_m,
-            ),
+            # At least as wide as a passage the robot fits through shows on the map.
+            ctx.look_filter(max(1, math.floor(2.0 * thin_m / res_m + 1e-9))),
             clearance_field=clearance,
         )
         if found is None:
@@ -476,13 +470,7 @@ class LookAtNarrowFrontier(PlanSource):
                 ctx.geometry,
                 ctx.xy_m,
                 ctx.clearance_m * prm.look_clearance_fraction,
-                FrontierFilter(
-                    min_frontier_cells=max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9)),
-                    min_unknown_depth_cells=prm.look_min_unknown_depth_m / res_m,
-                    reach_m=prm.fallback_reach_m,
-                    excluded_xy_m=ctx.memory.dropped_points(),
-                    excluded_radius_m=prm.blacklist_radius_m,
-                ),
+                ctx.look_filter(max(1, math.ceil(prm.look_min_frontier_m / res_m - 1e-9))),
                 clearance_field=clearance,
             )
             if found is None:

@@ -145,3 +145,28 @@ def privileged_world():
     """``privileged_world(world, start, radius_m, range_m, res_m)``: a ``PrivilegedWorld`` of a
     test world, as the privileged env hands it out."""
     return _privileged_world
+
+
+def _write_ros_map(
+    directory: Path, pixels: np.ndarray, name: str, origin_m: tuple[float, float] = (0.0, 0.0)
+) -> str:
+    """A ROS map_server pair (``name.pgm`` at 0.05 m per pixel, ``name.yaml``) in ``directory``;
+    the yaml's path. Pixels: 0 wall, 254 free (rows from the image's top)."""
+    from PIL import Image
+
+    Image.fromarray(np.asarray(pixels, dtype=np.uint8)).save(directory / f"{name}.pgm")
+    path = directory / f"{name}.yaml"
+    path.write_text(
+        f"image: {name}.pgm\nresolution: 0.05\norigin: [{origin_m[0]}, {origin_m[1]}, 0.0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    return str(path)
+
+
+@pytest.fixture
+def ros_map_file(tmp_path: Path):
+    """``ros_map_file(pixels, name, origin_m=(0, 0))``: write a small ROS map in ``tmp_path``
+    and return its yaml's path (a world spelling the env takes)."""
+    return lambda pixels, name, origin_m=(0.0, 0.0): _write_ros_map(
+        tmp_path, pixels, name, origin_m
+    )

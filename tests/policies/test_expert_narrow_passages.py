@@ -3,34 +3,24 @@ clearance but wider than the robot are explored, slowly and without touching the
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import gymnasium as gym
 import numpy as np
 import pytest
-from PIL import Image
 from semexplore_gym.policies.registry import make_policy
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
 
 
-def _rooms_joined_by_a_passage(tmp_path: Path, width_px: int) -> str:
-    """A ROS map (0.05 m pixels): two 1.5 m rooms joined by a 1.5 m straight passage
-    ``width_px`` pixels wide; the origin is off the cell grid, so no wall lies on a cell
-    border of the robot's map."""
+def _rooms_joined_by_a_passage(width_px: int) -> np.ndarray:
+    """Map pixels (0.05 m): two 1.5 m rooms joined by a 1.5 m straight passage ``width_px``
+    pixels wide."""
     img = np.zeros((90, 40), dtype=np.uint8)
     img[5:35, 5:35] = 254
     img[65:85, 5:35] = 254
     lo = 20 - width_px // 2
     img[35:65, lo : lo + width_px] = 254
-    Image.fromarray(img).save(tmp_path / "passage.pgm")
-    path = tmp_path / "passage.yaml"
-    path.write_text(
-        "image: passage.pgm\nresolution: 0.05\norigin: [0.013, 0.021, 0.0]\nnegate: 0\n"
-        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
-    )
-    return str(path)
+    return img
 
 
 def _mission(world: str, spec: str, seed: int):
@@ -45,10 +35,13 @@ def _mission(world: str, spec: str, seed: int):
 
 
 @pytest.mark.parametrize("width_px", [5, 6])
-def test_a_passage_just_wider_than_the_robot_is_explored_without_touching_it(tmp_path, width_px):
+def test_a_passage_just_wider_than_the_robot_is_explored_without_touching_it(
+    ros_map_file, width_px
+):
     # 0.25 m and 0.30 m: the env counts the far room as reachable (gaps from 0.23 m), the
     # planners' clearance (0.155 m, gaps from 0.31 m) does not.
-    world = _rooms_joined_by_a_passage(tmp_path, width_px)
+    # The origin is off the cell grid: no wall lies on a cell border of the robot's map.
+    world = ros_map_file(_rooms_joined_by_a_passage(width_px), "passage", (0.013, 0.021))
     default, _ = _mission(world, "semantic", seed=1)
     assert default.self_stopped and default.coverage < 0.8  # stops in the first room
     narrow, policy = _mission(world, "semantic[narrow_passages=true]", seed=1)

@@ -140,30 +140,22 @@ def test_train_cli_refuses_the_oracle_in_one_line_and_names_the_opt_in(tmp_path,
     assert "privileged" in err[0] and "expert.privileged_teacher=true" in err[0]
 
 
-def _two_rooms_and_a_gap(tmp_path, gap_px: int) -> str:
-    """A ROS map (0.05 m pixels): two 1.5 m rooms joined by a corridor ``gap_px`` wide with a
+def _two_rooms_and_a_gap(gap_px: int) -> np.ndarray:
+    """Map pixels (0.05 m): two 1.5 m rooms joined by a corridor ``gap_px`` wide with a
     dog-leg (no line of sight from one room into the other)."""
-    from PIL import Image
-
     img = np.zeros((90, 40), dtype=np.uint8)  # black: walls
     img[5:35, 5:35] = 254  # room A (image top)
     img[55:85, 5:35] = 254  # room B
     img[35:45, 8 : 8 + gap_px] = 254  # down from room A ...
     img[40 : 40 + gap_px, 8:32] = 254  # ... across ...
     img[40:55, 32 - gap_px : 32] = 254  # ... and down into room B
-    Image.fromarray(img).save(tmp_path / "gap.pgm")
-    path = tmp_path / "gap.yaml"
-    path.write_text(
-        "image: gap.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
-        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
-    )
-    return str(path)
+    return img
 
 
-def test_the_oracle_drives_through_a_passage_just_wider_than_the_robot(tmp_path):
+def test_the_oracle_drives_through_a_passage_just_wider_than_the_robot(ros_map_file):
     # 0.25 m: the robot is 0.21 m wide, the env counts the far room as reachable (clearance
     # radius + 0.01 m), and the potential field alone balances its two walls and stalls there.
-    world = _two_rooms_and_a_gap(tmp_path, gap_px=5)
+    world = ros_map_file(_two_rooms_and_a_gap(gap_px=5), "gap")
 
     def mission(**params):
         policy = OraclePolicy(OracleParams(**params))
