@@ -47,14 +47,14 @@ def one_round(world: str, policies: str, runs: int, max_time_s: float) -> dict[s
     return ratios
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--world", default="maze1")
     ap.add_argument("--policies", default="semantic,frontier")
     ap.add_argument("--runs", type=int, default=3, help="identical missions per policy (>= 2)")
     ap.add_argument("--max-time-s", type=float, default=40.0)
     ap.add_argument("--rounds", type=int, default=3, help="fresh-cache rounds (>= 1)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.runs < 2 or args.rounds < 1:
         ap.error(f"--runs must be >= 2 and --rounds >= 1, got {args.runs} and {args.rounds}")
     per_key: dict[str, list[float]] = {}
