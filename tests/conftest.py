@@ -170,3 +170,29 @@ def ros_map_file(tmp_path: Path):
     return lambda pixels, name, origin_m=(0.0, 0.0): _write_ros_map(
         tmp_path, pixels, name, origin_m
     )
+
+
+def _short_mission(world: str, policy, seed: int, max_time_s: float):
+    """One mission from a random start: ``policy`` is a spec (``make_policy``) or a Policy;
+    returns ``(MissionResult, policy)``."""
+    import gymnasium as gym
+    from semexplore_gym.policies.registry import make_policy
+
+    import semexplore_gym  # noqa: F401  (registers the env)
+    from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
+
+    policy = make_policy(policy) if isinstance(policy, str) else policy
+    env = gym.make(
+        "SemanticExplore-v0",
+        world=world,
+        overrides=[f"episode.max_time_s={max_time_s}", "episode.random_start=true"],
+        **map_observation_for(policy),
+    )
+    return run_mission(env, policy, seed=seed, ignore_terminated=True), policy
+
+
+@pytest.fixture
+def short_mission():
+    """``short_mission(world, policy, seed, max_time_s)``: one mission from the seed's random
+    start with the policy's own map observation; ``(result, policy)``."""
+    return _short_mission

@@ -3,13 +3,8 @@ clearance but wider than the robot are explored, slowly and without touching the
 
 from __future__ import annotations
 
-import gymnasium as gym
 import numpy as np
 import pytest
-from semexplore_gym.policies.registry import make_policy
-
-import semexplore_gym  # noqa: F401  (registers the env)
-from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
 
 
 def _rooms_joined_by_a_passage(width_px: int) -> np.ndarray:
@@ -23,28 +18,17 @@ def _rooms_joined_by_a_passage(width_px: int) -> np.ndarray:
     return img
 
 
-def _mission(world: str, spec: str, seed: int):
-    policy = make_policy(spec)
-    env = gym.make(
-        "SemanticExplore-v0",
-        world=world,
-        overrides=["episode.max_time_s=600", "episode.random_start=true"],
-        **map_observation_for(policy),
-    )
-    return run_mission(env, policy, seed=seed, ignore_terminated=True), policy
-
-
 @pytest.mark.parametrize("width_px", [5, 6])
 def test_a_passage_just_wider_than_the_robot_is_explored_without_touching_it(
-    ros_map_file, width_px
+    ros_map_file, short_mission, width_px
 ):
     # 0.25 m and 0.30 m: the env counts the far room as reachable (gaps from 0.23 m), the
     # planners' clearance (0.155 m, gaps from 0.31 m) does not.
     # The origin is off the cell grid: no wall lies on a cell border of the robot's map.
     world = ros_map_file(_rooms_joined_by_a_passage(width_px), "passage", (0.013, 0.021))
-    default, _ = _mission(world, "semantic", seed=1)
+    default, _ = short_mission(world, "semantic", 1, 600)
     assert default.self_stopped and default.coverage < 0.8  # stops in the first room
-    narrow, policy = _mission(world, "semantic[narrow_passages=true]", seed=1)
+    narrow, policy = short_mission(world, "semantic[narrow_passages=true]", 1, 600)
     assert narrow.self_stopped and narrow.coverage >= 0.97
     assert narrow.collisions == 0
     assert policy.counters["narrow_plans"] > 0 and policy.counters["tight_steps"] > 0

@@ -15,7 +15,7 @@ from semexplore_gym.policies.registry import make_policy
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, PrivilegedWorld
-from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
+from semexplore_gym.evaluation.rollout import map_observation_for
 
 pytest.importorskip("elkai")
 
@@ -102,30 +102,19 @@ def test_the_oracle_labels_a_dataset_when_asked_and_the_student_sees_only_featur
     assert set(data.obs) == set(make_learner_env(cfg).observation_space.spaces)
 
 
-def _mission(world: str, spec: str, seed: int):
-    policy = make_policy(spec)
-    env = gym.make(
-        "SemanticExplore-v0",
-        world=world,
-        overrides=["episode.max_time_s=900", "episode.random_start=true"],
-        **map_observation_for(policy),
-    )
-    return run_mission(env, policy, seed=seed, ignore_terminated=True)
-
-
 @pytest.mark.parametrize("world", ["maze:seed=3,size_m=5", "cave:seed=1,size_m=6"])
-def test_an_oracle_mission_stops_itself_at_the_goal_before_the_expert(world):
-    res = _mission(world, "oracle", seed=1)
+def test_an_oracle_mission_stops_itself_at_the_goal_before_the_expert(world, short_mission):
+    res, _ = short_mission(world, "oracle", 1, 900)
     assert res.self_stopped and res.stop_reason == "coverage_goal"
     assert res.coverage >= 0.99 and res.collisions == 0
-    expert = _mission(world, "semantic", seed=1)
+    expert, _ = short_mission(world, "semantic", 1, 900)
     assert res.t99_s is not None
     assert expert.t99_s is None or res.t99_s <= expert.t99_s
 
 
-def test_the_oracle_is_deterministic_for_a_fixed_seed():
-    a = _mission("maze:seed=3,size_m=4", "oracle", seed=2)
-    b = _mission("maze:seed=3,size_m=4", "oracle", seed=2)
+def test_the_oracle_is_deterministic_for_a_fixed_seed(short_mission):
+    a, _ = short_mission("maze:seed=3,size_m=4", "oracle", 2, 900)
+    b, _ = short_mission("maze:seed=3,size_m=4", "oracle", 2, 900)
     assert a.mission_time_s == b.mission_time_s
     assert np.array_equal(a.trajectory, b.trajectory)
 
@@ -152,20 +141,13 @@ def _two_rooms_and_a_gap(gap_px: int) -> np.ndarray:
     return img
 
 
-def test_the_oracle_drives_through_a_passage_just_wider_than_the_robot(ros_map_file):
+def test_the_oracle_drives_through_a_passage_just_wider_than_the_robot(ros_map_file, short_mission):
     # 0.25 m: the robot is 0.21 m wide, the env counts the far room as reachable (clearance
     # radius + 0.01 m), and the potential field alone balances its two walls and stalls there.
     world = ros_map_file(_two_rooms_and_a_gap(gap_px=5), "gap")
 
     def mission(**params):
-        policy = OraclePolicy(OracleParams(**params))
-        env = gym.make(
-            "SemanticExplore-v0",
-            world=world,
-            overrides=["episode.max_time_s=400", "episode.random_start=true"],
-            **map_observation_for(policy),
-        )
-        return run_mission(env, policy, seed=0, ignore_terminated=True), policy
+        return short_mission(world, OraclePolicy(OracleParams(**params)), 0, 400)
 
     res, policy = mission()
     assert res.self_stopped and res.stop_reason == "coverage_goal"
