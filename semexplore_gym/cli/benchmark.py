@@ -325,6 +325,8 @@ def _run(args: argparse.Namespace) -> int:
 
         if getattr(args, "split", None):
             raise ValueError("--robots runs --worlds or --suite; --split is for single robots")
+        if args.oracle:
+            raise ValueError("--oracle is for single robots: the oracle has no team version")
 
         return run_team_study(team_study_request(args))
     policies = _split_policies(args.policies)
@@ -429,4 +431,8 @@ def team_study_request(args: argparse.Namespace) -> Any:
         fixed_start=bool(args.fixed_start),
         progress=not args.no_progress,
         command=" ".join(shlex.quote(a) for a in sys.argv),
+        workers=args.workers,
+        backend=args.backend,
+        ray_address=args.ray_address,
+        plots=not args.no_plots,
     )

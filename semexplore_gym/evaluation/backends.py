@@ -11,10 +11,11 @@ import os
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
-from typing import Any
+from typing import Any, TypeVar
 
-from semexplore_gym.evaluation.tasks import Task
-
+#: A mission to run: the single-robot benchmark's ``Task`` or the team benchmark's
+#: ``TeamTask`` (frozen dataclasses, so they pickle and hash).
+Task = TypeVar("Task")
 #: What a backend yields per mission: the task and its record, or the exception it raised.
 Outcome = tuple[Task, dict[str, Any] | BaseException]
 MissionRunner = Callable[[Task], dict[str, Any]]
@@ -50,7 +51,7 @@ def die_with_parent() -> None:
     threading.Thread(target=watch, daemon=True, name="die-with-parent").start()
 
 
-def run_sequential(tasks: list[Task], fn: MissionRunner) -> Iterator[Outcome]:
+def run_sequential(tasks: list[Task], fn: MissionRunner[Task]) -> Iterator[Outcome[Task]]:
     """Each mission in this process, in order."""
     for t in tasks:
         try:
@@ -59,7 +60,9 @@ def run_sequential(tasks: list[Task], fn: MissionRunner) -> Iterator[Outcome]:
             yield t, e
 
 
-def run_processes(tasks: list[Task], workers: int, fn: MissionRunner) -> Iterator[Outcome]:
+def run_processes(
+    tasks: list[Task], workers: int, fn: MissionRunner[Task]
+) -> Iterator[Outcome[Task]]:
     """Missions in ``workers`` spawned processes that die with this one; ``fn`` must pickle."""
     import concurrent.futures as cf
     import multiprocessing as mp
@@ -79,8 +82,8 @@ def run_processes(tasks: list[Task], workers: int, fn: MissionRunner) -> Iterato
 
 
 def run_ray(
-    tasks: list[Task], address: str | None, workers: int, fn: MissionRunner
-) -> Iterator[Outcome]:
+    tasks: list[Task], address: str | None, workers: int, fn: MissionRunner[Task]
+) -> Iterator[Outcome[Task]]:
     """Missions as Ray tasks of one CPU each, on the cluster at ``address`` or a local Ray with
     ``workers`` CPUs (started here and shut down when the stream ends)."""
     try:
@@ -118,9 +121,9 @@ def mission_stream(
     backend: str,
     workers: int,
     ray_address: str | None,
-    task_fn: MissionRunner,
-    parallel_fn: MissionRunner,
-) -> Iterable[Outcome]:
+    task_fn: MissionRunner[Task],
+    parallel_fn: MissionRunner[Task],
+) -> Iterable[Outcome[Task]]:
     """The backend for these settings: Ray, worker processes (more than one worker and
     mission), or this process. ``task_fn`` runs in this process; ``parallel_fn`` (picklable by
     reference) in workers."""

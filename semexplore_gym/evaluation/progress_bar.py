@@ -5,8 +5,6 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from semexplore_gym.evaluation.tasks import Task
-
 
 class MissionsBar:
     """Counts finished missions of ``total`` (``done`` already in the output); off when
@@ -26,11 +24,15 @@ class MissionsBar:
                 dynamic_ncols=True,
             )
 
-    def finished(self, task: Task) -> None:
-        """One more mission ended (ran or failed)."""
+    def finished(self, task: Any) -> None:
+        """One more mission ended (ran or failed): a task with ``world``, ``policy`` and
+        ``seed`` (the team benchmark's adds ``n_robots``)."""
         if self._bar is not None:
             self._bar.update(1)
-            self._bar.set_postfix_str(f"{task.world} {task.policy} seed={task.seed}", refresh=False)
+            robots = f" n={task.n_robots}" if hasattr(task, "n_robots") else ""
+            self._bar.set_postfix_str(
+                f"{task.world} {task.policy}{robots} seed={task.seed}", refresh=False
+            )
 
     def close(self) -> None:
         if self._bar is not None:

@@ -24,9 +24,8 @@ robot_collisions   robot-robot contacts begun; ``contacts`` all contacts (walls 
 wall_time_s        wall-clock time of the mission
 ================== ==========================================================================
 
-``summary.md`` has one table per world family: medians per (policy, robots), the median of
-each seed's T99 ratio to one robot's (same policy, world and seed) and, per team size, a
-paired Wilcoxon test of each policy's T99 against ``independent``'s.
+``summary.md`` and ``team_speedup.png`` are written by
+:mod:`semexplore_gym.evaluation.team_report`.
 """
 
 from __future__ import annotations
@@ -34,12 +33,15 @@ from __future__ import annotations
 import csv
 import json
 import math
+import sys
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from semexplore_gym.evaluation.team_report import write_team_plot, write_team_summary
 
 COLUMNS = (
     "world",
@@ -191,7 +193,8 @@ class TeamBenchmarkConfig:
     ``time_limits`` gives some worlds their own limit (a suite's), else ``max_time_s``.
     ``team.end_on_coverage`` is set to false (the team, not the env's coverage goal, ends a
     mission) and ``episode.random_start`` to true unless ``fixed_start``; ``env_overrides``
-    come last.
+    come last. ``workers`` > 1 runs missions in that many processes (``backend="ray"``: on
+    Ray, at ``ray_address`` or a local one); rows are the same either way.
     """
 
     worlds: tuple[str, ...]
@@ -205,24 +208,89 @@ class TeamBenchmarkConfig:
     fixed_start: bool = False
     progress: bool = True
     time_limits: dict[str, float | None] = field(default_factory=dict)
+    workers: int = 1
+    backend: str = "process"
+    ray_address: str | None = None
 
 
-def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
-    """Every mission of ``config``, appended to ``config.out/runs.csv``.
+@dataclass(frozen=True)
+class TeamTask:
+    """One team mission: ``world`` (its ``seed=*`` already replaced), the team policy spec,
+    the team size, the seed, the time limit and the env's config and overrides."""
 
-    Rerunning the same command skips the missions already in ``runs.csv`` (resumes).
-    """
+    world: str
+    policy: str
+    n_robots: int
+    seed: int
+    max_time_s: float | None
+    env_config: Any
+    overrides: tuple[str, ...]
+
+
+#: Per process: the last env a team task made, reused while tasks share its world, size and
+#: config (a reset with the task's seed makes every mission independent of the one before).
+_ENV_CACHE: dict[str, Any] = {}
+
+
+def run_team_task(task: TeamTask) -> dict[str, Any]:
+    """The ``runs.csv`` row of one team mission (runs in this process or in a worker)."""
     from semexplore_gym.envs.multi_robot import make_multi
     from semexplore_gym.policies.team import make_team_policy
 
+    key = (task.world, task.n_robots, repr(task.env_config), task.overrides)
+    if _ENV_CACHE.get("key") != key:
+        _ENV_CACHE.clear()
+        _ENV_CACHE.update(
+            key=key,
+            env=make_multi(
+                world=task.world,
+                config=task.env_config,
+                overrides=list(task.overrides),
+                n_robots=task.n_robots,
+            ),
+        )
+    team = make_team_policy(task.policy)
+    row = run_team_mission(_ENV_CACHE["env"], team, task.seed, task.max_time_s).row()
+    row["world"] = task.world  # the spelling, as resume reads it back
+    return row
+
+
+def team_tasks(config: TeamBenchmarkConfig) -> list[TeamTask]:
+    """Every mission of ``config``, world-major, then team size, policy and seed."""
     c = config
-    worlds, policies, robot_counts, seeds = c.worlds, c.policies, c.robot_counts, c.seeds
-    max_time_s, env_config, progress, time_limits = (
-        c.max_time_s,
-        c.env_config,
-        c.progress,
-        c.time_limits,
-    )
+    overrides = ["episode.coverage_goal=1.0", "team.end_on_coverage=false"]
+    overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
+    if c.max_time_s is not None:
+        overrides.append(f"episode.max_time_s={c.max_time_s!r}")
+    overrides += list(c.env_overrides)
+    return [
+        TeamTask(
+            world=world.replace("seed=*", f"seed={seed}"),
+            policy=spec,
+            n_robots=int(n),
+            seed=int(seed),
+            max_time_s=(c.time_limits or {}).get(world, c.max_time_s),
+            env_config=c.env_config,
+            overrides=tuple(overrides),
+        )
+        for world in c.worlds
+        for n in c.robot_counts
+        for spec in c.policies
+        for seed in c.seeds
+    ]
+
+
+def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
+    """Every mission of ``config``, appended to ``config.out/runs.csv`` as it ends.
+
+    Rerunning the same command skips the missions already in ``runs.csv`` (resumes). A
+    mission that raises is reported on stderr and in ``failed``; the others go on.
+    """
+    from semexplore_gym.evaluation.backends import mission_stream
+    from semexplore_gym.evaluation.progress_bar import MissionsBar
+    from semexplore_gym.policies.team import make_team_policy
+
+    c = config
     out_dir = Path(c.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     csv_path = out_dir / "runs.csv"
@@ -231,131 +299,35 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
         with csv_path.open(newline="") as f:
             for r in csv.DictReader(f):
                 done.add((r["world"], r["policy"], int(r["n_robots"]), int(r["seed"])))
-    overrides = ["episode.coverage_goal=1.0", "team.end_on_coverage=false"]
-    overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
-    if max_time_s is not None:
-        overrides.append(f"episode.max_time_s={max_time_s!r}")
-    overrides += list(c.env_overrides)
-    ran = skipped = 0
+    names = {spec: make_team_policy(spec).name for spec in c.policies}
+    tasks = team_tasks(c)
+    todo = [t for t in tasks if (t.world, names[t.policy], t.n_robots, t.seed) not in done]
+    failed: list[tuple[tuple[str, str, int, int], str]] = []
     write_header = not csv_path.exists()
+    bar = MissionsBar(c.progress, total=len(tasks), done=len(tasks) - len(todo))
+    stream = mission_stream(todo, c.backend, c.workers, c.ray_address, run_team_task, run_team_task)
     with csv_path.open("a", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS)
         if write_header:
             writer.writeheader()
-        for world in worlds:
-            for n in robot_counts:
-                env = None
-                for spec in policies:
-                    for seed in seeds:
-                        w = world.replace("seed=*", f"seed={seed}")
-                        team = make_team_policy(spec)
-                        if env is None or env.world_spec != w:
-                            env = make_multi(
-                                world=w, config=env_config, overrides=overrides, n_robots=n
-                            )
-                        key = (str(env.world.name), team.name, int(n), int(seed))
-                        if key in done:
-                            skipped += 1
-                            continue
-                        limit = (time_limits or {}).get(world, max_time_s)
-                        res = run_team_mission(env, team, seed, max_time_s=limit)
-                        writer.writerow(res.row())
-                        f.flush()
-                        ran += 1
-                        if progress:
-                            print(
-                                f"{res.world} {res.policy} n={n} seed={seed}: T99="
-                                f"{res.T99_s} time={res.mission_time_s:.1f} cov={res.coverage:.3f} "
-                                f"overlap={res.overlap_ratio:.2f} rr={res.robot_collisions} "
-                                f"({res.wall_time_s:.0f} s wall)",
-                                flush=True,
-                            )
-    return {"ran": ran, "skipped": skipped, "runs": str(csv_path)}
-
-
-def _float(v: str) -> float:
-    return float(v) if v not in ("", "None") else math.nan
-
-
-def _median(values: list[float]) -> float:
-    arr = np.array([v for v in values if math.isfinite(v)])
-    return float(np.median(arr)) if arr.size else math.nan
-
-
-def _fmt(v: float, digits: int = 1) -> str:
-    return "-" if not math.isfinite(v) else f"{v:.{digits}f}"
-
-
-def write_team_summary(out: str | Path) -> Path:
-    """``out/summary.md`` from ``out/runs.csv`` (module docstring)."""
-    out_dir = Path(out)
-    with (out_dir / "runs.csv").open(newline="") as f:
-        rows = list(csv.DictReader(f))
-    t99: dict[tuple[str, str, int, int], float] = {}
-    for r in rows:
-        t99[(r["world"], r["policy"], int(r["n_robots"]), int(r["seed"]))] = _float(r["T99_s"])
-    families = sorted({r["world"].split(":")[0] for r in rows})
-    lines = ["# Team benchmark", ""]
-    for fam in families:
-        fam_rows = [r for r in rows if r["world"].split(":")[0] == fam]
-        lines += [
-            f"## {fam}",
-            "",
-            "| policy | robots | n | T90 s | T99 s | mission s | T99 / 1 robot | path total m "
-            "| path max m | overlap | robot coll. | self-stopped |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|",
-        ]
-        cells = sorted({(r["policy"], int(r["n_robots"])) for r in fam_rows})
-        for pol, n in cells:
-            rs = [r for r in fam_rows if r["policy"] == pol and int(r["n_robots"]) == n]
-            ratios = []
-            for r in rs:
-                one = t99.get((r["world"], pol, 1, int(r["seed"])), math.nan)
-                ratios.append(_float(r["T99_s"]) / one if one > 0 else math.nan)
-            per_robot_max = [max(float(v) for v in r["path_per_robot_m"].split(";")) for r in rs]
-            lines.append(
-                f"| {pol} | {n} | {len(rs)} | {_fmt(_median([_float(r['T90_s']) for r in rs]))} "
-                f"| {_fmt(_median([_float(r['T99_s']) for r in rs]))} "
-                f"| {_fmt(_median([_float(r['mission_time_s']) for r in rs]))} "
-                f"| {_fmt(_median(ratios), 2)} "
-                f"| {_fmt(_median([_float(r['path_total_m']) for r in rs]))} "
-                f"| {_fmt(_median(per_robot_max))} "
-                f"| {_fmt(_median([_float(r['overlap_ratio']) for r in rs]), 2)} "
-                f"| {sum(int(r['robot_collisions']) for r in rs)} "
-                f"| {sum(r['self_stopped'] == 'True' for r in rs)}/{len(rs)} |"
-            )
-        lines += ["", *_paired_tests(fam_rows), ""]
-    path = out_dir / "summary.md"
-    path.write_text("\n".join(lines) + "\n")
-    return path
-
-
-def _paired_tests(rows: list[dict[str, str]]) -> list[str]:
-    """Per team size, each policy's T99 against ``team_independent``'s on the same seeds."""
-    from scipy.stats import wilcoxon
-
-    out = []
-    by: dict[tuple[str, int], dict[tuple[str, int], float]] = {}
-    for r in rows:
-        by.setdefault((r["policy"], int(r["n_robots"])), {})[(r["world"], int(r["seed"]))] = _float(
-            r["T99_s"]
-        )
-    for (pol, n), vals in sorted(by.items()):
-        base = by.get(("team_independent", n))
-        if pol == "team_independent" or base is None:
-            continue
-        keys = [k for k in vals if k in base and math.isfinite(vals[k]) and math.isfinite(base[k])]
-        if len(keys) < 5:
-            out.append(f"- {pol} vs team_independent, {n} robots: {len(keys)} pairs, too few")
-            continue
-        a = np.array([vals[k] for k in keys])
-        b = np.array([base[k] for k in keys])
-        p = float(wilcoxon(a, b).pvalue) if np.any(a != b) else 1.0
-        out.append(
-            f"- {pol} vs team_independent, {n} robots: median T99 ratio "
-            f"{np.median(a / b):.2f} over {len(keys)} pairs, Wilcoxon p = {p:.3g}"
-        )
-    return out
+        try:
+            for task, row in stream:
+                bar.finished(task)
+                if isinstance(row, BaseException):
+                    key = (task.world, task.policy, task.n_robots, task.seed)
+                    failed.append((key, f"{type(row).__name__}: {row}"))
+                    print(f"mission {key} failed: {failed[-1][1]}", file=sys.stderr)
+                    continue
+                writer.writerow(row)
+                f.flush()
+        finally:
+            bar.close()
+    return {
+        "ran": len(todo) - len(failed),
+        "skipped": len(tasks) - len(todo),
+        "failed": failed,
+        "runs": str(csv_path),
+    }
 
 
 @dataclass(frozen=True)
@@ -381,6 +353,10 @@ class TeamStudyRequest:
     fixed_start: bool = False
     progress: bool = True
     command: str = ""
+    workers: int = 1
+    backend: str = "process"
+    ray_address: str | None = None
+    plots: bool = True
 
 
 def run_team_study(req: TeamStudyRequest) -> int:
@@ -435,13 +411,18 @@ def run_team_study(req: TeamStudyRequest) -> int:
             env_overrides=tuple(req.env_overrides),
             fixed_start=req.fixed_start,
             progress=req.progress,
+            workers=req.workers,
+            backend=req.backend,
+            ray_address=req.ray_address,
             time_limits=time_limits,
         )
     )
     summary = write_team_summary(out_dir)
-    print(json.dumps(res))
+    if req.plots:
+        write_team_plot(out_dir)
+    print(json.dumps({**res, "failed": len(res["failed"]), "summary": str(summary)}))
     print(summary.read_text())
-    return 0
+    return 1 if res["failed"] else 0
 
 
 def _suite_worlds(

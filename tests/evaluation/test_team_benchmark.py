@@ -50,11 +50,57 @@ def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
             assert float(r["overlap_ratio"]) == 0.0
         assert float(r["mission_time_s"]) <= 30.0 + 1e-6
     summary = (out / "summary.md").read_text()
-    assert "T99 / 1 robot" in summary and "overlap" in summary
+    assert "T99 / 1 robot" in summary and "overlap" in summary and "coverage min" in summary
+    assert (out / "team_speedup.png").stat().st_size > 0
     # Rerunning resumes: nothing runs again.
     assert main(argv) == 0
     with (out / "runs.csv").open(newline="") as f:
         assert len(list(csv.DictReader(f))) == 4
+    # Two worker processes write the same missions (in the order they end).
+    par = tmp_path / "par"
+    argv[argv.index(str(out))] = str(par)
+    assert main([*argv, "--workers", "2", "--no-plots"]) == 0
+    with (par / "runs.csv").open(newline="") as f:
+        par_rows = list(csv.DictReader(f))
+    assert not (par / "team_speedup.png").exists()
+
+    def key(r: dict[str, str]) -> tuple[str, ...]:
+        return tuple(v for k, v in r.items() if k != "wall_time_s")
+
+    assert sorted(map(key, par_rows)) == sorted(map(key, rows))
+
+
+def test_team_summary_pairs_and_speedups(tmp_path: Path) -> None:
+    from semexplore_gym.evaluation.team_report import paired_tests, speedup_ratios
+
+    rows = []
+    for seed in range(8):
+        for pol, t1, t2 in (("team_semantic", 100.0, 50.0), ("team_independent", 120.0, 90.0)):
+            for n, t99 in ((1, t1 + seed), (2, t2 + seed)):
+                never = pol == "team_independent" and n == 2 and seed == 7
+                rows.append(
+                    {
+                        "world": f"maze:seed={seed}",
+                        "policy": pol,
+                        "n_robots": str(n),
+                        "seed": str(seed),
+                        "T99_s": "" if never else str(t99),
+                    }
+                )
+    ratios = speedup_ratios(rows)
+    assert ratios[("maze", "team_semantic", 2)][0] == pytest.approx(0.5)
+    assert ratios[("maze", "team_semantic", 1)] == [1.0] * 8
+    lines = paired_tests(rows)
+    two = [line for line in lines if "2 robots" in line]
+    assert len(two) == 1 and "over 7 pairs" in two[0] and "(1 left out: no T99)" in two[0]
+    p = float(two[0].split("Wilcoxon p = ")[1].split(" ")[0])
+    assert p < 0.05  # semantic was faster on every one of the 7 seeds
+
+
+def test_benchmark_robots_refuses_the_oracle(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["benchmark", "--worlds", "maze1", "--robots", "2", "--oracle", "--out", "x"]
+    assert main(argv) != 0
+    assert "--oracle is for single robots" in capsys.readouterr().err
 
 
 def test_team_mission_gif(tmp_path: Path) -> None:
