@@ -384,20 +384,18 @@ def run_team_study(req: TeamStudyRequest) -> int:
     seeds = list(range(req.seed0, req.seed0 + runs))
     out_dir = Path(req.out)
     out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "manifest.json").write_text(
-        json.dumps(
-            {
-                "command": req.command,
-                "worlds": worlds,
-                "policies": policies,
-                "robots": counts,
-                "seeds": seeds,
-                "max_time_s": req.max_time_s,
-                "suite": req.suite,
-                "env_overrides": list(req.env_overrides),
-            },
-            indent=2,
-        )
+    _record_run(
+        out_dir / "manifest.json",
+        {
+            "command": req.command,
+            "worlds": worlds,
+            "policies": policies,
+            "robots": counts,
+            "seeds": seeds,
+            "max_time_s": req.max_time_s,
+            "suite": req.suite,
+            "env_overrides": list(req.env_overrides),
+        },
     )
     res = run_team_benchmark(
         TeamBenchmarkConfig(
@@ -423,6 +421,21 @@ def run_team_study(req: TeamStudyRequest) -> int:
     print(json.dumps({**res, "failed": len(res["failed"]), "summary": str(summary)}))
     print(summary.read_text())
     return 1 if res["failed"] else 0
+
+
+def _record_run(path: Path, entry: dict[str, Any]) -> None:
+    """Add ``entry`` to the ``runs`` of the manifest at ``path``: several commands may share an
+    output directory (one per world family, say), and ``summary.md`` covers all their rows."""
+    runs: list[dict[str, Any]] = []
+    if path.exists():
+        try:
+            old = json.loads(path.read_text())
+        except json.JSONDecodeError:
+            old = {}
+        runs = old.get("runs", [old] if "command" in old else [])
+    if entry not in runs:
+        runs.append(entry)
+    path.write_text(json.dumps({"runs": runs}, indent=2))
 
 
 def _suite_worlds(

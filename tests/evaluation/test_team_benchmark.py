@@ -157,3 +157,24 @@ def test_benchmark_missions_end_by_the_team_stop_rule(tmp_path: Path) -> None:
     assert row["self_stopped"] == "False"
     assert row["stop_reason"] == "env truncated (episode time limit)"
     assert float(row["mission_time_s"]) == pytest.approx(5.0)
+
+
+def test_two_commands_share_one_study_directory(tmp_path: Path) -> None:
+    # One command per family into one directory: runs.csv, summary.md and the manifest hold both.
+    import json
+
+    out = tmp_path / "study"
+    base = ["benchmark", "--robots", "1,2", "--policies", "independent", "--max-time-s", "10"]
+    base += ["--out", str(out), "--no-progress", "--no-plots"]
+    assert main([*base, "--worlds", "maze:seed=*,size_m=6", "--runs", "2", "--seed0", "5"]) == 0
+    assert main([*base, "--worlds", "office:seed=*,size_m=8", "--runs", "1", "--seed0", "7"]) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert sorted((r["world"], r["n_robots"]) for r in rows) == sorted(
+        [(f"maze:seed={s},size_m=6", n) for s in (5, 6) for n in ("1", "2")]
+        + [("office:seed=7,size_m=8", n) for n in ("1", "2")]
+    )
+    summary = (out / "summary.md").read_text()
+    assert "## maze" in summary and "## office" in summary
+    runs = json.loads((out / "manifest.json").read_text())["runs"]
+    assert [r["seeds"] for r in runs] == [[5, 6], [7]]
