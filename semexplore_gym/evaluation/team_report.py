@@ -2,7 +2,8 @@
 
 ``summary.md`` has one table per world family: medians per (policy, robots), the lowest
 coverage, the median of each seed's T99 ratio to one robot's (same policy, world and seed)
-and, per team size, a paired Wilcoxon test of each policy's T99 against ``independent``'s.
+and, per team size, a paired Wilcoxon test of each policy's T99 against ``independent``'s
+and of every other pair of policies.
 ``team_speedup.png`` draws that ratio against the team size, per family and policy (median
 and quartiles), with the perfect division 1/N for reference.
 """
@@ -101,39 +102,45 @@ def write_team_summary(out: str | Path) -> Path:
 
 
 def paired_tests(rows: list[dict[str, str]]) -> list[str]:
-    """Per team size, each policy's T99 against :data:`BASELINE`'s on the same seeds
-    (two-sided Wilcoxon signed-rank; pairs where either never reached 0.99 are counted and
-    left out)."""
-    from scipy.stats import wilcoxon
-
-    out = []
+    """Per team size, each policy's T99 against :data:`BASELINE`'s on the same seeds, then
+    every other pair of policies (two-sided Wilcoxon signed-rank; pairs of missions where
+    either never reached 0.99 are counted and left out)."""
     by: dict[tuple[str, int], dict[tuple[str, int], float]] = {}
     for r in rows:
         cell = by.setdefault((r["policy"], int(r["n_robots"])), {})
         cell[(r["world"], int(r["seed"]))] = _float(r["T99_s"])
-    for (pol, n), vals in sorted(by.items()):
-        base = by.get((BASELINE, n))
-        if pol == BASELINE or base is None:
-            continue
-        common = [k for k in vals if k in base]
-        keys = [k for k in common if math.isfinite(vals[k]) and math.isfinite(base[k])]
-        unreached = (
-            f" ({len(common) - len(keys)} left out: no T99)" if len(keys) < len(common) else ""
-        )
-        robots = "robot" if n == 1 else "robots"
-        if len(keys) < 5:
-            out.append(
-                f"- {pol} vs {BASELINE}, {n} {robots}: {len(keys)} pairs, too few{unreached}"
-            )
-            continue
-        a = np.array([vals[k] for k in keys])
-        b = np.array([base[k] for k in keys])
-        p = float(wilcoxon(a, b).pvalue) if np.any(a != b) else 1.0
-        out.append(
-            f"- {pol} vs {BASELINE}, {n} {robots}: median T99 ratio "
-            f"{np.median(a / b):.2f} over {len(keys)} pairs, Wilcoxon p = {p:.3g}{unreached}"
-        )
-    return out
+    policies = sorted({pol for pol, _ in by})
+    others = [pol for pol in policies if pol != BASELINE]
+    pairs = [(pol, BASELINE) for pol in others if BASELINE in policies]
+    pairs += [(x, y) for i, x in enumerate(others) for y in others[i + 1 :]]
+    sizes = sorted({n for _, n in by})
+    return [
+        _paired_line(x, y, n, by[(x, n)], by[(y, n)])
+        for x, y in pairs
+        for n in sizes
+        if (x, n) in by and (y, n) in by
+    ]
+
+
+def _paired_line(
+    x: str, y: str, n: int, vals: dict[tuple[str, int], float], base: dict[tuple[str, int], float]
+) -> str:
+    """One line of :func:`paired_tests`: ``x``'s T99 against ``y``'s with ``n`` robots."""
+    from scipy.stats import wilcoxon
+
+    common = [k for k in vals if k in base]
+    keys = [k for k in common if math.isfinite(vals[k]) and math.isfinite(base[k])]
+    unreached = f" ({len(common) - len(keys)} left out: no T99)" if len(keys) < len(common) else ""
+    robots = "robot" if n == 1 else "robots"
+    if len(keys) < 5:
+        return f"- {x} vs {y}, {n} {robots}: {len(keys)} pairs, too few{unreached}"
+    a = np.array([vals[k] for k in keys])
+    b = np.array([base[k] for k in keys])
+    p = float(wilcoxon(a, b).pvalue) if np.any(a != b) else 1.0
+    return (
+        f"- {x} vs {y}, {n} {robots}: median T99 ratio "
+        f"{np.median(a / b):.2f} over {len(keys)} pairs, Wilcoxon p = {p:.3g}{unreached}"
+    )
 
 
 def write_team_plot(out: str | Path) -> Path | None:
