@@ -6,6 +6,12 @@
 over branches), ``"coordinated_nobranch"`` (the same without the branch spreading),
 ``"semantic"`` (the coordinated semantic expert: the paper's expert per robot, goals divided
 through its ``choose_goal`` plug-in point) and ``"semantic_nosem"`` (its no-semantics ablation).
+
+A spec may end in a bracket of parameter overrides, as single-robot specs do:
+``"semantic[discount_weight=6]"``, ``"semantic[expert.cost.w_v=0;branch_weight=0]"``,
+``"greedy[claim_radius_m=3]"`` (dotted keys of :class:`SemanticTeamParams` or
+:class:`FrontierTeamParams`); the team's name in tables then carries the bracket
+(``team_semantic[discount_weight=6]``). A bracket without ``=`` is a label.
 """
 
 from __future__ import annotations
@@ -36,14 +42,39 @@ def team_policy_names() -> list[str]:
 
 
 def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
-    """A team policy by name (see :func:`team_policy_names`), keyword overrides on top."""
-    if spec in SEMANTIC_TEAM_POLICIES:
-        from semexplore_gym.policies.team.semantic_team import SemanticTeam, SemanticTeamParams
+    """A team policy by spec (a name of :func:`team_policy_names`, optionally with a bracket of
+    parameter overrides or a label: module docstring), keyword overrides on top.
 
-        return SemanticTeam(SemanticTeamParams(**{**SEMANTIC_TEAM_POLICIES[spec], **overrides}))
-    if spec not in TEAM_POLICIES:
-        raise ValueError(f"unknown team policy {spec!r}; known: {team_policy_names()}")
-    return FrontierTeam(FrontierTeamParams(**{**TEAM_POLICIES[spec], **overrides}))
+    Raises:
+        ValueError: an unknown name, a malformed bracket or an unknown or bad parameter; the
+            message names the spec.
+    """
+    from semexplore_gym.policies.specs import parse_spec
+
+    from semexplore_gym.config.builder import ConfigError, build_params
+
+    base, label, bracket = parse_spec(spec)
+    team: TeamPolicy
+    try:
+        if base in SEMANTIC_TEAM_POLICIES:
+            from semexplore_gym.policies.team.semantic_team import (
+                SemanticTeam,
+                SemanticTeamParams,
+            )
+
+            layer = SEMANTIC_TEAM_POLICIES[base]
+            team = SemanticTeam(build_params(SemanticTeamParams, layer, bracket), **overrides)
+        elif base in TEAM_POLICIES:
+            layer = TEAM_POLICIES[base]
+            team = FrontierTeam(build_params(FrontierTeamParams, layer, bracket), **overrides)
+        else:
+            raise ValueError(f"unknown team policy {spec!r}; known: {team_policy_names()}")
+    except (ConfigError, TypeError) as e:
+        raise ValueError(f"team policy {spec!r}: {e}") from None
+    if label is not None or bracket:
+        inner = spec[spec.rindex("[") + 1 : -1].strip()
+        team.name = f"{team.name}[{inner}]"
+    return team
 
 
 __all__ = [

@@ -419,7 +419,7 @@ def team_study_request(args: argparse.Namespace) -> Any:
         raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}") from None
     return TeamStudyRequest(
         robot_counts=counts,
-        policies=tuple(p.strip() for p in str(args.policies).split(",") if p.strip()),
+        policies=tuple(_split_policies(str(args.policies))),
         worlds=tuple(split_worlds(args.worlds or "")),
         out=Path(args.out),
         seed0=args.seed0,

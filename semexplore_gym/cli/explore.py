@@ -214,6 +214,7 @@ def run_team(args: argparse.Namespace) -> int:
     from semexplore_gym.envs.multi_robot import make_multi
     from semexplore_gym.envs.multi_robot_config import MAX_ROBOTS
     from semexplore_gym.evaluation.team_benchmark import run_team_mission
+    from semexplore_gym.policies.specs import strip_label
     from semexplore_gym.policies.team import make_team_policy, team_policy_names
 
     if not 1 <= args.robots <= MAX_ROBOTS:
@@ -221,10 +222,12 @@ def run_team(args: argparse.Namespace) -> int:
     if args.policy_config or args.overrides:
         raise ValueError("--policy-config and --policy-set do not apply with --robots")
     spec = args.policy or "semantic"
-    if spec not in team_policy_names():
+    if strip_label(spec) not in team_policy_names():
         raise ValueError(
-            f"--policy with --robots takes a team policy: {', '.join(team_policy_names())}"
+            f"--policy with --robots takes a team policy ({', '.join(team_policy_names())}), "
+            f"optionally with [key=value] overrides; got {spec!r}"
         )
+    team = make_team_policy(spec)  # a bad bracket fails before the env is built
     # Only the team's own stop or the time limit end the mission (as in the team benchmark).
     overrides = [f"episode.max_time_s={args.max_time_s!r}", "team.end_on_coverage=false"]
     env = make_multi(
@@ -237,7 +240,7 @@ def run_team(args: argparse.Namespace) -> int:
     try:
         res = run_team_mission(
             env,
-            make_team_policy(spec),
+            team,
             args.seed,
             max_time_s=args.max_time_s,
             gif_path=args.gif,

@@ -361,7 +361,8 @@ class TeamStudyRequest:
 
 def run_team_study(req: TeamStudyRequest) -> int:
     """Run the team benchmark of ``req``, write ``manifest.json`` and ``summary.md``, print them."""
-    from semexplore_gym.policies.team import team_policy_names
+    from semexplore_gym.policies.specs import strip_label
+    from semexplore_gym.policies.team import make_team_policy, team_policy_names
 
     counts = list(req.robot_counts)
     if not counts or any(not 1 <= c <= 8 for c in counts):
@@ -371,8 +372,13 @@ def run_team_study(req: TeamStudyRequest) -> int:
     if policies == ["semantic", "frontier", "nearest"]:
         # The single-robot default means "the usual comparison".
         policies = ["semantic", "coordinated", "independent"]
-    if any(p not in known for p in policies):
-        raise ValueError(f"--policies with --robots takes team policies: {', '.join(known)}")
+    for p in policies:
+        if strip_label(p) not in known:
+            raise ValueError(
+                f"--policies with --robots takes team policies ({', '.join(known)}), "
+                f"optionally with [key=value] overrides; got {p!r}"
+            )
+        make_team_policy(p)  # a bad bracket fails here, before any mission
     time_limits: dict[str, float | None] = {}
     runs = req.runs or 5
     worlds = list(req.worlds)

@@ -178,3 +178,58 @@ def test_two_commands_share_one_study_directory(tmp_path: Path) -> None:
     assert "## maze" in summary and "## office" in summary
     runs = json.loads((out / "manifest.json").read_text())["runs"]
     assert [r["seeds"] for r in runs] == [[5, 6], [7]]
+
+
+def test_benchmark_robots_compares_team_variants(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A team spec with a bracket of overrides is a variant of its own: rows, summary and
+    # resume key carry the bracket; a variant that changes nothing drives the same missions.
+    out = tmp_path / "variants"
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze:seed=2,size_m=6",
+        "--robots",
+        "2",
+        "--policies",
+        "greedy,greedy[claim_radius_m=2.0],greedy[claim_radius_m=0]",
+        "--runs",
+        "1",
+        "--max-time-s",
+        "20",
+        "--out",
+        str(out),
+        "--no-progress",
+        "--no-plots",
+    ]
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = {r["policy"]: r for r in csv.DictReader(f)}
+    assert set(rows) == {
+        "team_greedy",
+        "team_greedy[claim_radius_m=2.0]",
+        "team_greedy[claim_radius_m=0]",
+    }
+    same = ("coverage", "mission_time_s", "path_per_robot_m", "steps")
+    # 2.0 m is greedy's default claim radius: the same missions.
+    assert [rows["team_greedy"][k] for k in same] == [
+        rows["team_greedy[claim_radius_m=2.0]"][k] for k in same
+    ]
+    assert "team_greedy[claim_radius_m=0]" in (out / "summary.md").read_text()
+    capsys.readouterr()
+    # A misspelt parameter fails before any mission, naming the spec and the key.
+    bad = [*argv[:6], "semantic[discount_wieght=6]", *argv[7:]]
+    bad[bad.index(str(out))] = str(tmp_path / "bad")
+    assert main(bad) != 0
+    err = capsys.readouterr().err
+    assert "semantic[discount_wieght=6]" in err and "unknown config key" in err
+    assert not (tmp_path / "bad").exists()
+
+
+def test_explore_robots_takes_a_team_variant(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["explore", "--world", "maze:seed=2,size_m=6", "--robots", "2", "--max-time-s", "5"]
+    assert main([*argv, "--policy", "greedy[claim_radius_m=1]"]) == 0
+    assert "team_greedy[claim_radius_m=1]" in capsys.readouterr().out
+    assert main([*argv, "--policy", "greedy[claim_radius_m=x]"]) != 0
+    assert "claim_radius_m: expected a number, got 'x'" in capsys.readouterr().err

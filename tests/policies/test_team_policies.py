@@ -4,6 +4,7 @@ stop rule, and the coordinations' target division."""
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -144,3 +145,33 @@ def test_semantic_team_shares_dropped_goals() -> None:
     assert not b.goal_memory.is_blacklisted(gap)
     obs, _, _, _, infos = env.step(team.act(obs, infos))
     assert b.goal_memory.is_blacklisted(gap)
+
+
+def test_team_specs_take_parameter_overrides() -> None:
+    # A bracket of dotted overrides reaches the team's parameters and its members' experts,
+    # and names the variant; the plain names build exactly the default parameters.
+    team = make_team_policy("semantic[discount_weight=6;expert.cost.w_v=0.5]")
+    assert team.name == "team_semantic[discount_weight=6;expert.cost.w_v=0.5]"
+    assert team.params.discount_weight == 6.0  # type: ignore[attr-defined]
+    assert team.params.expert.cost.w_v == 0.5  # type: ignore[attr-defined]
+    assert make_team_policy("semantic").params.discount_weight == 2.0  # type: ignore[attr-defined]
+    greedy = make_team_policy("greedy[claim_radius_m=3]")
+    assert greedy.name == "team_greedy[claim_radius_m=3]"
+    assert greedy.params.claim_radius_m == 3.0  # type: ignore[attr-defined]
+    assert greedy.params.coordination == "greedy"  # type: ignore[attr-defined]
+    assert make_team_policy("independent[run A]").name == "team_independent[run A]"
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("semantic[discount_wieght=6]", "unknown config key 'discount_wieght'"),
+        ("semantic[discount_weight=abc]", "discount_weight: expected a number, got 'abc'"),
+        ("greedy[claim_radius_m=-1]", "claim_radius_m must be a finite number >= 0"),
+        ("semantic[expert.nope=1]", "unknown config key 'expert.nope'"),
+        ("teamwork[x=1]", "unknown team policy 'teamwork[x=1]'"),
+    ],
+)
+def test_bad_team_specs_fail_naming_the_spec(spec: str, message: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(message)):
+        make_team_policy(spec)
