@@ -135,6 +135,9 @@ class GoalMemory:
             maxlen=max(1, int(prm.shuttle_switches))
         )
         self.shuttle_xy_m: tuple[float, float] | None = None
+        # The narrow tier's goals, each with the map's room to move (cells the robot's centre
+        # may take at the narrow clearance) when it was first adopted.
+        self.narrow_goals: list[tuple[tuple[float, float], int]] = []
 
     # ------------------------------------------------------------------ queries
     def dropped_points(self) -> list[tuple[float, float]]:
@@ -172,6 +175,28 @@ class GoalMemory:
         return [p for p in pts if math.dist(p, xy_m) <= radius_m]
 
     # ------------------------------------------------------------------ events
+    def narrow_goal(
+        self,
+        goal_xy_m: tuple[float, float],
+        room_cells: int,
+        same_goal_m: float,
+        goals: int,
+        min_new_cells: float,
+    ) -> bool:
+        """The narrow tier proposes ``goal_xy_m``, the map holding ``room_cells`` cells the
+        robot's centre may take: True to give up instead (a new goal, while the last ``goals``
+        narrow goals, and all that ran since the first of them, added fewer than
+        ``min_new_cells`` of them; ``goals`` 0: never). A goal within ``same_goal_m`` of the last one continues it (and is never
+        given up: the robot may be crawling through the passage)."""
+        past = self.narrow_goals
+        if past and math.dist(goal_xy_m, past[-1][0]) <= same_goal_m:
+            past[-1] = (goal_xy_m, past[-1][1])
+            return False
+        if goals > 0 and len(past) >= goals and room_cells - past[-goals][1] < min_new_cells:
+            return True
+        past.append((goal_xy_m, room_cells))
+        return False
+
     def visit(self, xy_m: tuple[float, float]) -> None:
         """The robot is at ``xy_m`` (its trail)."""
         self.trail.add((int(xy_m[0] // TRAIL_CELL_M), int(xy_m[1] // TRAIL_CELL_M)))

@@ -89,6 +89,9 @@ NARROW_REACHED_M = 0.1
 #: A look into a narrow passage's mouth ends at least this far from the robot, somewhere its
 #: trail has not been (metres).
 NARROW_LOOK_MIN_M = 0.2
+#: A narrow goal within this of the last one is the same goal (it drifts as its frontier is
+#: mapped), for the narrow tier's give-up.
+NARROW_SAME_GOAL_M = 1.0
 
 
 class CommandedGoal(PlanSource):
@@ -407,6 +410,15 @@ class NarrowFallback(PlanSource):
             if mouth is None:
                 return None
             path, goal = mouth, (float(mouth[-1, 0]), float(mouth[-1, 1]))
+        # The give-up: a new narrow goal only while the last ones mapped room to move in
+        # (cells the robot's centre may take at the thin clearance; a crack narrower than the
+        # robot maps free cells, but none of these).
+        room = int(np.count_nonzero(clearance >= thin_m))
+        min_new = prm.narrow_give_up_m2 / ctx.geometry.resolution_m**2
+        if ctx.memory.narrow_goal(
+            goal, room, NARROW_SAME_GOAL_M, prm.narrow_give_up_goals, min_new
+        ):
+            return None
         ctx.counts.narrow_plans += 1
         return Plan(
             PlanKind.FALLBACK,

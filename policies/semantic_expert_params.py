@@ -118,6 +118,12 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``tight_speed_mps``, aiming ``tight_track_lookahead_m`` ahead, turning on the spot above
   ``tight_turn_in_place_rad``), kept in the middle between the walls the scan measures on
   both sides within ``tight_centring_range_m`` (the map places a wall only to within a cell).
+  The narrow tier gives up (``narrow_give_up_goals``, ``narrow_give_up_m2``) rather than take
+  a new goal once its last ``narrow_give_up_goals`` goals together mapped less than
+  ``narrow_give_up_m2`` of room to move (where the robot's centre may be at that clearance):
+  cave walls are full of cracks, narrower than the robot or whose far side is rock,
+  and driving into each costs minutes for nothing; it tries again once the map has grown by
+  that much since (from elsewhere).
 
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
 switches them all off: the paper's method alone).
@@ -291,6 +297,10 @@ class SemanticExpertParams:
             plus this (may be slightly negative: the map places each wall only to within a
             cell, so a passage 0.25 m wide can show as 4 free cells, 0.1 m from the walls'
             cells at its middle; the scan then says whether the robot fits).
+        narrow_give_up_goals: The narrow tier takes no new goal when its last this many ...
+        narrow_give_up_m2: ... mapped less than this much room to move in all (area where the
+            robot's centre may be at the narrow clearance, since the first of them was
+            adopted; 0 goals: never gives up).
         tight_speed_mps: Forward speed where a narrow plan's path is tight.
         tight_track_lookahead_m: There it aims at the path point this far ahead ...
         tight_turn_in_place_rad: ... and turns on the spot above this heading error ...
@@ -363,6 +373,8 @@ class SemanticExpertParams:
     view_min_unknown_m2: float = 0.5
     narrow_passages: bool = False
     narrow_clearance_margin_m: float = -0.005
+    narrow_give_up_goals: int = 4
+    narrow_give_up_m2: float = 0.5
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
@@ -450,6 +462,10 @@ class SemanticExpertParams:
         m = self.narrow_clearance_margin_m
         if isinstance(m, bool) or not isinstance(m, (int, float)) or not -0.05 <= m <= 0.5:
             raise ValueError(f"narrow_clearance_margin_m must be in [-0.05, 0.5] m, got {m!r}")
+        k = self.narrow_give_up_goals
+        if isinstance(k, bool) or not isinstance(k, int) or k < 0:
+            raise ValueError(f"narrow_give_up_goals must be an integer >= 0, got {k!r}")
+        require_finite(self, ("narrow_give_up_m2",), positive=False)
         tight = ("tight_speed_mps", "tight_track_lookahead_m", "tight_turn_in_place_rad")
         require_finite(self, (*tight, "tight_centring_range_m"), positive=True)
 

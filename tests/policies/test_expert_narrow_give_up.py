@@ -1,0 +1,76 @@
+"""The narrow tier's give-up: once its last plans mapped almost nothing (cracks whose far side
+is rock, slots too small to matter), the expert stops driving into them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+
+def _room_with_slots(width_px: int = 5, n: int = 8) -> np.ndarray:
+    """Map pixels (0.05 m): a 2 m room whose walls have ``n`` bent dead-end slots ``width_px``
+    wide (0.25 m: the env counts them reachable, the planners' clearance does not), 0.8 m out
+    and 0.5 m along, so their ends are seen only from inside."""
+    img = np.zeros((80, 80), dtype=np.uint8)
+    img[20:60, 20:60] = 254
+    d, w = 16, width_px
+    for k in range(n):
+        side, off = divmod(k, 2)
+        c = 27 + off * 18
+        if side == 0:
+            img[20 - d : 20, c : c + w] = 254
+            img[20 - d : 20 - d + w, c : c + 10] = 254
+        elif side == 1:
+            img[60 : 60 + d, c : c + w] = 254
+            img[60 + d - w : 60 + d, c : c + 10] = 254
+        elif side == 2:
+            img[c : c + w, 20 - d : 20] = 254
+            img[c : c + 10, 20 - d : 20 - d + w] = 254
+        else:
+            img[c : c + w, 60 : 60 + d] = 254
+            img[c : c + 10, 60 + d - w : 60 + d] = 254
+    return img
+
+
+def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file, short_mission):
+    world = ros_map_file(_room_with_slots(), "slots", (0.013, 0.021))
+    keeps_on, p_on = short_mission(
+        world, "semantic[narrow_passages=true;narrow_give_up_goals=0]", 2, 600
+    )
+    gives_up, p_up = short_mission(world, "semantic[narrow_passages=true]", 2, 600)
+    k = p_up.params.narrow_give_up_goals
+    assert len(p_on.goal_memory.narrow_goals) > k  # on into more slots
+    assert len(p_up.goal_memory.narrow_goals) == k  # then no new narrow goal
+    assert gives_up.self_stopped and keeps_on.self_stopped
+    assert gives_up.mission_time_s < 0.8 * keeps_on.mission_time_s
+    assert gives_up.collisions == keeps_on.collisions == 0
+
+
+def test_narrow_goal_gives_up_on_new_goals_after_goals_that_added_no_room():
+    from semexplore_gym.policies.expert_counters import ExpertCounters
+    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    memory = GoalMemory(SemanticExpertParams().goal_memory, ExpertCounters(), lambda *_: None)
+
+    def propose(xy, room, goals=2):
+        return memory.narrow_goal(xy, room, 1.0, goals, 50)
+
+    assert not propose((0.0, 0.0), 100)  # first goal
+    assert not propose((0.5, 0.0), 100)  # within 1 m: the same goal, drifting
+    assert not propose((3.0, 0.0), 120)  # a second goal
+    assert len(memory.narrow_goals) == 2
+    assert propose((6.0, 0.0), 149)  # two goals added 49 cells < 50: give up
+    assert not propose((3.4, 0.0), 149)  # the current goal goes on (crawling through)
+    assert not propose((6.0, 0.0), 149, goals=3)  # a longer window: not yet
+    assert not propose((9.0, 0.0), 160, goals=0)  # 0: never gives up
+    assert propose((12.0, 0.0), 165)  # the last two goals (120 -> 160 -> 165): 45 cells
+    assert not propose((12.0, 5.0), 200)  # the map grew by 80 since 120: try again
+
+
+@pytest.mark.parametrize("bad", [-1, 1.5, True])
+def test_narrow_give_up_goals_is_checked(bad):
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    with pytest.raises(ValueError, match="narrow_give_up_goals"):
+        SemanticExpertParams(narrow_give_up_goals=bad)
