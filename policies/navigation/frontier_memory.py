@@ -14,6 +14,7 @@ The semantic expert uses it so that it never gives up on a frontier it could sti
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,9 +122,10 @@ class FrontierMemory:
                 return
         self.dropped.append(DroppedGoal(goal_xy_m, reason, window))
 
-    def active_points(self) -> list[tuple[float, float]]:
-        """The goals dropped and not come back."""
-        return [d.xy_m for d in self.dropped if d.active]
+    def active_points(self, exclude: Sequence[str] = ()) -> list[tuple[float, float]]:
+        """The goals dropped and not come back (but those dropped for a reason in
+        ``exclude``)."""
+        return [d.xy_m for d in self.dropped if d.active and d.reason not in exclude]
 
     def is_dropped(self, xy_m: tuple[float, float]) -> bool:
         """Whether ``xy_m`` lies within ``radius_m`` of an active dropped goal."""

@@ -21,8 +21,9 @@ distance, as their own costs are not computed here). ``semantic=False`` is the a
 paper's semantic terms off (``w_p = w_I = 0``: cost = ``d / L_path + w_v v``) and no
 intersection matching (the distance discount and path spreading stay).
 
-A goal one robot drops (it looked from close by and the gap stayed closed, or its approaches
-failed) is dropped by its teammates too. The team stops when every robot's expert has stopped (no frontier left on its map); a robot
+A goal one robot drops because of what the map shows (it looked and the gap stayed closed, it
+reached it again and again, no grid path leads there) is dropped by its teammates too; a goal
+whose approaches failed is not (a teammate may have been in the way). The team stops when every robot's expert has stopped (no frontier left on its map); a robot
 that stopped while teammates work looks again every ``idle_recheck_s``. Robots yield to
 higher-priority teammates in passages as in :mod:`~semexplore_gym.policies.team.frontier_teams`.
 """
@@ -42,6 +43,9 @@ from semexplore_gym.policies.team.base import TeamPolicy
 from semexplore_gym.policies.team.frontier_teams import yield_action
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
+
+#: Drops a robot keeps to itself (see ``_share_drops``): its approaches failed.
+UNSHARED_DROP_REASONS = ("attempts",)
 
 
 @dataclass(frozen=True)
@@ -173,11 +177,14 @@ class SemanticTeam(TeamPolicy):
         return actions
 
     def _share_drops(self, observations: dict[str, dict[str, np.ndarray]]) -> None:
-        """A goal one robot dropped (looked at from close by and still closed, or its
-        approaches failed) is dropped by its teammates too, once: they would otherwise cross
-        the building to find the same gap closed. Each robot revives it by its own rule."""
+        """A goal one robot dropped for what the map shows (looked at from close by or from
+        elsewhere and still closed, reached again and again, no grid path) is dropped by its
+        teammates too, once: they would otherwise cross the building to find the same gap
+        closed. Failed approaches stay the robot's own (:data:`UNSHARED_DROP_REASONS`: a
+        teammate in the way fails an approach; shared, such drops once stopped a whole team
+        at a third of a maze). Each robot revives a drop by its own rule."""
         for j, src in enumerate(self.members):
-            for xy in src.goal_memory.dropped_points():
+            for xy in src.goal_memory.frontiers.active_points(exclude=UNSHARED_DROP_REASONS):
                 key = (round(xy[0], 3), round(xy[1], 3))
                 if key in self._shared:
                     continue

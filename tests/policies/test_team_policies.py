@@ -17,6 +17,7 @@ from semexplore_gym.policies.team.frontier_teams import FrontierTarget, Frontier
 
 from semexplore_gym.core.worlds.build import world_from_segments  # noqa: E402
 from semexplore_gym.envs.multi_robot import make_multi  # noqa: E402
+from semexplore_gym.evaluation.team_benchmark import run_team_mission  # noqa: E402
 
 RADIUS_M = 0.105
 
@@ -145,6 +146,24 @@ def test_semantic_team_shares_dropped_goals() -> None:
     assert not b.goal_memory.is_blacklisted(gap)
     obs, _, _, _, infos = env.step(team.act(obs, infos))
     assert b.goal_memory.is_blacklisted(gap)
+    # A goal whose approaches failed stays the robot's own (a teammate may have blocked it).
+    door = (2.6, 0.4)
+    a.goal_memory.drop(np.asarray(obs["robot_0"]["map"]), door, "attempts")
+    obs, _, _, _, infos = env.step(team.act(obs, infos))
+    assert a.goal_memory.is_blacklisted(door) and not b.goal_memory.is_blacklisted(door)
+
+
+def test_failed_approaches_do_not_stop_the_team() -> None:
+    # Three robots in a braided maze fail approaches where they block each other; when those
+    # drops were shared, every robot ran out of frontiers at once and the team stopped at 0.32
+    # coverage (found on a tuning seed with discount_weight=6).
+    env = make_multi(
+        world="maze:seed=2000,size_m=14,braid=0.3",
+        n_robots=3,
+        overrides=["team.end_on_coverage=false", "episode.random_start=true"],
+    )
+    res = run_team_mission(env, make_team_policy("semantic[discount_weight=6]"), 2000, 3000.0)
+    assert res.self_stopped and res.coverage >= 0.97
 
 
 def test_team_specs_take_parameter_overrides() -> None:
