@@ -118,8 +118,8 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``tight_speed_mps``, aiming ``tight_track_lookahead_m`` ahead, turning on the spot above
   ``tight_turn_in_place_rad``), kept in the middle between the walls the scan measures on
   both sides within ``tight_centring_range_m`` (the map places a wall only to within a cell).
-  The narrow tier gives up (``narrow_give_up_goals``, ``narrow_give_up_m2``) rather than take
-  a new goal once its last ``narrow_give_up_goals`` goals together mapped less than
+  Optionally the narrow tier gives up (``narrow_give_up_goals`` > 0, ``narrow_give_up_m2``)
+  rather than take a new goal once its last ``narrow_give_up_goals`` goals together mapped less than
   ``narrow_give_up_m2`` of room to move (where the robot's centre may be at that clearance):
   cave walls are full of cracks, narrower than the robot or whose far side is rock,
   and driving into each costs minutes for nothing; it tries again once the map has grown by
@@ -297,7 +297,8 @@ class SemanticExpertParams:
             plus this (may be slightly negative: the map places each wall only to within a
             cell, so a passage 0.25 m wide can show as 4 free cells, 0.1 m from the walls'
             cells at its middle; the scan then says whether the robot fits).
-        narrow_give_up_goals: The narrow tier takes no new goal when its last this many ...
+        narrow_give_up_goals: The narrow tier takes no new goal when its last this many (0, the
+            default: it never gives up; 4 measured in docs/results.md) ...
         narrow_give_up_m2: ... mapped less than this much room to move in all (area where the
             robot's centre may be at the narrow clearance, since the first of them was
             adopted; 0 goals: never gives up).
@@ -373,7 +374,7 @@ class SemanticExpertParams:
     view_min_unknown_m2: float = 0.5
     narrow_passages: bool = False
     narrow_clearance_margin_m: float = -0.005
-    narrow_give_up_goals: int = 4
+    narrow_give_up_goals: int = 0
     narrow_give_up_m2: float = 0.5
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06

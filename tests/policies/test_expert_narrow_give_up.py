@@ -1,5 +1,5 @@
-"""The narrow tier's give-up: once its last plans mapped almost nothing (cracks whose far side
-is rock, slots too small to matter), the expert stops driving into them."""
+"""The narrow tier's optional give-up: once its last goals mapped almost no room to move (cracks
+narrower than the robot, slots too small to matter), the expert stops driving into them."""
 
 from __future__ import annotations
 
@@ -34,10 +34,10 @@ def _room_with_slots(width_px: int = 5, n: int = 8) -> np.ndarray:
 
 def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file, short_mission):
     world = ros_map_file(_room_with_slots(), "slots", (0.013, 0.021))
-    keeps_on, p_on = short_mission(
-        world, "semantic[narrow_passages=true;narrow_give_up_goals=0]", 2, 600
+    keeps_on, p_on = short_mission(world, "semantic[narrow_passages=true]", 2, 600)
+    gives_up, p_up = short_mission(
+        world, "semantic[narrow_passages=true;narrow_give_up_goals=4]", 2, 600
     )
-    gives_up, p_up = short_mission(world, "semantic[narrow_passages=true]", 2, 600)
     k = p_up.params.narrow_give_up_goals
     assert len(p_on.goal_memory.narrow_goals) > k  # on into more slots
     assert len(p_up.goal_memory.narrow_goals) == k  # then no new narrow goal
