@@ -186,8 +186,9 @@ class GoalMemory:
         """The narrow tier proposes ``goal_xy_m``, the map holding ``room_cells`` cells the
         robot's centre may take: True to give up instead (a new goal, while the last ``goals``
         narrow goals, and all that ran since the first of them, added fewer than
-        ``min_new_cells`` of them; ``goals`` 0: never). A goal within ``same_goal_m`` of the last one continues it (and is never
-        given up: the robot may be crawling through the passage)."""
+        ``min_new_cells`` of them; ``goals`` 0: never). A goal within ``same_goal_m`` of the
+        last one continues it and is never given up (the robot may be crawling through the
+        passage)."""
         past = self.narrow_goals
         if past and math.dist(goal_xy_m, past[-1][0]) <= same_goal_m:
             past[-1] = (goal_xy_m, past[-1][1])

@@ -23,8 +23,9 @@ intersection matching (the distance discount and path spreading stay).
 
 A goal one robot drops because of what the map shows (it looked and the gap stayed closed, it
 reached it again and again, no grid path leads there) is dropped by its teammates too; a goal
-whose approaches failed is not (a teammate may have been in the way). The team stops when every robot's expert has stopped (no frontier left on its map); a robot
-that stopped while teammates work looks again every ``idle_recheck_s``. Robots yield to
+whose approaches failed is not (a teammate may have been in the way). The team stops when
+every robot's expert has stopped (no frontier left on its map); a robot that stopped while
+teammates work looks again every ``idle_recheck_s``. Robots yield to
 higher-priority teammates in passages as in :mod:`~semexplore_gym.policies.team.frontier_teams`.
 """
 
