@@ -140,9 +140,10 @@ class GoalMemory:
         self.narrow_goals: list[tuple[tuple[float, float], int]] = []
 
     # ------------------------------------------------------------------ queries
-    def dropped_points(self) -> list[tuple[float, float]]:
-        """The dropped goals that have not come back."""
-        return self.frontiers.active_points()
+    def dropped_points(self, exclude: Sequence[str] = ()) -> list[tuple[float, float]]:
+        """The dropped goals that have not come back (but those dropped for a reason in
+        ``exclude``)."""
+        return self.frontiers.active_points(exclude)
 
     def is_blacklisted(self, xy_m: tuple[float, float]) -> bool:
         """Whether ``xy_m`` lies near a dropped goal."""

@@ -49,11 +49,11 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
         ValueError: an unknown name, a malformed bracket or an unknown or bad parameter; the
             message names the spec.
     """
-    from semexplore_gym.policies.specs import parse_spec
+    from semexplore_gym.policies.specs import parse_spec, split_bracket
 
     from semexplore_gym.config.builder import ConfigError, build_params
 
-    base, label, bracket = parse_spec(spec)
+    base, _, bracket = parse_spec(spec)
     team: TeamPolicy
     try:
         if base in SEMANTIC_TEAM_POLICIES:
@@ -71,8 +71,8 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
             raise ValueError(f"unknown team policy {spec!r}; known: {team_policy_names()}")
     except (ConfigError, TypeError) as e:
         raise ValueError(f"team policy {spec!r}: {e}") from None
-    if label is not None or bracket:
-        inner = spec[spec.rindex("[") + 1 : -1].strip()
+    inner = split_bracket(spec)[1]
+    if inner:
         team.name = f"{team.name}[{inner}]"
     return team
 

@@ -185,7 +185,7 @@ class SemanticTeam(TeamPolicy):
         teammate in the way fails an approach; shared, such drops once stopped a whole team
         at a third of a maze). Each robot revives a drop by its own rule."""
         for j, src in enumerate(self.members):
-            for xy in src.goal_memory.frontiers.active_points(exclude=UNSHARED_DROP_REASONS):
+            for xy in src.goal_memory.dropped_points(exclude=UNSHARED_DROP_REASONS):
                 key = (round(xy[0], 3), round(xy[1], 3))
                 if key in self._shared:
                     continue
