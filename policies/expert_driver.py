@@ -49,7 +49,8 @@ class ExpertDriver(SemanticExpertPolicy):
     """The semantic expert driven by an outside goal choice or outside cost weights.
 
     Args:
-        params: Expert parameters (default: the paper's).
+        params: Expert parameters (default: the robust expert's); ``grid_candidate`` is always
+            off (the outside choice, not the grid's nearest frontier, decides).
         segmenter: See :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`.
 
     Attributes:
@@ -63,7 +64,9 @@ class ExpertDriver(SemanticExpertPolicy):
     def __init__(
         self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
     ) -> None:
-        super().__init__(params, segmenter)
+        # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
+        base = params if params is not None else SemanticExpertParams()
+        super().__init__(replace(base, grid_candidate=False), segmenter)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

@@ -55,7 +55,9 @@ from semexplore_gym.core.frontiers.viewpoint import (
     unknown_extent_cells,
     unknown_rim,
 )
+from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
+from semexplore_gym.core.planning.polyline import heading_angle
 
 __all__ = [
     "DEFAULT_PLAN_SOURCES",
@@ -260,6 +262,10 @@ class SemanticFrontier(PlanSource):
         if not ctx.candidates:
             return None
         chosen = ctx.choose_goal(ctx.candidates)
+        if ctx.params.grid_candidate:
+            nearer = _cheaper_grid_frontier(ctx, chosen)
+            if nearer is not None:
+                return nearer
         path: np.ndarray | None = chosen.path_m
         if (
             ctx.params.entry_detour
@@ -272,6 +278,36 @@ class SemanticFrontier(PlanSource):
         if path is None:
             return None
         return Plan(PlanKind.SEMANTIC, chosen.goal_xy_m, ctx.resampled(path), chosen)
+
+
+def _cheaper_grid_frontier(ctx: PlanContext, chosen: FrontierCandidate) -> Plan | None:
+    """The grid's nearest frontier when it costs less than Algorithm 1's ``chosen``.
+
+    It is scored by the same ``C`` with no semantic gain (``d / L_path + w_v * v``, the
+    ``L_path`` of this replan), so a frontier the topometric map has no pathway for, or reaches
+    only the long way round, is taken as the robot passes it rather than left for the end. A
+    grid frontier within the commitment radius of ``chosen`` is the same goal: Algorithm 1's
+    plan stands.
+    """
+    found = nearest_reachable_frontier(
+        ctx.grid,
+        ctx.geometry,
+        ctx.xy_m,
+        ctx.clearance_m,
+        frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
+        clearance_field=ctx.clearance_field(),
+    )
+    if found is None or (
+        math.dist(found.goal_xy_m, chosen.goal_xy_m) <= ctx.params.commitment_radius_m
+    ):
+        return None
+    w = ctx.params.cost
+    v_rad = heading_angle(found.path_m, ctx.xy_m, ctx.pose[2], w.heading_lookahead_m)
+    cost = found.path_length_m / chosen.l_path_m + w.w_v * v_rad
+    if cost >= chosen.cost:
+        return None
+    ctx.counts.grid_frontier_plans += 1
+    return Plan(PlanKind.FALLBACK, found.goal_xy_m, ctx.resampled(found.path_m))
 
 
 class CommittedFallback(PlanSource):

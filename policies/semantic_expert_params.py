@@ -308,6 +308,10 @@ class SemanticExpertParams:
         tight_centring_range_m: ... centred between walls the scan sees within this on both
             sides.
         entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
+        grid_candidate: The nearest frontier a grid search reaches competes with Algorithm 1's
+            choice, scored by the same ``C`` without semantic terms (``d / L_path + w_v * v``):
+            frontiers the topometric map has no pathway for (or reaches the long way) are
+            explored as the robot passes them, not left for the end.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
         stuck_recovery: Watch progress; back off, retry or drop the goal when stuck.
@@ -381,6 +385,7 @@ class SemanticExpertParams:
     tight_turn_in_place_rad: float = 0.15
     tight_centring_range_m: float = 0.3
     entry_detour: bool = True
+    grid_candidate: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
     stuck_recovery: bool = True
@@ -496,6 +501,7 @@ PAPER_PURE: dict[str, object] = {
     "shuttle_guard": False,
     "view_unseen_frontiers": False,
     "entry_detour": False,
+    "grid_candidate": False,
     "goal_commitment": False,
     "local_min_escape": False,
     "stuck_recovery": False,

@@ -63,7 +63,8 @@ class SemanticTeamParams:
         idle_recheck_s: A stopped robot looks again this often while teammates work.
         yield_distance_m: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         yield_cone_rad: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
-        expert: Each robot's expert parameters.
+        expert: Each robot's expert parameters (``grid_candidate`` off by default: the team's
+            coordinated choice, not each robot's nearest frontier, decides).
     """
 
     semantic: bool = True
@@ -75,7 +76,9 @@ class SemanticTeamParams:
     idle_recheck_s: float = 5.0
     yield_distance_m: float = 0.7
     yield_cone_rad: float = 1.2
-    expert: SemanticExpertParams = dataclasses.field(default_factory=SemanticExpertParams)
+    expert: SemanticExpertParams = dataclasses.field(
+        default_factory=lambda: SemanticExpertParams(grid_candidate=False)
+    )
 
 
 class _ExpertMember(SemanticExpertPolicy):

@@ -1,0 +1,114 @@
+"""The grid's nearest frontier competes with Algorithm 1's choice (``grid_candidate``): scored
+by the same ``C`` without semantic terms."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
+
+RES_M = 0.05
+ROBOT_XY_M = (1.0, 1.5)
+
+
+def _corridor() -> tuple[np.ndarray, GridGeometry]:
+    """A 3 m x 5 m free room walled on three sides; its last 0.5 m (x > 4.5 m) is unseen."""
+    grid = np.full((60, 100), FREE, dtype=np.uint8)
+    grid[:2, :] = grid[-2:, :] = OCCUPIED
+    grid[:, :2] = OCCUPIED
+    grid[2:-2, 90:] = UNKNOWN
+    return grid, GridGeometry(RES_M, 0.0, 0.0, 60, 100)
+
+
+def _context(chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
+    from semexplore_gym.policies.expert_counters import ExpertCounters
+    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.expert_plan_context import PlanContext
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    grid, geometry = _corridor()
+    prm = SemanticExpertParams(**params)
+    counts = ExpertCounters()
+    # Algorithm 1's choice (stand-in): by default a goal 0.8 m behind the robot, L_path 2 m.
+    chosen = SimpleNamespace(
+        goal_xy_m=goal_xy_m,
+        path_m=np.array([ROBOT_XY_M, goal_xy_m]),
+        l_path_m=2.0,
+        cost=chosen_cost,
+    )
+    ctx = PlanContext(
+        grid=grid,
+        pose=(*ROBOT_XY_M, 0.0),  # heading +x, toward the unseen end
+        geometry=geometry,
+        params=prm,
+        clearance_m=0.155,
+        robot_radius_m=0.105,
+        candidates=[chosen],  # type: ignore[list-item]
+        current=None,
+        memory=GoalMemory(prm.goal_memory, counts, lambda *_: None),
+        counts=counts,
+        choose_goal=lambda cands: cands[0],
+        log=lambda *_: None,
+    )
+    return ctx
+
+
+def _propose(ctx):
+    from semexplore_gym.policies.expert_plan_sources import SemanticFrontier
+
+    return SemanticFrontier().propose(ctx)
+
+
+def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice() -> None:
+    from semexplore_gym.policies.expert_plan import PlanKind
+
+    # The unseen end is about 3.4 m ahead: C = 3.4 / 2 + w_v * 0 = 1.7 < 5.
+    ctx = _context(chosen_cost=5.0)
+    plan = _propose(ctx)
+    assert plan.kind == PlanKind.FALLBACK
+    assert plan.goal_xy_m[0] > 4.3  # next to the unseen end
+    assert ctx.counts.grid_frontier_plans == 1
+
+
+@pytest.mark.parametrize("chosen_cost", [1.0, 1.6])
+def test_algorithm_1s_choice_stands_when_the_grid_frontier_is_not_cheaper(
+    chosen_cost: float,
+) -> None:
+    from semexplore_gym.policies.expert_plan import PlanKind
+
+    ctx = _context(chosen_cost=chosen_cost)  # the grid frontier costs about 1.7
+    plan = _propose(ctx)
+    assert plan.kind == PlanKind.SEMANTIC and plan.goal_xy_m == (0.2, 1.5)
+    assert ctx.counts.grid_frontier_plans == 0
+
+
+def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal() -> None:
+    from semexplore_gym.policies.expert_plan import PlanKind
+
+    ctx = _context(chosen_cost=5.0, goal_xy_m=(4.0, 1.8))  # within 1 m of the grid's goal
+    assert _propose(ctx).kind == PlanKind.SEMANTIC
+    assert ctx.counts.grid_frontier_plans == 0
+
+
+def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone() -> None:
+    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
+
+    assert PAPER_PURE["grid_candidate"] is False
+    ctx = _context(chosen_cost=5.0, grid_candidate=False)
+    assert _propose(ctx).kind == PlanKind.SEMANTIC
+    assert ctx.counts.grid_frontier_plans == 0
+
+
+def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_mission) -> None:
+    """An 8 m maze (a tuning world of #33): the frontiers Algorithm 1 leaves behind are taken on the way."""
+    world = "maze:seed=61001,size_m=8,braid=0.3"
+    new, p_new = short_mission(world, "semantic", 5000, 1200)
+    old, p_old = short_mission(world, "semantic[grid_candidate=false]", 5000, 1200)
+    assert p_new.counters["grid_frontier_plans"] > 0
+    assert p_old.counters["grid_frontier_plans"] == 0
+    assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0
+    assert new.path_length_m < 0.9 * old.path_length_m
