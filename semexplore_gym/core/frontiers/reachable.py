@@ -94,11 +94,15 @@ def frontier_groups(
     if min_unknown_depth_cells > 0 and keep[1:].any():
         # Depth of unknown cells: distance to the nearest known cell. The grid is padded with
         # unknown so that unknown space running off the map counts as deep.
+        # wall_distance_m is scipy's distance_transform_edt bit for bit (distances to the
+        # cells marked OCCUPIED), a few times faster: this runs at every replan.
         pad = int(math.ceil(min_unknown_depth_cells)) + 2
         padded = np.pad(unknown, pad, constant_values=True)
-        deep = ndimage.distance_transform_edt(padded) >= min_unknown_depth_cells
+        known_marked = np.where(padded, UNKNOWN, OCCUPIED).astype(np.uint8)
+        deep = wall_distance_m(known_marked, 1.0) >= min_unknown_depth_cells
         if deep.any():
-            near_deep = (ndimage.distance_transform_edt(~deep) <= min_unknown_depth_cells + 2.0)[
+            deep_marked = np.where(deep, OCCUPIED, UNKNOWN).astype(np.uint8)
+            near_deep = (wall_distance_m(deep_marked, 1.0) <= min_unknown_depth_cells + 2.0)[
                 pad:-pad, pad:-pad
             ]
             ok = np.zeros(n + 1, dtype=bool)

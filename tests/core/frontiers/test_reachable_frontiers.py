@@ -203,3 +203,34 @@ def test_step_cost_is_the_numpy_expression_bit_for_bit() -> None:
         np.testing.assert_array_equal(
             _step_cost(dist, usable, clearance_m, wall_cost, extra_m), want
         )
+
+
+def test_frontier_groups_depth_check_is_the_distance_transform_definition():
+    """The unknown-depth check (run at every replan, through a compiled transform) keeps
+    exactly the groups that scipy's Euclidean distance transform keeps, on random maps."""
+    import math
+
+    from scipy import ndimage
+
+    from semexplore_gym.core.frontiers.detection import frontier_cell_mask
+    from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
+
+    def reference(grid, depth):
+        cells = frontier_cell_mask(grid, cell_convention="free")
+        labels, n = ndimage.label(cells, structure=np.ones((3, 3), dtype=bool))
+        pad = int(math.ceil(depth)) + 2
+        deep = ndimage.distance_transform_edt(np.pad(grid == UNKNOWN, pad, constant_values=True))
+        deep = deep >= depth
+        near = (ndimage.distance_transform_edt(~deep) <= depth + 2.0)[pad:-pad, pad:-pad]
+        return {int(v) for v in np.unique(labels[cells & near]) if v > 0}, labels
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        h, w = (int(v) for v in rng.integers(6, 40, 2))
+        coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(h, w), p=[0.5, 0.2, 0.3])
+        grid = np.kron(coarse, np.ones((3, 3), dtype=np.uint8)).astype(np.uint8)
+        depth = float(rng.choice([1.0, 2.5, 4.0]))
+        kept_ref, ref_labels = reference(grid, depth)
+        labels, n = frontier_groups(grid, 1, min_unknown_depth_cells=depth)
+        assert n == len(kept_ref)
+        assert {int(v) for v in np.unique(ref_labels[labels > 0])} == kept_ref
