@@ -86,6 +86,7 @@ def group_by_family(
 
 COMPARED_METRICS: tuple[tuple[str, str], ...] = (
     ("mission_time_s", "mission time"),
+    ("path_length_m", "path length"),
     ("T90_s", "T90"),
     ("T99_s", "T99"),
     ("mean_map_generation_ms", "map generation ms"),
@@ -110,18 +111,19 @@ def _comparison_table(
     by_policy: dict[str, list[dict[str, Any]]], reference: str, paired_by: str
 ) -> list[str]:
     """The reference policy against each other one, paired by (world, seed)."""
-    from scipy.stats import mannwhitneyu
+    from scipy.stats import mannwhitneyu, wilcoxon
 
     if reference not in by_policy or len(by_policy) < 2:
         return []
     lines = [
         f"{reference} vs each other policy, paired by {paired_by}. Ratio = median({reference}) / "
         f"median(other); paired ratio = median over pairs of {reference} / other (worlds of "
-        "different sizes pooled in a family weigh alike); p = two-sided Mann–Whitney U; wins = "
-        f"missions where {reference} is lower.",
+        "different sizes pooled in a family weigh alike); p = two-sided Mann–Whitney U; p W = "
+        "two-sided Wilcoxon signed-rank test on the pairs' log ratios; wins = missions where "
+        f"{reference} is lower.",
         "",
-        "| vs | metric | ratio of medians | paired ratio | p (Mann–Whitney U) | wins |",
-        "|---|---|---:|---:|---:|---:|",
+        "| vs | metric | ratio of medians | paired ratio | p (Mann–Whitney U) | p W | wins |",
+        "|---|---|---:|---:|---:|---:|---:|",
     ]
 
     def key(r: dict[str, Any]) -> tuple[str, int]:
@@ -142,7 +144,7 @@ def _comparison_table(
             a = np.array([x for x, _ in both], dtype=float)
             b = np.array([y for _, y in both], dtype=float)
             if a.size == 0:
-                lines.append(f"| {other} | {label} | – | – | – | – |")
+                lines.append(f"| {other} | {label} | – | – | – | – | – |")
                 continue
             ratio = np.median(a) / np.median(b) if np.median(b) > 0 else math.inf
             pos = b > 0
@@ -150,16 +152,21 @@ def _comparison_table(
             if a.size >= 2 and np.all(a == a[0]) and np.all(b == b[0]):
                 # Each side one repeated value: a test or a win count over copies means nothing.
                 lines.append(
-                    f"| {other} | {label} | {ratio:.2f} | {paired} | {no_variation(a.size)} | – |"
+                    f"| {other} | {label} | {ratio:.2f} | {paired} | {no_variation(a.size)} "
+                    "| – | – |"
                 )
                 continue
             wins = int(np.sum(a < b))
-            if a.size < 2:  # one pair: no test
-                p_cell = "– (1 pair)"
-            else:
+            p_cell, pw_cell = "– (1 pair)", "–"
+            if a.size >= 2:
                 p_cell = f"{mannwhitneyu(a, b, alternative='two-sided').pvalue:.3g}"
+                both_pos = (a > 0) & (b > 0)
+                log_ratio = np.log(a[both_pos] / b[both_pos])
+                if log_ratio.size >= 2 and np.any(log_ratio != 0):
+                    pw_cell = f"{wilcoxon(log_ratio, alternative='two-sided').pvalue:.3g}"
             lines.append(
-                f"| {other} | {label} | {ratio:.2f} | {paired} | {p_cell} | {wins}/{a.size} |"
+                f"| {other} | {label} | {ratio:.2f} | {paired} | {p_cell} | {pw_cell} "
+                f"| {wins}/{a.size} |"
             )
     lines.append("")
     return lines

@@ -42,9 +42,22 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
     for r in rows:
         assert 0.0 < r["coverage"] <= 1.0
         assert 0.0 < r["mission_time_s"] <= 40.0 + 1e-6
+    import numpy as np
+
     summary = (out / "summary.md").read_text()
     for world in ("maze1", "maze:seed=*,size_m=4"):
         assert f"## {world}" in summary
+    # The expert against each baseline, paired: path length too, with a Wilcoxon p.
+    import re
+
+    assert "| p (Mann–Whitney U) | p W | wins |" in summary
+    path_rows = re.findall(r"^\| nearest \| path length \| ([\d.]+) \| ([\d.]+) \|", summary, re.M)
+    assert path_rows  # per family, over all worlds, per world
+    sem = {(r["world"], r["seed"]): r["path_length_m"] for r in rows if r["policy"] == "semantic"}
+    near = {(r["world"], r["seed"]): r["path_length_m"] for r in rows if r["policy"] == "nearest"}
+    per_maze1 = np.median([sem["maze1", s] / near["maze1", s] for s in (0, 1)])
+    section = summary.split("## maze1")[1]
+    assert re.search(rf"\| nearest \| path length \| [\d.]+ \| {per_maze1:.2f} \|", section)
     for name in (
         "explored_area.png",
         "mission_time.png",
@@ -54,7 +67,6 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
     ):
         assert (out / name).exists()
     # Paired: every policy starts a seed from the same pose; different seeds start elsewhere.
-    import numpy as np
 
     def start(policy: str, seed: int) -> np.ndarray:
         return np.load(out / "trajectories" / f"maze1__{policy}__{seed}.npy")[0]
