@@ -74,7 +74,8 @@ class FrontierValueParams:
     """Parameters of :class:`FrontierValuePolicy`.
 
     Attributes:
-        expert: The semantic expert's parameters (its cost weights and switch margin included).
+        expert: The semantic expert's parameters (its cost weights and switch margin included;
+            ``grid_candidate`` is always off: the learned ranking decides).
         value: The learned value's weights.
     """
 
@@ -95,7 +96,9 @@ class FrontierValuePolicy(SemanticExpertPolicy):
         self, params: FrontierValueParams | None = None, segmenter: Segmenter | None = None
     ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
-        super().__init__(self.value_params.expert, segmenter=segmenter)
+        # The learned ranking chooses: the grid's nearest frontier must not overrule it.
+        expert = dataclasses.replace(self.value_params.expert, grid_candidate=False)
+        super().__init__(expert, segmenter=segmenter)
         self._obs: dict[str, np.ndarray] | None = None
 
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:

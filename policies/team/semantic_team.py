@@ -63,7 +63,7 @@ class SemanticTeamParams:
         idle_recheck_s: A stopped robot looks again this often while teammates work.
         yield_distance_m: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         yield_cone_rad: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
-        expert: Each robot's expert parameters (``grid_candidate`` off by default: the team's
+        expert: Each robot's expert parameters (``grid_candidate`` is always off: the team's
             coordinated choice, not each robot's nearest frontier, decides).
     """
 
@@ -76,16 +76,14 @@ class SemanticTeamParams:
     idle_recheck_s: float = 5.0
     yield_distance_m: float = 0.7
     yield_cone_rad: float = 1.2
-    expert: SemanticExpertParams = dataclasses.field(
-        default_factory=lambda: SemanticExpertParams(grid_candidate=False)
-    )
+    expert: SemanticExpertParams = dataclasses.field(default_factory=SemanticExpertParams)
 
 
 class _ExpertMember(SemanticExpertPolicy):
     """One robot's expert; its goal choice is the team's."""
 
     def __init__(self, team: SemanticTeam, index: int, params: SemanticExpertParams) -> None:
-        super().__init__(params)
+        super().__init__(dataclasses.replace(params, grid_candidate=False))
         self.team = team
         self.index = index
         self.goal_intersection_xy: tuple[float, float] | None = None

@@ -112,3 +112,19 @@ def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_miss
     assert p_old.counters["grid_frontier_plans"] == 0
     assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0
     assert new.path_length_m < 0.9 * old.path_length_m
+
+
+def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
+    """Teams, the learning agents' driver and the learned frontier value make the choice: the
+    grid's nearest frontier never overrules it, whatever the parameters say."""
+    from semexplore_gym.policies.expert_driver import ExpertDriver
+    from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
+
+    assert SemanticExpertParams().grid_candidate  # the robust expert's default
+    on = SemanticExpertParams(grid_candidate=True)
+    assert not ExpertDriver(on).params.grid_candidate
+    assert not ExpertDriver().params.grid_candidate
+    assert not FrontierValuePolicy().params.grid_candidate
+    assert not _ExpertMember(SemanticTeam(), 0, on).params.grid_candidate
