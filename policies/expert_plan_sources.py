@@ -295,7 +295,9 @@ def _cheaper_grid_frontier(ctx: PlanContext, chosen: FrontierCandidate) -> Plan 
         ctx.xy_m,
         ctx.clearance_m,
         frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
-        clearance_field=ctx.clearance_field(),
+        # The whole map's clearance only when a source already paid for it this replan: the
+        # search computes the same values within the window of known cells, much cheaper.
+        clearance_field=ctx.clearance_cache,
     )
     if found is None or (
         math.dist(found.goal_xy_m, chosen.goal_xy_m) <= ctx.params.commitment_radius_m

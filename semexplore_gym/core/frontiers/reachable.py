@@ -190,28 +190,39 @@ def nearest_reachable_frontier(
         if not (math.isfinite(value) and value >= 0.0):
             raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     res = geometry.resolution_m
+    # Everything below happens within the window of the known cells (a large map is mostly
+    # unknown): usable cells are FREE, so the search never leaves it, and the margin holds the
+    # start's 0.5 m escape and the goals' reach. Same result as on the whole grid, cell for cell.
+    margin = int(math.ceil(0.5 / res)) + int(math.ceil(f.reach_m / res)) + 2
+    r0, r1, c0, c1 = _known_window(g, geometry, start_xy_m, margin)
+    full_dist = clearance_field
+    g = np.ascontiguousarray(g[r0:r1, c0:c1])
     labels, n = frontier_groups(g, f.min_frontier_cells, f.min_unknown_depth_cells)
     if n == 0:
         return None
-    if len(f.excluded_xy_m) and not _drop_excluded(labels, geometry, f):
+    if len(f.excluded_xy_m) and not _drop_excluded(labels, geometry, f, (r0, c0)):
         return None
-    dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
+    dist = (
+        np.ascontiguousarray(full_dist[r0:r1, c0:c1])
+        if full_dist is not None
+        else clearance_field_m(g, res)
+    )
     usable = _usable(g, dist, clearance_m)
     near = _dilate(labels > 0, f.reach_m / res) if f.reach_m > 0 else labels > 0
     goal_mask = usable & near
 
     cost = _step_cost(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
-    path = _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
+    path = _search_path(g, geometry, usable, cost, goal_mask, start_xy_m, (r0, c0))
     if path is None:
         return None
     gr, gc = (int(v) for v in geometry.world_to_grid(path[-1, 0], path[-1, 1]))
     xs, ys = path[:, 0], path[:, 1]
     # The frontier group nearest the goal cell is the one it serves.
     fr, fc = np.nonzero(labels)
-    j = int(np.argmin((fr - gr) ** 2 + (fc - gc) ** 2))
+    j = int(np.argmin((fr + r0 - gr) ** 2 + (fc + c0 - gc) ** 2))
     grp = labels == labels[fr[j], fc[j]]
     gr_rows, gr_cols = np.nonzero(grp)
-    cx, cy = geometry.grid_to_world(gr_rows.mean(), gr_cols.mean())
+    cx, cy = geometry.grid_to_world((gr_rows + r0).mean(), (gr_cols + c0).mean())
     return ReachableFrontier(
         goal_xy_m=(float(xs[-1]), float(ys[-1])),
         path_m=path,
@@ -221,10 +232,38 @@ def nearest_reachable_frontier(
     )
 
 
-def _drop_excluded(labels: np.ndarray, geometry: GridGeometry, frontiers: FrontierFilter) -> bool:
-    """Unlabel (in place) the frontier cells near the excluded points; False if none is left."""
+def _known_window(
+    g: np.ndarray, geometry: GridGeometry, start_xy_m: tuple[float, float], margin: int
+) -> tuple[int, int, int, int]:
+    """``(r0, r1, c0, c1)``: the rows and columns holding every known cell and the start cell,
+    widened by ``margin`` cells (clipped to the grid)."""
+    h, w = g.shape
+    known = g != UNKNOWN
+    rows = np.flatnonzero(known.any(axis=1))
+    cols = np.flatnonzero(known.any(axis=0))
+    sr, sc = (int(v) for v in geometry.world_to_grid(start_xy_m[0], start_xy_m[1]))
+    if len(rows) == 0:
+        rows = cols = np.empty(0, dtype=np.int64)
+    lo_r, hi_r = min([*rows[:1], sr]), max([*rows[-1:], sr])
+    lo_c, hi_c = min([*cols[:1], sc]), max([*cols[-1:], sc])
+    return (
+        max(int(lo_r) - margin, 0),
+        min(int(hi_r) + margin + 1, h),
+        max(int(lo_c) - margin, 0),
+        min(int(hi_c) + margin + 1, w),
+    )
+
+
+def _drop_excluded(
+    labels: np.ndarray,
+    geometry: GridGeometry,
+    frontiers: FrontierFilter,
+    offset: tuple[int, int] = (0, 0),
+) -> bool:
+    """Unlabel (in place) the frontier cells near the excluded points; False if none is left.
+    ``labels`` covers the grid's window starting at cell ``offset``."""
     fr, fc = np.nonzero(labels)
-    fx, fy = geometry.grid_to_world(fr, fc)
+    fx, fy = geometry.grid_to_world(fr + offset[0], fc + offset[1])
     drop = np.zeros(len(fr), dtype=bool)
     for ex, ey in frontiers.excluded_xy_m:
         drop |= np.hypot(fx - ex, fy - ey) <= frontiers.excluded_radius_m
@@ -410,11 +449,17 @@ def pocket_exit_path(
 
 
 def _start_cell(
-    g: np.ndarray, geometry: GridGeometry, usable: np.ndarray, start_xy_m: tuple[float, float]
+    g: np.ndarray,
+    geometry: GridGeometry,
+    usable: np.ndarray,
+    start_xy_m: tuple[float, float],
+    offset: tuple[int, int] = (0, 0),
 ) -> tuple[int, int] | None:
-    """The search's start: the robot's cell when usable, else the nearest usable within 0.5 m."""
+    """The search's start: the robot's cell when usable, else the nearest usable within 0.5 m
+    (cells of the window starting at ``offset``)."""
     h, w = g.shape
     sr, sc = (int(v) for v in geometry.world_to_grid(start_xy_m[0], start_xy_m[1]))
+    sr, sc = sr - offset[0], sc - offset[1]
     if not (0 <= sr < h and 0 <= sc < w):
         return None
     if not usable[sr, sc]:
@@ -434,9 +479,12 @@ def _search_path(
     cost: np.ndarray,
     goal_mask: np.ndarray,
     start_xy_m: tuple[float, float],
+    offset: tuple[int, int] = (0, 0),
 ) -> np.ndarray | None:
+    """The search from the start to the first goal cell settled, as a world polyline; the
+    arrays cover the grid's window starting at cell ``offset``."""
     w = g.shape[1]
-    start = _start_cell(g, geometry, usable, start_xy_m)
+    start = _start_cell(g, geometry, usable, start_xy_m, offset)
     if start is None:
         return None
     sr, sc = start
@@ -450,7 +498,7 @@ def _search_path(
         k = parent[k]
     cells.reverse()
     idx = np.asarray(cells)
-    xs, ys = geometry.grid_to_world(idx // w, idx % w)
+    xs, ys = geometry.grid_to_world(idx // w + offset[0], idx % w + offset[1])
     return np.vstack([np.asarray(start_xy_m, dtype=np.float64)[None, :], np.column_stack([xs, ys])])
 
 

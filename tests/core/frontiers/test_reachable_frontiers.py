@@ -234,3 +234,52 @@ def test_frontier_groups_depth_check_is_the_distance_transform_definition():
         labels, n = frontier_groups(grid, 1, min_unknown_depth_cells=depth)
         assert n == len(kept_ref)
         assert {int(v) for v in np.unique(ref_labels[labels > 0])} == kept_ref
+
+
+def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monkeypatch):
+    """The nearest reachable frontier is found within the window of the known cells (a large
+    map is mostly unknown); on random maps it is the very result of the whole grid's search."""
+    from semexplore_gym.core.frontiers import reachable
+    from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
+
+    rng = np.random.default_rng(11)
+    cases = []
+    for _ in range(40):
+        h, w = (int(v) for v in rng.integers(60, 140, 2))
+        grid = np.full((h, w), UNKNOWN, dtype=np.uint8)
+        r0, c0 = (int(v) for v in rng.integers(0, 20, 2))
+        rh, rw = int(rng.integers(20, h - r0)), int(rng.integers(20, w - c0))
+        coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(rh // 4, rw // 4), p=[0.7, 0.1, 0.2])
+        block = np.kron(coarse, np.ones((4, 4), dtype=np.uint8))
+        grid[r0 : r0 + block.shape[0], c0 : c0 + block.shape[1]] = block
+        free = np.argwhere(grid == FREE)
+        if len(free) == 0:
+            continue
+        geom = GridGeometry(0.05, -1.0, 2.0, h, w)
+        r, c = free[int(rng.integers(len(free)))]
+        xs, ys = geom.grid_to_world(r, c)
+        start = (float(xs) + 0.01, float(ys) - 0.01)
+        filt = FrontierFilter(
+            int(rng.integers(1, 5)),
+            reach_m=float(rng.choice([0.0, 0.1, 0.3])),
+            min_unknown_depth_cells=float(rng.choice([0.0, 4.0])),
+            excluded_xy_m=[start] if rng.random() < 0.3 else [],
+        )
+        cases.append((grid, geom, start, filt))
+
+    def run_all():
+        out = []
+        for grid, geom, start, filt in cases:
+            out.append(nearest_reachable_frontier(grid, geom, start, 0.1, filt))
+        return out
+
+    windowed = run_all()
+    monkeypatch.setattr(reachable, "_known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
+    whole = run_all()
+    assert sum(f is not None for f in whole) >= 20
+    for a, b in zip(windowed, whole, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert a.goal_xy_m == b.goal_xy_m and a.frontier_xy_m == b.frontier_xy_m
+            assert a.path_length_m == b.path_length_m and a.n_frontier_cells == b.n_frontier_cells
+            np.testing.assert_array_equal(a.path_m, b.path_m)
