@@ -99,12 +99,12 @@ def test_identical_samples_print_no_variation_instead_of_p(tmp_path) -> None:
     )
     text = write_summary(tmp_path).read_text()
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | mission time |"))
-    ratio, paired, p, wins = (c.strip() for c in line.strip("|").split("|")[2:6])
+    ratio, paired, p, p_w, wins = (c.strip() for c in line.strip("|").split("|")[2:7])
     assert ratio == "0.67" and paired == "0.67"
-    assert p == "no variation (4 identical samples)" and wins == "–"
+    assert p == "no variation (4 identical samples)" and p_w == wins == "–"
     # A metric that varies still gets its test.
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | global planning"))
-    assert "no variation" not in line and line.strip("|").split("|")[5].strip() == "0/4"
+    assert "no variation" not in line and line.strip("|").split("|")[6].strip() == "0/4"
     semantic = next(ln for ln in text.splitlines() if ln.startswith("| semantic | 4 |"))
     assert "100.0 — no variation (4 identical samples)" in semantic
 

@@ -92,10 +92,11 @@ def test_summary_compares_reference_with_each_baseline(tmp_path) -> None:
     text = write_summary(tmp_path).read_text()
     assert "## maze1" in text and "| semantic | 6 | 6/6 |" in text
     line = next(ln for ln in text.splitlines() if ln.startswith("| frontier | mission time |"))
-    ratio, paired, p, wins = (c.strip() for c in line.strip("|").split("|")[2:6])
+    ratio, paired, p, p_w, wins = (c.strip() for c in line.strip("|").split("|")[2:7])
     assert float(ratio) < 0.75  # ~110 s vs ~170 s
     assert float(paired) < 0.75
     assert float(p) < 0.01
+    assert float(p_w) < 0.05  # six pairs, all the same way: the smallest two-sided p is 1/32
     assert wins == "6/6"
 
 

@@ -94,7 +94,11 @@ def _shuttle_mission(params: SemanticExpertParams, period_s: float, time_s: floa
 def test_a_goal_shuttle_slower_than_the_oscillation_window_is_caught_and_broken() -> None:
     # Costs trade places every 150 s, longer than the oscillation guard's 120 s window: the
     # guard alone lets the robot switch goals every 150 s for as long as the mission lasts.
-    quiet = dict(stuck_recovery=False, local_min_escape=False, resegment_min_new_m2=0.0)
+    # The ranker stands in for Algorithm 1's costs: the grid's nearest frontier must not
+    # compete with it here (grid_candidate is measured on its own).
+    quiet = dict(
+        stuck_recovery=False, local_min_escape=False, resegment_min_new_m2=0.0, grid_candidate=False
+    )
     guard_only = _shuttle_mission(SemanticExpertParams(shuttle_guard=False, **quiet), 150, 1500)
     assert guard_only.counters["switches"] >= 8
     assert guard_only.counters["shuttles"] == 0

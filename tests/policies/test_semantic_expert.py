@@ -380,7 +380,7 @@ def test_counters_keep_their_names_and_mission_metrics_follow_them():
     names = list(pol.counters)
     assert names[:3] == ["replans", "segmentations", "semantic_plans"]
     assert names[-3:] == ["scored_replans", "semantic_decisive", "replan_no_plan"]
-    assert len(names) == 23 and pol.counters["semantic_plans"] == 1
+    assert len(names) == 24 and pol.counters["semantic_plans"] == 1
     assert pol.mission_metrics() == {"scored_replans": 1, "semantic_share": 0.0}
     pol.reset(obs, INFO, seed=0)
     assert pol.mission_metrics() == {"scored_replans": 0, "semantic_share": None}
