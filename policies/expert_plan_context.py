@@ -17,9 +17,11 @@ from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.core.frontiers.reachable import (
     FrontierFilter,
+    ReachableFrontier,
     clearance_field_m,
     grid_path_to,
     known_free_clearance_m,
+    nearest_reachable_frontier,
 )
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
@@ -106,6 +108,20 @@ class PlanContext:
                 self.grid, self.geometry.resolution_m
             )
         return self.known_clearance_cache
+
+    def nearest_grid_frontier(self) -> ReachableFrontier | None:
+        """The nearest frontier the grid fallback's search reaches from the robot (its filters,
+        the goal memory's drops). The whole map's clearance field is used only when a source
+        already computed it this replan: the search computes the same values within the window
+        of the known cells, much cheaper on a large map."""
+        return nearest_reachable_frontier(
+            self.grid,
+            self.geometry,
+            self.xy_m,
+            self.clearance_m,
+            frontiers=FrontierFilter(**self.fallback_search_kwargs()),
+            clearance_field=self.clearance_cache,
+        )
 
     def resampled(self, path_m: np.ndarray) -> np.ndarray:
         """``path_m`` resampled at the map's resolution (what the path follower expects)."""

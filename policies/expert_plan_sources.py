@@ -289,16 +289,7 @@ def _cheaper_grid_frontier(ctx: PlanContext, chosen: FrontierCandidate) -> Plan 
     grid frontier within the commitment radius of ``chosen`` is the same goal: Algorithm 1's
     plan stands.
     """
-    found = nearest_reachable_frontier(
-        ctx.grid,
-        ctx.geometry,
-        ctx.xy_m,
-        ctx.clearance_m,
-        frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
-        # The whole map's clearance only when a source already paid for it this replan: the
-        # search computes the same values within the window of known cells, much cheaper.
-        clearance_field=ctx.clearance_cache,
-    )
+    found = ctx.nearest_grid_frontier()
     if found is None or (
         math.dist(found.goal_xy_m, chosen.goal_xy_m) <= ctx.params.commitment_radius_m
     ):
@@ -345,14 +336,7 @@ class NearestFallback(PlanSource):
     def propose(self, ctx: PlanContext) -> Plan | None:
         if not ctx.params.grid_fallback:
             return None
-        found = nearest_reachable_frontier(
-            ctx.grid,
-            ctx.geometry,
-            ctx.xy_m,
-            ctx.clearance_m,
-            frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
-            clearance_field=ctx.clearance_field(),
-        )
+        found = ctx.nearest_grid_frontier()
         if found is None:
             return None
         return Plan(PlanKind.FALLBACK, found.goal_xy_m, ctx.resampled(found.path_m))
