@@ -195,6 +195,8 @@ def nearest_reachable_frontier(
     # start's 0.5 m escape and the goals' reach. Same result as on the whole grid, cell for cell.
     margin = int(math.ceil(0.5 / res)) + int(math.ceil(f.reach_m / res)) + 2
     r0, r1, c0, c1 = _known_window(g, geometry, start_xy_m, margin)
+    if r0 >= r1 or c0 >= c1:  # nothing known and the start off the grid
+        return None
     full_dist = clearance_field
     g = np.ascontiguousarray(g[r0:r1, c0:c1])
     labels, n = frontier_groups(g, f.min_frontier_cells, f.min_unknown_depth_cells)

@@ -273,6 +273,9 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
             out.append(nearest_reachable_frontier(grid, geom, start, 0.1, filt))
         return out
 
+    unseen = np.full((30, 30), UNKNOWN, dtype=np.uint8)
+    off_grid = GridGeometry(0.05, 0.0, 0.0, 30, 30)
+    assert nearest_reachable_frontier(unseen, off_grid, (9.0, 0.5), 0.1, FrontierFilter(1)) is None
     windowed = run_all()
     monkeypatch.setattr(reachable, "_known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
     whole = run_all()
