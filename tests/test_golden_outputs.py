@@ -41,6 +41,9 @@ MISSIONS = [
     ("maze2", "semantic", 1, None),
     ("office:seed=1,size_m=12", "semantic", 0, None),
     ("cave:seed=1", "semantic", 0, None),
+    # The paper's method alone: changes to the robust expert must leave it as it is.
+    ("maze1", "semantic-paper", 0, 400.0),
+    ("cave:seed=1", "semantic-paper", 0, 400.0),
     ("maze1", "frontier", 0, 120.0),
     ("maze2", "nearest", 0, 120.0),
 ]
