@@ -103,10 +103,10 @@ def frontier_groups(
         # cells marked OCCUPIED), a few times faster: this runs at every replan.
         pad = int(math.ceil(min_unknown_depth_cells)) + 2
         padded = np.pad(unknown, pad, constant_values=True)
-        known_marked = np.where(padded, UNKNOWN, OCCUPIED).astype(np.uint8)
+        known_marked = np.where(padded, np.uint8(UNKNOWN), np.uint8(OCCUPIED))
         deep = wall_distance_m(known_marked, 1.0) >= min_unknown_depth_cells
         if deep.any():
-            deep_marked = np.where(deep, OCCUPIED, UNKNOWN).astype(np.uint8)
+            deep_marked = np.where(deep, np.uint8(OCCUPIED), np.uint8(UNKNOWN))
             near_deep = (wall_distance_m(deep_marked, 1.0) <= min_unknown_depth_cells + 2.0)[
                 pad:-pad, pad:-pad
             ]
