@@ -87,6 +87,7 @@ def group_by_family(
 COMPARED_METRICS: tuple[tuple[str, str], ...] = (
     ("mission_time_s", "mission time"),
     ("path_length_m", "path length"),
+    ("D99_m", "distance to 99 %"),
     ("T90_s", "T90"),
     ("T99_s", "T99"),
     ("mean_map_generation_ms", "map generation ms"),
@@ -248,6 +249,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     rows = read_runs(out / "runs.csv")
     if not rows:
         raise ValueError(f"no finished missions in {out / 'runs.csv'}")
+    add_distance_to_99(out, rows)
     groups = group_runs(rows)
     lines = [
         "# Benchmark summary",
@@ -284,6 +286,16 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     path = out / "summary.md"
     path.write_text("\n".join(lines))
     return path
+
+
+def add_distance_to_99(out: Path, rows: list[dict[str, Any]]) -> None:
+    """Set each row's ``D99_m``: the distance driven until coverage first reached 99 % (from
+    its trace and trajectory; None when it never did or they are missing)."""
+    from semexplore_gym.evaluation.learning_table import distance_to_coverage_m
+
+    for r in rows:
+        d = distance_to_coverage_m(out, r)
+        r["D99_m"] = d if d is not None and math.isfinite(d) else None
 
 
 def _trace(out: Path, r: dict[str, Any]) -> np.ndarray | None:
