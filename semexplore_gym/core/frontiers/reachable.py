@@ -32,6 +32,7 @@ from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.frontiers.reachable_kernels import (
     dijkstra,
     dilate,
+    near_marked,
     nearest_usable,
     step_cost_kernel,
 )
@@ -106,12 +107,11 @@ def frontier_groups(
         known_marked = np.where(padded, np.uint8(UNKNOWN), np.uint8(OCCUPIED))
         deep = wall_distance_m(known_marked, 1.0) >= min_unknown_depth_cells
         if deep.any():
-            deep_marked = np.where(deep, np.uint8(OCCUPIED), np.uint8(UNKNOWN))
-            near_deep = (wall_distance_m(deep_marked, 1.0) <= min_unknown_depth_cells + 2.0)[
-                pad:-pad, pad:-pad
-            ]
+            # Deep unknown within depth + 2 cells, tested at the frontier cells only.
+            fr, fc = np.nonzero(cells)
+            near = near_marked(deep, fr + pad, fc + pad, min_unknown_depth_cells + 2.0)
             ok = np.zeros(n + 1, dtype=bool)
-            ok[np.unique(labels[cells & near_deep])] = True
+            ok[np.unique(labels[fr[near], fc[near]])] = True
             keep &= ok
         else:
             keep[:] = False
@@ -241,8 +241,9 @@ def _served_group(
     gr, gc = (int(v) for v in geometry.world_to_grid(goal_xy_m[0], goal_xy_m[1]))
     fr, fc = np.nonzero(labels)
     j = int(np.argmin((fr + r0 - gr) ** 2 + (fc + c0 - gc) ** 2))
-    grp = labels == labels[fr[j], fc[j]]
-    rows, cols = np.nonzero(grp)
+    lab = labels[fr, fc]
+    grp = lab == lab[j]  # the group's cells, in the same (row-major) order as a mask's nonzero
+    rows, cols = fr[grp], fc[grp]
     cx, cy = geometry.grid_to_world((rows + r0).mean(), (cols + c0).mean())
     return (float(cx), float(cy)), int(grp.sum())
 

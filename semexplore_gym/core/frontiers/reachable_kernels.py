@@ -3,7 +3,8 @@
 The step cost near walls, an 8-connected Dijkstra that stops at the first goal cell (a step
 costs the mean of its two cells' costs times its length; the grid planners of
 :mod:`semexplore_gym.core.planning.grid_search_kernels` charge the entered cell's), a disc
-dilation and the start's nearest usable cell. Moved here unchanged from ``reachable.py``.
+dilation, the start's nearest usable cell (moved here unchanged from ``reachable.py``), and a
+disc test at a few cells (:func:`near_marked`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["dijkstra", "dilate", "nearest_usable", "step_cost_kernel"]
+__all__ = ["dijkstra", "dilate", "near_marked", "nearest_usable", "step_cost_kernel"]
 
 
 @njit(cache=True)
@@ -177,3 +178,32 @@ def nearest_usable(usable, passable, sr, sc, max_cells):  # pragma: no cover - n
                 qc[tail] = cc
                 tail += 1
     return -1, -1
+
+
+@njit(cache=True)
+def near_marked(mask, rows, cols, limit):  # pragma: no cover - numba
+    """Whether a True cell of ``mask`` lies within ``limit`` cells of each ``(rows[i], cols[i])``:
+    ``sqrt(dr^2 + dc^2) <= limit`` for some marked cell, the very test of a distance transform
+    to the marked cells thresholded at ``limit`` (same floats), at those cells only."""
+    h, w = mask.shape
+    k = int(math.floor(limit))
+    out = np.zeros(rows.shape[0], np.bool_)
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        c = cols[i]
+        found = False
+        for dr in range(-k, k + 1):
+            rr = r + dr
+            if rr < 0 or rr >= h:
+                continue
+            for dc in range(-k, k + 1):
+                cc = c + dc
+                if cc < 0 or cc >= w or not mask[rr, cc]:
+                    continue
+                if math.sqrt(float(dr * dr + dc * dc)) <= limit:
+                    found = True
+                    break
+            if found:
+                break
+        out[i] = found
+    return out

@@ -286,3 +286,24 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
             assert a.goal_xy_m == b.goal_xy_m and a.frontier_xy_m == b.frontier_xy_m
             assert a.path_length_m == b.path_length_m and a.n_frontier_cells == b.n_frontier_cells
             np.testing.assert_array_equal(a.path_m, b.path_m)
+
+
+def test_near_marked_is_the_thresholded_distance_transform():
+    """The depth check's disc test at a few cells answers what scipy's distance transform to the
+    marked cells, thresholded, answers there (limits on and off the integer distances)."""
+    from scipy import ndimage
+
+    from semexplore_gym.core.frontiers.reachable_kernels import near_marked
+
+    rng = np.random.default_rng(5)
+    for _ in range(40):
+        h, w = (int(v) for v in rng.integers(5, 50, 2))
+        mask = rng.random((h, w)) < float(rng.choice([0.0, 0.01, 0.05, 0.3]))
+        limit = float(rng.choice([1.0, 2.0, 3.5, 6.0, 2.0**0.5, 5.0**0.5]))
+        rows, cols = (v.astype(np.int64) for v in np.nonzero(rng.random((h, w)) < 0.3))
+        want = (
+            (ndimage.distance_transform_edt(~mask) <= limit)[rows, cols]
+            if mask.any()
+            else (np.zeros(len(rows), dtype=bool))
+        )
+        np.testing.assert_array_equal(near_marked(mask, rows, cols, limit), want)
