@@ -15,12 +15,16 @@ from semexplore_gym.evaluation.report import add_distance_to_99, write_summary
 WORLD = "maze:seed=1,size_m=6"
 
 
+def _bench(out, policies: str, max_time_s: str) -> list[dict]:
+    argv = ["benchmark", "--worlds", WORLD, "--policies", policies, "--runs"]
+    argv += ["2" if "," in policies else "1", "--max-time-s", max_time_s, "--out", str(out)]
+    assert main([*argv, "--no-oracle", "--no-plots", "--no-progress"]) == 0
+    return read_runs(out / "runs.csv")
+
+
 def test_the_summary_pairs_the_distance_to_99_percent(tmp_path, capsys) -> None:
     out = tmp_path / "b"
-    argv = ["benchmark", "--worlds", WORLD, "--policies", "semantic,nearest", "--runs", "2"]
-    argv += ["--max-time-s", "300", "--no-oracle", "--no-plots", "--no-progress"]
-    assert main([*argv, "--out", str(out)]) == 0
-    rows = read_runs(out / "runs.csv")
+    rows = _bench(out, "semantic,nearest", "300")
     d99 = {(r["policy"], r["seed"]): distance_to_coverage_m(out, r) for r in rows}
     assert all(d is not None and np.isfinite(d) for d in d99.values())  # all reached 99 %
     for r in rows:  # no farther than the whole path, and more than nothing for nearest
@@ -35,10 +39,7 @@ def test_the_summary_pairs_the_distance_to_99_percent(tmp_path, capsys) -> None:
 
 def test_a_mission_that_never_reached_99_percent_has_no_distance(tmp_path, capsys) -> None:
     out = tmp_path / "b"
-    argv = ["benchmark", "--worlds", WORLD, "--policies", "nearest", "--runs", "1"]
-    argv += ["--max-time-s", "4", "--no-oracle", "--no-plots", "--no-progress"]
-    assert main([*argv, "--out", str(out)]) == 0
-    rows = read_runs(out / "runs.csv")
+    rows = _bench(out, "nearest", "4")
     add_distance_to_99(out, rows)
     assert rows[0]["coverage"] < 0.99 and rows[0]["D99_m"] is None
     (out / "traces" / next(p.name for p in (out / "traces").iterdir())).unlink()
