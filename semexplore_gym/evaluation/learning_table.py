@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from semexplore_gym.evaluation.run_writer import distance_to_coverage_m
+
 #: The expert every row is compared with (``semexplore benchmark``'s reference policy).
 EXPERT = "semantic"
 ORACLE = "oracle"
@@ -78,28 +80,6 @@ def _median_cell(rows: list[dict[str, Any]], key: str) -> str:
         return "–"
     med = float(np.percentile(v, 50, method="lower"))
     return "∞" if math.isinf(med) else (f"{med:.3f}" if key == "coverage" else f"{med:.1f}")
-
-
-def distance_to_coverage_m(out_dir: Any, row: dict[str, Any], level: float = 0.99) -> float | None:
-    """Distance the robot of ``row`` drove until its coverage first reached ``level`` (inf:
-    never; None: its trace or trajectory is missing)."""
-    from pathlib import Path
-
-    from semexplore_gym.evaluation.run_writer import task_stem
-
-    stem = task_stem(row["world"], row["policy"], int(row["seed"]))
-    out = Path(out_dir)
-    try:
-        trace = np.loadtxt(out / "traces" / f"{stem}.csv", delimiter=",", skiprows=1, ndmin=2)
-        poses = np.load(out / "trajectories" / f"{stem}.npy")
-    except (OSError, ValueError):
-        return None
-    n = min(len(trace), len(poses))
-    hit = np.flatnonzero(trace[:n, 1] >= level)
-    if hit.size == 0:
-        return math.inf
-    steps = np.hypot(*np.diff(poses[: int(hit[0]) + 1, :2], axis=0).T)
-    return float(steps.sum())
 
 
 def _order(policies: list[str]) -> list[str]:

@@ -18,7 +18,7 @@ import numpy as np
 
 from semexplore_gym.evaluation.path_decomposition import decomposition_table
 from semexplore_gym.evaluation.run_row import read_runs
-from semexplore_gym.evaluation.run_writer import file_slug, task_stem
+from semexplore_gym.evaluation.run_writer import distance_to_coverage_m, file_slug, task_stem
 
 #: The policy every other one is compared against in ``summary.md``.
 REFERENCE_POLICY = "semantic"
@@ -291,8 +291,6 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
 def add_distance_to_99(out: Path, rows: list[dict[str, Any]]) -> None:
     """Set each row's ``D99_m``: the distance driven until coverage first reached 99 % (from
     its trace and trajectory; None when it never did or they are missing)."""
-    from semexplore_gym.evaluation.learning_table import distance_to_coverage_m
-
     for r in rows:
         d = distance_to_coverage_m(out, r)
         r["D99_m"] = d if d is not None and math.isfinite(d) else None

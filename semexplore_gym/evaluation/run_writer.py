@@ -1,10 +1,12 @@
 """The benchmark's output directory: ``runs.csv`` appended row by row, traces, trajectories and
-the manifest ``benchmark.json``."""
+the manifest ``benchmark.json``; and the distance a mission drove until a coverage level, read
+back from its trace and trajectory (:func:`distance_to_coverage_m`)."""
 
 from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import re
 import time
@@ -124,3 +126,21 @@ def _add_columns(path: Path) -> None:
         w.writeheader()
         w.writerows(rows)
     os.replace(tmp, path)
+
+
+def distance_to_coverage_m(out_dir: Any, row: dict[str, Any], level: float = 0.99) -> float | None:
+    """Distance the robot of ``row`` drove until its coverage first reached ``level`` (inf:
+    never; None: its trace or trajectory is missing)."""
+    stem = task_stem(row["world"], row["policy"], int(row["seed"]))
+    out = Path(out_dir)
+    try:
+        trace = np.loadtxt(out / "traces" / f"{stem}.csv", delimiter=",", skiprows=1, ndmin=2)
+        poses = np.load(out / "trajectories" / f"{stem}.npy")
+    except (OSError, ValueError):
+        return None
+    n = min(len(trace), len(poses))
+    hit = np.flatnonzero(trace[:n, 1] >= level)
+    if hit.size == 0:
+        return math.inf
+    steps = np.hypot(*np.diff(poses[: int(hit[0]) + 1, :2], axis=0).T)
+    return float(steps.sum())

@@ -9,8 +9,8 @@ import numpy as np
 
 from semexplore_gym.cli import main
 from semexplore_gym.evaluation.harness import read_runs
-from semexplore_gym.evaluation.learning_table import distance_to_coverage_m
 from semexplore_gym.evaluation.report import add_distance_to_99, write_summary
+from semexplore_gym.evaluation.run_writer import distance_to_coverage_m
 
 WORLD = "maze:seed=1,size_m=6"
 
