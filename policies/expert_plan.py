@@ -38,6 +38,9 @@ class PlanKind(StrValueEnum):
     COMMANDED = "commanded"
     #: A place that sees into a frontier reached without clearing it.
     VIEW = "view"
+    #: A frontier a learned chooser picked among every reachable one
+    #: (:class:`~semexplore_gym.policies.frontier_student.FrontierStudentPolicy`).
+    LEARNED = "learned"
 
 
 @dataclass
@@ -88,6 +91,7 @@ class ExpertMode(StrValueEnum):
     LOOK = "look"
     COMMANDED = "commanded"
     VIEW = "view"
+    LEARNED = "learned"
     ESCAPE = "escape"
     RECOVERY = "recovery"
     WAITING = "waiting"

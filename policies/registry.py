@@ -2,7 +2,9 @@
 
 Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
-value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier"`` (ROS frontier_exploration
+value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier-student"`` (the expert's
+navigation choosing among every frontier by a score learned from the oracle,
+``frontier-student:runs/NAME/model.yaml``; :mod:`semexplore_gym.policies.frontier_student`), ``"frontier"`` (ROS frontier_exploration
 baseline), ``"nearest"`` (Yamauchi's nearest frontier), ``"random"``, ``"oracle"`` (privileged:
 reads the true world, a yardstick for benchmarks, :mod:`semexplore_gym.policies.oracle`), ``"sb3:<model.zip>"`` (a
 trained agent: an egocentric BC/DAgger/PPO model, or a frontier-choice / planner-weights macro
@@ -17,6 +19,7 @@ Spec strings and their brackets are parsed by :mod:`semexplore_gym.policies.spec
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from types import ModuleType
 from typing import Any
@@ -64,6 +67,27 @@ def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
     )
 
     return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
+
+
+def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
+    """The expert's navigation choosing among every frontier by a learned score
+    (:mod:`semexplore_gym.policies.frontier_student`)."""
+    from semexplore_gym.policies.frontier_student import (
+        FrontierStudentParams,
+        FrontierStudentPolicy,
+    )
+
+    if arg:  # frontier-student:runs/NAME/model.yaml, a trained model
+        if not os.path.isfile(arg):
+            raise ValueError(f"policy 'frontier-student:{arg}': no such model file")
+        if overrides.get("params") is not None:
+            raise ValueError(
+                f"policy 'frontier-student:{arg}': give the model file or params, not both"
+            )
+        overrides["params"] = arg
+    return _expert_like(
+        "frontier-student", "", overrides, FrontierStudentPolicy, FrontierStudentParams
+    )
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
@@ -146,8 +170,13 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
 
     model = get_pretrained(arg)
     if model.model_path.suffix == ".yaml":
-        # A learned frontier value: its weights on top of the expert (no torch needed).
-        policy = _frontier_value("", {"params": model.model_path, **overrides})
+        # A learned frontier value or a frontier student: weights on top of the expert's
+        # navigation (no torch needed); a student's file has a ``model`` section.
+        from semexplore_gym.config.loading import load_yaml_file
+
+        data = load_yaml_file(model.model_path, f"pretrained model {arg!r}") or {}
+        factory = _frontier_student if "model" in data else _frontier_value
+        policy = factory("", {"params": model.model_path, **overrides})
     else:
         policy = _sb3(str(model.model_path), overrides)
     policy.name = model.spec
@@ -238,6 +267,7 @@ def policy_factories() -> dict[str, Factory]:
         "semantic": _semantic,
         "semantic-paper": _semantic_paper,
         "frontier-value": _frontier_value,
+        "frontier-student": _frontier_student,
         "frontier": _frontier,
         "nearest": _nearest,
         "random": _random,

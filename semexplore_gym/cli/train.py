@@ -1,4 +1,4 @@
-"""``semexplore train --algo bc|dagger|ppo|maskable_ppo|frontier_value --train-config FILE --out DIR``: train an agent.
+"""``semexplore train --algo bc|dagger|ppo|maskable_ppo|frontier_value|oracle_student --train-config FILE --out DIR``: train an agent.
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
@@ -11,9 +11,14 @@ the driving expert's parameters). Every run directory gets ``model.zip``, the re
 tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``metrics.json``.
 ``frontier_value`` fits a learned frontier value for the expert (no torch needed) and writes
 ``model.yaml``, ``generations.jsonl``, ``config.yaml``, ``args.json`` and ``metrics.json``.
+``oracle_student`` trains the frontier student on the oracle's labels by DAgger (no torch;
+:mod:`~semexplore_gym.training.oracle_student`) and writes ``model.yaml``, one model per round,
+the labels (``samples/``), ``episodes.jsonl``, ``rounds.jsonl`` and ``metrics.json``; rerun the
+same command to resume.
 
 The shipped configs (``configs/agents/*.yml``: bc_maze, dagger_maze, ppo_maze,
-frontier_choice_maze, planner_weights_maze, frontier_value) work from any directory.
+frontier_choice_maze, planner_weights_maze, frontier_value, oracle_student) work from any
+directory.
 
 Example::
 
@@ -41,7 +46,7 @@ from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.config import ConfigError, to_dict
 from semexplore_gym.evaluation.errors import ParameterError
 
-ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value")
+ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value", "oracle_student")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -49,7 +54,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "train",
-        help="train a learning agent (BC, DAgger, PPO, MaskablePPO or a learned frontier value)",
+        help="train a learning agent (BC, DAgger, PPO, MaskablePPO, a learned frontier value "
+        "or the frontier student taught by the oracle)",
         description=describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -57,8 +63,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--algo",
         required=True,
         choices=ALGOS,
-        help="bc, dagger, ppo, maskable_ppo (macro-action envs) or frontier_value (a learned "
-        "frontier value for the expert, fitted by a cross-entropy method over missions)",
+        help="bc, dagger, ppo, maskable_ppo (macro-action envs), frontier_value (a learned "
+        "frontier value for the expert, fitted by a cross-entropy method over missions) or "
+        "oracle_student (a frontier chooser trained by DAgger on the oracle's labels)",
     )
     p.add_argument(
         "--train-config",
@@ -95,6 +102,8 @@ def _command_line(args: argparse.Namespace) -> str:
 def run(args: argparse.Namespace) -> int:
     if args.algo == "frontier_value":
         return _run_frontier_value(args)
+    if args.algo == "oracle_student":
+        return _run_oracle_student(args)
     try:
         import stable_baselines3  # noqa: F401
         import torch
@@ -142,6 +151,28 @@ def _run_frontier_value(args: argparse.Namespace) -> int:
     _write_run_record(out, cfg, args)
     t0 = time.perf_counter()
     final = train_frontier_value(cfg, out, log=lambda line: print(line, flush=True))
+    metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
+    print(json.dumps(metrics, default=float))
+    return 0
+
+
+def _run_oracle_student(args: argparse.Namespace) -> int:
+    """``--algo oracle_student``: no torch; DAgger on the oracle's labels
+    (:mod:`~semexplore_gym.training.oracle_student`)."""
+    from semexplore_gym.training.oracle_student import (
+        load_oracle_student_config,
+        train_oracle_student,
+    )
+
+    try:
+        cfg = load_oracle_student_config(args.train_config, args.overrides)
+    except ConfigError as e:
+        raise ValueError(str(e)) from e
+    out = Path(args.out)
+    _write_run_record(out, cfg, args)
+    t0 = time.perf_counter()
+    final = train_oracle_student(cfg, out, log=lambda line: print(line, flush=True))
     metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print(json.dumps(metrics, default=float))

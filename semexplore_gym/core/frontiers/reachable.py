@@ -199,7 +199,7 @@ def nearest_reachable_frontier(
     # unknown): usable cells are FREE, so the search never leaves it, and the margin holds the
     # start's 0.5 m escape and the goals' reach. Same result as on the whole grid, cell for cell.
     margin = int(math.ceil(0.5 / res)) + int(math.ceil(f.reach_m / res)) + 2
-    r0, r1, c0, c1 = _known_window(g, geometry, start_xy_m, margin)
+    r0, r1, c0, c1 = known_window(g, geometry, start_xy_m, margin)
     if r0 >= r1 or c0 >= c1:  # nothing known and the start off the grid
         return None
     full_dist = clearance_field
@@ -207,18 +207,18 @@ def nearest_reachable_frontier(
     labels, n = frontier_groups(g, f.min_frontier_cells, f.min_unknown_depth_cells)
     if n == 0:
         return None
-    if len(f.excluded_xy_m) and not _drop_excluded(labels, geometry, f, (r0, c0)):
+    if len(f.excluded_xy_m) and not drop_excluded(labels, geometry, f, (r0, c0)):
         return None
     dist = (
         np.ascontiguousarray(full_dist[r0:r1, c0:c1])
         if full_dist is not None
         else clearance_field_m(g, res)
     )
-    usable = _usable(g, dist, clearance_m)
+    usable = usable_cells(g, dist, clearance_m)
     near = dilate(labels > 0, f.reach_m / res) if f.reach_m > 0 else labels > 0
     goal_mask = usable & near
 
-    cost = _step_cost(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
+    cost = step_cost_field(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
     path = _search_path(g, geometry, usable, cost, goal_mask, start_xy_m, (r0, c0))
     if path is None:
         return None
@@ -248,7 +248,7 @@ def _served_group(
     return (float(cx), float(cy)), int(grp.sum())
 
 
-def _known_window(
+def known_window(
     g: np.ndarray, geometry: GridGeometry, start_xy_m: tuple[float, float], margin: int
 ) -> tuple[int, int, int, int]:
     """``(r0, r1, c0, c1)``: the rows and columns holding every known cell and the start cell,
@@ -270,7 +270,7 @@ def _known_window(
     )
 
 
-def _drop_excluded(
+def drop_excluded(
     labels: np.ndarray,
     geometry: GridGeometry,
     frontiers: FrontierFilter,
@@ -304,7 +304,7 @@ def grid_path_to(
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     res = geometry.resolution_m
     dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
-    usable = _usable(g, dist, clearance_m)
+    usable = usable_cells(g, dist, clearance_m)
     h, w = g.shape
     gr, gc = (int(v) for v in geometry.world_to_grid(goal_xy_m[0], goal_xy_m[1]))
     rad = int(math.ceil(goal_radius_m / res))
@@ -321,7 +321,7 @@ def grid_path_to(
     goal_mask &= usable
     if not goal_mask.any():
         return None
-    cost = _step_cost(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
+    cost = step_cost_field(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
     return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
 
 
@@ -344,26 +344,28 @@ def grid_path_to_mask(
         if clearance_field is not None
         else clearance_field_m(g, geometry.resolution_m)
     )
-    usable = _usable(g, dist, clearance_m)
+    usable = usable_cells(g, dist, clearance_m)
     goals = usable & np.asarray(goal_mask, dtype=bool)
     if not goals.any():
         return None
-    cost = _step_cost(dist, usable, clearance_m, WALL_COST, PREFER_EXTRA_M)
+    cost = step_cost_field(dist, usable, clearance_m, WALL_COST, PREFER_EXTRA_M)
     return _search_path(g, geometry, usable, cost, goals, start_xy_m)
 
 
-def _usable(g: np.ndarray, dist: np.ndarray, clearance_m: float) -> np.ndarray:
+def usable_cells(g: np.ndarray, dist: np.ndarray, clearance_m: float) -> np.ndarray:
     """FREE cells at least ``clearance_m`` from every OCCUPIED cell (to rounding)."""
     return (g == FREE) & (dist >= clearance_m - 1e-9)
 
 
-def _step_cost(
+def step_cost_field(
     dist: np.ndarray,
     usable: np.ndarray,
     clearance_m: float,
     wall_cost: float,
     prefer_extra_m: float,
 ) -> np.ndarray:
+    """The searches' cost of entering each cell (see the module docstring: 1 far from walls,
+    up to ``1 + wall_cost`` near them; ``usable`` cells only, the others are never entered)."""
     if not (
         math.isfinite(wall_cost)
         and wall_cost >= 0.0
@@ -426,26 +428,26 @@ def pocket_exit_path(
         if clearance_field is not None
         else clearance_field_m(g, geometry.resolution_m)
     )
-    usable = _usable(g, dist, clearance_m)
+    usable = usable_cells(g, dist, clearance_m)
     n_usable = int(np.count_nonzero(usable))
     if n_usable == 0:
         return None
     labels, _n = ndimage.label(usable)
     sizes = np.bincount(labels.ravel())
     sizes[0] = 0
-    start = _start_cell(g, geometry, usable, start_xy_m)
+    start = search_start_cell(g, geometry, usable, start_xy_m)
     own = int(labels[start]) if start is not None else 0
     big = sizes >= max_share * n_usable
     big[0] = False
     if own and big[own]:
         return None
     big[own] = False
-    wide = _usable(g, dist, exit_clearance_m)
-    cost = _step_cost(dist, wide, exit_clearance_m, WALL_COST, PREFER_EXTRA_M)
+    wide = usable_cells(g, dist, exit_clearance_m)
+    cost = step_cost_field(dist, wide, exit_clearance_m, WALL_COST, PREFER_EXTRA_M)
     return _search_path(g, geometry, wide, cost, big[labels], start_xy_m)
 
 
-def _start_cell(
+def search_start_cell(
     g: np.ndarray,
     geometry: GridGeometry,
     usable: np.ndarray,
@@ -481,7 +483,7 @@ def _search_path(
     """The search from the start to the first goal cell settled, as a world polyline; the
     arrays cover the grid's window starting at cell ``offset``."""
     w = g.shape[1]
-    start = _start_cell(g, geometry, usable, start_xy_m, offset)
+    start = search_start_cell(g, geometry, usable, start_xy_m, offset)
     if start is None:
         return None
     sr, sc = start

@@ -181,7 +181,7 @@ def test_pocket_exit_path_leads_out_of_a_pocket_only():
 
 
 def test_step_cost_is_the_numpy_expression_bit_for_bit() -> None:
-    from semexplore_gym.core.frontiers.reachable import _step_cost
+    from semexplore_gym.core.frontiers.reachable import step_cost_field
 
     rng = np.random.default_rng(0)
     for k in range(60):
@@ -201,7 +201,7 @@ def test_step_cost_is_the_numpy_expression_bit_for_bit() -> None:
             want = np.ones(dist.shape)
         want = np.where(usable, want, np.inf)
         np.testing.assert_array_equal(
-            _step_cost(dist, usable, clearance_m, wall_cost, extra_m), want
+            step_cost_field(dist, usable, clearance_m, wall_cost, extra_m), want
         )
 
 
@@ -277,7 +277,7 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
     off_grid = GridGeometry(0.05, 0.0, 0.0, 30, 30)
     assert nearest_reachable_frontier(unseen, off_grid, (9.0, 0.5), 0.1, FrontierFilter(1)) is None
     windowed = run_all()
-    monkeypatch.setattr(reachable, "_known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
+    monkeypatch.setattr(reachable, "known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
     whole = run_all()
     assert sum(f is not None for f in whole) >= 20
     for a, b in zip(windowed, whole, strict=True):
