@@ -15,6 +15,7 @@ from semexplore_gym.policies.expert_goal_memory import GoalMemory
 from semexplore_gym.policies.expert_plan import Plan
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
+from semexplore_gym.core.frontiers.options import FrontierOptions, reachable_frontier_options
 from semexplore_gym.core.frontiers.reachable import (
     FrontierFilter,
     ReachableFrontier,
@@ -126,6 +127,18 @@ class PlanContext:
     def resampled(self, path_m: np.ndarray) -> np.ndarray:
         """``path_m`` resampled at the map's resolution (what the path follower expects)."""
         return resample_polyline(path_m, self.geometry.resolution_m)
+
+    def grid_frontier_options(self) -> FrontierOptions:
+        """Every frontier the grid fallback's search reaches from the robot (its filters, the
+        goal memory's drops), each with its goal and path (the frontier student's options)."""
+        return reachable_frontier_options(
+            self.grid,
+            self.geometry,
+            self.xy_m,
+            self.clearance_m,
+            frontiers=FrontierFilter(**self.fallback_search_kwargs()),
+            clearance_field=self.clearance_cache,
+        )
 
     def grid_route(self, goal_xy_m: tuple[float, float]) -> np.ndarray | None:
         """A clearance-aware grid path from the robot to ``goal_xy_m`` (None: none)."""

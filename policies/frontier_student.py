@@ -40,8 +40,7 @@ from semexplore_gym.core.features.frontier_option_features import (
     OPTION_FEATURE_NAMES,
     frontier_option_features,
 )
-from semexplore_gym.core.frontiers.options import FrontierOptions, reachable_frontier_options
-from semexplore_gym.core.frontiers.reachable import FrontierFilter
+from semexplore_gym.core.frontiers.options import FrontierOptions
 
 __all__ = [
     "FrontierStudentModel",
@@ -194,14 +193,7 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         self.decisions = 0
 
     def _decide(self, ctx: PlanContext) -> Plan | None:
-        options = reachable_frontier_options(
-            ctx.grid,
-            ctx.geometry,
-            ctx.xy_m,
-            ctx.clearance_m,
-            frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
-            clearance_field=ctx.clearance_cache,
-        )
+        options = ctx.grid_frontier_options()
         if len(options) == 0:
             return None
         prm = self.student_params

@@ -143,18 +143,7 @@ def _run_frontier_value(args: argparse.Namespace) -> int:
         train_frontier_value,
     )
 
-    try:
-        cfg = load_frontier_value_config(args.train_config, args.overrides)
-    except ConfigError as e:
-        raise ValueError(str(e)) from e
-    out = Path(args.out)
-    _write_run_record(out, cfg, args)
-    t0 = time.perf_counter()
-    final = train_frontier_value(cfg, out, log=lambda line: print(line, flush=True))
-    metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
-    print(json.dumps(metrics, default=float))
-    return 0
+    return _run_without_torch(args, load_frontier_value_config, train_frontier_value)
 
 
 def _run_oracle_student(args: argparse.Namespace) -> int:
@@ -165,14 +154,20 @@ def _run_oracle_student(args: argparse.Namespace) -> int:
         train_oracle_student,
     )
 
+    return _run_without_torch(args, load_oracle_student_config, train_oracle_student)
+
+
+def _run_without_torch(args: argparse.Namespace, load: Any, train: Any) -> int:
+    """Load the config, write the run record, ``train(cfg, out, log=...)``, write
+    ``metrics.json`` (its result, the wall time and ``model.yaml``'s path)."""
     try:
-        cfg = load_oracle_student_config(args.train_config, args.overrides)
+        cfg = load(args.train_config, args.overrides)
     except ConfigError as e:
         raise ValueError(str(e)) from e
     out = Path(args.out)
     _write_run_record(out, cfg, args)
     t0 = time.perf_counter()
-    final = train_oracle_student(cfg, out, log=lambda line: print(line, flush=True))
+    final = train(cfg, out, log=lambda line: print(line, flush=True))
     metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print(json.dumps(metrics, default=float))

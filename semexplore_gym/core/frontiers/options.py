@@ -20,6 +20,7 @@ from scipy import ndimage
 from semexplore_gym.core.frontiers.reachable import (
     FrontierFilter,
     StepCost,
+    checked_search_inputs,
     clearance_field_m,
     drop_excluded,
     frontier_groups,
@@ -29,7 +30,6 @@ from semexplore_gym.core.frontiers.reachable import (
     usable_cells,
 )
 from semexplore_gym.core.grid import GridGeometry
-from semexplore_gym.core.planning.grid_scan import checked_encoded_grid
 from semexplore_gym.core.planning.grid_search import distance_field
 
 __all__ = ["FrontierOptions", "reachable_frontier_options"]
@@ -114,13 +114,8 @@ def reachable_frontier_options(
     Raises:
         ValueError: on a malformed grid, a shape mismatch or negative distances.
     """
-    g = checked_encoded_grid(grid)
-    if g.shape != geometry.shape:
-        raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
+    g = checked_search_inputs(grid, geometry, clearance_m, frontiers)
     f = frontiers
-    for name, value in (("clearance_m", clearance_m), ("reach_m", f.reach_m)):
-        if not (math.isfinite(value) and value >= 0.0):
-            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     res = geometry.resolution_m
     start = (float(start_xy_m[0]), float(start_xy_m[1]))
     margin = int(math.ceil(0.5 / res)) + int(math.ceil(f.reach_m / res)) + 2

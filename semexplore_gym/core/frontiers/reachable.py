@@ -183,17 +183,8 @@ def nearest_reachable_frontier(
     Raises:
         ValueError: on a malformed grid, a shape mismatch or negative distances.
     """
-    g = checked_encoded_grid(grid)
-    if g.shape != geometry.shape:
-        raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
+    g = checked_search_inputs(grid, geometry, clearance_m, frontiers)
     f = frontiers
-    for name, value in (
-        ("clearance_m", clearance_m),
-        ("reach_m", f.reach_m),
-        ("excluded_radius_m", f.excluded_radius_m),
-    ):
-        if not (math.isfinite(value) and value >= 0.0):
-            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     res = geometry.resolution_m
     # Everything below happens within the window of the known cells (a large map is mostly
     # unknown): usable cells are FREE, so the search never leaves it, and the margin holds the
@@ -230,6 +221,24 @@ def nearest_reachable_frontier(
         frontier_xy_m=centre_xy_m,
         n_frontier_cells=n_cells,
     )
+
+
+def checked_search_inputs(
+    grid: npt.ArrayLike, geometry: GridGeometry, clearance_m: float, frontiers: FrontierFilter
+) -> np.ndarray:
+    """The encoded grid, after checking its shape against ``geometry`` and that the
+    distances are finite and >= 0 (ValueError naming the bad one)."""
+    g = checked_encoded_grid(grid)
+    if g.shape != geometry.shape:
+        raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
+    for name, value in (
+        ("clearance_m", clearance_m),
+        ("reach_m", frontiers.reach_m),
+        ("excluded_radius_m", frontiers.excluded_radius_m),
+    ):
+        if not (math.isfinite(value) and value >= 0.0):
+            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return g
 
 
 def _served_group(
