@@ -1,15 +1,16 @@
 """The frontier student: the semantic expert's navigation, a learned choice among every frontier.
 
 At each replan the student lists every frontier a clearance-aware grid search reaches from the
-robot (:func:`~semexplore_gym.core.frontiers.options.reachable_frontier_options`, the grid
-fallback's filters and the goal memory's drops), scores each by a linear function of its
+robot (``PlanContext.grid_frontier_options``: the grid fallback's filters and the goal memory's
+drops), scores each by a linear function of its
 features (:mod:`~semexplore_gym.core.features.frontier_option_features`: path cost, the unknown
 area round it, its isolation from the other frontiers, whether it is the current goal, ...)
-and drives to the best over that option's grid path. It keeps that goal until it is reached,
-mapped or no longer reachable (``keep_goal``), and only then chooses again. Algorithm 1 is not asked; everything else is the
-expert's: retries and views of goals reached without clearing them, the path follower, the
-collision guard, the blacklists, the pocket escape, the narrow tier and the stop rule (when no
-frontier is reachable, the expert's later sources run as usual).
+and drives to the best over that option's grid path. It keeps that goal until it is
+reached, mapped or no longer reachable (``keep_goal``), and only then chooses again. Algorithm 1
+is not asked; everything else is the expert's: retries and views of goals reached without
+clearing them, the path follower, the collision guard, the blacklists, the pocket escape, the
+narrow tier and the stop rule (when no frontier is reachable, the expert's later sources run as
+usual).
 
 The weights are learned from the oracle (:mod:`semexplore_gym.training.oracle_student`): at
 states the student itself reaches, the privileged teacher prices every option by the length of
@@ -166,7 +167,8 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         params: The expert's parameters, the model and the switch margin.
         segmenter: The expert's segmenter (its topometric map still drives its look and view
             sources).
-        chooser: Training code only: called at every decision, may override the choice.
+        chooser: Training code only: called at every choice (not while ``keep_goal`` keeps the
+            goal), may override it.
     """
 
     name = "frontier-student"

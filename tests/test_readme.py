@@ -318,6 +318,15 @@ TINY_PPO = [
     "ppo.batch_size=4",
     "ppo.n_epochs=1",
 ]
+#: The frontier student's DAgger and its headroom script: one short mission on a small maze.
+TINY_ORACLE_STUDENT = [
+    "rounds=1",
+    "episodes_per_round=1",
+    "splits=[mazes]",
+    "max_size_m=6",
+    "max_time_s=60",
+    "workers=1",
+]
 TINY_FRONTIER_VALUE = [
     "generations=1",
     "population=2",
@@ -350,6 +359,9 @@ def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
             return _replace_or_add(argv, "--expert-max-time-s", "20")
         if script == "scripts/bench_compute_scaling.py":
             return [*_replace_or_add(argv, "--repeats", "1"), "--quick"]
+        if script == "scripts/teacher_headroom.py":
+            argv = _replace_or_add(_replace_or_add(argv, "--episodes", "1"), "--workers", "1")
+            return [*argv, *(t for s in TINY_ORACLE_STUDENT[2:5] for t in (SET, s))]
         if script == "scripts/fuzz.py":
             return _replace_or_add(_replace_or_add(argv, "--sample", "12"), "--jobs", "1")
         return argv
@@ -379,6 +391,7 @@ def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
             "bc": TINY_IMITATION,
             "dagger": TINY_IMITATION + TINY_DAGGER,
             "frontier_value": TINY_FRONTIER_VALUE,
+            "oracle_student": TINY_ORACLE_STUDENT,
         }.get(algo, TINY_PPO)
         return [*argv, *(t for s in sets for t in (SET, s))]
     return argv
