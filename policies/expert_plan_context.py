@@ -120,7 +120,7 @@ class PlanContext:
             self.geometry,
             self.xy_m,
             self.clearance_m,
-            frontiers=FrontierFilter(**self.fallback_search_kwargs()),
+            frontiers=self.fallback_filter(),
             clearance_field=self.clearance_cache,
         )
 
@@ -136,7 +136,7 @@ class PlanContext:
             self.geometry,
             self.xy_m,
             self.clearance_m,
-            frontiers=FrontierFilter(**self.fallback_search_kwargs()),
+            frontiers=self.fallback_filter(),
             clearance_field=self.clearance_cache,
         )
 
@@ -178,6 +178,10 @@ class PlanContext:
             excluded_xy_m=self.memory.dropped_points(),
             excluded_radius_m=prm.blacklist_radius_m,
         )
+
+    def fallback_filter(self) -> FrontierFilter:
+        """The grid fallback's :class:`FrontierFilter` (:meth:`fallback_search_kwargs`)."""
+        return FrontierFilter(**self.fallback_search_kwargs())
 
     def fallback_search_kwargs(self) -> dict[str, Any]:
         """Which frontiers the grid fallback counts (the same for its every search)."""

@@ -380,7 +380,7 @@ class PocketEscape(PlanSource):
             ctx.geometry,
             outside,
             ctx.clearance_m,
-            frontiers=FrontierFilter(**ctx.fallback_search_kwargs()),
+            frontiers=ctx.fallback_filter(),
             clearance_field=clearance,
         )
         if found is None:

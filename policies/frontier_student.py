@@ -204,7 +204,7 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         if prm.keep_goal and kept is not None:  # no choice to make
             choice = kept
         else:
-            choice = self._choose(ctx, options, current)
+            choice = self._choose(ctx, options, current, kept)
         goal = options.goal_xy_m[choice]
         return Plan(
             PlanKind.LEARNED,
@@ -213,19 +213,22 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         )
 
     def _choose(
-        self, ctx: PlanContext, options: FrontierOptions, current: tuple[float, float] | None
+        self,
+        ctx: PlanContext,
+        options: FrontierOptions,
+        current: tuple[float, float] | None,
+        kept: int | None,
     ) -> int:
-        """Score the options; the best (or the current goal within the margin), or the
-        training chooser's pick."""
+        """Score the options; the best (or ``kept``, the current goal's option, within the
+        margin), or the training chooser's pick."""
         prm = self.student_params
         feats = frontier_option_features(
             ctx.grid, ctx.geometry, ctx.pose, options, current, ctx.params.commitment_radius_m
         )
         scores = prm.model.scores(feats)
         choice = int(np.argmax(scores))
-        cur = np.flatnonzero(feats[:, OPTION_FEATURE_NAMES.index("current")] > 0)
-        if len(cur) and scores[cur[0]] >= scores[choice] - prm.switch_margin:
-            choice = int(cur[0])
+        if kept is not None and scores[kept] >= scores[choice] - prm.switch_margin:
+            choice = kept
         self.decisions += 1
         if self.chooser is not None:
             decision = StudentDecision(
