@@ -48,6 +48,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--train-config", default=None, help="oracle_student config YAML")
     ap.add_argument("--train-set", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(argv)
+    from semexplore_gym.core.coverage_tour.tour import require_solver
+
+    try:
+        require_solver()  # the teacher's tours
+    except ImportError as e:
+        ap.error(str(e))
     if args.episodes < 1 or args.workers < 1:
         ap.error(f"--episodes and --workers must be >= 1, got {args.episodes}, {args.workers}")
     cfg = load_oracle_student_config(args.train_config, args.train_set)

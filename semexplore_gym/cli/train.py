@@ -149,11 +149,17 @@ def _run_frontier_value(args: argparse.Namespace) -> int:
 def _run_oracle_student(args: argparse.Namespace) -> int:
     """``--algo oracle_student``: no torch; DAgger on the oracle's labels
     (:mod:`~semexplore_gym.training.oracle_student`)."""
+    from semexplore_gym.core.coverage_tour.tour import require_solver
     from semexplore_gym.training.oracle_student import (
         load_oracle_student_config,
         train_oracle_student,
     )
 
+    try:
+        require_solver()  # the teacher's tours; checked before any episode starts
+    except ImportError as e:
+        print(f"semexplore train --algo oracle_student: {e}", file=sys.stderr)
+        return 2
     return _run_without_torch(args, load_oracle_student_config, train_oracle_student)
 
 

@@ -159,3 +159,20 @@ def test_semexplore_train_resumes_and_the_student_runs_through_benchmark(tmp_pat
     )
     rows = (bench / "runs.csv").read_text()
     assert "frontier-student" in rows
+
+
+def test_training_without_the_tour_solver_fails_at_once_naming_the_extra(
+    tmp_path, monkeypatch, capsys
+) -> None:
+    from semexplore_gym.cli import main
+    from semexplore_gym.core.coverage_tour import tour
+
+    def missing() -> None:
+        raise ImportError(tour.SOLVER_HINT)
+
+    monkeypatch.setattr(tour, "require_solver", missing)
+    out = tmp_path / "run"
+    assert main(["train", "--algo", "oracle_student", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "semexplore-gym[oracle]" in err and "Traceback" not in err
+    assert not out.exists()
