@@ -13,6 +13,10 @@ baselines (nearest, FE) last:
 * ``p W``: two-sided Wilcoxon signed-rank test on the pairs' log ratios to the expert (T99;
   mission time). A pair where one side never reached 99 % counts as a very large ratio (±log
   1e6: ranks only), a pair where neither did as a tie.
+
+A second table, "Against the best baseline", pairs every other policy with the family's best
+baseline: nearest or FE, whichever has the shorter median mission time on that family (the bar
+of the learning issue's goal), with the same ratios and tests.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ ORACLE = "oracle"
 #: Baselines, listed last.
 BASELINES = ("nearest", "frontier")
 SECTION_TITLE = "## Learning benchmark"
+BEST_BASELINE_TITLE = "### Against the best baseline"
 _BIG_LOG = math.log(1e6)
 
 
@@ -74,11 +79,15 @@ def _p_cell(logs: np.ndarray) -> str:
     return f"{wilcoxon(logs, alternative='two-sided').pvalue:.2g}"
 
 
-def _median_cell(rows: list[dict[str, Any]], key: str) -> str:
+def _median(rows: list[dict[str, Any]], key: str) -> float:
     v = np.asarray([_value(r, key) for r in rows], dtype=np.float64)
-    if v.size == 0:
+    return float(np.percentile(v, 50, method="lower")) if v.size else math.nan
+
+
+def _median_cell(rows: list[dict[str, Any]], key: str) -> str:
+    med = _median(rows, key)
+    if math.isnan(med):
         return "–"
-    med = float(np.percentile(v, 50, method="lower"))
     return "∞" if math.isinf(med) else (f"{med:.3f}" if key == "coverage" else f"{med:.1f}")
 
 
@@ -132,7 +141,44 @@ def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> lis
             cells += [_p_cell(logs[(EXPERT, "T99_s")]), _p_cell(logs[(EXPERT, "mission_time_s")])]
             lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
     lines.append("")
-    return lines
+    return lines + _best_baseline_lines(rows)
+
+
+def best_baseline(by_policy: dict[str, list[dict[str, Any]]]) -> str | None:
+    """The baseline (of :data:`BASELINES`) with the shortest median mission time, if any ran."""
+    medians = {b: _median(by_policy[b], "mission_time_s") for b in BASELINES if b in by_policy}
+    return min(medians, key=lambda b: medians[b]) if medians else None
+
+
+def _best_baseline_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The "Against the best baseline" table: each policy paired with its family's best
+    baseline (nothing when no family ran a baseline)."""
+    from semexplore_gym.evaluation.report import group_by_family
+
+    lines = [
+        BEST_BASELINE_TITLE,
+        "",
+        "Per family, the baseline with the shorter median mission time, and the median ratio "
+        "of every other policy's figure to it over (world, seed) pairs (< 1: faster); p W = "
+        "two-sided Wilcoxon signed-rank test on the log ratios.",
+        "",
+        "| family | policy | best baseline | pairs | T99 ÷ baseline | time ÷ baseline | "
+        "p W T99 | p W time |",
+        "|---|---|---|---:|---:|---:|---:|---:|",
+    ]
+    for family, by_policy in group_by_family(rows).items():
+        base = best_baseline(by_policy)
+        if base is None:
+            continue
+        ref = {(r["world"], int(r["seed"])): r for r in by_policy[base]}
+        for policy in _order(list(by_policy)):
+            if policy == base:
+                continue
+            t99, time_s = (_paired(by_policy[policy], ref, k) for k in ("T99_s", "mission_time_s"))
+            cells = [base, str(t99.size), _ratio_cell(t99), _ratio_cell(time_s)]
+            cells += [_p_cell(t99), _p_cell(time_s)]
+            lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
+    return lines + [""] if len(lines) > 6 else []
 
 
 def write_learning_table(out_dir: Any) -> list[str]:

@@ -12,7 +12,11 @@ import pytest
 from semexplore_gym.cli import main
 from semexplore_gym.config.resources import configs_dir
 from semexplore_gym.evaluation.harness import read_runs
-from semexplore_gym.evaluation.learning_table import SECTION_TITLE, learning_table_lines
+from semexplore_gym.evaluation.learning_table import (
+    BEST_BASELINE_TITLE,
+    SECTION_TITLE,
+    learning_table_lines,
+)
 from semexplore_gym.evaluation.splits import PARTS, RULE, list_splits, load_split, split_suite
 from semexplore_gym.evaluation.suites import list_suites, load_suite, world_family
 
@@ -132,9 +136,15 @@ def test_a_split_part_runs_through_benchmark_with_the_learning_table(tmp_path, c
     assert {r["policy"] for r in rows} == {"semantic", "nearest", "oracle"}
     summary = (out / "summary.md").read_text()
     assert "Suites: `tiny-test` v1" in summary and SECTION_TITLE in summary
-    table = summary[summary.index(SECTION_TITLE) :].splitlines()
-    body = [line for line in table if line.startswith("| maze |")]
+    table = summary[summary.index(SECTION_TITLE) : summary.index(BEST_BASELINE_TITLE)]
+    body = [line for line in table.splitlines() if line.startswith("| maze |")]
     assert [line.split("|")[2].strip() for line in body] == ["oracle", "semantic", "nearest"]
+    against = summary[summary.index(BEST_BASELINE_TITLE) :].splitlines()
+    against = [line.split("|")[2:4] for line in against if line.startswith("| maze |")]
+    assert [[c.strip() for c in cells] for cells in against] == [
+        ["oracle", "nearest"],
+        ["semantic", "nearest"],
+    ]
     assert SECTION_TITLE in printed and (out / "regret.csv").is_file()
     d99 = {line.split("|")[2].strip(): line.split("|")[7].strip() for line in body}
     assert all(v == "∞" or float(v) > 0 for v in d99.values()) and d99["oracle"] != "∞", d99
@@ -166,3 +176,32 @@ def test_learning_table_ratios_and_infinite_t99() -> None:
     assert cells["mine"][2] == "80.0"  # median of 80, 80, ∞
     assert cells["mine"][4] == "–"  # no benchmark directory: no D99
     assert cells["oracle"][5] == "0.50"
+
+
+def test_the_best_baseline_is_the_faster_one_per_family_and_pairs_every_policy() -> None:
+    def row(world: str, policy: str, seed: int, t99: float | None, time_s: float) -> dict:
+        return {"world": world, "policy": policy, "seed": seed, "coverage": 0.99,
+                "T99_s": t99, "mission_time_s": time_s}  # fmt: skip
+
+    maze, office = "maze:seed=1", "office:seed=1"
+    rows = [row(maze, "semantic", s, 100.0, 100.0) for s in range(3)]
+    rows += [row(maze, "nearest", s, 120.0, 125.0) for s in range(3)]
+    rows += [row(maze, "frontier", s, 200.0, 150.0) for s in range(3)]  # slower: not the bar
+    rows += [row(maze, "mine", s, 60.0, 100.0) for s in range(3)]
+    rows += [row(office, "semantic", 0, 100.0, 100.0), row(office, "frontier", 0, 80.0, 90.0)]
+    rows += [row(office, "nearest", 0, 70.0, 95.0)]  # FE has the shorter time here
+    lines = learning_table_lines(rows)
+    against = lines[lines.index(BEST_BASELINE_TITLE) :]
+    cells = {
+        tuple(c.strip() for c in line.split("|")[1:4]): [c.strip() for c in line.split("|")[4:-1]]
+        for line in against
+        if line.startswith(("| maze |", "| office |"))
+    }
+    assert cells[("maze", "mine", "nearest")][:3] == ["3", "0.50", "0.80"]
+    assert cells[("maze", "semantic", "nearest")][1:3] == ["0.83", "0.80"]
+    assert cells[("maze", "frontier", "nearest")][1:3] == ["1.67", "1.20"]
+    assert ("maze", "nearest", "nearest") not in cells
+    assert cells[("office", "nearest", "frontier")][1:3] == ["0.88", "1.06"]
+    # without a baseline there is no second table
+    no_base = [r for r in rows if r["policy"] not in ("nearest", "frontier")]
+    assert BEST_BASELINE_TITLE not in learning_table_lines(no_base)
