@@ -15,8 +15,9 @@ baselines (nearest, FE) last:
   1e6: ranks only), a pair where neither did as a tie.
 
 A second table, "Against the best baseline", pairs every other policy with the family's best
-baseline: nearest or FE, whichever has the shorter median mission time on that family (the bar
-of the learning issue's goal), with the same ratios and tests.
+baseline: nearest or FE, whichever is faster on that family (the bar of the learning issue's
+goal): the shorter median T99, then the shorter median mission time (a baseline that stops
+early below 99 % is not the faster one), with the same ratios and tests.
 """
 
 from __future__ import annotations
@@ -145,8 +146,13 @@ def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> lis
 
 
 def best_baseline(by_policy: dict[str, list[dict[str, Any]]]) -> str | None:
-    """The baseline (of :data:`BASELINES`) with the shortest median mission time, if any ran."""
-    medians = {b: _median(by_policy[b], "mission_time_s") for b in BASELINES if b in by_policy}
+    """The faster baseline (of :data:`BASELINES`) of those that ran: the shorter median T99,
+    then the shorter median mission time."""
+    medians = {
+        b: (_median(by_policy[b], "T99_s"), _median(by_policy[b], "mission_time_s"))
+        for b in BASELINES
+        if b in by_policy
+    }
     return min(medians, key=lambda b: medians[b]) if medians else None
 
 
@@ -158,9 +164,9 @@ def _best_baseline_lines(rows: list[dict[str, Any]]) -> list[str]:
     lines = [
         BEST_BASELINE_TITLE,
         "",
-        "Per family, the baseline with the shorter median mission time, and the median ratio "
-        "of every other policy's figure to it over (world, seed) pairs (< 1: faster); p W = "
-        "two-sided Wilcoxon signed-rank test on the log ratios.",
+        "Per family, the faster baseline (shorter median T99, then mission time), and the "
+        "median ratio of every other policy's figure to it over (world, seed) pairs (< 1: "
+        "faster); p W = two-sided Wilcoxon signed-rank test on the log ratios.",
         "",
         "| family | policy | best baseline | pairs | T99 ÷ baseline | time ÷ baseline | "
         "p W T99 | p W time |",

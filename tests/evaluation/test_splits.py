@@ -189,7 +189,9 @@ def test_the_best_baseline_is_the_faster_one_per_family_and_pairs_every_policy()
     rows += [row(maze, "frontier", s, 200.0, 150.0) for s in range(3)]  # slower: not the bar
     rows += [row(maze, "mine", s, 60.0, 100.0) for s in range(3)]
     rows += [row(office, "semantic", 0, 100.0, 100.0), row(office, "frontier", 0, 80.0, 90.0)]
-    rows += [row(office, "nearest", 0, 70.0, 95.0)]  # FE has the shorter time here
+    rows += [row(office, "nearest", 0, 85.0, 80.0)]  # FE reaches 99 % sooner here
+    rows += [row(office, "semantic", 1, 100.0, 100.0), row(office, "frontier", 1, 80.0, 90.0)]
+    rows += [row(office, "nearest", 1, 85.0, 80.0)]
     lines = learning_table_lines(rows)
     against = lines[lines.index(BEST_BASELINE_TITLE) :]
     cells = {
@@ -201,7 +203,14 @@ def test_the_best_baseline_is_the_faster_one_per_family_and_pairs_every_policy()
     assert cells[("maze", "semantic", "nearest")][1:3] == ["0.83", "0.80"]
     assert cells[("maze", "frontier", "nearest")][1:3] == ["1.67", "1.20"]
     assert ("maze", "nearest", "nearest") not in cells
-    assert cells[("office", "nearest", "frontier")][1:3] == ["0.88", "1.06"]
+    assert cells[("office", "nearest", "frontier")][1:3] == ["1.06", "0.89"]
+    # a baseline that stops early without reaching 99 % is not the faster one
+    quits = [
+        {**r, "T99_s": None, "mission_time_s": 10.0} if r["policy"] == "frontier" else r
+        for r in rows
+    ]
+    against = learning_table_lines(quits)
+    assert any(line.startswith("| office | frontier | nearest |") for line in against)
     # without a baseline there is no second table
     no_base = [r for r in rows if r["policy"] not in ("nearest", "frontier")]
     assert BEST_BASELINE_TITLE not in learning_table_lines(no_base)
