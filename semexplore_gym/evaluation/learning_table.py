@@ -117,7 +117,8 @@ def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> lis
         "time ÷ expert | T99 ÷ oracle | time ÷ oracle | p W T99 | p W time |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    for family, by_policy in group_by_family(rows).items():
+    families = group_by_family(rows)
+    for family, by_policy in families.items():
         refs = {
             name: {(r["world"], int(r["seed"])): r for r in by_policy.get(name, [])}
             for name in (EXPERT, ORACLE)
@@ -142,7 +143,7 @@ def learning_table_lines(rows: list[dict[str, Any]], out_dir: Any = None) -> lis
             cells += [_p_cell(logs[(EXPERT, "T99_s")]), _p_cell(logs[(EXPERT, "mission_time_s")])]
             lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
     lines.append("")
-    return lines + _best_baseline_lines(rows)
+    return lines + _best_baseline_lines(families)
 
 
 def best_baseline(by_policy: dict[str, list[dict[str, Any]]]) -> str | None:
@@ -156,12 +157,10 @@ def best_baseline(by_policy: dict[str, list[dict[str, Any]]]) -> str | None:
     return min(medians, key=lambda b: medians[b]) if medians else None
 
 
-def _best_baseline_lines(rows: list[dict[str, Any]]) -> list[str]:
-    """The "Against the best baseline" table: each policy paired with its family's best
-    baseline (nothing when no family ran a baseline)."""
-    from semexplore_gym.evaluation.report import group_by_family
-
-    lines = [
+def _best_baseline_lines(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str]:
+    """The "Against the best baseline" table for rows grouped by family, then policy: each
+    policy paired with its family's best baseline (nothing when no family ran a baseline)."""
+    head = [
         BEST_BASELINE_TITLE,
         "",
         "Per family, the faster baseline (shorter median T99, then mission time), and the "
@@ -172,7 +171,8 @@ def _best_baseline_lines(rows: list[dict[str, Any]]) -> list[str]:
         "p W T99 | p W time |",
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]
-    for family, by_policy in group_by_family(rows).items():
+    body = []
+    for family, by_policy in families.items():
         base = best_baseline(by_policy)
         if base is None:
             continue
@@ -183,8 +183,8 @@ def _best_baseline_lines(rows: list[dict[str, Any]]) -> list[str]:
             t99, time_s = (_paired(by_policy[policy], ref, k) for k in ("T99_s", "mission_time_s"))
             cells = [base, str(t99.size), _ratio_cell(t99), _ratio_cell(time_s)]
             cells += [_p_cell(t99), _p_cell(time_s)]
-            lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
-    return lines + [""] if len(lines) > 6 else []
+            body.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
+    return [*head, *body, ""] if body else []
 
 
 def write_learning_table(out_dir: Any) -> list[str]:
