@@ -24,24 +24,26 @@ from semexplore_gym.core.frontiers.reachable import (
     known_free_clearance_m,
     nearest_reachable_frontier,
 )
-from semexplore_gym.core.grid import UNKNOWN, GridGeometry
+from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.potential_field import resample_polyline
 
 __all__ = [
     "PlanContext",
     "PlanSource",
+    "frontier_near",
+    "goal_open",
     "path_clearance_along",
     "standable_prefix",
     "unknown_near",
 ]
 
 
-def unknown_near(
-    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], radius_m: float
-) -> bool:
-    """Whether an UNKNOWN cell lies in the box of half-size ``radius_m`` round ``xy`` (or the
-    box reaches past the map's edge, beyond which all is unknown)."""
+def _box_cells(
+    geometry: GridGeometry, xy: tuple[float, float], radius_m: float, rim: int
+) -> tuple[int, int, int, int] | None:
+    """Rows and columns ``(r0, c0, r1, c1)`` of the box of half-size ``radius_m`` round ``xy``;
+    None when the box, widened by ``rim`` cells, reaches past the map's edge."""
     g = geometry
     # g.world_to_grid's arithmetic on scalars (called every step: no arrays)
     ox, oy, res = g.origin_x_m, g.origin_y_m, g.resolution_m
@@ -49,9 +51,48 @@ def unknown_near(
     r0 = math.floor((float(xy[1] - radius_m) - oy) / res)
     c1 = math.floor((float(xy[0] + radius_m) - ox) / res)
     r1 = math.floor((float(xy[1] + radius_m) - oy) / res)
-    if r0 < 0 or c0 < 0 or r1 >= g.height or c1 >= g.width:
+    if r0 < rim or c0 < rim or r1 >= g.height - rim or c1 >= g.width - rim:
+        return None
+    return r0, c0, r1, c1
+
+
+def unknown_near(
+    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], radius_m: float
+) -> bool:
+    """Whether an UNKNOWN cell lies in the box of half-size ``radius_m`` round ``xy`` (or the
+    box reaches past the map's edge, beyond which all is unknown)."""
+    box = _box_cells(geometry, xy, radius_m, 0)
+    if box is None:
         return True
+    r0, c0, r1, c1 = box
     return bool((grid[r0 : r1 + 1, c0 : c1 + 1] == UNKNOWN).any())
+
+
+def frontier_near(
+    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], radius_m: float
+) -> bool:
+    """Whether a frontier cell (UNKNOWN with a FREE 4-neighbour) lies in the box of half-size
+    ``radius_m`` round ``xy`` (or the box reaches past the map's edge)."""
+    box = _box_cells(geometry, xy, radius_m, 1)
+    if box is None:
+        return True
+    r0, c0, r1, c1 = box
+    window = grid[r0 - 1 : r1 + 2, c0 - 1 : c1 + 2]
+    unknown = window[1:-1, 1:-1] == UNKNOWN
+    if not unknown.any():
+        return False
+    free = window == FREE
+    beside = free[:-2, 1:-1] | free[2:, 1:-1] | free[1:-1, :-2] | free[1:-1, 2:]
+    return bool((unknown & beside).any())
+
+
+def goal_open(
+    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], params: SemanticExpertParams
+) -> bool:
+    """Whether the frontier a goal at ``xy`` serves is still there: a frontier cell (with
+    ``vanish_on_frontier``; else any UNKNOWN cell) within ``goal_check_radius_m`` of it."""
+    near = frontier_near if params.vanish_on_frontier else unknown_near
+    return near(grid, geometry, xy, params.goal_check_radius_m)
 
 
 @dataclass

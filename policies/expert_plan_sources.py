@@ -38,6 +38,7 @@ from semexplore_gym.policies.expert_plan import Plan, PlanKind
 from semexplore_gym.policies.expert_plan_context import (
     PlanContext,
     PlanSource,
+    goal_open,
     path_clearance_along,
     standable_prefix,
     unknown_near,
@@ -72,6 +73,7 @@ __all__ = [
     "RetryFailedGoal",
     "SemanticFrontier",
     "ViewFrontier",
+    "goal_open",
     "insert_plan_source",
     "path_clearance_along",
     "standable_prefix",
@@ -262,7 +264,10 @@ class SemanticFrontier(PlanSource):
         if not ctx.candidates:
             return None
         chosen = ctx.choose_goal(ctx.candidates)
-        if ctx.params.grid_candidate:
+        # A goal the shuttle guard holds is seen through: the grid's frontier must not take
+        # turns with it (the two sources would shuttle between them as Algorithm 1's did).
+        held = ctx.params.shuttle_guard_holds_grid and ctx.memory.is_shuttle_goal(chosen.goal_xy_m)
+        if ctx.params.grid_candidate and not held:
             nearer = _cheaper_grid_frontier(ctx, chosen)
             if nearer is not None:
                 return nearer
@@ -319,7 +324,7 @@ class CommittedFallback(PlanSource):
             or ctx.memory.is_blacklisted(old.goal_xy_m)
             or math.hypot(ctx.pose[0] - old.goal_xy_m[0], ctx.pose[1] - old.goal_xy_m[1])
             <= prm.goal_reached_radius_m
-            or not unknown_near(ctx.grid, ctx.geometry, old.goal_xy_m, prm.goal_check_radius_m)
+            or not goal_open(ctx.grid, ctx.geometry, old.goal_xy_m, prm)
         ):
             return None
         path = ctx.grid_route(old.goal_xy_m)

@@ -88,8 +88,8 @@ from semexplore_gym.policies.expert_plan_sources import (
     DEFAULT_PLAN_SOURCES,
     PlanContext,
     PlanSource,
+    goal_open,
     insert_plan_source,
-    unknown_near,
 )
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
@@ -287,12 +287,12 @@ class SemanticExpertPolicy(Policy):
             return "goal_reached"
         if plan.progress >= len(plan.path_m) - 1:
             return "path_done"
-        # Goal vanished: no unknown cell is left near it (its frontier has been mapped). A
+        # Goal vanished: no frontier (vanish_on_frontier; else unknown) cell is left near it. A
         # commanded goal may lie in known space: it lasts until reached; a view's is its frontier.
         view = plan.kind == PlanKind.VIEW and plan.frontier_xy_m is not None
         watched = plan.frontier_xy_m if view and plan.frontier_xy_m else plan.goal_xy_m
-        if plan.kind != PlanKind.COMMANDED and not unknown_near(
-            grid, self.geometry, watched, self.params.goal_check_radius_m
+        if plan.kind != PlanKind.COMMANDED and not goal_open(
+            grid, self.geometry, watched, self.params
         ):
             return "goal_vanished"
         return ""

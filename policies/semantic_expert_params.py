@@ -6,8 +6,10 @@ What the paper leaves open, and how the expert handles it (parameters in
 * **Event-driven and periodic replanning** (``replan_period_s``, ``goal_reached_radius_m``,
   ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
   segmentation and search run only every ``replan_period_s``, and at once when the goal is
-  reached, when it vanishes (no UNKNOWN cell is left within ``goal_check_radius_m`` of it: its
-  frontier has been mapped), when the path is used up, or when a recovery ends. A scheduled
+  reached, when it vanishes (no frontier cell, UNKNOWN next to FREE, is left within
+  ``goal_check_radius_m`` of it: its frontier has been mapped; ``vanish_on_frontier=false``:
+  no UNKNOWN cell at all, which unknown space behind a mapped wall keeps from happening), when
+  the path is used up, or when a recovery ends. A scheduled
   replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
   became known since the last one, e.g. while the robot crosses explored space.
 * **Goal commitment** (``commitment_radius_m``, ``switch_margin``): at a replan the frontier
@@ -224,7 +226,15 @@ class SemanticExpertParams:
             the previous topometric map from the new pose.
         goal_reached_radius_m: The goal counts as reached within this distance.
         goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
-            left within this distance of it.
+            left within this distance of it (with ``vanish_on_frontier``: no frontier cell).
+        shuttle_guard_holds_grid: The goal the shuttle guard holds is kept against the grid's
+            nearest frontier too (``grid_candidate``), not only against Algorithm 1's other
+            frontiers: else the two sources can take turns for ever.
+        vanish_on_frontier: The goal has vanished when no *frontier* cell (UNKNOWN next to
+            FREE) is left near it, rather than no UNKNOWN cell: unknown space behind a mapped
+            wall (a thick wall's inside, the far side of a thin one) is no frontier, and waiting
+            for it to be mapped drove the robot all the way to goals whose frontier was long
+            mapped. Also the committed fallback's test. Off in the paper-pure preset.
         commitment_radius_m: A frontier this close to the current goal is the same goal.
         switch_margin: Another frontier replaces the current one only if cheaper by this much.
         min_frontier_width_m: Narrower frontier openings are ignored.
@@ -331,6 +341,7 @@ class SemanticExpertParams:
     resegment_min_new_m2: float = 0.1
     goal_reached_radius_m: float = 0.35
     goal_check_radius_m: float = 0.5
+    vanish_on_frontier: bool = True
     commitment_radius_m: float = 1.0
     switch_margin: float = 0.5
     min_frontier_width_m: float = 0.25
@@ -370,6 +381,7 @@ class SemanticExpertParams:
     shuttle_switches: int = 6
     shuttle_radius_m: float = 1.0
     shuttle_min_new_m2: float = 1.0
+    shuttle_guard_holds_grid: bool = True
     view_unseen_frontiers: bool = True
     view_rim_radius_m: float = 0.5
     view_range_fraction: float = 0.7
@@ -502,6 +514,8 @@ PAPER_PURE: dict[str, object] = {
     "view_unseen_frontiers": False,
     "entry_detour": False,
     "grid_candidate": False,
+    "vanish_on_frontier": False,
+    "shuttle_guard_holds_grid": False,
     "goal_commitment": False,
     "local_min_escape": False,
     "stuck_recovery": False,

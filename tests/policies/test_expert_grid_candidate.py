@@ -106,8 +106,10 @@ def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone() -> None:
 def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_mission) -> None:
     """An 8 m maze (a tuning world of #33): the frontiers Algorithm 1 leaves behind are taken on the way."""
     world = "maze:seed=61001,size_m=8,braid=0.3"
-    new, p_new = short_mission(world, "semantic", 5000, 1200)
-    old, p_old = short_mission(world, "semantic[grid_candidate=false]", 5000, 1200)
+    # the expert of that time (two later changes off), so that this tests one change
+    then = "vanish_on_frontier=false;shuttle_guard_holds_grid=false"
+    new, p_new = short_mission(world, f"semantic[{then}]", 5000, 1200)
+    old, p_old = short_mission(world, f"semantic[grid_candidate=false;{then}]", 5000, 1200)
     assert p_new.counters["grid_frontier_plans"] > 0
     assert p_old.counters["grid_frontier_plans"] == 0
     assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0
@@ -128,3 +130,19 @@ def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     assert not ExpertDriver().params.grid_candidate
     assert not FrontierValuePolicy().params.grid_candidate
     assert not _ExpertMember(SemanticTeam(), 0, on).params.grid_candidate
+
+
+@pytest.mark.parametrize("holds", [True, False])
+def test_the_goal_the_shuttle_guard_holds_is_kept_against_the_grid_frontier(holds: bool) -> None:
+    """A goal adopted again without progress is seen through: the grid's frontier does not
+    take turns with it (else the two sources shuttle, as on a real SLAM map for 2,000 s)."""
+    from semexplore_gym.policies.expert_plan import PlanKind
+
+    ctx = _context(chosen_cost=5.0, shuttle_guard_holds_grid=holds)  # the grid's is cheaper
+    ctx.memory.shuttle_xy_m = (0.2, 1.5)  # the shuttle guard holds Algorithm 1's goal
+    plan = _propose(ctx)
+    assert plan.kind == (PlanKind.SEMANTIC if holds else PlanKind.FALLBACK)
+    assert ctx.counts.grid_frontier_plans == (0 if holds else 1)
+    ctx = _context(chosen_cost=5.0)  # the guard holds another goal: the grid's frontier wins
+    ctx.memory.shuttle_xy_m = (3.0, 0.5)
+    assert _propose(ctx).kind == PlanKind.FALLBACK

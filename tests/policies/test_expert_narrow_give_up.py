@@ -34,9 +34,12 @@ def _room_with_slots(width_px: int = 5, n: int = 8) -> np.ndarray:
 
 def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file, short_mission):
     world = ros_map_file(_room_with_slots(), "slots", (0.013, 0.021))
-    keeps_on, p_on = short_mission(world, "semantic[narrow_passages=true]", 2, 600)
+    # The expert of the time the give-up was made (vanish_on_frontier came later: with it, the
+    # unknown rock round a slot's end is no frontier and fewer slots become goals).
+    old_test = "vanish_on_frontier=false;shuttle_guard_holds_grid=false"
+    keeps_on, p_on = short_mission(world, f"semantic[narrow_passages=true;{old_test}]", 2, 600)
     gives_up, p_up = short_mission(
-        world, "semantic[narrow_passages=true;narrow_give_up_goals=4]", 2, 600
+        world, f"semantic[narrow_passages=true;narrow_give_up_goals=4;{old_test}]", 2, 600
     )
     k = p_up.params.narrow_give_up_goals
     assert len(p_on.goal_memory.narrow_goals) > k  # on into more slots
