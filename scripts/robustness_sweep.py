@@ -47,6 +47,13 @@ FAMILIES: dict[str, list[str]] = {
         "size_m=12,min_passage_m=0.8",
         "size_m=15",
     ],
+    "noisecave": [
+        "size_m=8,threshold=0.4",
+        "size_m=10,threshold=0.44",
+        "size_m=12,threshold=0.48",
+        "size_m=14,threshold=0.42",
+        "size_m=16,threshold=0.46",
+    ],
     "forest": [
         "size_m=6,density=10",
         "size_m=8",

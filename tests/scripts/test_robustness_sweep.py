@@ -6,6 +6,7 @@ import csv
 import runpy
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "robustness_sweep.py"
@@ -41,3 +42,22 @@ def test_unknown_family_is_a_clear_error(tmp_path: Path) -> None:
     with pytest.raises(SystemExit) as e:
         main(["--families", "castle", "--out", str(tmp_path / "x")])
     assert e.value.code == 2
+
+
+def test_every_family_variant_builds_a_world_and_value_noise_caves_are_swept() -> None:
+    from semexplore_gym.maps.world_specs import make_world
+
+    ns = runpy.run_path(str(SCRIPT), run_name="sweep")
+    families = ns["FAMILIES"]
+    assert "noisecave" in families  # the value-noise caves are part of the default sweep
+    per_family = max(len(v) for v in families.values())
+    worlds = ns["sweep_worlds"](list(families), per_family, 0)
+    assert len(worlds) == per_family * len(families)
+    thresholds = set()
+    for spelling in worlds:
+        world = make_world(spelling, np.random.default_rng(0))
+        free_m2 = world.free_mask.sum() * world.free_geometry.resolution_m**2
+        assert free_m2 > 1.0, spelling
+        if spelling.startswith("noisecave:"):
+            thresholds.add(spelling.split("threshold=")[1])
+    assert len(thresholds) >= 3  # several thresholds, narrow to wide passages
