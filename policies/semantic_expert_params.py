@@ -227,9 +227,6 @@ class SemanticExpertParams:
         goal_reached_radius_m: The goal counts as reached within this distance.
         goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
             left within this distance of it (with ``vanish_on_frontier``: no frontier cell).
-        shuttle_guard_holds_grid: The goal the shuttle guard holds is kept against the grid's
-            nearest frontier too (``grid_candidate``), not only against Algorithm 1's other
-            frontiers: else the two sources can take turns for ever.
         vanish_on_frontier: The goal has vanished when no *frontier* cell (UNKNOWN next to
             FREE) is left near it, rather than no UNKNOWN cell: unknown space behind a mapped
             wall (a thick wall's inside, the far side of a thin one) is no frontier, and waiting
@@ -290,6 +287,9 @@ class SemanticExpertParams:
         shuttle_radius_m: A goal this close to an earlier one is the same goal.
         shuttle_min_new_m2: Known area the map must gain between two adoptions of the same goal
             for the second not to count as a shuttle.
+        shuttle_guard_holds_grid: The goal the shuttle guard holds is kept against the grid's
+            nearest frontier too (``grid_candidate``), not only against Algorithm 1's other
+            frontiers: else the two sources can take turns for ever.
         view_unseen_frontiers: Before dropping a frontier reached without clearing, drive to a
             place that sees into it (see above; part of ``reach_blacklist`` and
             ``look_at_narrow_frontiers``).
