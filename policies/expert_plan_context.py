@@ -15,6 +15,7 @@ from semexplore_gym.policies.expert_goal_memory import GoalMemory
 from semexplore_gym.policies.expert_plan import Plan
 from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
+from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.frontiers.options import FrontierOptions, reachable_frontier_options
 from semexplore_gym.core.frontiers.reachable import (
     FrontierFilter,
@@ -24,7 +25,7 @@ from semexplore_gym.core.frontiers.reachable import (
     known_free_clearance_m,
     nearest_reachable_frontier,
 )
-from semexplore_gym.core.grid import FREE, UNKNOWN, GridGeometry
+from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 from semexplore_gym.core.planning.potential_field import resample_polyline
 
@@ -77,13 +78,9 @@ def frontier_near(
     if box is None:
         return True
     r0, c0, r1, c1 = box
+    # the box with a rim of one cell, so that its edge cells see all four neighbours
     window = grid[r0 - 1 : r1 + 2, c0 - 1 : c1 + 2]
-    unknown = window[1:-1, 1:-1] == UNKNOWN
-    if not unknown.any():
-        return False
-    free = window == FREE
-    beside = free[:-2, 1:-1] | free[2:, 1:-1] | free[1:-1, :-2] | free[1:-1, 2:]
-    return bool((unknown & beside).any())
+    return bool(frontier_cell_mask(window)[1:-1, 1:-1].any())
 
 
 def goal_open(
