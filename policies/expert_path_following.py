@@ -192,11 +192,12 @@ class PathFollower:
         return cmd.v_mps, cmd.omega_radps, escaping
 
     def tight(self, plan: Plan) -> bool:
-        """A narrow plan (``narrow_passages``) whose next stretch has less than the planners'
-        clearance on the map (the expert then holds its periodic replans: a plan from inside
-        the passage would hand the robot back to the potential field)."""
+        """A narrow plan (``narrow_passages``, ``room_beyond_gaps``: one that carries its path's
+        clearance) whose next stretch has less than the planners' clearance on the map (the
+        expert then holds its periodic replans: a plan from inside the passage would hand the
+        robot back to the potential field)."""
         along = plan.path_clearance_m
-        if along is None or not self.params.narrow_passages:
+        if along is None:
             return False
         n = int(math.ceil(TIGHT_LOOKAHEAD_M / self.geometry.resolution_m)) + 1
         ahead = along[plan.progress : plan.progress + n]

@@ -126,6 +126,15 @@ What the paper leaves open, and how the expert handles it (parameters in
   cave walls are full of cracks, narrower than the robot or whose far side is rock,
   and driving into each costs minutes for nothing; it tries again once the map has grown by
   that much since (from elsewhere).
+* **Room beyond a gap** (``room_beyond_gaps``, ``narrow_min_room_m2``; on by default): when
+  nothing is reachable at the planners' clearance, but the map shows room beyond a gap
+  narrower than it (at least ``narrow_min_room_m2`` of space with the planners' clearance and a
+  frontier next to it, seen through the gap:
+  :mod:`semexplore_gym.core.frontiers.beyond_gap`), the robot goes through the gap at the
+  narrow tier's clearance (tracked slowly and exactly as above) and on to that frontier. It
+  needs no ``narrow_passages``: it drives into a gap only where the LiDAR already saw room on
+  the far side, never into a crack whose far side is rock, so it costs nothing where nothing
+  lies beyond (``narrow_passages`` comes after it and probes the cracks too).
 
 Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
 switches them all off: the paper's method alone).
@@ -312,6 +321,10 @@ class SemanticExpertParams:
         narrow_give_up_m2: ... mapped less than this much room to move in all (area where the
             robot's centre may be at the narrow clearance, since the first of them was
             adopted; 0 goals: never gives up).
+        room_beyond_gaps: Go through a gap narrower than the planners' clearance where the map
+            shows room with a frontier beyond it (see the module docstring).
+        narrow_min_room_m2: Room beyond a gap is at least this much area the robot's centre
+            may take at the planners' clearance.
         tight_speed_mps: Forward speed where a narrow plan's path is tight.
         tight_track_lookahead_m: There it aims at the path point this far ahead ...
         tight_turn_in_place_rad: ... and turns on the spot above this heading error ...
@@ -392,6 +405,8 @@ class SemanticExpertParams:
     narrow_clearance_margin_m: float = -0.005
     narrow_give_up_goals: int = 0
     narrow_give_up_m2: float = 0.5
+    room_beyond_gaps: bool = True
+    narrow_min_room_m2: float = 0.5
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
@@ -483,7 +498,7 @@ class SemanticExpertParams:
         k = self.narrow_give_up_goals
         if isinstance(k, bool) or not isinstance(k, int) or k < 0:
             raise ValueError(f"narrow_give_up_goals must be an integer >= 0, got {k!r}")
-        require_finite(self, ("narrow_give_up_m2",), positive=False)
+        require_finite(self, ("narrow_give_up_m2", "narrow_min_room_m2"), positive=False)
         tight = ("tight_speed_mps", "tight_track_lookahead_m", "tight_turn_in_place_rad")
         require_finite(self, (*tight, "tight_centring_range_m"), positive=True)
 
@@ -516,6 +531,7 @@ PAPER_PURE: dict[str, object] = {
     "grid_candidate": False,
     "vanish_on_frontier": False,
     "shuttle_guard_holds_grid": False,
+    "room_beyond_gaps": False,
     "goal_commitment": False,
     "local_min_escape": False,
     "stuck_recovery": False,

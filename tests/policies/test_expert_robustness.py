@@ -189,8 +189,17 @@ def test_the_grid_check_leads_out_of_a_pocket_instead_of_stopping() -> None:
     assert pol.counters["pocket_escapes"] == 1
     assert pol.goal_xy_m[0] > 3.3  # at the room's frontier
     assert any(e == "pocket" for _t, e, _d in pol.events)
-    # Without the escape the check sees only the pocket: no fallback goal (a look, then a stop).
-    off = SemanticExpertPolicy(SemanticExpertParams(pocket_escape=False), segmenter=_empty_tmap)
+    # Without the escape the room beyond the pocket's gap, which the map shows with its
+    # frontier, still leads out (at the narrow tier's clearance) ...
+    room = SemanticExpertPolicy(SemanticExpertParams(pocket_escape=False), segmenter=_empty_tmap)
+    room.reset(in_pocket, INFO, seed=0)
+    room.act(in_pocket, INFO)
+    assert room.plan_source == "fallback" and room.goal_xy_m[0] > 3.3
+    assert room.counters["pocket_escapes"] == 0 and room.counters["narrow_plans"] == 1
+    assert any(e == "room" for _t, e, _d in room.events)
+    # ... and without both the check sees only the pocket: no fallback goal (a look, a stop).
+    no_way = SemanticExpertParams(pocket_escape=False, room_beyond_gaps=False)
+    off = SemanticExpertPolicy(no_way, segmenter=_empty_tmap)
     off.reset(in_pocket, INFO, seed=0)
     for _ in range(20):
         off.act(in_pocket, INFO)

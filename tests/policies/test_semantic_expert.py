@@ -419,6 +419,7 @@ def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
         "committed_fallback",
         "nearest_fallback",
         "pocket_escape",
+        "room_beyond_gap",
         "narrow_fallback",
         "look",
     ]
