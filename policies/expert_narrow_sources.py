@@ -62,19 +62,12 @@ class RoomBeyondGap(PlanSource):
         )
         if way is None:
             return None
-        entry = (float(way[-1, 0]), float(way[-1, 1]))
-        found = nearest_reachable_frontier(
-            ctx.grid,
-            ctx.geometry,
-            entry,
-            ctx.clearance_m,
-            frontiers=ctx.fallback_filter(),
-            clearance_field=ctx.clearance_field(),
-        )
+        found = ctx.frontier_beyond(way)
         if found is None:
             return None
         ctx.counts.narrow_plans += 1
         if ctx.current is None or ctx.current.goal_xy_m != found.goal_xy_m:
+            entry = tuple(round(float(v), 2) for v in way[-1])
             ctx.log("room", f"through a gap at {entry}, then to {found.goal_xy_m}")
         path = ctx.resampled(np.vstack([way, found.path_m[1:]]))
         return Plan(

@@ -162,6 +162,19 @@ class PlanContext:
             clearance_field=self.clearance_cache,
         )
 
+    def frontier_beyond(self, way_m: np.ndarray) -> ReachableFrontier | None:
+        """The nearest frontier the grid fallback's search reaches (at the planners'
+        clearance) from the end of ``way_m``, a way out of where the robot stands (a pocket,
+        through a gap): the second leg of such a plan."""
+        return nearest_reachable_frontier(
+            self.grid,
+            self.geometry,
+            (float(way_m[-1, 0]), float(way_m[-1, 1])),
+            self.clearance_m,
+            frontiers=self.fallback_filter(),
+            clearance_field=self.clearance_field(),
+        )
+
     def resampled(self, path_m: np.ndarray) -> np.ndarray:
         """``path_m`` resampled at the map's resolution (what the path follower expects)."""
         return resample_polyline(path_m, self.geometry.resolution_m)

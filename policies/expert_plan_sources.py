@@ -374,14 +374,7 @@ class PocketEscape(PlanSource):
         if exit_path is None:
             return None
         outside = (float(exit_path[-1, 0]), float(exit_path[-1, 1]))
-        found = nearest_reachable_frontier(
-            ctx.grid,
-            ctx.geometry,
-            outside,
-            ctx.clearance_m,
-            frontiers=ctx.fallback_filter(),
-            clearance_field=clearance,
-        )
+        found = ctx.frontier_beyond(exit_path)
         if found is None:
             return None
         ctx.counts.pocket_escapes += 1
