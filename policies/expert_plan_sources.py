@@ -18,6 +18,9 @@ source                  proposes
 ``committed_fallback``  the grid fallback's goal of the last plan, while it lasts
 ``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
+``room_beyond_gap``     through a gap narrower than the clearance into room the map shows
+                        beyond it, with a frontier (``room_beyond_gaps``; in
+                        :mod:`~semexplore_gym.policies.expert_narrow_sources`)
 ``narrow_fallback``     the nearest frontier a grid search reaches with a thinner clearance
                         (``narrow_passages``), through passages followed slowly and exactly
 ``look``                close to a frontier too narrow to reach, to look again
