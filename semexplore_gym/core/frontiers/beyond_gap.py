@@ -16,6 +16,8 @@ field: the caller's choice of what a wall is) to the nearest cell of such a regi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
 from scipy import ndimage
@@ -27,6 +29,7 @@ from semexplore_gym.core.frontiers.reachable import (
     drop_excluded,
     frontier_groups,
     grid_path_to_mask,
+    known_window,
     search_start_cell,
     usable_cells,
 )
@@ -74,27 +77,37 @@ def room_beyond_gap_path(
         raise ValueError(f"need 0 <= thin_m <= clearance_m, got {thin_m!r}, {clearance_m!r}")
     if np.shape(thin_field) != g.shape:
         raise ValueError(f"thin_field shape {np.shape(thin_field)} does not match {g.shape}")
+    # Everything but the last search happens within the window of the known cells (a large
+    # map is mostly unknown; usable cells are FREE), as in nearest_reachable_frontier: the same
+    # result as on the whole grid, cell for cell, at the cost of the explored part only.
+    res = geometry.resolution_m
+    margin = int(math.ceil(0.5 / res)) + int(math.ceil(frontiers.reach_m / res)) + 2
+    r0, r1, c0, c1 = known_window(g, geometry, start_xy_m, margin)
+    if r0 >= r1 or c0 >= c1:
+        return None
+    w = np.ascontiguousarray(g[r0:r1, c0:c1])
     labels_f, n = frontier_groups(
-        g, frontiers.min_frontier_cells, frontiers.min_unknown_depth_cells
+        w, frontiers.min_frontier_cells, frontiers.min_unknown_depth_cells
     )
     if n == 0 or (
-        len(frontiers.excluded_xy_m) and not drop_excluded(labels_f, geometry, frontiers)
+        len(frontiers.excluded_xy_m) and not drop_excluded(labels_f, geometry, frontiers, (r0, c0))
     ):
         return None
-    usable = usable_cells(g, clearance_field_m(g, geometry.resolution_m), clearance_m)
+    usable = usable_cells(w, clearance_field_m(w, res), clearance_m)
     regions, n_regions = ndimage.label(usable)
     if n_regions == 0:
         return None
-    res = geometry.resolution_m
     near = dilate(labels_f > 0, frontiers.reach_m / res) if frontiers.reach_m > 0 else labels_f > 0
     served = np.zeros(n_regions + 1, dtype=bool)
     served[np.unique(regions[near & usable])] = True
     sizes = np.bincount(regions.ravel(), minlength=n_regions + 1)
     room = served & (sizes >= max(1, int(min_room_cells)))
     room[0] = False
-    start = search_start_cell(g, geometry, usable, start_xy_m)
+    start = search_start_cell(w, geometry, usable, start_xy_m, (r0, c0))
     if start is not None:
         room[regions[start]] = False
     if not room.any():
         return None
-    return grid_path_to_mask(g, geometry, start_xy_m, room[regions], thin_m, thin_field)
+    goal = np.zeros(g.shape, dtype=bool)
+    goal[r0:r1, c0:c1] = room[regions]
+    return grid_path_to_mask(g, geometry, start_xy_m, goal, thin_m, thin_field)

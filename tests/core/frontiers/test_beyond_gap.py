@@ -77,3 +77,17 @@ def test_bad_input_is_refused_with_the_bad_value() -> None:
         room_beyond_gap_path(g, geom, (1.0, 1.5), CLEARANCE_M, THIN_M, known[:, :10])
     with pytest.raises(ValueError, match="clearance_m"):
         room_beyond_gap_path(g, geom, (1.0, 1.5), -1.0, THIN_M, known)
+
+
+def test_unknown_space_round_the_map_changes_nothing() -> None:
+    # The search works within the known cells' window: a map inside a wide unknown border
+    # gives the same way, shifted by the border.
+    g, geom = _two_rooms()
+    pad = 200
+    big = np.pad(g, pad, constant_values=UNKNOWN)
+    big_geom = GridGeometry(RES, -pad * RES, -pad * RES, *big.shape)
+    small = _path(g, geom)
+    known = known_free_clearance_m(big, RES)
+    large = room_beyond_gap_path(big, big_geom, (1.0, 1.5), CLEARANCE_M, THIN_M, known)
+    assert small is not None and large is not None
+    np.testing.assert_allclose(large, small, atol=1e-9)
