@@ -114,13 +114,21 @@ class FrontierMemory:
         grid: np.ndarray,
         geometry: GridGeometry,
     ) -> None:
-        """Give up on ``goal_xy_m`` until the map round it changes."""
+        """Give up on ``goal_xy_m`` until the map round it changes.
+
+        A goal near one dropped before is the same place (it comes back at most
+        ``max_revivals`` times in all); when it is not the very same point it is kept as a point
+        of its own as well, so that the frontier cells round *it* are excluded too: a search
+        that excludes frontier cells near the dropped points would else find the same goal
+        again, beyond the old point's radius, and drop it again, for ever."""
         window = self._window(grid, geometry, goal_xy_m)
-        for d in self.dropped:
-            if self._near(d.xy_m, goal_xy_m):
-                d.active, d.reason, d.window_known = True, reason, window
-                return
-        self.dropped.append(DroppedGoal(goal_xy_m, reason, window))
+        near = [d for d in self.dropped if self._near(d.xy_m, goal_xy_m)]
+        same = [d for d in near if d.xy_m == goal_xy_m]
+        for d in same or near[:1]:
+            d.active, d.reason, d.window_known = True, reason, window
+        if not same:
+            revivals = near[0].revivals if near else 0
+            self.dropped.append(DroppedGoal(goal_xy_m, reason, window, revivals=revivals))
 
     def active_points(self, exclude: Sequence[str] = ()) -> list[tuple[float, float]]:
         """The goals dropped and not come back (but those dropped for a reason in

@@ -249,6 +249,27 @@ def test_frontier_memory_drops_revives_and_caps_revivals() -> None:
     assert mem.count("attempts") == 1 and mem.count("looked") == 0
 
 
+def test_a_goal_dropped_near_an_older_drop_is_excluded_round_itself_too() -> None:
+    # The livelock this prevents: the grid fallback excludes frontier cells near the dropped
+    # points; a goal 0.45 m from an older drop is "the same place", and if only the old point
+    # were kept, the frontier 0.9 m from it (beside the new goal) stayed searchable, and the
+    # same goal came back after every drop.
+    grid = _two_rooms(0.6)
+    mem = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3)
+    mem.drop((2.5, 1.5), "looked", grid, GEOM)
+    mem.drop((2.95, 1.5), "attempts", grid, GEOM)
+    assert mem.active_points() == [(2.5, 1.5), (2.95, 1.5)]
+    assert mem.is_dropped((3.4, 1.5))  # within the radius of the new point only
+    mem.drop((2.95, 1.5), "attempts", grid, GEOM)  # the very same point: no third entry
+    assert len(mem.dropped) == 2
+    changed = grid.copy()
+    changed[20:40, 51:60] = FREE
+    assert sorted(mem.revive(changed, GEOM)) == [(2.5, 1.5), (2.95, 1.5)]
+    mem.drop((2.6, 1.5), "attempts", changed, GEOM)  # a third point near both
+    assert mem.dropped[-1].revivals == 1  # the place's revivals go with it
+    assert mem.revive(grid, GEOM) == []  # so it does not come back again
+
+
 def test_abandoned_goals_are_remembered_for_the_oscillation_window() -> None:
     mem = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3)
     mem.abandon((1.0, 1.0), 10.0)
