@@ -121,6 +121,7 @@ class GoalMemory:
             prm.revive_min_changed_cells,
             prm.max_revivals,
             prm.max_goal_attempts,
+            drop_each_point=prm.drop_each_point,
         )
         self.blacklist = GoalBlacklist(prm.blacklist_radius_m)
         self.retry: Retry | None = None

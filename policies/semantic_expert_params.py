@@ -62,7 +62,10 @@ What the paper leaves open, and how the expert handles it (parameters in
 * **Dropped frontiers come back** (``revive_window_m``, ``revive_min_changed_cells``,
   ``max_revivals``): when at least ``revive_min_changed_cells`` cells within
   ``revive_window_m`` of a dropped goal changed since it was dropped (the map around it grew or
-  was corrected), it is considered again, at most ``max_revivals`` times.
+  was corrected), it is considered again, at most ``max_revivals`` times. A goal dropped
+  within ``blacklist_radius_m`` of an earlier drop is the same place for that count; with
+  ``drop_each_point`` (on) it keeps a point of its own too, so the frontier round it is ignored
+  as well (without, the grid fallback could find the same goal again at once, for ever).
 * **The stop rule**: the mission stops only when the grid fallback (a clearance-aware grid
   search, the final check) finds no frontier the robot's disc can reach, besides dropped goals;
   the stop reason names the rule and counts what was dropped and why.
@@ -201,6 +204,7 @@ class GoalMemoryParams:
     revive_window_m: float
     revive_min_changed_cells: int
     max_revivals: int
+    drop_each_point: bool
     reach_blacklist: bool
     oscillation_guard: bool
     oscillation_window_s: float
@@ -269,6 +273,8 @@ class SemanticExpertParams:
         revive_window_m: Radius round a dropped goal watched for map changes.
         revive_min_changed_cells: Changed cells in that window that bring a dropped goal back.
         max_revivals: How often one place may come back.
+        drop_each_point: A goal dropped near an earlier drop keeps a point of its own (see
+            above).
         pocket_escape: When the grid check finds nothing from a pocket of the usable map,
             leave the pocket and check again from outside (see above; part of
             ``grid_fallback``).
@@ -378,6 +384,7 @@ class SemanticExpertParams:
     revive_window_m: float = 0.75
     revive_min_changed_cells: int = 40
     max_revivals: int = 2
+    drop_each_point: bool = True
     pocket_escape: bool = True
     pocket_max_share: float = 0.1
     pocket_clearance_margin_m: float = 0.025
@@ -532,6 +539,7 @@ PAPER_PURE: dict[str, object] = {
     "vanish_on_frontier": False,
     "shuttle_guard_holds_grid": False,
     "room_beyond_gaps": False,
+    "drop_each_point": False,
     "goal_commitment": False,
     "local_min_escape": False,
     "stuck_recovery": False,

@@ -54,6 +54,8 @@ class FrontierMemory:
         min_changed_cells: Cells of that window that must change to bring a goal back.
         max_revivals: How often one place may come back.
         max_attempts: Failed approaches before a goal is dropped.
+        drop_each_point: A goal dropped near an earlier drop (the same place) keeps a point of
+            its own as well (see :meth:`drop`); False: only the earlier point is kept.
     """
 
     def __init__(
@@ -63,12 +65,14 @@ class FrontierMemory:
         min_changed_cells: int,
         max_revivals: int,
         max_attempts: int,
+        drop_each_point: bool = True,
     ) -> None:
         self.radius_m = float(radius_m)
         self.window_m = float(window_m)
         self.min_changed_cells = int(min_changed_cells)
         self.max_revivals = int(max_revivals)
         self.max_attempts = int(max_attempts)
+        self.drop_each_point = bool(drop_each_point)
         self.dropped: list[DroppedGoal] = []
         self._failures: list[tuple[tuple[float, float], int, tuple[float, float]]] = []
         self._abandoned: list[tuple[tuple[float, float], float]] = []
@@ -118,15 +122,17 @@ class FrontierMemory:
 
         A goal near one dropped before is the same place (it comes back at most
         ``max_revivals`` times in all); when it is not the very same point it is kept as a point
-        of its own as well, so that the frontier cells round *it* are excluded too: a search
-        that excludes frontier cells near the dropped points would else find the same goal
-        again, beyond the old point's radius, and drop it again, for ever."""
+        of its own as well (with ``drop_each_point``), so that the frontier cells round *it* are
+        excluded too: a search that excludes frontier cells near the dropped points would else
+        find the same goal again, beyond the old point's radius, and drop it again, for ever."""
         window = self._window(grid, geometry, goal_xy_m)
         near = [d for d in self.dropped if self._near(d.xy_m, goal_xy_m)]
-        same = [d for d in near if d.xy_m == goal_xy_m]
-        for d in same or near[:1]:
+        hit = near[:1]
+        if self.drop_each_point:
+            hit = [d for d in near if d.xy_m == goal_xy_m] or hit
+        for d in hit:
             d.active, d.reason, d.window_known = True, reason, window
-        if not same:
+        if not near or (self.drop_each_point and hit[0].xy_m != goal_xy_m):
             revivals = near[0].revivals if near else 0
             self.dropped.append(DroppedGoal(goal_xy_m, reason, window, revivals=revivals))
 

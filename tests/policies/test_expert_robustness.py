@@ -268,6 +268,11 @@ def test_a_goal_dropped_near_an_older_drop_is_excluded_round_itself_too() -> Non
     mem.drop((2.6, 1.5), "attempts", changed, GEOM)  # a third point near both
     assert mem.dropped[-1].revivals == 1  # the place's revivals go with it
     assert mem.revive(grid, GEOM) == []  # so it does not come back again
+    old = FrontierMemory(0.5, 0.75, 40, max_revivals=1, max_attempts=3, drop_each_point=False)
+    old.drop((2.5, 1.5), "looked", grid, GEOM)
+    old.drop((2.95, 1.5), "attempts", grid, GEOM)
+    assert old.active_points() == [(2.5, 1.5)]  # before the fix: the earlier point only
+    assert not old.is_dropped((3.4, 1.5))
 
 
 def test_abandoned_goals_are_remembered_for_the_oscillation_window() -> None:
