@@ -139,6 +139,8 @@ class GoalMemory:
         # The narrow tier's goals, each with the map's room to move (cells the robot's centre
         # may take at the narrow clearance) when it was first adopted.
         self.narrow_goals: list[tuple[tuple[float, float], int]] = []
+        # When the map last gained room to move, as the narrow tier saw it: (time, room).
+        self.narrow_room_since: tuple[float, int] | None = None
 
     # ------------------------------------------------------------------ queries
     def dropped_points(self, exclude: Sequence[str] = ()) -> list[tuple[float, float]]:
@@ -184,6 +186,8 @@ class GoalMemory:
         same_goal_m: float,
         goals: int,
         min_new_cells: float,
+        now_s: float = 0.0,
+        give_up_s: float = 0.0,
     ) -> bool:
         """The narrow tier proposes ``goal_xy_m``, the map holding ``room_cells`` cells the
         robot's centre may take: True to give up instead (a new goal, while the last ``goals``
@@ -197,6 +201,12 @@ class GoalMemory:
             return False
         if goals > 0 and len(past) >= goals and room_cells - past[-goals][1] < min_new_cells:
             return True
+        if give_up_s > 0.0:
+            since = self.narrow_room_since
+            if since is None or room_cells - since[1] >= min_new_cells:
+                self.narrow_room_since = (now_s, room_cells)
+            elif now_s - since[0] > give_up_s:
+                return True
         past.append((goal_xy_m, room_cells))
         return False
 

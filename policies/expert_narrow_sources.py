@@ -121,7 +121,13 @@ class NarrowFallback(PlanSource):
         room = int(np.count_nonzero(clearance >= thin_m))
         min_new = prm.narrow_give_up_m2 / ctx.geometry.resolution_m**2
         if ctx.memory.narrow_goal(
-            goal, room, NARROW_SAME_GOAL_M, prm.narrow_give_up_goals, min_new
+            goal,
+            room,
+            NARROW_SAME_GOAL_M,
+            prm.narrow_give_up_goals,
+            min_new,
+            now_s=ctx.time_s,
+            give_up_s=prm.narrow_give_up_s,
         ):
             return None
         ctx.counts.narrow_plans += 1

@@ -110,6 +110,7 @@ class PlanContext:
         choose_goal: The expert's goal choice among ``candidates``.
         log: Records an event ``(name, detail)`` in the expert's event log.
         lidar_range_m: The LiDAR's ``(min_range_m, max_range_m)``.
+        time_s: The expert's clock at this replan (seconds).
     """
 
     grid: np.ndarray
@@ -125,6 +126,7 @@ class PlanContext:
     choose_goal: Callable[[list[FrontierCandidate]], FrontierCandidate]
     log: Callable[[str, str], None]
     lidar_range_m: tuple[float, float] = (0.0, 3.5)
+    time_s: float = 0.0
     clearance_cache: np.ndarray | None = field(default=None, repr=False)
     known_clearance_cache: np.ndarray | None = field(default=None, repr=False)
 

@@ -349,10 +349,9 @@ class SemanticExpertPolicy(Policy):
     def drive_to(self, goal_xy_m: tuple[float, float] | None) -> None:
         """Drive to ``goal_xy_m`` (metres, world frame) from the next ``act`` on.
 
-        The ``commanded`` plan source plans a clearance-aware grid route there; the expert's
-        path following drives it (escapes, stuck recovery included). Once the goal is reached
-        (within ``goal_reached_radius_m``), its approach fails or no route reaches it, the
-        command ends and the expert chooses its goals again. None ends the command now.
+        The ``commanded`` plan source plans a clearance-aware grid route there; the path
+        following drives it (escapes, recoveries included). Once the goal is reached, its
+        approach fails or no route reaches it, the command ends. None ends it now.
         """
         xy = None if goal_xy_m is None else (float(goal_xy_m[0]), float(goal_xy_m[1]))
         self.goal_memory.command(xy)
@@ -471,6 +470,7 @@ class SemanticExpertPolicy(Policy):
             choose_goal=self.choose_goal,
             log=self._log,
             lidar_range_m=(self._min_range_m, self.limits.max_range_m),
+            time_s=self._time_s,
         )
         new_plan = None
         for source in self.plan_sources:

@@ -128,7 +128,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``narrow_give_up_m2`` of room to move (where the robot's centre may be at that clearance):
   cave walls are full of cracks, narrower than the robot or whose far side is rock,
   and driving into each costs minutes for nothing; it tries again once the map has grown by
-  that much since (from elsewhere).
+  that much since (from elsewhere). ``narrow_give_up_s`` > 0 gives up by time instead: no new
+  narrow goal once the map has gained less than ``narrow_give_up_m2`` of room to move in the
+  last ``narrow_give_up_s`` seconds (both measured in docs/results.md; off by default).
 * **Room beyond a gap** (``room_beyond_gaps``, ``narrow_min_room_m2``; on by default): when
   nothing is reachable at the planners' clearance, but the map shows room beyond a gap
   narrower than it (at least ``narrow_min_room_m2`` of space with the planners' clearance and a
@@ -327,6 +329,9 @@ class SemanticExpertParams:
         narrow_give_up_m2: ... mapped less than this much room to move in all (area where the
             robot's centre may be at the narrow clearance, since the first of them was
             adopted; 0 goals: never gives up).
+        narrow_give_up_s: The narrow tier takes no new goal once this long (seconds) has passed
+            since the map last gained ``narrow_give_up_m2`` of room to move, counted from its
+            first goal (0, the default: never; 100 measured in docs/results.md).
         room_beyond_gaps: Go through a gap narrower than the planners' clearance where the map
             shows room with a frontier beyond it (see the module docstring).
         narrow_min_room_m2: Room beyond a gap is at least this much area the robot's centre
@@ -412,6 +417,7 @@ class SemanticExpertParams:
     narrow_clearance_margin_m: float = -0.005
     narrow_give_up_goals: int = 0
     narrow_give_up_m2: float = 0.5
+    narrow_give_up_s: float = 0.0
     room_beyond_gaps: bool = True
     narrow_min_room_m2: float = 0.5
     tight_speed_mps: float = 0.08
@@ -505,7 +511,9 @@ class SemanticExpertParams:
         k = self.narrow_give_up_goals
         if isinstance(k, bool) or not isinstance(k, int) or k < 0:
             raise ValueError(f"narrow_give_up_goals must be an integer >= 0, got {k!r}")
-        require_finite(self, ("narrow_give_up_m2", "narrow_min_room_m2"), positive=False)
+        require_finite(
+            self, ("narrow_give_up_m2", "narrow_give_up_s", "narrow_min_room_m2"), positive=False
+        )
         tight = ("tight_speed_mps", "tight_track_lookahead_m", "tight_turn_in_place_rad")
         require_finite(self, (*tight, "tight_centring_range_m"), positive=True)
 

@@ -32,14 +32,22 @@ def _room_with_slots(width_px: int = 5, n: int = 8) -> np.ndarray:
     return img
 
 
-def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file, short_mission):
+def _slots_missions(ros_map_file, short_mission, give_up: str):
+    """The narrow tier in the slotted room without and with the give-up ``give_up``: the
+    missions ``(keeps_on, p_on), (gives_up, p_up)``."""
     world = ros_map_file(_room_with_slots(), "slots", (0.013, 0.021))
     # The expert of the time the give-up was made (vanish_on_frontier came later: with it, the
     # unknown rock round a slot's end is no frontier and fewer slots become goals).
     old_test = "vanish_on_frontier=false;shuttle_guard_holds_grid=false"
-    keeps_on, p_on = short_mission(world, f"semantic[narrow_passages=true;{old_test}]", 2, 600)
-    gives_up, p_up = short_mission(
-        world, f"semantic[narrow_passages=true;narrow_give_up_goals=4;{old_test}]", 2, 600
+    return (
+        short_mission(world, f"semantic[narrow_passages=true;{old_test}]", 2, 600),
+        short_mission(world, f"semantic[narrow_passages=true;{give_up};{old_test}]", 2, 600),
+    )
+
+
+def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file, short_mission):
+    (keeps_on, p_on), (gives_up, p_up) = _slots_missions(
+        ros_map_file, short_mission, "narrow_give_up_goals=4"
     )
     k = p_up.params.narrow_give_up_goals
     assert len(p_on.goal_memory.narrow_goals) > k  # on into more slots
@@ -77,3 +85,49 @@ def test_narrow_give_up_goals_is_checked(bad):
 
     with pytest.raises(ValueError, match="narrow_give_up_goals"):
         SemanticExpertParams(narrow_give_up_goals=bad)
+
+
+def test_narrow_goal_gives_up_once_the_map_gained_no_room_for_a_while():
+    from semexplore_gym.policies.expert_counters import ExpertCounters
+    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    memory = GoalMemory(SemanticExpertParams().goal_memory, ExpertCounters(), lambda *_: None)
+
+    def propose(xy, room, now_s, give_up_s=100.0):
+        return memory.narrow_goal(xy, room, 1.0, 0, 50, now_s=now_s, give_up_s=give_up_s)
+
+    assert not propose((0.0, 0.0), 100, 10.0)  # the clock starts at the first narrow goal
+    assert not propose((3.0, 0.0), 140, 60.0)  # 40 new cells < 50: the clock runs on
+    assert not propose((6.0, 0.0), 149, 110.0)  # 100 s since 10 s: not more than 100 s yet
+    assert propose((9.0, 0.0), 149, 111.0)  # 101 s without 50 new cells: give up
+    assert not propose((6.4, 0.0), 149, 150.0)  # the current goal goes on (crawling through)
+    assert propose((12.0, 0.0), 149, 150.0, give_up_s=100.0)  # still given up
+    assert not propose((12.0, 0.0), 149, 150.0, give_up_s=0.0)  # 0: never gives up
+    assert not propose((15.0, 0.0), 151, 300.0)  # 51 cells since 10 s: the clock restarts
+    assert memory.narrow_room_since == (300.0, 151)
+    assert not propose((18.0, 0.0), 151, 400.0)  # 100 s since 300 s
+    assert propose((21.0, 0.0), 160, 400.5)
+    memory.reset(memory.geometry)
+    assert memory.narrow_room_since is None  # a new mission
+
+
+def test_the_narrow_tier_gives_up_after_a_while_without_new_room(ros_map_file, short_mission):
+    (keeps_on, p_on), (gives_up, p_up) = _slots_missions(
+        ros_map_file, short_mission, "narrow_give_up_s=30"
+    )
+    # Slots a few cells deep add (almost) no room: after 30 s the narrow tier takes no new one.
+    assert 1 <= len(p_up.goal_memory.narrow_goals) < len(p_on.goal_memory.narrow_goals)
+    assert p_up.counts.narrow_plans < p_on.counts.narrow_plans
+    assert gives_up.self_stopped and keeps_on.self_stopped
+    assert gives_up.mission_time_s < 0.85 * keeps_on.mission_time_s
+    assert gives_up.coverage >= keeps_on.coverage - 0.01
+    assert gives_up.collisions == keeps_on.collisions == 0
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "30"])
+def test_narrow_give_up_s_is_checked(bad):
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    with pytest.raises(ValueError, match="narrow_give_up_s"):
+        SemanticExpertParams(narrow_give_up_s=bad)
