@@ -194,7 +194,9 @@ class GoalMemory:
         narrow goals, and all that ran since the first of them, added fewer than
         ``min_new_cells`` of them; ``goals`` 0: never). A goal within ``same_goal_m`` of the
         last one continues it and is never given up (the robot may be crawling through the
-        passage)."""
+        passage). With ``give_up_s`` > 0, a new goal is also given up once the room grew by
+        less than ``min_new_cells`` in the ``give_up_s`` seconds up to ``now_s`` (the clock
+        starts at the first narrow goal and restarts whenever the room grows that much)."""
         past = self.narrow_goals
         if past and math.dist(goal_xy_m, past[-1][0]) <= same_goal_m:
             past[-1] = (goal_xy_m, past[-1][1])
