@@ -127,12 +127,10 @@ class FrontierMemory:
         find the same goal again, beyond the old point's radius, and drop it again, for ever."""
         window = self._window(grid, geometry, goal_xy_m)
         near = [d for d in self.dropped if self._near(d.xy_m, goal_xy_m)]
-        hit = near[:1]
-        if self.drop_each_point:
-            hit = [d for d in near if d.xy_m == goal_xy_m] or hit
-        for d in hit:
+        own = next((d for d in near if d.xy_m == goal_xy_m), None) if self.drop_each_point else None
+        for d in [own] if own is not None else near[:1]:
             d.active, d.reason, d.window_known = True, reason, window
-        if not near or (self.drop_each_point and hit[0].xy_m != goal_xy_m):
+        if not near or (self.drop_each_point and own is None):
             revivals = near[0].revivals if near else 0
             self.dropped.append(DroppedGoal(goal_xy_m, reason, window, revivals=revivals))
 
