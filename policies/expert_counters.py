@@ -24,6 +24,8 @@ class ExpertCounters:
         semantic_plans: Plans adopted from Algorithm 1's frontiers.
         fallback_plans: Every other plan adopted (grid fallback, retry, look, commanded).
         entry_detours: Grid detours onto a semantic path whose first leg crossed a wall.
+        semantic_grid_routes: Semantic plans driven over the grid's route to Algorithm 1's goal
+            instead of the map's path (``semantic_grid_route``).
         grid_frontier_plans: Replans where the grid's nearest frontier cost less than
             Algorithm 1's choice and was taken instead (``grid_candidate``).
         escapes: Local-minimum escapes of the potential field.
@@ -53,6 +55,7 @@ class ExpertCounters:
     semantic_plans: int = 0
     fallback_plans: int = 0
     entry_detours: int = 0
+    semantic_grid_routes: int = 0
     grid_frontier_plans: int = 0
     escapes: int = 0
     recoveries: int = 0

@@ -50,7 +50,9 @@ class ExpertDriver(SemanticExpertPolicy):
 
     Args:
         params: Expert parameters (default: the robust expert's); ``grid_candidate`` is always
-            off (the outside choice, not the grid's nearest frontier, decides).
+            off (the outside choice, not the grid's nearest frontier, decides), and so is
+            ``semantic_grid_route`` (the learned agents were trained and measured driving the
+            map's paths).
         segmenter: See :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`.
 
     Attributes:
@@ -66,7 +68,7 @@ class ExpertDriver(SemanticExpertPolicy):
     ) -> None:
         # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
         base = params if params is not None else SemanticExpertParams()
-        super().__init__(replace(base, grid_candidate=False), segmenter)
+        super().__init__(replace(base, grid_candidate=False, semantic_grid_route=False), segmenter)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

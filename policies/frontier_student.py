@@ -89,7 +89,8 @@ class FrontierStudentParams:
 
     Attributes:
         expert: The semantic expert's parameters (navigation, memory, stop rule; its
-            frontier choice is not used while the student has options).
+            frontier choice is not used while the student has options; ``grid_candidate`` and
+            ``semantic_grid_route`` are always off).
         model: The learned score.
         keep_goal: Keep the current goal while it is still one of the options (reached,
             mapped or unreachable goals end it); the choice is made only then. False: choose
@@ -180,7 +181,9 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         chooser: OptionChooser | None = None,
     ) -> None:
         self.student_params = params if params is not None else FrontierStudentParams()
-        expert = dataclasses.replace(self.student_params.expert, grid_candidate=False)
+        expert = dataclasses.replace(
+            self.student_params.expert, grid_candidate=False, semantic_grid_route=False
+        )
         sources = insert_plan_source(
             DEFAULT_PLAN_SOURCES, StudentFrontier(self._decide), before="semantic"
         )

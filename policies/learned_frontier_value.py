@@ -75,7 +75,8 @@ class FrontierValueParams:
 
     Attributes:
         expert: The semantic expert's parameters (its cost weights and switch margin included;
-            ``grid_candidate`` is always off: the learned ranking decides).
+            ``grid_candidate`` and ``semantic_grid_route`` are always off: the learned ranking
+            decides, driven as it was measured).
         value: The learned value's weights.
     """
 
@@ -97,7 +98,9 @@ class FrontierValuePolicy(SemanticExpertPolicy):
     ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
         # The learned ranking chooses: the grid's nearest frontier must not overrule it.
-        expert = dataclasses.replace(self.value_params.expert, grid_candidate=False)
+        expert = dataclasses.replace(
+            self.value_params.expert, grid_candidate=False, semantic_grid_route=False
+        )
         super().__init__(expert, segmenter=segmenter)
         self._obs: dict[str, np.ndarray] | None = None
 

@@ -346,6 +346,9 @@ class SemanticExpertParams:
             choice, scored by the same ``C`` without semantic terms (``d / L_path + w_v * v``):
             frontiers the topometric map has no pathway for (or reaches the long way) are
             explored as the robot passes them, not left for the end.
+        semantic_grid_route: Drive to Algorithm 1's goal over the grid's clearance-aware route
+            instead of the topometric map's path through the skeleton (the goal and its cost
+            are Algorithm 1's); the map's path where the grid has no route.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
         stuck_recovery: Watch progress; back off, retry or drop the goal when stuck.
@@ -426,6 +429,7 @@ class SemanticExpertParams:
     tight_centring_range_m: float = 0.3
     entry_detour: bool = True
     grid_candidate: bool = True
+    semantic_grid_route: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
     stuck_recovery: bool = True
@@ -544,6 +548,7 @@ PAPER_PURE: dict[str, object] = {
     "view_unseen_frontiers": False,
     "entry_detour": False,
     "grid_candidate": False,
+    "semantic_grid_route": False,
     "vanish_on_frontier": False,
     "shuttle_guard_holds_grid": False,
     "room_beyond_gaps": False,

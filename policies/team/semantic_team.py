@@ -64,7 +64,8 @@ class SemanticTeamParams:
         yield_distance_m: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         yield_cone_rad: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         expert: Each robot's expert parameters (``grid_candidate`` is always off: the team's
-            coordinated choice, not each robot's nearest frontier, decides).
+            coordinated choice, not each robot's nearest frontier, decides; so is
+            ``semantic_grid_route``: the teams were measured driving the map's paths).
     """
 
     semantic: bool = True
@@ -83,7 +84,9 @@ class _ExpertMember(SemanticExpertPolicy):
     """One robot's expert; its goal choice is the team's."""
 
     def __init__(self, team: SemanticTeam, index: int, params: SemanticExpertParams) -> None:
-        super().__init__(dataclasses.replace(params, grid_candidate=False))
+        super().__init__(
+            dataclasses.replace(params, grid_candidate=False, semantic_grid_route=False)
+        )
         self.team = team
         self.index = index
         self.goal_intersection_xy: tuple[float, float] | None = None

@@ -1,0 +1,121 @@
+"""Algorithm 1's goal driven over the grid's route (``semantic_grid_route``): the goal and its
+cost stay Algorithm 1's, the path is the grid's clearance-aware route instead of the map's."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
+
+RES_M = 0.05
+ROBOT_XY_M = (1.0, 1.5)
+GOAL_XY_M = (4.0, 1.5)
+#: The map's path (a stand-in for the skeleton's): up by a wall and back down, 3.84 m long.
+MAP_PATH_M = np.array([ROBOT_XY_M, (2.5, 2.7), GOAL_XY_M])
+
+
+def _room() -> tuple[np.ndarray, GridGeometry]:
+    """A 3 m x 5 m free room walled all round."""
+    grid = np.full((60, 100), FREE, dtype=np.uint8)
+    grid[:2, :] = grid[-2:, :] = OCCUPIED
+    grid[:, :2] = grid[:, -2:] = OCCUPIED
+    return grid, GridGeometry(RES_M, 0.0, 0.0, 60, 100)
+
+
+def _context(grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M, **params):
+    from semexplore_gym.policies.expert_counters import ExpertCounters
+    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.expert_plan_context import PlanContext
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+    prm = SemanticExpertParams(**{"grid_candidate": False, **params})
+    counts = ExpertCounters()
+    path = MAP_PATH_M.copy()
+    path[-1] = goal_xy_m
+    chosen = SimpleNamespace(goal_xy_m=goal_xy_m, path_m=path, l_path_m=4.0, cost=0.5)
+    return PlanContext(
+        grid=grid,
+        pose=(*ROBOT_XY_M, 0.0),
+        geometry=geometry,
+        params=prm,
+        clearance_m=0.155,
+        robot_radius_m=0.105,
+        candidates=[chosen],  # type: ignore[list-item]
+        current=None,
+        memory=GoalMemory(prm.goal_memory, counts, lambda *_: None),
+        counts=counts,
+        choose_goal=lambda cands: cands[0],
+        log=lambda *_: None,
+    )
+
+
+def _length_m(path: np.ndarray) -> float:
+    return float(np.hypot(*np.diff(path, axis=0).T).sum())
+
+
+def _propose(ctx):
+    from semexplore_gym.policies.expert_plan_sources import SemanticFrontier
+
+    return SemanticFrontier().propose(ctx)
+
+
+def test_the_goal_is_driven_to_over_the_grids_route() -> None:
+    from semexplore_gym.policies.expert_plan import PlanKind
+
+    ctx = _context(*_room(), semantic_grid_route=True)
+    plan = _propose(ctx)
+    assert plan.kind == PlanKind.SEMANTIC and plan.goal_xy_m == GOAL_XY_M
+    assert plan.candidate is ctx.candidates[0]  # Algorithm 1's choice, its cost untouched
+    assert _length_m(plan.path_m) < 3.3 < _length_m(MAP_PATH_M)  # straight across: about 3 m
+    assert np.allclose(plan.path_m[0], ROBOT_XY_M, atol=0.05)
+    assert np.hypot(*(plan.path_m[-1] - GOAL_XY_M)) <= 0.15 + 1e-9  # the grid route's reach
+    assert np.abs(plan.path_m[:, 1] - 1.5).max() < 0.2  # never up by the wall
+    assert ctx.counts.semantic_grid_routes == 1
+
+
+def test_switched_off_the_maps_path_is_driven() -> None:
+    ctx = _context(*_room(), semantic_grid_route=False)
+    plan = _propose(ctx)
+    assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
+    assert plan.path_m[:, 1].max() > 2.6
+    assert ctx.counts.semantic_grid_routes == 0
+
+
+def test_where_the_grid_has_no_route_the_maps_path_stands() -> None:
+    """A wall across the room, with a gap narrower than the planners' clearance: the grid
+    finds no route, the map's path (which the segmentation drew) is driven as before."""
+    grid, geometry = _room()
+    grid[:, 70:72] = OCCUPIED  # at x = 3.5 m, past the map path's first leg
+    grid[28:33, 70:72] = FREE  # a 0.25 m gap: under 2 x 0.155 m
+    ctx = _context(grid, geometry, semantic_grid_route=True)
+    plan = _propose(ctx)
+    assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
+    assert ctx.counts.semantic_grid_routes == 0
+
+
+def test_the_robust_expert_has_it_and_the_paper_pure_preset_does_not() -> None:
+    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE, SemanticExpertParams
+
+    assert SemanticExpertParams().semantic_grid_route
+    assert PAPER_PURE["semantic_grid_route"] is False
+
+
+def test_policies_measured_on_the_maps_paths_keep_them() -> None:
+    """Teams, the learning agents' driver, the frontier student and the learned frontier value
+    were trained and measured driving the map's paths: they keep them, whatever the
+    parameters say."""
+    from semexplore_gym.policies.expert_driver import ExpertDriver
+    from semexplore_gym.policies.frontier_student import FrontierStudentPolicy
+    from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
+    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
+
+    on = SemanticExpertParams(semantic_grid_route=True)
+    assert not ExpertDriver(on).params.semantic_grid_route
+    assert not ExpertDriver().params.semantic_grid_route
+    assert not FrontierValuePolicy().params.semantic_grid_route
+    assert not FrontierStudentPolicy().params.semantic_grid_route
+    assert not _ExpertMember(SemanticTeam(), 0, on).params.semantic_grid_route
