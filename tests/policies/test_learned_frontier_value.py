@@ -26,8 +26,9 @@ def _trajectory(spec: str, max_time_s: float, **overrides: float) -> np.ndarray:
 
 
 def test_with_every_weight_at_zero_it_is_the_expert_step_for_step() -> None:
-    # The expert it re-ranks: Algorithm 1's choice, without the grid candidate.
-    expert = _trajectory("semantic[grid_candidate=false]", 40.0)
+    # The expert it re-ranks: Algorithm 1's choice, without the grid candidate, along the map's
+    # paths (as the learned value was measured).
+    expert = _trajectory("semantic[grid_candidate=false;semantic_grid_route=false]", 40.0)
     learned = _trajectory("frontier-value", 40.0)
     assert len(expert) > 10
     np.testing.assert_array_equal(learned, expert)

@@ -98,7 +98,9 @@ def obs_at(
 
 def test_semantic_plan_drives_towards_the_frontier_and_reports_stats():
     grid = corridor_grid()
-    pol = SemanticExpertPolicy(segmenter=corridor_tmap)
+    # along the map's path (the grid's route instead: test_expert_semantic_grid_route.py)
+    prm = SemanticExpertParams(semantic_grid_route=False)
+    pol = SemanticExpertPolicy(prm, segmenter=corridor_tmap)
     obs = obs_at(grid, 0.5, 1.0, 0.0)
     pol.reset(obs, INFO, seed=0)
     a = pol.act(obs, INFO)
@@ -380,7 +382,7 @@ def test_counters_keep_their_names_and_mission_metrics_follow_them():
     names = list(pol.counters)
     assert names[:3] == ["replans", "segmentations", "semantic_plans"]
     assert names[-3:] == ["scored_replans", "semantic_decisive", "replan_no_plan"]
-    assert len(names) == 24 and pol.counters["semantic_plans"] == 1
+    assert len(names) == 25 and pol.counters["semantic_plans"] == 1
     assert pol.mission_metrics() == {"scored_replans": 1, "semantic_share": 0.0}
     pol.reset(obs, INFO, seed=0)
     assert pol.mission_metrics() == {"scored_replans": 0, "semantic_share": None}

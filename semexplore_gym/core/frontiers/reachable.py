@@ -312,10 +312,22 @@ def grid_path_to(
     if g.shape != geometry.shape:
         raise ValueError(f"grid shape {g.shape} does not match geometry shape {geometry.shape}")
     res = geometry.resolution_m
-    dist = clearance_field if clearance_field is not None else clearance_field_m(g, res)
+    # Within the window of the known cells, as nearest_reachable_frontier: usable cells are
+    # FREE, so neither the search nor a goal cell leaves it. Same path as on the whole grid.
+    w0r, w1r, w0c, w1c = known_window(g, geometry, start_xy_m, int(math.ceil(0.5 / res)) + 2)
+    if w0r >= w1r or w0c >= w1c:
+        return None
+    dist = (
+        clearance_field[w0r:w1r, w0c:w1c]
+        if clearance_field is not None
+        else clearance_field_m(g, res)[w0r:w1r, w0c:w1c]
+    )
+    g = np.ascontiguousarray(g[w0r:w1r, w0c:w1c])
+    dist = np.ascontiguousarray(dist)
     usable = usable_cells(g, dist, clearance_m)
     h, w = g.shape
     gr, gc = (int(v) for v in geometry.world_to_grid(goal_xy_m[0], goal_xy_m[1]))
+    gr, gc = gr - w0r, gc - w0c
     rad = int(math.ceil(goal_radius_m / res))
     r0, r1 = max(gr - rad, 0), min(gr + rad + 1, h)
     c0, c1 = max(gc - rad, 0), min(gc + rad + 1, w)
@@ -323,7 +335,7 @@ def grid_path_to(
         return None
     goal_mask = np.zeros((h, w), dtype=bool)
     rr, cc = np.mgrid[r0:r1, c0:c1]
-    xs, ys = geometry.grid_to_world(rr, cc)
+    xs, ys = geometry.grid_to_world(rr + w0r, cc + w0c)
     goal_mask[r0:r1, c0:c1] = np.hypot(xs - goal_xy_m[0], ys - goal_xy_m[1]) <= max(
         goal_radius_m, 0.5 * res
     )
@@ -331,7 +343,7 @@ def grid_path_to(
     if not goal_mask.any():
         return None
     cost = step_cost_field(dist, usable, clearance_m, step_cost.wall_cost, step_cost.prefer_extra_m)
-    return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m)
+    return _search_path(g, geometry, usable, cost, goal_mask, start_xy_m, (w0r, w0c))
 
 
 def grid_path_to_mask(

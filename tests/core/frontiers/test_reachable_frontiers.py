@@ -288,6 +288,48 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
             np.testing.assert_array_equal(a.path_m, b.path_m)
 
 
+def test_a_route_within_the_known_window_is_the_route_on_the_whole_grid(monkeypatch):
+    """``grid_path_to`` searches within the window of the known cells too: on random maps, to
+    random goals (known, unknown, off the map), the very path of the whole grid's search."""
+    from semexplore_gym.core.frontiers import reachable
+    from semexplore_gym.core.frontiers.reachable import clearance_field_m, grid_path_to
+    from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
+
+    rng = np.random.default_rng(12)
+    cases = []
+    for _ in range(40):
+        h, w = (int(v) for v in rng.integers(60, 140, 2))
+        grid = np.full((h, w), UNKNOWN, dtype=np.uint8)
+        r0, c0 = (int(v) for v in rng.integers(0, 20, 2))
+        rh, rw = int(rng.integers(20, h - r0)), int(rng.integers(20, w - c0))
+        coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(rh // 4, rw // 4), p=[0.7, 0.1, 0.2])
+        block = np.kron(coarse, np.ones((4, 4), dtype=np.uint8))
+        grid[r0 : r0 + block.shape[0], c0 : c0 + block.shape[1]] = block
+        free = np.argwhere(grid == FREE)
+        if len(free) < 2:
+            continue
+        geom = GridGeometry(0.05, -1.0, 2.0, h, w)
+        (r, c), (gr, gc) = free[rng.integers(len(free), size=2)]
+        start = tuple(float(v) + 0.01 for v in geom.grid_to_world(r, c))
+        goal = tuple(float(v) for v in geom.grid_to_world(gr, gc))
+        if rng.random() < 0.2:  # anywhere, on the map or off it
+            goal = (float(rng.uniform(-2.0, w * 0.05)), float(rng.uniform(1.0, 3.0 + h * 0.05)))
+        field = clearance_field_m(grid, 0.05) if rng.random() < 0.5 else None
+        cases.append((grid, geom, start, goal, float(rng.choice([0.15, 0.3])), field))
+
+    def run_all():
+        return [grid_path_to(g, geo, s, t, 0.1, rad, f) for g, geo, s, t, rad, f in cases]
+
+    windowed = run_all()
+    monkeypatch.setattr(reachable, "known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
+    whole = run_all()
+    assert sum(p is not None for p in whole) >= 15
+    for a, b in zip(windowed, whole, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            np.testing.assert_array_equal(a, b)
+
+
 def test_near_marked_is_the_thresholded_distance_transform():
     """The depth check's disc test at a few cells answers what scipy's distance transform to the
     marked cells, thresholded, answers there (limits on and off the integer distances)."""
