@@ -119,3 +119,15 @@ def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     assert not FrontierValuePolicy().params.semantic_grid_route
     assert not FrontierStudentPolicy().params.semantic_grid_route
     assert not _ExpertMember(SemanticTeam(), 0, on).params.semantic_grid_route
+
+
+def test_in_a_maze_the_expert_drives_less_over_the_grids_routes(short_mission) -> None:
+    """An 8 m maze (a tuning world of the path decomposition): the same goals, shorter drives."""
+    world = "maze:seed=61001,size_m=8,braid=0.3"
+    new, p_new = short_mission(world, "semantic", 5000, 1200)
+    old, p_old = short_mission(world, "semantic[semantic_grid_route=false]", 5000, 1200)
+    assert p_new.counters["semantic_grid_routes"] > 0
+    assert p_old.counters["semantic_grid_routes"] == 0
+    assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0
+    assert new.path_length_m < 0.9 * old.path_length_m
+    assert new.mission_time_s < old.mission_time_s
