@@ -253,9 +253,10 @@ class SemanticFrontier(PlanSource):
 
     With ``semantic_grid_route``, the robot drives to that goal over the grid's clearance-aware
     route instead (the map's path runs through the skeleton, by the middle of every area and
-    intersection on the way: on the tuning worlds it was a third longer than the shortest path);
-    the map's path where the grid has none. With ``entry_detour``, when the straight first leg from the robot to the path crosses a
-    wall, a grid route leads onto the path instead (none: pass).
+    intersection on the way; the route cuts those corners at the planners' clearance); the
+    map's path where the grid has none. With ``entry_detour``, when the straight first leg from
+    the robot to the map's path crosses a wall, a grid route leads onto the path instead (none:
+    pass).
     """
 
     name = "semantic"

@@ -43,6 +43,9 @@ FAMILY_WORLDS = (
 #: A world whose map has intersections: segmenting it joins legs at their centres, which the
 #: 3 m maze never does.
 SEGMENTED_WORLD = "maze1"
+#: A world whose skeleton has spurs to prune (their removal re-thins it): the warm-up mission
+#: reaches that only by chance, depending on the path the policy drives.
+PRUNED_WORLD = "office:seed=0,size_m=8"
 #: How long compiling every kernel takes: 296 kernels in 64 s of CPU time, one core (measured
 #: for the semantic expert on an empty cache), so about a minute when that core is free; 3-6 min
 #: of wall time on a 2-core machine shared by ~8 jobs. The warm-up prints the real figure.
@@ -156,8 +159,8 @@ def run_warmup_mission(
 def reach_rare_kernels() -> None:
     """Run the kernels a short mission may not reach: each procedural family's generator, a
     ROS map and a HouseExpo plan loaded from files, and the segmentation (of a read-only map, as
-    the expert sees it) of :data:`SEGMENTED_WORLD`'s ground truth, and the path decomposition's
-    shortest path at a clearance."""
+    the expert sees it) of :data:`SEGMENTED_WORLD`'s and :data:`PRUNED_WORLD`'s ground truths,
+    and the path decomposition's shortest path at a clearance."""
     import json
     import tempfile
     from pathlib import Path
@@ -188,10 +191,11 @@ def reach_rare_kernels() -> None:
         plan = {"id": "0" * 32, "room_num": 1, "bbox": {"min": [0, 0], "max": [4, 3]}}
         (d / "plan.json").write_text(json.dumps({**plan, "verts": house}))
         make_world(d / "plan.json")
-    world = make_world(SEGMENTED_WORLD)
-    grid = np.where(world.free_mask, FREE, OCCUPIED).astype(np.uint8)
-    grid.setflags(write=False)
-    segment_map(grid, world.free_geometry, clearance_m=0.2)
+    for spec in (SEGMENTED_WORLD, PRUNED_WORLD):
+        world = make_world(spec)
+        grid = np.where(world.free_mask, FREE, OCCUPIED).astype(np.uint8)
+        grid.setflags(write=False)
+        segment_map(grid, world.free_geometry, clearance_m=0.2)
     # The path decomposition's shortest paths, measured when a mission ends.
     room = np.full((12, 12), FREE, np.uint8)
     room[[0, -1], :] = room[:, [0, -1]] = OCCUPIED
