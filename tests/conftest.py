@@ -196,3 +196,36 @@ def short_mission():
     """``short_mission(world, policy, seed, max_time_s)``: one mission from the seed's random
     start with the policy's own map observation; ``(result, policy)``."""
     return _short_mission
+
+
+def _plan_context(grid, geometry, params, pose, candidates=(), current=None):
+    """A plan source's context on ``grid`` (the robot at ``pose``, the planners' clearance
+    0.155 m, fresh counters and goal memory, ``choose_goal`` taking the first candidate)."""
+    from semexplore_gym.policies.expert_counters import ExpertCounters
+    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.expert_plan_context import PlanContext
+
+    counts = ExpertCounters()
+    memory = GoalMemory(params.goal_memory, counts, lambda *_: None)
+    memory.reset(geometry, params.goal_memory)
+    return PlanContext(
+        grid=grid,
+        pose=pose,
+        geometry=geometry,
+        params=params,
+        clearance_m=0.155,
+        robot_radius_m=0.105,
+        candidates=list(candidates),
+        current=current,
+        memory=memory,
+        counts=counts,
+        choose_goal=lambda cands: cands[0],
+        log=lambda *_: None,
+    )
+
+
+@pytest.fixture
+def plan_context():
+    """``plan_context(grid, geometry, params, pose, candidates=(), current=None)``: a
+    :class:`PlanContext` for calling one plan source's ``propose`` by hand."""
+    return _plan_context

@@ -23,15 +23,11 @@ def _corridor() -> tuple[np.ndarray, GridGeometry]:
     return grid, GridGeometry(RES_M, 0.0, 0.0, 60, 100)
 
 
-def _context(chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.expert_plan_context import PlanContext
+def _context(plan_context, chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
     from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
     grid, geometry = _corridor()
     prm = SemanticExpertParams(**params)
-    counts = ExpertCounters()
     # Algorithm 1's choice (stand-in): by default a goal 0.8 m behind the robot, L_path 2 m.
     chosen = SimpleNamespace(
         goal_xy_m=goal_xy_m,
@@ -39,21 +35,8 @@ def _context(chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
         l_path_m=2.0,
         cost=chosen_cost,
     )
-    ctx = PlanContext(
-        grid=grid,
-        pose=(*ROBOT_XY_M, 0.0),  # heading +x, toward the unseen end
-        geometry=geometry,
-        params=prm,
-        clearance_m=0.155,
-        robot_radius_m=0.105,
-        candidates=[chosen],  # type: ignore[list-item]
-        current=None,
-        memory=GoalMemory(prm.goal_memory, counts, lambda *_: None),
-        counts=counts,
-        choose_goal=lambda cands: cands[0],
-        log=lambda *_: None,
-    )
-    return ctx
+    # heading +x, toward the unseen end
+    return plan_context(grid, geometry, prm, (*ROBOT_XY_M, 0.0), [chosen])
 
 
 def _propose(ctx):
@@ -62,11 +45,11 @@ def _propose(ctx):
     return SemanticFrontier().propose(ctx)
 
 
-def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice() -> None:
+def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice(plan_context) -> None:
     from semexplore_gym.policies.expert_plan import PlanKind
 
     # The unseen end is about 3.4 m ahead: C = 3.4 / 2 + w_v * 0 = 1.7 < 5.
-    ctx = _context(chosen_cost=5.0)
+    ctx = _context(plan_context, chosen_cost=5.0)
     plan = _propose(ctx)
     assert plan.kind == PlanKind.FALLBACK
     assert plan.goal_xy_m[0] > 4.3  # next to the unseen end
@@ -75,30 +58,33 @@ def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice() -> None:
 
 @pytest.mark.parametrize("chosen_cost", [1.0, 1.6])
 def test_algorithm_1s_choice_stands_when_the_grid_frontier_is_not_cheaper(
+    plan_context,
     chosen_cost: float,
 ) -> None:
     from semexplore_gym.policies.expert_plan import PlanKind
 
-    ctx = _context(chosen_cost=chosen_cost)  # the grid frontier costs about 1.7
+    ctx = _context(plan_context, chosen_cost=chosen_cost)  # the grid frontier costs about 1.7
     plan = _propose(ctx)
     assert plan.kind == PlanKind.SEMANTIC and plan.goal_xy_m == (0.2, 1.5)
     assert ctx.counts.grid_frontier_plans == 0
 
 
-def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal() -> None:
+def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal(plan_context) -> None:
     from semexplore_gym.policies.expert_plan import PlanKind
 
-    ctx = _context(chosen_cost=5.0, goal_xy_m=(4.0, 1.8))  # within 1 m of the grid's goal
+    ctx = _context(
+        plan_context, chosen_cost=5.0, goal_xy_m=(4.0, 1.8)
+    )  # within 1 m of the grid's goal
     assert _propose(ctx).kind == PlanKind.SEMANTIC
     assert ctx.counts.grid_frontier_plans == 0
 
 
-def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone() -> None:
+def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone(plan_context) -> None:
     from semexplore_gym.policies.expert_plan import PlanKind
     from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
     assert PAPER_PURE["grid_candidate"] is False
-    ctx = _context(chosen_cost=5.0, grid_candidate=False)
+    ctx = _context(plan_context, chosen_cost=5.0, grid_candidate=False)
     assert _propose(ctx).kind == PlanKind.SEMANTIC
     assert ctx.counts.grid_frontier_plans == 0
 
@@ -133,16 +119,22 @@ def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
 
 
 @pytest.mark.parametrize("holds", [True, False])
-def test_the_goal_the_shuttle_guard_holds_is_kept_against_the_grid_frontier(holds: bool) -> None:
+def test_the_goal_the_shuttle_guard_holds_is_kept_against_the_grid_frontier(
+    plan_context, holds: bool
+) -> None:
     """A goal adopted again without progress is seen through: the grid's frontier does not
     take turns with it (else the two sources shuttle, as on a real SLAM map for 2,000 s)."""
     from semexplore_gym.policies.expert_plan import PlanKind
 
-    ctx = _context(chosen_cost=5.0, shuttle_guard_holds_grid=holds)  # the grid's is cheaper
+    ctx = _context(
+        plan_context, chosen_cost=5.0, shuttle_guard_holds_grid=holds
+    )  # the grid's is cheaper
     ctx.memory.shuttle_xy_m = (0.2, 1.5)  # the shuttle guard holds Algorithm 1's goal
     plan = _propose(ctx)
     assert plan.kind == (PlanKind.SEMANTIC if holds else PlanKind.FALLBACK)
     assert ctx.counts.grid_frontier_plans == (0 if holds else 1)
-    ctx = _context(chosen_cost=5.0)  # the guard holds another goal: the grid's frontier wins
+    ctx = _context(
+        plan_context, chosen_cost=5.0
+    )  # the guard holds another goal: the grid's frontier wins
     ctx.memory.shuttle_xy_m = (3.0, 0.5)
     assert _propose(ctx).kind == PlanKind.FALLBACK

@@ -25,31 +25,14 @@ def _room() -> tuple[np.ndarray, GridGeometry]:
     return grid, GridGeometry(RES_M, 0.0, 0.0, 60, 100)
 
 
-def _context(grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M, **params):
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.expert_plan_context import PlanContext
+def _context(plan_context, grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M, **params):
     from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
     prm = SemanticExpertParams(**{"grid_candidate": False, **params})
-    counts = ExpertCounters()
     path = MAP_PATH_M.copy()
     path[-1] = goal_xy_m
     chosen = SimpleNamespace(goal_xy_m=goal_xy_m, path_m=path, l_path_m=4.0, cost=0.5)
-    return PlanContext(
-        grid=grid,
-        pose=(*ROBOT_XY_M, 0.0),
-        geometry=geometry,
-        params=prm,
-        clearance_m=0.155,
-        robot_radius_m=0.105,
-        candidates=[chosen],  # type: ignore[list-item]
-        current=None,
-        memory=GoalMemory(prm.goal_memory, counts, lambda *_: None),
-        counts=counts,
-        choose_goal=lambda cands: cands[0],
-        log=lambda *_: None,
-    )
+    return plan_context(grid, geometry, prm, (*ROBOT_XY_M, 0.0), [chosen])
 
 
 def _length_m(path: np.ndarray) -> float:
@@ -62,10 +45,10 @@ def _propose(ctx):
     return SemanticFrontier().propose(ctx)
 
 
-def test_the_goal_is_driven_to_over_the_grids_route() -> None:
+def test_the_goal_is_driven_to_over_the_grids_route(plan_context) -> None:
     from semexplore_gym.policies.expert_plan import PlanKind
 
-    ctx = _context(*_room(), semantic_grid_route=True)
+    ctx = _context(plan_context, *_room(), semantic_grid_route=True)
     plan = _propose(ctx)
     assert plan.kind == PlanKind.SEMANTIC and plan.goal_xy_m == GOAL_XY_M
     assert plan.candidate is ctx.candidates[0]  # Algorithm 1's choice, its cost untouched
@@ -76,21 +59,21 @@ def test_the_goal_is_driven_to_over_the_grids_route() -> None:
     assert ctx.counts.semantic_grid_routes == 1
 
 
-def test_switched_off_the_maps_path_is_driven() -> None:
-    ctx = _context(*_room(), semantic_grid_route=False)
+def test_switched_off_the_maps_path_is_driven(plan_context) -> None:
+    ctx = _context(plan_context, *_room(), semantic_grid_route=False)
     plan = _propose(ctx)
     assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
     assert plan.path_m[:, 1].max() > 2.6
     assert ctx.counts.semantic_grid_routes == 0
 
 
-def test_where_the_grid_has_no_route_the_maps_path_stands() -> None:
+def test_where_the_grid_has_no_route_the_maps_path_stands(plan_context) -> None:
     """A wall across the room, with a gap narrower than the planners' clearance: the grid
     finds no route, the map's path (which the segmentation drew) is driven as before."""
     grid, geometry = _room()
     grid[:, 70:72] = OCCUPIED  # at x = 3.5 m, past the map path's first leg
     grid[28:33, 70:72] = FREE  # a 0.25 m gap: under 2 x 0.155 m
-    ctx = _context(grid, geometry, semantic_grid_route=True)
+    ctx = _context(plan_context, grid, geometry, semantic_grid_route=True)
     plan = _propose(ctx)
     assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
     assert ctx.counts.semantic_grid_routes == 0
