@@ -236,8 +236,9 @@ def test_frontier_groups_depth_check_is_the_distance_transform_definition():
         assert {int(v) for v in np.unique(ref_labels[labels > 0])} == kept_ref
 
 
-def _known_patch_map(rng: np.random.Generator) -> np.ndarray:
-    """A random map: a patch of 4-cell blocks (free, wall, unknown) in a wide unknown border."""
+def _known_patch_map(rng: np.random.Generator) -> tuple[np.ndarray, GridGeometry]:
+    """A random map and its frame: a patch of 4-cell blocks (free, wall, unknown) in a wide
+    unknown border."""
     from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 
     h, w = (int(v) for v in rng.integers(60, 140, 2))
@@ -247,24 +248,36 @@ def _known_patch_map(rng: np.random.Generator) -> np.ndarray:
     coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(rh // 4, rw // 4), p=[0.7, 0.1, 0.2])
     block = np.kron(coarse, np.ones((4, 4), dtype=np.uint8))
     grid[r0 : r0 + block.shape[0], c0 : c0 + block.shape[1]] = block
-    return grid
+    return grid, GridGeometry(0.05, -1.0, 2.0, h, w)
+
+
+def _windowed_and_whole(monkeypatch, run_all, at_least: int) -> list[tuple]:
+    """``run_all()``'s results within the known window and (patched) on the whole grid, in
+    pairs; both found or both not, and at least ``at_least`` found."""
+    from semexplore_gym.core.frontiers import reachable
+
+    windowed = run_all()
+    monkeypatch.setattr(reachable, "known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
+    whole = run_all()
+    assert sum(r is not None for r in whole) >= at_least
+    pairs = list(zip(windowed, whole, strict=True))
+    assert all((a is None) == (b is None) for a, b in pairs)
+    return pairs
 
 
 def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monkeypatch):
     """The nearest reachable frontier is found within the window of the known cells (a large
     map is mostly unknown); on random maps it is the very result of the whole grid's search."""
-    from semexplore_gym.core.frontiers import reachable
     from semexplore_gym.core.grid import FREE, UNKNOWN
 
     rng = np.random.default_rng(11)
     cases = []
     for _ in range(40):
-        grid = _known_patch_map(rng)
+        grid, geom = _known_patch_map(rng)
         h, w = grid.shape
         free = np.argwhere(grid == FREE)
         if len(free) == 0:
             continue
-        geom = GridGeometry(0.05, -1.0, 2.0, h, w)
         r, c = free[int(rng.integers(len(free)))]
         xs, ys = geom.grid_to_world(r, c)
         start = (float(xs) + 0.01, float(ys) - 0.01)
@@ -285,12 +298,7 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
     unseen = np.full((30, 30), UNKNOWN, dtype=np.uint8)
     off_grid = GridGeometry(0.05, 0.0, 0.0, 30, 30)
     assert nearest_reachable_frontier(unseen, off_grid, (9.0, 0.5), 0.1, FrontierFilter(1)) is None
-    windowed = run_all()
-    monkeypatch.setattr(reachable, "known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
-    whole = run_all()
-    assert sum(f is not None for f in whole) >= 20
-    for a, b in zip(windowed, whole, strict=True):
-        assert (a is None) == (b is None)
+    for a, b in _windowed_and_whole(monkeypatch, run_all, at_least=20):
         if a is not None:
             assert a.goal_xy_m == b.goal_xy_m and a.frontier_xy_m == b.frontier_xy_m
             assert a.path_length_m == b.path_length_m and a.n_frontier_cells == b.n_frontier_cells
@@ -300,19 +308,17 @@ def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monk
 def test_a_route_within_the_known_window_is_the_route_on_the_whole_grid(monkeypatch):
     """``grid_path_to`` searches within the window of the known cells too: on random maps, to
     random goals (known, unknown, off the map), the very path of the whole grid's search."""
-    from semexplore_gym.core.frontiers import reachable
     from semexplore_gym.core.frontiers.reachable import clearance_field_m, grid_path_to
     from semexplore_gym.core.grid import FREE
 
     rng = np.random.default_rng(12)
     cases = []
     for _ in range(40):
-        grid = _known_patch_map(rng)
+        grid, geom = _known_patch_map(rng)
         h, w = grid.shape
         free = np.argwhere(grid == FREE)
         if len(free) < 2:
             continue
-        geom = GridGeometry(0.05, -1.0, 2.0, h, w)
         (r, c), (gr, gc) = free[rng.integers(len(free), size=2)]
         start = tuple(float(v) + 0.01 for v in geom.grid_to_world(r, c))
         goal = tuple(float(v) for v in geom.grid_to_world(gr, gc))
@@ -324,12 +330,7 @@ def test_a_route_within_the_known_window_is_the_route_on_the_whole_grid(monkeypa
     def run_all():
         return [grid_path_to(g, geo, s, t, 0.1, rad, f) for g, geo, s, t, rad, f in cases]
 
-    windowed = run_all()
-    monkeypatch.setattr(reachable, "known_window", lambda g, *_: (0, g.shape[0], 0, g.shape[1]))
-    whole = run_all()
-    assert sum(p is not None for p in whole) >= 15
-    for a, b in zip(windowed, whole, strict=True):
-        assert (a is None) == (b is None)
+    for a, b in _windowed_and_whole(monkeypatch, run_all, at_least=15):
         if a is not None:
             np.testing.assert_array_equal(a, b)
 
