@@ -39,6 +39,7 @@ from semexplore_gym.policies.semantic_expert import (
     SemanticExpertParams,
     SemanticExpertPolicy,
 )
+from semexplore_gym.policies.semantic_expert_params import for_outside_choice
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
@@ -68,7 +69,7 @@ class ExpertDriver(SemanticExpertPolicy):
     ) -> None:
         # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
         base = params if params is not None else SemanticExpertParams()
-        super().__init__(replace(base, grid_candidate=False, semantic_grid_route=False), segmenter)
+        super().__init__(for_outside_choice(base), segmenter)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

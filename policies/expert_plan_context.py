@@ -194,14 +194,17 @@ class PlanContext:
         )
 
     def grid_route(self, goal_xy_m: tuple[float, float]) -> np.ndarray | None:
-        """A clearance-aware grid path from the robot to ``goal_xy_m`` (None: none)."""
+        """A clearance-aware grid path from the robot to ``goal_xy_m`` (None: none). As for
+        :meth:`nearest_grid_frontier`, the whole map's clearance field is used only when a
+        source already computed it this replan; else the search computes it within the known
+        cells' window (the same values)."""
         return grid_path_to(
             self.grid,
             self.geometry,
             self.xy_m,
             goal_xy_m,
             self.clearance_m,
-            clearance_field=self.clearance_field(),
+            clearance_field=self.clearance_cache,
         )
 
     def narrow_clearance_m(self) -> float:

@@ -25,7 +25,6 @@ model (every weight 0 except ``-1`` on ``path_m``) it drives to the nearest fron
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -35,7 +34,7 @@ from semexplore_gym.policies.expert_plan import Plan, PlanKind
 from semexplore_gym.policies.expert_plan_context import PlanContext, PlanSource
 from semexplore_gym.policies.expert_plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
 from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
 
 from semexplore_gym.core.features.frontier_option_features import (
     OPTION_FEATURE_NAMES,
@@ -181,9 +180,7 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         chooser: OptionChooser | None = None,
     ) -> None:
         self.student_params = params if params is not None else FrontierStudentParams()
-        expert = dataclasses.replace(
-            self.student_params.expert, grid_candidate=False, semantic_grid_route=False
-        )
+        expert = for_outside_choice(self.student_params.expert)
         sources = insert_plan_source(
             DEFAULT_PLAN_SOURCES, StudentFrontier(self._decide), before="semantic"
         )

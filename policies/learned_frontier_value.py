@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
 
 from semexplore_gym.core.features.frontier_features import FEATURE_NAMES, frontier_value_features
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
@@ -98,9 +98,7 @@ class FrontierValuePolicy(SemanticExpertPolicy):
     ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
         # The learned ranking chooses: the grid's nearest frontier must not overrule it.
-        expert = dataclasses.replace(
-            self.value_params.expert, grid_candidate=False, semantic_grid_route=False
-        )
+        expert = for_outside_choice(self.value_params.expert)
         super().__init__(expert, segmenter=segmenter)
         self._obs: dict[str, np.ndarray] | None = None
 

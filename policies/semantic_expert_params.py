@@ -149,7 +149,7 @@ switches them all off: the paper's method alone).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Literal, TypeVar
 
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
@@ -157,7 +157,13 @@ from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.validation import require_finite
 
-__all__ = ["PAPER_PURE", "GoalMemoryParams", "PathFollowingParams", "SemanticExpertParams"]
+__all__ = [
+    "PAPER_PURE",
+    "GoalMemoryParams",
+    "PathFollowingParams",
+    "SemanticExpertParams",
+    "for_outside_choice",
+]
 
 _Group = TypeVar("_Group")
 
@@ -530,6 +536,14 @@ class SemanticExpertParams:
     def goal_memory(self) -> GoalMemoryParams:
         """The goal memory's parameters (a view of this object's fields)."""
         return _group(GoalMemoryParams, self)
+
+
+def for_outside_choice(params: SemanticExpertParams) -> SemanticExpertParams:
+    """``params`` for an expert whose goals an outside choice makes (teams, the learning agents'
+    driver, the frontier student, the learned frontier value): ``grid_candidate`` off (the
+    grid's nearest frontier must not overrule that choice) and ``semantic_grid_route`` off
+    (those policies were trained and measured on the map's paths)."""
+    return replace(params, grid_candidate=False, semantic_grid_route=False)
 
 
 #: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
 from semexplore_gym.policies.team.base import TeamPolicy
 from semexplore_gym.policies.team.frontier_teams import yield_action
 
@@ -84,9 +84,7 @@ class _ExpertMember(SemanticExpertPolicy):
     """One robot's expert; its goal choice is the team's."""
 
     def __init__(self, team: SemanticTeam, index: int, params: SemanticExpertParams) -> None:
-        super().__init__(
-            dataclasses.replace(params, grid_candidate=False, semantic_grid_route=False)
-        )
+        super().__init__(for_outside_choice(params))
         self.team = team
         self.index = index
         self.goal_intersection_xy: tuple[float, float] | None = None

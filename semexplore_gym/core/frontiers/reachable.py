@@ -317,13 +317,12 @@ def grid_path_to(
     w0r, w1r, w0c, w1c = known_window(g, geometry, start_xy_m, int(math.ceil(0.5 / res)) + 2)
     if w0r >= w1r or w0c >= w1c:
         return None
-    dist = (
-        clearance_field[w0r:w1r, w0c:w1c]
-        if clearance_field is not None
-        else clearance_field_m(g, res)[w0r:w1r, w0c:w1c]
-    )
     g = np.ascontiguousarray(g[w0r:w1r, w0c:w1c])
-    dist = np.ascontiguousarray(dist)
+    dist = (
+        np.ascontiguousarray(clearance_field[w0r:w1r, w0c:w1c])
+        if clearance_field is not None
+        else clearance_field_m(g, res)  # every wall is in the window: the same values
+    )
     usable = usable_cells(g, dist, clearance_m)
     h, w = g.shape
     gr, gc = (int(v) for v in geometry.world_to_grid(goal_xy_m[0], goal_xy_m[1]))

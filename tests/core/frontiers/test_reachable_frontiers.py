@@ -236,19 +236,23 @@ def test_frontier_groups_depth_check_is_the_distance_transform_definition():
         assert {int(v) for v in np.unique(ref_labels[labels > 0])} == kept_ref
 
 
-def _known_patch_map(rng: np.random.Generator) -> tuple[np.ndarray, GridGeometry]:
-    """A random map and its frame: a patch of 4-cell blocks (free, wall, unknown) in a wide
+def _known_patch_maps(rng: np.random.Generator, n: int, min_free: int):
+    """Up to ``n`` random maps, each with its frame and its FREE cells (those with fewer than
+    ``min_free`` are skipped): a patch of 4-cell blocks (free, wall, unknown) in a wide
     unknown border."""
     from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN
 
-    h, w = (int(v) for v in rng.integers(60, 140, 2))
-    grid = np.full((h, w), UNKNOWN, dtype=np.uint8)
-    r0, c0 = (int(v) for v in rng.integers(0, 20, 2))
-    rh, rw = int(rng.integers(20, h - r0)), int(rng.integers(20, w - c0))
-    coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(rh // 4, rw // 4), p=[0.7, 0.1, 0.2])
-    block = np.kron(coarse, np.ones((4, 4), dtype=np.uint8))
-    grid[r0 : r0 + block.shape[0], c0 : c0 + block.shape[1]] = block
-    return grid, GridGeometry(0.05, -1.0, 2.0, h, w)
+    for _ in range(n):
+        h, w = (int(v) for v in rng.integers(60, 140, 2))
+        grid = np.full((h, w), UNKNOWN, dtype=np.uint8)
+        r0, c0 = (int(v) for v in rng.integers(0, 20, 2))
+        rh, rw = int(rng.integers(20, h - r0)), int(rng.integers(20, w - c0))
+        coarse = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(rh // 4, rw // 4), p=[0.7, 0.1, 0.2])
+        block = np.kron(coarse, np.ones((4, 4), dtype=np.uint8))
+        grid[r0 : r0 + block.shape[0], c0 : c0 + block.shape[1]] = block
+        free = np.argwhere(grid == FREE)
+        if len(free) >= min_free:
+            yield grid, GridGeometry(0.05, -1.0, 2.0, h, w), free
 
 
 def _windowed_and_whole(monkeypatch, run_all, at_least: int) -> list[tuple]:
@@ -268,16 +272,11 @@ def _windowed_and_whole(monkeypatch, run_all, at_least: int) -> list[tuple]:
 def test_the_search_within_the_known_window_is_the_search_on_the_whole_grid(monkeypatch):
     """The nearest reachable frontier is found within the window of the known cells (a large
     map is mostly unknown); on random maps it is the very result of the whole grid's search."""
-    from semexplore_gym.core.grid import FREE, UNKNOWN
+    from semexplore_gym.core.grid import UNKNOWN
 
     rng = np.random.default_rng(11)
     cases = []
-    for _ in range(40):
-        grid, geom = _known_patch_map(rng)
-        h, w = grid.shape
-        free = np.argwhere(grid == FREE)
-        if len(free) == 0:
-            continue
+    for grid, geom, free in _known_patch_maps(rng, 40, min_free=1):
         r, c = free[int(rng.integers(len(free)))]
         xs, ys = geom.grid_to_world(r, c)
         start = (float(xs) + 0.01, float(ys) - 0.01)
@@ -309,16 +308,11 @@ def test_a_route_within_the_known_window_is_the_route_on_the_whole_grid(monkeypa
     """``grid_path_to`` searches within the window of the known cells too: on random maps, to
     random goals (known, unknown, off the map), the very path of the whole grid's search."""
     from semexplore_gym.core.frontiers.reachable import clearance_field_m, grid_path_to
-    from semexplore_gym.core.grid import FREE
 
     rng = np.random.default_rng(12)
     cases = []
-    for _ in range(40):
-        grid, geom = _known_patch_map(rng)
+    for grid, geom, free in _known_patch_maps(rng, 40, min_free=2):
         h, w = grid.shape
-        free = np.argwhere(grid == FREE)
-        if len(free) < 2:
-            continue
         (r, c), (gr, gc) = free[rng.integers(len(free), size=2)]
         start = tuple(float(v) + 0.01 for v in geom.grid_to_world(r, c))
         goal = tuple(float(v) for v in geom.grid_to_world(gr, gc))
