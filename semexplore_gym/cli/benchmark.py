@@ -92,6 +92,13 @@ def validate_args(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {short_repr(args.out)} is an existing file; give a directory")
+    table = getattr(args, "best_known", None)
+    if table is not None:
+        from semexplore_gym.evaluation.best_known import read_table
+
+        if not Path(table).is_file():
+            raise ValueError(f"--best-known {short_repr(table)}: no such file")
+        read_table(table)  # a malformed table fails now, naming its line
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -200,6 +207,15 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
         help="also run the privileged oracle (full-knowledge tour) on every (world, seed) and "
         "write each mission's regret against it (regret.csv, summary.md, regret_ladder.png); "
         "default: on with --suite or --split, off otherwise",
+    )
+    p.add_argument(
+        "--best-known",
+        default=None,
+        metavar="TABLE",
+        help="best-known table (CSV) to compare each mission with: T99 and distance to 99 %% "
+        "against the best any policy reached from the same start and the certified lower bound "
+        "(summary.md 'Against the best known'; OUT/best_known.csv is the table updated with the "
+        "run); default: the shipped configs/best_known/best_known.csv",
     )
 
 
@@ -358,6 +374,7 @@ def _run(args: argparse.Namespace) -> int:
             "max_time_s": args.max_time_s,
             "fixed_start": bool(args.fixed_start),
             "config": args.env_config,
+            "env_overrides": list(args.env_overrides),
             "env_config": env_config_record,
             "workers": args.workers,
             "backend": args.backend,
@@ -400,6 +417,9 @@ def _write_reports(args: argparse.Namespace, with_oracle: bool) -> tuple[Any, li
 
         regret = write_regret(args.out, plots=not args.no_plots)
         plots += [regret["plot"]] if regret["plot"] else []
+    from semexplore_gym.evaluation.best_known import write_best_known
+
+    write_best_known(args.out, getattr(args, "best_known", None))
     if getattr(args, "split", None):
         from semexplore_gym.evaluation.learning_table import write_learning_table
 
