@@ -1,0 +1,74 @@
+"""scripts/update_best_known.py: run folders merged into a table, bounds added and resumed."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from semexplore_gym.evaluation.best_known import read_table
+
+REPO = Path(__file__).resolve().parents[2]
+WORLD = "maze:seed=1,size_m=4"
+
+
+def _script() -> Any:
+    spec = importlib.util.spec_from_file_location(
+        "update_best_known", REPO / "scripts" / "update_best_known.py"
+    )
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["update_best_known"] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def run_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from semexplore_gym.cli import main
+
+    out = tmp_path_factory.mktemp("bk") / "run"
+    args = ["benchmark", "--worlds", WORLD, "--policies", "nearest,semantic", "--runs", "2"]
+    args += ["--max-time-s", "400", "--no-progress", "--no-plots", "--out", str(out)]
+    assert main(args) == 0
+    return out
+
+
+def test_a_run_is_merged_and_its_bounds_hold(run_folder: Path, tmp_path: Path, capsys: Any):
+    pytest.importorskip("elkai")
+    from semexplore_gym.evaluation.run_row import read_runs
+
+    table = tmp_path / "t.csv"
+    assert (
+        _script().main(
+            [str(run_folder), "--table", str(table), "--bounds", "--json", "--no-progress"]
+        )
+        == 0
+    )
+    report = json.loads(capsys.readouterr().out)
+    assert report["entries"] == 2 and report["bounds_computed"] == 2
+    assert report["without_bound"] == 0
+    entries = read_table(table)
+    rows = read_runs(run_folder / "runs.csv")
+    for (world, seed, start), e in entries.items():
+        assert (world, start) == (WORLD, "random")
+        mine = [r for r in rows if r["seed"] == seed and r["T99_s"] is not None]
+        assert e["T99_s"] == pytest.approx(min(r["T99_s"] for r in mine), abs=1e-3)
+        assert e["T99_policy"] in ("nearest", "semantic")
+        # The certified bound never lies above what a policy did.
+        assert 0 < e["lower_bound_s"] <= e["T99_s"]
+        assert 0 < e["lower_bound_m"] <= e["D99_m"]
+    # Run again: nothing new, no bound computed twice.
+    assert _script().main([str(run_folder), "--table", str(table), "--bounds", "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["new_best_known"] == 0 and again["bounds_computed"] == 0
+
+
+def test_a_folder_without_runs_is_one_error_line(tmp_path: Path, capsys: Any):
+    assert _script().main([str(tmp_path), "--table", str(tmp_path / "t.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no runs.csv" in err[0]
