@@ -36,6 +36,71 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(skip)
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        f"clean_clone: run once more by .ci/run with ../shared hidden ({HIDE_SHARED_ENV}=1)",
+    )
+
+
+# ------------------------------------------------------------------------------ the fast tier
+#: Simulated seconds a test not marked ``slow`` may drive robots in this process (every
+#: ``RobotSim.step`` and ``TeamSim.step`` counts its ``dt_s``). ``pytest -m "not slow"`` is the
+#: contributors' fast tier (DEVELOPERS.md, "Tests"): a whole mission with a real budget belongs
+#: in the slow tier, and this limit says so by failing the test. Simulated time, not wall time:
+#: the same verdict on any machine and under any load. Missions run in worker processes
+#: (``benchmark --workers 2``, subprocesses) are not counted.
+FAST_TIER_SIMULATED_S = 1000.0
+
+
+class _SimulatedClock:
+    """Simulated seconds driven by the robot sims since the last :meth:`reset`."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+
+    def reset(self) -> None:
+        self.seconds = 0.0
+
+    def wrap(self, cls: type) -> None:
+        step = cls.step
+
+        def counted_step(sim, *args, **kwargs):
+            self.seconds += args[-1] if args else kwargs["dt_s"]
+            return step(sim, *args, **kwargs)
+
+        cls.step = counted_step  # type: ignore[method-assign]
+
+
+@pytest.fixture(scope="session")
+def _simulated_clock() -> Iterator[_SimulatedClock]:
+    from semexplore_gym.sim.robot import RobotSim
+    from semexplore_gym.sim.team import TeamSim
+
+    clock = _SimulatedClock()
+    originals = [(cls, cls.step) for cls in (RobotSim, TeamSim)]
+    for cls, _ in originals:
+        clock.wrap(cls)
+    yield clock
+    for cls, step in originals:
+        cls.step = step  # type: ignore[method-assign]
+
+
+@pytest.fixture(autouse=True)
+def _fast_tier_budget(request: pytest.FixtureRequest, _simulated_clock: _SimulatedClock):
+    """Fail a test not marked ``slow`` that simulates more than :data:`FAST_TIER_SIMULATED_S`."""
+    _simulated_clock.reset()
+    yield
+    simulated_s = _simulated_clock.seconds
+    request.node.user_properties.append(("simulated_s", round(simulated_s, 1)))
+    if simulated_s > FAST_TIER_SIMULATED_S and request.node.get_closest_marker("slow") is None:
+        pytest.fail(
+            f"{request.node.nodeid} simulates {simulated_s:.0f} s of robot time (fast-tier limit "
+            f"{FAST_TIER_SIMULATED_S:.0f} s): shrink its budget or mark it @pytest.mark.slow",
+            pytrace=False,
+        )
+
+
 @pytest.fixture(scope="session")
 def tiny_macro_train_args() -> Callable[[float], list[str]]:
     """``semexplore train`` overrides for a few-step macro-env training on a 4 m maze.
