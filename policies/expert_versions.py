@@ -9,9 +9,10 @@ another weight. Every run record (the mission JSON of ``semexplore explore``, ``
 ``policy_version`` column and ``summary.md``) states the version a spec resolved to
 (:func:`expert_version`).
 
-A new release whose expert behaves differently adds a version here, its layer restoring the
-version before it being the previous newest version's layer plus the new behaviour switched
-off; ``tests/policies/test_expert_versions.py`` holds each version to its composition.
+A release that changes the expert's behaviour adds a version here with an empty layer (today's
+defaults), and each older version's layer keeps its missions as they were (today: the switches
+of what came later, off). ``tests/policies/test_expert_versions.py`` holds ``semantic-v2`` to
+the 0.2.0 release's own mission on a small office and ``semantic`` to ``semantic-v3``.
 """
 
 from __future__ import annotations
