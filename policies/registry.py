@@ -1,6 +1,8 @@
 """Build any policy from a short spec string: ``make_policy("semantic", **overrides)``.
 
-Specs: ``"semantic"`` (the scripted expert), ``"semantic-paper"`` (the paper's method alone,
+Specs: ``"semantic"`` (the scripted expert, its newest version), ``"semantic-v2"``,
+``"semantic-v3"`` (its named versions, :mod:`semexplore_gym.policies.expert_versions`),
+``"semantic-paper"``  (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
 value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier-student"`` (the expert's
 navigation choosing among every frontier by a score learned from the oracle,
@@ -44,10 +46,22 @@ def _expert_like(
     return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter)
 
 
-def _semantic(arg: str, overrides: dict[str, Any]) -> Policy:
-    from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+def _semantic_version(name: str) -> Factory:
+    """The factory of a named expert version (``semantic`` = the newest;
+    :mod:`semexplore_gym.policies.expert_versions`): its layer below the caller's params."""
 
-    return _expert_like("semantic", arg, overrides, SemanticExpertPolicy, SemanticExpertParams)
+    def factory(arg: str, overrides: dict[str, Any]) -> Policy:
+        from semexplore_gym.policies.expert_versions import version_layer
+        from semexplore_gym.policies.semantic_expert import (
+            SemanticExpertParams,
+            SemanticExpertPolicy,
+        )
+
+        layer = version_layer(name)
+        layers = (SemanticExpertParams, layer) if layer else (SemanticExpertParams,)
+        return _expert_like(name, arg, overrides, SemanticExpertPolicy, *layers)
+
+    return factory
 
 
 def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -263,8 +277,11 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
 
 def policy_factories() -> dict[str, Factory]:
     """The known policy names and their factories ``(argument, overrides) -> Policy``."""
+    from semexplore_gym.policies.expert_versions import EXPERT_VERSIONS, NEWEST_ALIAS
+
     return {
-        "semantic": _semantic,
+        NEWEST_ALIAS: _semantic_version(NEWEST_ALIAS),
+        **{name: _semantic_version(name) for name in EXPERT_VERSIONS},
         "semantic-paper": _semantic_paper,
         "frontier-value": _frontier_value,
         "frontier-student": _frontier_student,

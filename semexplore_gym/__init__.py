@@ -31,7 +31,7 @@ from pathlib import Path
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 #: The public API served by :func:`__getattr__`: name -> the module that defines it. Imported on
 #: first use, so that ``import semexplore_gym`` (which every ``semexplore_gym.*`` import runs)

@@ -36,6 +36,80 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(skip)
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        f"clean_clone: run once more by .ci/run with ../shared hidden ({HIDE_SHARED_ENV}=1)",
+    )
+
+
+# ------------------------------------------------------------------------------ the fast tier
+#: Simulated seconds of env missions a test not marked ``slow`` may run in this process (every
+#: ``SemanticExploreEnv.advance``, which ``step`` and the vector env call, and every
+#: ``SemanticExploreMultiEnv.step`` counts its ``dt_s``). ``pytest -m "not slow"`` is the
+#: contributors' fast tier (DEVELOPERS.md, "Tests"): a whole mission with a big budget belongs
+#: in the slow tier, and this limit says so by failing the test. Simulated time, not wall time:
+#: the same verdict on any machine and under any load (the fast tier's largest was 999 s when
+#: the limit was set). Not counted: missions in worker processes (``--workers 2``,
+#: subprocesses) and policies driven without the env; mark those by hand.
+FAST_TIER_SIMULATED_S = 1200.0
+
+
+class _SimulatedClock:
+    """Simulated seconds of env steps since the last :meth:`reset`."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+
+    def reset(self) -> None:
+        self.seconds = 0.0
+
+    def count(self, cls: type, method: str) -> Callable[[], None]:
+        """Count ``cls.method``'s calls (``dt_s`` of the env's config each); returns the undo."""
+        original = getattr(cls, method)
+
+        def counted(env, *args, **kwargs):
+            self.seconds += env.config.episode.dt_s
+            return original(env, *args, **kwargs)
+
+        setattr(cls, method, counted)
+        return lambda: setattr(cls, method, original)
+
+
+@pytest.fixture(scope="session")
+def _simulated_clock() -> Iterator[_SimulatedClock]:
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    clock = _SimulatedClock()
+    undo = [clock.count(SemanticExploreEnv, "advance")]
+    try:  # the multi-robot env needs the 'multi' extra (pettingzoo)
+        from semexplore_gym.envs.multi_robot import SemanticExploreMultiEnv
+    except ImportError:
+        pass
+    else:
+        undo.append(clock.count(SemanticExploreMultiEnv, "step"))
+    yield clock
+    for restore in undo:
+        restore()
+
+
+@pytest.fixture(autouse=True)
+def _fast_tier_budget(request: pytest.FixtureRequest, _simulated_clock: _SimulatedClock):
+    """Fail a test not marked ``slow`` whose missions simulate more than
+    :data:`FAST_TIER_SIMULATED_S`."""
+    _simulated_clock.reset()
+    yield
+    simulated_s = _simulated_clock.seconds
+    request.node.user_properties.append(("simulated_s", round(simulated_s, 1)))
+    if simulated_s > FAST_TIER_SIMULATED_S and request.node.get_closest_marker("slow") is None:
+        pytest.fail(
+            f"{request.node.nodeid} runs {simulated_s:.0f} s of simulated missions (fast-tier "
+            f"limit {FAST_TIER_SIMULATED_S:.0f} s): shrink its budget or mark it "
+            "@pytest.mark.slow",
+            pytrace=False,
+        )
+
+
 @pytest.fixture(scope="session")
 def tiny_macro_train_args() -> Callable[[float], list[str]]:
     """``semexplore train`` overrides for a few-step macro-env training on a 4 m maze.

@@ -33,8 +33,9 @@ REGENERATE = os.environ.get("SEMEXPLORE_REGENERATE_GOLDEN") == "1"
 _TIMED = {"mean_map_generation_ms", "mean_global_planning_ms", "wall_time_s"}
 #: Columns added after the pins were taken: missions are pinned by the rest (the same trace,
 #: trajectory and figures mean the same missions); coverage at the planner's clearance
-#: (tests/evaluation/test_planner_coverage.py) and the decomposition have their own tests.
-_ADDED_AFTER_PINS = {"coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS}
+#: (tests/evaluation/test_planner_coverage.py), the decomposition and the expert's version
+#: (tests/policies/test_expert_versions.py) have their own tests.
+_ADDED_AFTER_PINS = {"coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS, "policy_version"}
 
 MISSIONS = [
     ("maze1", "semantic", 0, None),

@@ -30,14 +30,37 @@ def _pyproject_version() -> str:
 
 
 # ------------------------------------------------------------------------------------ version
+VERSION = "0.3.0"
+
+
 def test_version_is_one_number_everywhere(capsys: pytest.CaptureFixture[str]) -> None:
-    assert semexplore_gym.__version__ == _pyproject_version() == "0.2.0"
+    assert semexplore_gym.__version__ == _pyproject_version() == VERSION
     with pytest.raises(SystemExit) as exc:
         main(["--version"])
     assert exc.value.code == 0
-    assert capsys.readouterr().out.strip() == "semexplore 0.2.0"
+    assert capsys.readouterr().out.strip() == f"semexplore {VERSION}"
+
+
+def test_the_changelog_has_the_release_under_the_unreleased_section() -> None:
     changelog = (REPO / "CHANGELOG.md").read_text()
-    assert "## [0.2.0]" in changelog
+    headings = re.findall(r"^## .*$", changelog, re.M)
+    assert headings[:3] == [
+        "## [Unreleased]",
+        f"## [{VERSION}] - 2026-12-04",
+        "## [0.2.0] - 2026-11-27",
+    ]
+    # Nothing above the first heading but the preamble: every entry is in a section.
+    assert not re.search(r"^### ", changelog.split("## [Unreleased]", 1)[0], re.M)
+
+
+def test_the_licence_file_is_mit_and_declared() -> None:
+    text = (REPO / "LICENSE").read_text()
+    assert (
+        text.startswith("MIT License") and "Copyright (c) 2026 SemanticExplore developers" in text
+    )
+    pyproject = (REPO / "pyproject.toml").read_text()
+    assert re.search(r'^license = "MIT"$', pyproject, re.M)
+    assert re.search(r'^license-files = \["LICENSE"\]$', pyproject, re.M)
 
 
 def test_the_command_runs_as_a_module() -> None:
@@ -48,7 +71,7 @@ def test_the_command_runs_as_a_module() -> None:
         cwd=REPO,
         timeout=120,
     )
-    assert out.returncode == 0 and out.stdout.strip() == "semexplore 0.2.0", out.stderr
+    assert out.returncode == 0 and out.stdout.strip() == f"semexplore {VERSION}", out.stderr
 
 
 # -------------------------------------------------------------------------------------- wheel
@@ -59,7 +82,7 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> zipfile.ZipFile:
     skip = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
     for name in ("semexplore_gym", "policies", "configs"):
         shutil.copytree(REPO / name, src / name, ignore=skip)
-    for name in ("setup.py", "pyproject.toml", "README.md"):
+    for name in ("setup.py", "pyproject.toml", "README.md", "LICENSE"):
         shutil.copy(REPO / name, src / name)
     dist = tmp_path_factory.mktemp("dist")
     cmd = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q"]
@@ -91,7 +114,16 @@ def test_the_wheel_carries_every_config_and_pretrained_model(wheel: zipfile.ZipF
             rel = f.relative_to(REPO).as_posix()
             assert f"semexplore_gym/{rel}" in names, rel
     meta = wheel.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
-    assert "Version: 0.2.0" in meta and "moviepy" in meta  # RecordVideo: the render extra
+    assert f"Version: {VERSION}" in meta and "moviepy" in meta  # RecordVideo: the render extra
+
+
+def test_the_wheel_carries_the_licence(wheel: zipfile.ZipFile) -> None:
+    names = wheel.namelist()
+    licence = [n for n in names if n.endswith(".dist-info/licenses/LICENSE")]
+    assert licence, [n for n in names if ".dist-info/" in n]
+    assert wheel.read(licence[0]) == (REPO / "LICENSE").read_bytes()
+    meta = wheel.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+    assert "License-Expression: MIT" in meta and "License-File: LICENSE" in meta
 
 
 def test_the_old_policies_import_path_names_the_new_one() -> None:

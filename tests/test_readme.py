@@ -456,6 +456,7 @@ def _run_snippet(block: Block) -> str | None:
 
 
 @pytest.mark.slow
+@pytest.mark.clean_clone
 def test_every_documented_command_runs(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, tiny_macro_train_args, one_torch_thread
 ) -> None:
@@ -548,6 +549,26 @@ def test_every_documented_command_runs(
         assert skipped and not timings, "with ../shared hidden every real-map command must skip"
         return
     assert (work / "maze1.gif").is_file() and (work / "runs" / "bc" / "model.zip").is_file()
+
+
+def test_ci_runs_only_the_clean_clone_checks_without_shared() -> None:
+    """.ci/run runs this file twice, the second time with ../shared hidden: that pass selects
+    the tests marked ``clean_clone`` (the commands that need the real maps, which must skip),
+    so the slow blocks run once; every other test here gives the same result either way."""
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    hidden = [
+        line for line in ci.splitlines() if line.startswith("SEMEXPLORE_TEST_HIDE_SHARED=1 pytest")
+    ]
+    assert len(hidden) == 1, hidden
+    argv = shlex.split(hidden[0].split("||")[0])
+    assert argv[argv.index("-m") + 1] == "clean_clone" and "tests/test_readme.py" in argv
+    marked = [
+        name
+        for name, obj in globals().items()
+        if name.startswith("test_")
+        and any(m.name == "clean_clone" for m in getattr(obj, "pytestmark", []))
+    ]
+    assert marked == ["test_every_documented_command_runs"]
 
 
 # ------------------------------------------------------------------------------ the site

@@ -37,6 +37,8 @@ _FIELDS = (
     "training_time",
     "results",
 )
+#: Fields an entry may leave out, with their default.
+_OPTIONAL_FIELDS = {"expert_version": "semantic-v2"}
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,9 @@ class PretrainedModel:
         config: The training config of that command (``configs/agents/...``, shipped).
         training_time: Wall time of the training run and the machine it ran on.
         results: Its measured results on unseen worlds, and how they were measured.
+        expert_version: The expert version its results were compared with: the expert of its
+            time (``semantic-v2`` for the models measured before the 0.3.0 release, unless its
+            entry says otherwise; :mod:`semexplore_gym.policies.expert_versions`).
     """
 
     name: str
@@ -63,6 +68,7 @@ class PretrainedModel:
     config: str
     training_time: str
     results: str
+    expert_version: str = "semantic-v2"
 
     @property
     def spec(self) -> str:
@@ -92,13 +98,14 @@ class PretrainedModel:
             ("reproduce", self.command),
             ("config", self.config),
             ("results", self.results),
+            ("expert", f"compared with {self.expert_version} (the expert of its time)"),
             ("model", str(self.model_path)),
         ]
         return [self.spec] + [f"  {k + ':':<12}{v}" for k, v in rows]
 
     def to_dict(self) -> dict[str, Any]:
         """The index fields plus ``spec``, ``model_path`` and ``size_bytes``."""
-        d: dict[str, Any] = {k: getattr(self, k) for k in _FIELDS}
+        d: dict[str, Any] = {k: getattr(self, k) for k in (*_FIELDS, *_OPTIONAL_FIELDS)}
         size = self.model_path.stat().st_size if self.model_path.is_file() else None
         return {"spec": self.spec, **d, "model_path": str(self.model_path), "size_bytes": size}
 
@@ -109,6 +116,8 @@ def pretrained_models() -> list[PretrainedModel]:
     Raises:
         ValueError: the index is malformed (a missing or unknown field).
     """
+    from semexplore_gym.policies.expert_versions import EXPERT_VERSIONS
+
     from semexplore_gym.config.loading import load_yaml_file
 
     data = load_yaml_file(INDEX_PATH, "pretrained model index") or {}
@@ -117,10 +126,22 @@ def pretrained_models() -> list[PretrainedModel]:
         raise ValueError(f"{INDEX_PATH} must hold a 'models' list")
     models = []
     for entry in entries:
-        if not isinstance(entry, dict) or set(entry) != set(_FIELDS):
+        if not isinstance(entry, dict) or not set(_FIELDS) <= set(entry) <= {
+            *_FIELDS,
+            *_OPTIONAL_FIELDS,
+        }:
             keys = sorted(entry) if isinstance(entry, dict) else entry
-            raise ValueError(f"{INDEX_PATH}: each model needs exactly {list(_FIELDS)}, got {keys}")
-        models.append(PretrainedModel(**{k: " ".join(str(entry[k]).split()) for k in _FIELDS}))
+            raise ValueError(
+                f"{INDEX_PATH}: each model needs exactly {list(_FIELDS)} (optional: "
+                f"{list(_OPTIONAL_FIELDS)}), got {keys}"
+            )
+        values = {**_OPTIONAL_FIELDS, **entry}
+        if values["expert_version"] not in EXPERT_VERSIONS:
+            raise ValueError(
+                f"{INDEX_PATH}: model {entry['name']!r}: expert_version must be one of "
+                f"{list(EXPERT_VERSIONS)}, got {values['expert_version']!r}"
+            )
+        models.append(PretrainedModel(**{k: " ".join(str(values[k]).split()) for k in values}))
     return models
 
 

@@ -28,6 +28,7 @@ JSON_KEYS: tuple[str, ...] = (
     "path_length_m",
     "collisions",
     "wall_time_s",
+    "policy_version",
 )
 
 
@@ -50,7 +51,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--policy",
         default=None,
-        help="policy spec: semantic (default), semantic-paper (the paper's method alone), "
+        help="policy spec: semantic (default: the expert's newest version, semantic-v3), "
+        "semantic-v2 (the 0.2.0 expert), semantic-paper (the paper's method alone), "
         "frontier, nearest, random, oracle (PRIVILEGED: reads the true world through the env's "
         "privileged channel; a full-knowledge yardstick, not an explorer), pretrained:NAME (see 'semexplore pretrained'), "
         "sb3:MODEL.zip, py:FILE.py:CLASS or py:package.module:CLASS (your own Policy); a bracket sets "
@@ -148,6 +150,7 @@ def run(args: argparse.Namespace) -> int:
     import semexplore_gym  # noqa: F401  (registers the env)
     from semexplore_gym.evaluation.rollout import GifOptions, map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
+    from semexplore_gym.policies.expert_versions import expert_version
     from semexplore_gym.policies.registry import make_policy
     from semexplore_gym.policies.specs import load_policy_config
 
@@ -200,6 +203,8 @@ def run(args: argparse.Namespace) -> int:
     summary = result.summary()
     # The spec as given: a policy's own name may shorten it (sb3:model.zip for sb3:runs/x/model.zip).
     summary["policy"] = spec
+    # The expert's named version the spec ran ("semantic" runs the newest); "" for other policies.
+    summary["policy_version"] = expert_version(spec)
     if args.json:
         print(json.dumps({k: summary[k] for k in JSON_KEYS}))
     else:
@@ -255,11 +260,17 @@ def run_team(args: argparse.Namespace) -> int:
     return 0
 
 
+def _version(summary: dict[str, Any]) -> str:
+    """``"semantic-v3, "`` when the spec runs a named expert version it does not spell out."""
+    version = summary.get("policy_version") or ""
+    return f"{version}, " if version and version != summary["policy"] else ""
+
+
 def format_result(summary: dict[str, Any]) -> str:
     """Human-readable lines of a :meth:`MissionResult.summary`."""
     lines = [
         f"world            {summary['world']}",
-        f"policy           {summary['policy']} (seed {summary['seed']})",
+        f"policy           {summary['policy']} ({_version(summary)}seed {summary['seed']})",
         f"coverage         {summary['coverage']:.4f}  ({summary['explored_area_m2']:.2f} m^2 mapped)",
         f"mission_time_s   {summary['mission_time_s']:.1f}",
         f"self_stopped     {summary['self_stopped']}",

@@ -38,9 +38,9 @@ from semexplore_gym.envs.multi_robot_config import (
     split_team_overrides,
 )
 from semexplore_gym.envs.semantic_explore import (
-    FrozenInfo,
     SemanticExploreEnv,
     is_unseeded_procedural,
+    static_info_of,
 )
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
@@ -168,27 +168,7 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.agents: list[str] = []
         self._build_world_state()
         self._build_spaces()
-        self._static_info: dict[str, Any] = {
-            "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
-            "robot": FrozenInfo(
-                {
-                    "radius_m": cfg.robot.radius_m,
-                    "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
-                    "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
-                }
-            ),
-            "lidar": FrozenInfo(
-                {
-                    "n_beams": cfg.lidar.n_beams,
-                    "min_range_m": cfg.lidar.min_range_m,
-                    "max_range_m": cfg.lidar.max_range_m,
-                    "angle_increment_rad": cfg.lidar.angle_increment_rad,
-                    "mount_x_m": cfg.lidar.mount_x_m,
-                    "mount_y_m": cfg.lidar.mount_y_m,
-                }
-            ),
-            "dt_s": cfg.episode.dt_s,
-        }
+        self._static_info = static_info_of(cfg, self.map_geometry)
         self._area_per_cell_m2 = cfg.mapping.resolution_m**2
         self._np_random: np.random.Generator | None = None
         self._started = False

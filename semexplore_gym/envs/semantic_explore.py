@@ -72,6 +72,33 @@ class FrozenInfo(Mapping):
         return (FrozenInfo, (self._d,))
 
 
+def static_info_of(config: EnvConfig, geometry: GridGeometry) -> dict[str, Any]:
+    """The ``info`` entries fixed by the config (shared read-only mappings), the same for the
+    single-robot env and each agent of the multi-robot env."""
+    cfg = config
+    return {
+        "map_geometry": FrozenInfo(geometry.to_dict()),
+        "robot": FrozenInfo(
+            {
+                "radius_m": cfg.robot.radius_m,
+                "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
+                "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
+            }
+        ),
+        "lidar": FrozenInfo(
+            {
+                "n_beams": cfg.lidar.n_beams,
+                "min_range_m": cfg.lidar.min_range_m,
+                "max_range_m": cfg.lidar.max_range_m,
+                "angle_increment_rad": cfg.lidar.angle_increment_rad,
+                "mount_x_m": cfg.lidar.mount_x_m,
+                "mount_y_m": cfg.lidar.mount_y_m,
+            }
+        ),
+        "dt_s": cfg.episode.dt_s,
+    }
+
+
 class SemanticExploreEnv(gym.Env):
     """Explore an unknown building with a TurtleBot3 Burger and a 2D LiDAR.
 
@@ -249,7 +276,7 @@ class SemanticExploreEnv(gym.Env):
         self._build_world_state()
         self.observation_space = self._observation_space()
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-        self._static_info = self._static_entries()
+        self._static_info = static_info_of(self.config, self.map_geometry)
         self._area_per_cell_m2 = cfg.mapping.resolution_m**2
         self._static_every_step = self.static_info == "every_step"
         self._overlay: dict[str, Any] = {}
@@ -281,31 +308,6 @@ class SemanticExploreEnv(gym.Env):
             lim = 2**30
             space.spaces["map_offset_cells"] = spaces.Box(-lim, lim, shape=(2,), dtype=np.int32)
         return space
-
-    def _static_entries(self) -> dict[str, Any]:
-        """The ``info`` entries fixed by the config (shared read-only mappings)."""
-        cfg = self.config
-        return {
-            "map_geometry": FrozenInfo(self.map_geometry.to_dict()),
-            "robot": FrozenInfo(
-                {
-                    "radius_m": cfg.robot.radius_m,
-                    "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
-                    "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
-                }
-            ),
-            "lidar": FrozenInfo(
-                {
-                    "n_beams": cfg.lidar.n_beams,
-                    "min_range_m": cfg.lidar.min_range_m,
-                    "max_range_m": cfg.lidar.max_range_m,
-                    "angle_increment_rad": cfg.lidar.angle_increment_rad,
-                    "mount_x_m": cfg.lidar.mount_x_m,
-                    "mount_y_m": cfg.lidar.mount_y_m,
-                }
-            ),
-            "dt_s": cfg.episode.dt_s,
-        }
 
     def _build_world_state(self) -> None:
         cfg = self.config

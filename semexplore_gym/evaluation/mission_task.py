@@ -29,7 +29,10 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     """The ``runs.csv`` row of ``task`` from its :class:`~.rollout.MissionResult`; the
     policy-specific columns come from the policy's ``mission_metrics()`` (None if absent),
     ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
-    which still holds the env), the path decomposition's from the result's (None without one)."""
+    which still holds the env), the path decomposition's from the result's (None without one),
+    ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert_versions.expert_version`)."""
+    from semexplore_gym.policies.expert_versions import expert_version
+
     parts = getattr(res, "path_decomposition", None)
     decomposition = parts.columns() if parts is not None else dict.fromkeys(DECOMPOSITION_COLUMNS)
     return RunRow(
@@ -52,6 +55,7 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
         **{k: res.policy_metrics.get(k) for k in POLICY_COLUMNS},
         coverage_at_planner_clearance=coverage_at_planner_clearance,
         **decomposition,
+        policy_version=expert_version(task.policy),
     )
 
 

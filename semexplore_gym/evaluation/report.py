@@ -242,6 +242,15 @@ def _suite_lines(out: Path) -> list[str]:
     return [f"Suites: {named}.", ""]
 
 
+def _version_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """Which named expert version each policy spec ran (``runs.csv``'s ``policy_version``)."""
+    versions = {r["policy"]: r.get("policy_version") for r in rows if r.get("policy_version")}
+    if not versions:
+        return []
+    named = ", ".join(f"`{p}` = {v}" for p, v in sorted(versions.items()))
+    return [f"Expert versions: {named}.", ""]
+
+
 def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY) -> Path:
     """Write ``summary.md``: per world, per family and over all worlds, medians/IQRs and the
     reference policy against each other one."""
@@ -257,6 +266,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         f"{len(rows)} missions from `{out / 'runs.csv'}`. Cells: median [IQR].",
         "",
         *_suite_lines(out),
+        *_version_lines(rows),
     ]
     families = group_by_family(rows)
     if len(groups) > 1:

@@ -5,8 +5,10 @@
 policies); ``coverage_at_planner_clearance`` is the coverage of the cells reachable at the
 semantic expert's planning clearance (:mod:`.planner_coverage`; every policy); the path
 decomposition's columns (:mod:`.path_decomposition`: the path split into parts that add up to
-``path_length_m``, goals cleared and abandoned, the goals' detour ratio) come for every policy.
-All of these were added after the first release, so older files may lack them.
+``path_length_m``, goals cleared and abandoned, the goals' detour ratio) come for every policy;
+``policy_version`` names the semantic expert's version a spec ran (``semantic-v3`` for
+``semantic``; empty for policies without versions). All of these were added after the first
+release, so older files may lack them.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ class RunRow:
     goals_abandoned: int | None = None
     median_goal_detour_ratio: float | None = None
     goal_detour_excess_m: float | None = None
+    policy_version: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -78,10 +81,10 @@ POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
 OPTIONAL_COLUMNS: frozenset[str] = frozenset(
-    {*POLICY_COLUMNS, "coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS}
+    {*POLICY_COLUMNS, "coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS, "policy_version"}
 )
 
-_TEXT_COLUMNS = ("world", "policy", "stop_reason")
+_TEXT_COLUMNS = ("world", "policy", "stop_reason", "policy_version")
 _INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans", "goals_cleared", "goals_abandoned")
 
 

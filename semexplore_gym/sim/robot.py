@@ -125,7 +125,111 @@ class PhysicsParams:
             )
 
 
-class RobotSim:
+class PymunkSim:
+    """What :class:`RobotSim` and :class:`~semexplore_gym.sim.team.TeamSim` share: the world's
+    walls in a pymunk space, robots driven through a kinematic control body, the fixed substep
+    count near walls, the exact arc far from them, and pickling by the inputs (pymunk objects
+    hold C pointers: a copy rebuilds its space)."""
+
+    world: World
+    robot_params: RobotParams
+    physics_params: PhysicsParams
+    _substep_dt_key: float
+    _substeps: int
+    space: pymunk.Space
+
+    def _new_space(self) -> pymunk.Space:
+        """A space with the physics settings and the world's walls (static, skinned segments)."""
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.collision_slop = self.physics_params.collision_slop_m
+        space.iterations = self.physics_params.solver_iterations
+        static = space.static_body
+        shapes = []
+        for x0, y0, x1, y1 in self.world.segments_m:
+            s = pymunk.Segment(static, (float(x0), float(y0)), (float(x1), float(y1)), WALL_SKIN_M)
+            s.friction = 0.0
+            s.elasticity = 0.0
+            s.collision_type = WALL_COLLISION_TYPE
+            s.filter = pymunk.ShapeFilter(categories=0b01)
+            shapes.append(s)
+        space.add(*shapes)
+        self._substep_dt_key = -1.0
+        self._substeps = 1
+        return space
+
+    def _add_robot_body(
+        self, space: pymunk.Space
+    ) -> tuple[pymunk.Body, pymunk.Circle, pymunk.Body]:
+        """Add a robot to ``space``: its body, wall disc, control body and drive joints;
+        returns ``(body, disc, control)``."""
+        r = self.robot_params
+        moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
+        body = pymunk.Body(r.mass_kg, moment)
+        # Walls get a skin and the disc shrinks by the same amount: the contact geometry is
+        # unchanged, but rounded wall ends give clean contact normals at corners.
+        shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
+        shape.friction = 0.0
+        shape.elasticity = 0.0
+        shape.collision_type = ROBOT_COLLISION_TYPE
+        shape.filter = pymunk.ShapeFilter(categories=0b10)
+        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+        pivot.max_bias = 0.0
+        pivot.max_force = r.max_drive_force_n
+        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+        gear.error_bias = 0.0
+        gear.max_bias = 0.0
+        gear.max_force = r.max_turn_torque_nm
+        space.add(body, shape, control, pivot, gear)
+        return body, shape, control
+
+    def _substeps_for(self, dt_s: float) -> int:
+        if dt_s != self._substep_dt_key:
+            travel = self.robot_params.max_linear_speed_mps * dt_s
+            pp = self.physics_params
+            self._substeps = min(
+                pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m))
+            )
+            self._substep_dt_key = dt_s
+        return self._substeps
+
+    def _drive_arc(self, body: pymunk.Body, v: float, w: float, dt_s: float) -> None:
+        """Move ``body`` along the exact differential-drive arc of ``(v, w)`` for ``dt_s``."""
+        # The C calls behind body.position, body.angle, ... = and reindex_shapes_for_body.
+        b = body._body
+        p = _cp.cpBodyGetPosition(b)
+        x, y = p.x, p.y
+        yaw = _cp.cpBodyGetAngle(b)
+        if abs(w) > 1e-9:
+            yaw2 = yaw + w * dt_s
+            x += v / w * (math.sin(yaw2) - math.sin(yaw))
+            y -= v / w * (math.cos(yaw2) - math.cos(yaw))
+        else:
+            yaw2 = yaw
+            x += v * dt_s * math.cos(yaw)
+            y += v * dt_s * math.sin(yaw)
+        _cp.cpBodySetPosition(b, (x, y))
+        _cp.cpBodySetAngle(b, yaw2)
+        _cp.cpBodySetVelocity(b, (v * math.cos(yaw2), v * math.sin(yaw2)))
+        _cp.cpBodySetAngularVelocity(b, w)
+        _cp.cpSpaceReindexShapesForBody(self.space._space, b)
+
+    def _inputs_state(self) -> dict:
+        """The inputs a copy rebuilds its space from (the start of ``__getstate__``)."""
+        return {
+            "world": self.world,
+            "robot_params": self.robot_params,
+            "physics_params": self.physics_params,
+        }
+
+    def _restore_inputs(self, state: dict) -> None:
+        self.world = state["world"]
+        self.robot_params = state["robot_params"]
+        self.physics_params = state["physics_params"]
+
+
+class RobotSim(PymunkSim):
     """Pymunk space holding one world's walls and the robot.
 
     Args:
@@ -141,43 +245,10 @@ class RobotSim:
         self._build()
 
     def _build(self) -> None:
-        space = pymunk.Space()
-        space.gravity = (0.0, 0.0)
-        space.collision_slop = self.physics_params.collision_slop_m
-        space.iterations = self.physics_params.solver_iterations
-        static = space.static_body
-        shapes = []
-        for x0, y0, x1, y1 in self.world.segments_m:
-            s = pymunk.Segment(static, (float(x0), float(y0)), (float(x1), float(y1)), WALL_SKIN_M)
-            s.friction = 0.0
-            s.elasticity = 0.0
-            s.collision_type = WALL_COLLISION_TYPE
-            s.filter = pymunk.ShapeFilter(categories=0b01)
-            shapes.append(s)
-        space.add(*shapes)
-
-        r = self.robot_params
-        moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
-        body = pymunk.Body(r.mass_kg, moment)
-        # Walls get a skin and the disc shrinks by the same amount: the contact geometry is
-        # unchanged, but rounded wall ends give clean contact normals at corners.
-        shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
-        shape.friction = 0.0
-        shape.elasticity = 0.0
-        shape.collision_type = ROBOT_COLLISION_TYPE
-        shape.filter = pymunk.ShapeFilter(categories=0b10)
+        space = self._new_space()
+        body, _, control = self._add_robot_body(space)
         self._wall_filter = pymunk.ShapeFilter(mask=0b01)
         self._query_info = _ffi.new("cpPointQueryInfo *")  # scratch for the near-wall query
-        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
-        pivot.max_bias = 0.0
-        pivot.max_force = r.max_drive_force_n
-        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
-        gear.error_bias = 0.0
-        gear.max_bias = 0.0
-        gear.max_force = r.max_turn_torque_nm
-        space.add(body, shape, control, pivot, gear)
-
         self._touching = 0
         self._began = False
         self._suppress_begin = False
@@ -200,8 +271,6 @@ class RobotSim:
         self.control = control
         self.collisions = 0
         self.in_contact = False
-        self._substep_dt_key = -1.0
-        self._substeps = 1
 
     def reset(self, pose: tuple[float, float, float]) -> None:
         """Place the robot at rest at ``pose`` = (x_m, y_m, yaw_rad)."""
@@ -245,7 +314,7 @@ class RobotSim:
             self._query_info,
         )
         if near == _ffi.NULL and self._touching == 0:
-            self._drive_free(linear_mps, angular_radps, dt_s)
+            self._drive_arc(self.body, linear_mps, angular_radps, dt_s)
             self.in_contact = False
             return False
         h = dt_s / n
@@ -282,42 +351,10 @@ class RobotSim:
         self.in_contact = self._touching > 0
         return new_collision
 
-    def _substeps_for(self, dt_s: float) -> int:
-        if dt_s != self._substep_dt_key:
-            travel = self.robot_params.max_linear_speed_mps * dt_s
-            pp = self.physics_params
-            self._substeps = min(
-                pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m))
-            )
-            self._substep_dt_key = dt_s
-        return self._substeps
-
-    def _drive_free(self, v: float, w: float, dt_s: float) -> None:
-        # The C calls behind body.position, body.angle, ... = and reindex_shapes_for_body.
-        b = self.body._body
-        p = _cp.cpBodyGetPosition(b)
-        x, y = p.x, p.y
-        yaw = _cp.cpBodyGetAngle(b)
-        if abs(w) > 1e-9:
-            yaw2 = yaw + w * dt_s
-            x += v / w * (math.sin(yaw2) - math.sin(yaw))
-            y -= v / w * (math.cos(yaw2) - math.cos(yaw))
-        else:
-            yaw2 = yaw
-            x += v * dt_s * math.cos(yaw)
-            y += v * dt_s * math.sin(yaw)
-        _cp.cpBodySetPosition(b, (x, y))
-        _cp.cpBodySetAngle(b, yaw2)
-        _cp.cpBodySetVelocity(b, (v * math.cos(yaw2), v * math.sin(yaw2)))
-        _cp.cpBodySetAngularVelocity(b, w)
-        _cp.cpSpaceReindexShapesForBody(self.space._space, b)
-
     # Pymunk objects hold C pointers: pickle the inputs and rebuild.
     def __getstate__(self) -> dict:
         return {
-            "world": self.world,
-            "robot_params": self.robot_params,
-            "physics_params": self.physics_params,
+            **self._inputs_state(),
             "pose": self.pose,
             "velocity": tuple(self.body.velocity),
             "angular_velocity": float(self.body.angular_velocity),
@@ -326,9 +363,7 @@ class RobotSim:
         }
 
     def __setstate__(self, state: dict) -> None:
-        self.world = state["world"]
-        self.robot_params = state["robot_params"]
-        self.physics_params = state["physics_params"]
+        self._restore_inputs(state)
         self._build()
         self.reset(state["pose"])
         self.body.velocity = state["velocity"]

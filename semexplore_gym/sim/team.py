@@ -1,7 +1,8 @@
 """A team of TurtleBot3s in one pymunk space, and LiDAR scans that see teammates.
 
 :class:`TeamSim` is :class:`~semexplore_gym.sim.robot.RobotSim` for ``n`` robots: the same
-walls, bodies, drive joints and substepping, with the robots added to one space so that they
+walls, bodies, drive joints, substepping, free-space arcs and pickling (both are a
+:class:`~semexplore_gym.sim.robot.PymunkSim`), with the robots added to one space so that they
 collide with the walls and with each other. With one robot it makes the same Chipmunk calls in
 the same order as :class:`RobotSim` (the multi-robot env's one-robot equivalence test relies on
 it).
@@ -25,8 +26,8 @@ from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import (
     ROBOT_COLLISION_TYPE,
     WALL_COLLISION_TYPE,
-    WALL_SKIN_M,
     PhysicsParams,
+    PymunkSim,
     RobotParams,
 )
 
@@ -34,7 +35,7 @@ from semexplore_gym.sim.robot import (
 BUMPER_COLLISION_TYPE = 3
 
 
-class TeamSim:
+class TeamSim(PymunkSim):
     """Pymunk space holding one world's walls and ``n_robots`` robots.
 
     Args:
@@ -60,11 +61,7 @@ class TeamSim:
         self._build()
 
     def _build(self) -> None:
-        space = pymunk.Space()
-        space.gravity = (0.0, 0.0)
-        space.collision_slop = self.physics_params.collision_slop_m
-        space.iterations = self.physics_params.solver_iterations
-        self._add_walls(space)
+        space = self._new_space()
         self.bodies: list[pymunk.Body] = []
         self.controls: list[pymunk.Body] = []
         self._index_of: dict[pymunk.Shape, int] = {}
@@ -81,41 +78,11 @@ class TeamSim:
         self.collisions = [0] * n
         self.robot_collisions = 0
         self.in_contact = [False] * n
-        self._substep_dt_key = -1.0
-        self._substeps = 1
-
-    def _add_walls(self, space: pymunk.Space) -> None:
-        """Add the world's wall segments to ``space`` as static, skinned segments."""
-        static = space.static_body
-        shapes = []
-        for x0, y0, x1, y1 in self.world.segments_m:
-            s = pymunk.Segment(static, (float(x0), float(y0)), (float(x1), float(y1)), WALL_SKIN_M)
-            s.friction = 0.0
-            s.elasticity = 0.0
-            s.collision_type = WALL_COLLISION_TYPE
-            s.filter = pymunk.ShapeFilter(categories=0b01)
-            shapes.append(s)
-        space.add(*shapes)
 
     def _add_robot(self, space: pymunk.Space, i: int) -> None:
         """Add robot ``i``'s body, wall disc, drive joints (and bumper disc in a team)."""
         r = self.robot_params
-        moment = pymunk.moment_for_circle(r.mass_kg, 0.0, r.radius_m)
-        body = pymunk.Body(r.mass_kg, moment)
-        shape = pymunk.Circle(body, r.radius_m - WALL_SKIN_M)
-        shape.friction = 0.0
-        shape.elasticity = 0.0
-        shape.collision_type = ROBOT_COLLISION_TYPE
-        shape.filter = pymunk.ShapeFilter(categories=0b10)
-        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
-        pivot.max_bias = 0.0
-        pivot.max_force = r.max_drive_force_n
-        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
-        gear.error_bias = 0.0
-        gear.max_bias = 0.0
-        gear.max_force = r.max_turn_torque_nm
-        space.add(body, shape, control, pivot, gear)
+        body, shape, control = self._add_robot_body(space)
         self.bodies.append(body)
         self.controls.append(control)
         self._index_of[shape] = i
@@ -227,7 +194,7 @@ class TeamSim:
             free = bool(d.min() > 2.0 * reach)
         if free:
             for i, (v, w) in enumerate(commands):
-                self._drive_free(i, v, w, dt_s)
+                self._drive_arc(self.bodies[i], v, w, dt_s)
                 self.in_contact[i] = False
             return [False] * self.n_robots
         h = dt_s / n_sub
@@ -266,42 +233,10 @@ class TeamSim:
             self.in_contact[i] = self._touching[i] > 0
         return new
 
-    def _substeps_for(self, dt_s: float) -> int:
-        if dt_s != self._substep_dt_key:
-            travel = self.robot_params.max_linear_speed_mps * dt_s
-            pp = self.physics_params
-            self._substeps = min(
-                pp.max_substeps, max(1, math.ceil(travel / pp.max_substep_travel_m))
-            )
-            self._substep_dt_key = dt_s
-        return self._substeps
-
-    def _drive_free(self, i: int, v: float, w: float, dt_s: float) -> None:
-        # The exact arc of RobotSim._drive_free.
-        b = self.bodies[i]._body
-        p = _cp.cpBodyGetPosition(b)
-        x, y = p.x, p.y
-        yaw = _cp.cpBodyGetAngle(b)
-        if abs(w) > 1e-9:
-            yaw2 = yaw + w * dt_s
-            x += v / w * (math.sin(yaw2) - math.sin(yaw))
-            y -= v / w * (math.cos(yaw2) - math.cos(yaw))
-        else:
-            yaw2 = yaw
-            x += v * dt_s * math.cos(yaw)
-            y += v * dt_s * math.sin(yaw)
-        _cp.cpBodySetPosition(b, (x, y))
-        _cp.cpBodySetAngle(b, yaw2)
-        _cp.cpBodySetVelocity(b, (v * math.cos(yaw2), v * math.sin(yaw2)))
-        _cp.cpBodySetAngularVelocity(b, w)
-        _cp.cpSpaceReindexShapesForBody(self.space._space, b)
-
     # Pymunk objects hold C pointers: pickle the inputs and rebuild.
     def __getstate__(self) -> dict:
         return {
-            "world": self.world,
-            "robot_params": self.robot_params,
-            "physics_params": self.physics_params,
+            **self._inputs_state(),
             "n_robots": self.n_robots,
             "poses": self.poses,
             "velocities": [tuple(b.velocity) for b in self.bodies],
@@ -312,9 +247,7 @@ class TeamSim:
         }
 
     def __setstate__(self, state: dict) -> None:
-        self.world = state["world"]
-        self.robot_params = state["robot_params"]
-        self.physics_params = state["physics_params"]
+        self._restore_inputs(state)
         self.n_robots = state["n_robots"]
         self._build()
         self.reset(state["poses"])

@@ -98,6 +98,7 @@ def test_overlapping_train_and_test_seeds_are_rejected(tmp_path: Path) -> None:
     assert main([*argv, "--test-seed0", "0", "--out", str(tmp_path)]) == 2
 
 
+@pytest.mark.slow
 def test_compare_weights_writes_table_and_plot(tmp_path: Path) -> None:
     out = tmp_path / "cw"
     argv = [*_tiny_run(max_time_s=20), "--out", str(out)]

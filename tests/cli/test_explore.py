@@ -98,6 +98,7 @@ def test_explore_gives_the_shared_map_to_policies_that_declare_it(
     assert made[0] == want  # the mission env (a warm-up env may follow)
 
 
+@pytest.mark.slow
 def test_explore_with_a_team_writes_a_team_gif(tmp_path, capsys):
     pytest.importorskip("pettingzoo")
     gif = tmp_path / "team.gif"

@@ -72,6 +72,7 @@ def test_explore_with_an_unknown_pretrained_name_is_a_clear_error(
     )
 
 
+@pytest.mark.slow
 def test_benchmark_runs_pretrained_specs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import math
 
+import pytest
+
 from semexplore_gym.evaluation.harness import CSV_COLUMNS
 from semexplore_gym.evaluation.regret import (
     REGRET_COLUMNS,
@@ -74,6 +76,7 @@ def test_write_regret_adds_a_csv_a_summary_section_and_is_idempotent(tmp_path):
     assert "### maze" in text and "### cave" in text and "### all worlds" in text
 
 
+@pytest.mark.slow
 def test_benchmark_with_the_oracle_writes_the_regret(tmp_path, capsys):
     import json
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
+import pytest
 
 from semexplore_gym.cli import main
 from semexplore_gym.evaluation.harness import read_runs
@@ -22,6 +23,7 @@ def _bench(out, policies: str, max_time_s: str) -> list[dict]:
     return read_runs(out / "runs.csv")
 
 
+@pytest.mark.slow
 def test_the_summary_pairs_the_distance_to_99_percent(tmp_path, capsys) -> None:
     out = tmp_path / "b"
     rows = _bench(out, "semantic,nearest", "300")

@@ -13,6 +13,7 @@ from semexplore_gym.cli import main  # noqa: E402
 from semexplore_gym.evaluation.team_benchmark import COLUMNS  # noqa: E402
 
 
+@pytest.mark.slow
 def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
     out = tmp_path / "team"
     argv = [

@@ -54,6 +54,7 @@ def test_classifier() -> None:
     assert fuzz.classify(ok, 0, b"", False) == "accepted"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="needs fork")
 def test_fuzz_sample_has_no_traceback_hang_or_garbage() -> None:
     fuzz = _fuzz()

@@ -307,6 +307,7 @@ def _sliver_mission(params: SemanticExpertParams, time_s: float) -> SemanticExpe
     return pol
 
 
+@pytest.mark.slow
 def test_a_mission_with_only_unseeable_slivers_left_stops_by_itself() -> None:
     pol = _sliver_mission(SemanticExpertParams(), 3000.0)
     assert pol.done, pol.counters

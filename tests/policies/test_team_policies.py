@@ -153,6 +153,7 @@ def test_semantic_team_shares_dropped_goals() -> None:
     assert a.goal_memory.is_blacklisted(door) and not b.goal_memory.is_blacklisted(door)
 
 
+@pytest.mark.slow
 def test_failed_approaches_do_not_stop_the_team() -> None:
     # Three robots in a braided maze fail approaches where they block each other; when those
     # drops were shared, every robot ran out of frontiers at once and the team stopped at 0.32

@@ -1,0 +1,149 @@
+"""Named expert versions: ``semantic-v2`` is the 0.2.0 expert, ``semantic-v3`` today's, and
+``semantic`` the newest; every run record states the version a spec ran."""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import fields, replace
+from pathlib import Path
+
+import pytest
+from semexplore_gym.policies.expert_versions import (
+    EXPERT_VERSIONS,
+    LATEST_EXPERT,
+    expert_version,
+)
+from semexplore_gym.policies.registry import make_policy
+from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+
+from semexplore_gym.cli import main
+
+#: Every switch added after 0.2.0, off: the 0.2.0 expert as a spec of today's.
+LONG_SPEC = (
+    "semantic[shuttle_guard=false;view_unseen_frontiers=false;grid_candidate=false;"
+    "vanish_on_frontier=false;shuttle_guard_holds_grid=false;room_beyond_gaps=false;"
+    "drop_each_point=false;semantic_grid_route=false]"
+)
+#: The README's spec for the expert before (shuttle guard and views still on).
+SIX_SWITCH_SPEC = (
+    "semantic[grid_candidate=false;vanish_on_frontier=false;shuttle_guard_holds_grid=false;"
+    "room_beyond_gaps=false;drop_each_point=false;semantic_grid_route=false]"
+)
+#: A small world on which the 0.2.0 expert and today's differ.
+WORLD = "office:seed=0,size_m=8"
+#: The 0.2.0 release's own code on WORLD (semexplore explore --world WORLD --max-time-s 300
+#: --json, seed 0, run from the 0.2.0 sources): what semantic-v2 must give.
+RELEASE_0_2_0 = {"mission_time_s": 117.2, "path_length_m": 24.989, "coverage": 1.0}
+
+
+def test_the_names_resolve_to_versions() -> None:
+    assert list(EXPERT_VERSIONS) == ["semantic-v2", "semantic-v3"]
+    assert LATEST_EXPERT == "semantic-v3"
+    assert expert_version("semantic") == "semantic-v3"
+    assert expert_version("semantic[cost.w_v=2]") == "semantic-v3"
+    assert expert_version("semantic[tuned]") == "semantic-v3"
+    assert expert_version("semantic-v2[cost.w_v=2]") == "semantic-v2"
+    assert expert_version("semantic-v3") == "semantic-v3"
+    for other in ("semantic-paper", "nearest", "frontier-student", "pretrained:frontier_value"):
+        assert expert_version(other) == ""
+
+
+def test_semantic_is_the_newest_version_and_todays_defaults() -> None:
+    newest = make_policy("semantic").params
+    assert make_policy("semantic-v3").params == newest == SemanticExpertParams()
+
+
+def test_semantic_v2_is_the_long_switch_spec_and_takes_overrides() -> None:
+    v2, today = make_policy("semantic-v2").params, SemanticExpertParams()
+    assert v2 == make_policy(LONG_SPEC).params != today
+    # Only on/off switches differ from today's defaults: the 0.2.0 expert's values are today's.
+    changed = {f.name for f in fields(v2) if getattr(v2, f.name) != getattr(today, f.name)}
+    assert changed == set(EXPERT_VERSIONS["semantic-v2"].layer)
+    assert all(getattr(today, k) is True for k in changed)
+    tuned = make_policy("semantic-v2[cost.w_v=2]").params
+    assert tuned == replace(v2, cost=replace(v2.cost, w_v=2.0))
+
+
+def test_an_unknown_version_is_a_clear_error() -> None:
+    with pytest.raises(ValueError, match="unknown policy 'semantic-v9'.*semantic-v2"):
+        make_policy("semantic-v9")
+    with pytest.raises(ValueError, match="semantic-v2.*bogus"):
+        make_policy("semantic-v2[bogus=1]")
+
+
+def _explore(policy: str, capsys: pytest.CaptureFixture[str]) -> dict:
+    argv = ["explore", "--world", WORLD, "--policy", policy, "--max-time-s", "300"]
+    assert main([*argv, "--json", "--no-progress"]) == 0
+    return json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+
+
+@pytest.mark.slow
+def test_semantic_v2_runs_by_name_as_the_0_2_0_release_did(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    v2 = _explore("semantic-v2", capsys)
+    assert v2["policy_version"] == "semantic-v2"
+    assert {k: v2[k] for k in RELEASE_0_2_0} == RELEASE_0_2_0
+    long_spec = _explore(LONG_SPEC, capsys)
+    assert long_spec["policy_version"] == "semantic-v3"  # today's expert with switches set
+    assert {k: long_spec[k] for k in RELEASE_0_2_0} == RELEASE_0_2_0
+
+
+@pytest.mark.slow
+def test_the_shuttle_guard_and_the_views_came_after_0_2_0_too(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Six switches off (the spec the docs gave for "the expert before") is not the 0.2.0
+    expert: the shuttle guard and the views of unseen frontiers came after it as well. On maze2
+    the 0.2.0 release's code took 261.0 s over 54.885 m (the same command from its sources)."""
+    argv = ["explore", "--world", "maze2", "--max-time-s", "1200", "--json", "--no-progress"]
+    runs = {}
+    for spec in ("semantic-v2", SIX_SWITCH_SPEC):
+        assert main([*argv, "--policy", spec]) == 0
+        runs[spec] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    release = {"mission_time_s": 261.0, "path_length_m": 54.885}
+    assert {k: runs["semantic-v2"][k] for k in release} == release
+    assert {k: runs[SIX_SWITCH_SPEC][k] for k in release} != release
+
+
+@pytest.mark.slow
+def test_semantic_runs_semantic_v3_by_name(capsys: pytest.CaptureFixture[str]) -> None:
+    newest_run, v3 = _explore("semantic", capsys), _explore("semantic-v3", capsys)
+    assert newest_run["policy_version"] == v3["policy_version"] == "semantic-v3"
+    keys = ("mission_time_s", "path_length_m", "coverage", "stop_reason")
+    assert {k: newest_run[k] for k in keys} == {k: v3[k] for k in keys}
+    assert v3["mission_time_s"] != RELEASE_0_2_0["mission_time_s"]  # the versions differ here
+
+
+def test_benchmark_rows_and_summary_state_the_version(tmp_path: Path) -> None:
+    out = tmp_path / "bench"
+    argv = ["benchmark", "--worlds", "maze:seed=0,size_m=3", "--runs", "1", "--max-time-s", "5"]
+    policies = "semantic,semantic-v2[cost.w_v=2],nearest"
+    code = main([*argv, "--policies", policies, "--no-plots", "--no-progress", "--out", str(out)])
+    assert code == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = {r["policy"]: r["policy_version"] for r in csv.DictReader(f)}
+    assert rows == {
+        "semantic": "semantic-v3",
+        "semantic-v2[cost.w_v=2]": "semantic-v2",
+        "nearest": "",
+    }
+    summary = (out / "summary.md").read_text()
+    assert (
+        "Expert versions: `semantic` = semantic-v3, `semantic-v2[cost.w_v=2]` = semantic-v2."
+        in (summary)
+    )
+
+
+def test_pretrained_details_name_the_expert_version(capsys: pytest.CaptureFixture[str]) -> None:
+    from semexplore_gym.policies.pretrained import pretrained_models
+
+    assert main(["pretrained", "--details"]) == 0
+    out = capsys.readouterr().out
+    models = pretrained_models()
+    assert all(m.expert_version == "semantic-v2" for m in models)  # all measured before 0.3.0
+    assert out.count("expert:     compared with semantic-v2 (the expert of its time)") == len(
+        models
+    )
+    assert all(m.to_dict()["expert_version"] == "semantic-v2" for m in models)
