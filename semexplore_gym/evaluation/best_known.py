@@ -44,6 +44,8 @@ COLUMNS: tuple[str, ...] = (
 SECTION_TITLE = "## Against the best known"
 #: A mission beats the best known when its T99 is below it by more than this share.
 BEAT_MARGIN = 0.005
+#: ``semexplore explore``'s time limit when ``--max-time-s`` is not given.
+EXPLORE_DEFAULT_LIMIT_S = 1200.0
 _FLOAT_COLUMNS = ("T99_s", "D99_m", "lower_bound_s", "lower_bound_m")
 _STARTS = ("random", "fixed")
 
@@ -187,8 +189,11 @@ def reproduce_command(row: dict[str, Any]) -> str:
         "--seed",
         str(int(row["seed"])),
     ]
-    if row.get("start") == "fixed":
-        parts.append("--fixed-start")
+    random = "false" if row.get("start") == "fixed" else "true"
+    parts += ["--env-set", f"episode.random_start={random}"]
+    limit = _finite(row.get("mission_time_s"))
+    if limit is not None and limit > EXPLORE_DEFAULT_LIMIT_S:
+        parts += ["--max-time-s", str(math.ceil(limit))]
     return " ".join(shlex.quote(p) for p in parts) + " --json"
 
 

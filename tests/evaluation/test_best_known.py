@@ -127,8 +127,10 @@ def test_a_beat_comes_with_the_command_that_reproduces_it():
     cmd = reproduce_command(beat)
     assert cmd == (
         "semexplore explore --world maze:seed=1,size_m=5 --policy 'semantic[cost.w_v=2]' "
-        "--seed 3 --fixed-start --json"
+        "--seed 3 --env-set episode.random_start=false --json"
     )
+    long = reproduce_command({**beat, "start": "random", "mission_time_s": 2400.4})
+    assert long.endswith("--env-set episode.random_start=true --max-time-s 2401 --json")
     lines = summary_lines([], [{**beat, "best_known_T99_s": 200.0}], 2)
     assert any(cmd in line and "150.0 s (best known 200.0 s)" in line for line in lines)
 
@@ -159,7 +161,10 @@ def test_benchmark_compares_with_a_table_and_writes_the_updated_one(tmp_path, ca
     capsys.readouterr()
     text = (tmp_path / "run" / "summary.md").read_text()
     assert SECTION_TITLE in text and "New best known (1 mission beat" in text
-    assert "semexplore explore --world maze:seed=1,size_m=4 --policy nearest --seed 0" in text
+    assert (
+        "semexplore explore --world maze:seed=1,size_m=4 --policy nearest --seed 0 "
+        "--env-set episode.random_start=true --json"
+    ) in text
     updated = read_table(tmp_path / "run" / "best_known.csv")[(world, 0, "random")]
     assert updated["T99_policy"] == "nearest" and updated["T99_s"] < 1e4
     assert updated["lower_bound_s"] == 1.0
