@@ -47,6 +47,7 @@ def user_file(tmp_path):
 def test_py_spec_loads_a_class_from_a_file_with_overrides(user_file) -> None:
     p = make_policy(f"py:{user_file}:Spinner", turn=-0.75)
     assert isinstance(p, Policy) and p.name == "spinner"
+    p.reset({}, {})
     assert p.act({}, {}).tolist() == [0.0, -0.75]
     # the file is imported once per process: a second policy shares the class
     q = make_policy(f"py:{user_file}:Spinner")
@@ -56,6 +57,7 @@ def test_py_spec_loads_a_class_from_a_file_with_overrides(user_file) -> None:
 def test_py_spec_loads_a_factory_from_a_module(user_file, monkeypatch) -> None:
     monkeypatch.syspath_prepend(str(user_file.parent))
     p = make_policy("py:my_planner:make_spinner[mine]")
+    p.reset({}, {})
     assert p.act({}, {}).tolist() == [0.0, 0.25]
 
 
