@@ -91,8 +91,8 @@ def test_benchmark_runs_a_user_policy_next_to_a_builtin(user_file, tmp_path, cap
     spec = f"py:{user_file}:Spinner[spin]"
     argv = ["benchmark", "--worlds", "maze:size_m=3", "--policies", f"random,{spec}"]
     argv += ["--runs", "1", "--max-time-s", "4", "--out", str(out), "--no-progress", "--no-plots"]
-    assert main(argv) == 0
-    assert json.loads(capsys.readouterr().out.splitlines()[0])["failed"] == 0
+    assert main([*argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["failed"] == 0
     rows = {r["policy"]: r for r in read_runs(out / "runs.csv")}
     assert set(rows) == {"random", spec}
     # spinning on the spot: no distance travelled, unlike the random policy
