@@ -78,7 +78,23 @@ def test_a_reset_that_fails_leaves_the_policy_unusable(env) -> None:
         policy.act(obs, info)
 
 
-@pytest.mark.parametrize("name", ["greedy", "semantic"])
+TEAM_NAMES = [
+    "independent",
+    "greedy",
+    "coordinated",
+    "coordinated_nobranch",
+    "semantic",
+    "semantic_nosem",
+]
+
+
+def test_every_team_policy_is_covered() -> None:
+    from semexplore_gym.policies.team import team_policy_names
+
+    assert sorted(TEAM_NAMES) == sorted(team_policy_names())
+
+
+@pytest.mark.parametrize("name", TEAM_NAMES)
 def test_team_policies_say_the_same(name) -> None:
     pytest.importorskip("pettingzoo")
     from semexplore_gym.policies.team import make_team_policy
