@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import abc
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -101,6 +103,58 @@ def read_env_facts(info: dict[str, Any], policy_name: str) -> EnvFacts:
         ) from None
 
 
+class PolicyNotResetError(RuntimeError):
+    """``act`` was called before the policy's first ``reset``: a policy needs the episode's
+    first observation and ``info`` (the map frame, the robot's limits) before it can act."""
+
+
+#: The flag a policy instance carries once its ``reset`` has run to the end.
+RESET_DONE_ATTR = "_reset_done"
+
+
+def require_reset_before_act(cls: type) -> None:
+    """Make ``cls``'s own ``act`` raise :class:`PolicyNotResetError` until ``reset`` has run.
+
+    Wraps the ``reset`` and ``act`` that ``cls`` itself defines (not inherited ones, which are
+    wrapped where they are defined): ``reset`` marks the instance as reset when it returns,
+    whether or not it calls ``super().reset``; ``act`` checks the mark first. :class:`Policy`
+    and :class:`~semexplore_gym.policies.team.base.TeamPolicy` call it for every subclass.
+    """
+    for name, wrap in (("reset", _marking_reset), ("act", _checked_act)):
+        method = vars(cls).get(name)
+        if callable(method) and not getattr(method, "__isabstractmethod__", False):
+            setattr(cls, name, wrap(method))
+
+
+def _marking_reset(reset: Callable[..., Any]) -> Callable[..., Any]:
+    @functools.wraps(reset)
+    def marking_reset(self: Any, *args: Any, **kwargs: Any) -> Any:
+        setattr(self, RESET_DONE_ATTR, False)
+        try:
+            out = reset(self, *args, **kwargs)
+        except BaseException:
+            # A reset that fails part-way (after super().reset) leaves the policy unusable.
+            setattr(self, RESET_DONE_ATTR, False)
+            raise
+        setattr(self, RESET_DONE_ATTR, True)
+        return out
+
+    return marking_reset
+
+
+def _checked_act(act: Callable[..., Any]) -> Callable[..., Any]:
+    @functools.wraps(act)
+    def checked_act(self: Any, *args: Any, **kwargs: Any) -> Any:
+        if not getattr(self, RESET_DONE_ATTR, False):
+            raise PolicyNotResetError(
+                f"{type(self).__name__}.act: call reset(obs, info, seed=...) first, with the "
+                "observation and info of env.reset"
+            )
+        return act(self, *args, **kwargs)
+
+    return checked_act
+
+
 class Policy(abc.ABC):
     """A controller from observations to actions.
 
@@ -108,7 +162,8 @@ class Policy(abc.ABC):
     (including ``info["map_geometry"]`` and the robot limits), never the simulator.
 
     Lifecycle: ``reset(obs, info, seed=...)`` at the start of an episode, then
-    ``act(obs, info)`` each step. ``done`` turns True when the policy considers the mission
+    ``act(obs, info)`` each step (before the first ``reset``, ``act`` raises
+    :class:`PolicyNotResetError`). ``done`` turns True when the policy considers the mission
     over (``stop_reason`` says why); ``last_stats`` holds the compute times of the last step.
     """
 
@@ -120,11 +175,16 @@ class Policy(abc.ABC):
     #: unless a test shows the policy's missions identical with ``"copy"`` and ``"shared"``.
     reads_map_in_step_only: bool = False
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        require_reset_before_act(cls)
+
     def __init__(self) -> None:
         self.done: bool = False
         self.stop_reason: str = ""
         self.last_stats: StepStats = StepStats()
         self.rng: np.random.Generator = np.random.default_rng()
+        self._reset_done = False
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
@@ -164,3 +224,6 @@ class Policy(abc.ABC):
     def overlay(self) -> dict[str, Any]:
         """Drawing hints for the renderer (see :mod:`semexplore_gym.rendering`); empty by default."""
         return {}
+
+
+require_reset_before_act(Policy)  # its own reset marks too (subclasses that do not override it)

@@ -6,6 +6,7 @@ import abc
 from typing import Any
 
 import numpy as np
+from semexplore_gym.policies.base import require_reset_before_act
 
 
 class TeamPolicy(abc.ABC):
@@ -14,16 +15,22 @@ class TeamPolicy(abc.ABC):
     It sees what the robots see: each agent's observation and ``info``. Lifecycle:
     ``reset(observations, infos, seed=...)``, then ``act(observations, infos)`` each step,
     which returns ``{agent: action}``. ``done`` turns True when the team considers the mission
-    over (``stop_reason`` says why).
+    over (``stop_reason`` says why). Before the first ``reset``, ``act`` raises
+    :class:`~semexplore_gym.policies.base.PolicyNotResetError`.
     """
 
     name: str = "team"
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        require_reset_before_act(cls)
 
     def __init__(self) -> None:
         self.done = False
         self.stop_reason = ""
         self.agents: list[str] = []
         self.counters: dict[str, int] = {}
+        self._reset_done = False
 
     def reset(
         self,
@@ -63,3 +70,6 @@ class TeamPolicy(abc.ABC):
     def mission_metrics(self) -> dict[str, Any]:
         """Extra per-mission figures (name -> number); empty by default."""
         return {}
+
+
+require_reset_before_act(TeamPolicy)  # its own reset marks too (subclasses that do not override it)

@@ -67,8 +67,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
+    from semexplore_gym.cli._output import json_stdout
+
     try:
-        return int(args._run(args) or 0)
+        with json_stdout(args):
+            return int(args._run(args) or 0)
     except BrokenPipeError:
         # The reader went away (``semexplore segment ... --json | head``): stop quietly; point
         # stdout at /dev/null so the interpreter's final flush does not raise again.

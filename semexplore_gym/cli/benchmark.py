@@ -22,13 +22,13 @@ in every worker: use only files from sources you trust.
 from __future__ import annotations
 
 import argparse
-import json
 import shlex
 import sys
 from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.cli._output import add_json_flag, print_result
 from semexplore_gym.cli.world_lists import check_worlds, refuse_repeats, split_list, split_worlds
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import ParameterError
@@ -200,6 +200,7 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip figures")
+    add_json_flag(p, "the counts of missions run, skipped and failed and the report paths")
     p.add_argument(
         "--oracle",
         action=argparse.BooleanOptionalAction,
@@ -344,7 +345,9 @@ def _run(args: argparse.Namespace) -> int:
         if args.oracle:
             raise ValueError("--oracle is for single robots: the oracle has no team version")
 
-        return run_team_study(team_study_request(args))
+        report = run_team_study(team_study_request(args))
+        print_result(args, report, Path(report["summary"]).read_text())
+        return 1 if report["failed"] else 0
     policies = _split_policies(args.policies)
     if not policies:
         raise ValueError("--policies is empty")
@@ -390,18 +393,14 @@ def _run(args: argparse.Namespace) -> int:
         suites=[{"name": r["name"], "version": r["version"]} for r in suites] or None,
     )
     summary, plots = _write_reports(args, with_oracle)
-    print(
-        json.dumps(
-            {
-                "ran": res["ran"],
-                "skipped": res["skipped"],
-                "failed": len(res["failed"]),
-                "summary": str(summary),
-                "plots": [str(p) for p in plots],
-            }
-        )
-    )
-    print(Path(summary).read_text())
+    report = {
+        "ran": res["ran"],
+        "skipped": res["skipped"],
+        "failed": len(res["failed"]),
+        "summary": str(summary),
+        "plots": [str(p) for p in plots],
+    }
+    print_result(args, report, Path(summary).read_text())
     return 1 if res["failed"] else 0
 
 

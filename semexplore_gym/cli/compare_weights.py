@@ -42,6 +42,7 @@ from typing import Any
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.cli._output import add_json_flag, print_result
 from semexplore_gym.core.validation import short_repr
 from semexplore_gym.evaluation.errors import ParameterError
 
@@ -330,6 +331,7 @@ def _add_scoring_and_run_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="TPE sampler seed (default: %(default)s)")
     p.add_argument("--env-config", default=None, help="env config: preset name or YAML path")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    add_json_flag(p, "the tuned weights and the report paths")
     add_renamed_flag(p, "--config", "use --env-config (env config preset or YAML)")
     p.add_argument(
         "--workers",
@@ -502,22 +504,18 @@ def run(args: argparse.Namespace) -> int:
     table = summarise(rows, labels, args.target_coverage, args.penalty_s)
     csv_path, md_path = write_table(out, table, sets, agents)
     plot = write_boxplot(out, rows, labels)
-    print(
-        json.dumps(
-            {
-                "trials": len(result.trials),
-                "best_train_value": result.best_value,
-                "tuned": result.best_weights,
-                "tuned_is_paper": tuned_is_paper(sets),
-                "table": str(md_path),
-                "csv": str(csv_path),
-                "plot": str(plot),
-                "per_family": str(summary),
-                "failed": len(res["failed"]),
-            }
-        )
-    )
-    print(md_path.read_text())
+    report = {
+        "trials": len(result.trials),
+        "best_train_value": result.best_value,
+        "tuned": result.best_weights,
+        "tuned_is_paper": tuned_is_paper(sets),
+        "table": str(md_path),
+        "csv": str(csv_path),
+        "plot": str(plot),
+        "per_family": str(summary),
+        "failed": len(res["failed"]),
+    }
+    print_result(args, report, md_path.read_text())
     if tuned_is_paper(sets):
         print(TUNED_IS_PAPER_NOTE.replace("`", ""), file=sys.stderr)
     return 1 if res["failed"] else 0

@@ -12,11 +12,11 @@ Example::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag, check_output_flag
+from semexplore_gym.cli._output import print_json
 from semexplore_gym.evaluation.warmup import COMPILE_ESTIMATE
 
 #: Keys of the ``--json`` object, in order.
@@ -206,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
     # The expert's named version the spec ran ("semantic" runs the newest); "" for other policies.
     summary["policy_version"] = expert_version(spec)
     if args.json:
-        print(json.dumps({k: summary[k] for k in JSON_KEYS}))
+        print_json(args, {k: summary[k] for k in JSON_KEYS})
     else:
         print(format_result(summary))
     if args.gif:
@@ -252,7 +252,7 @@ def run_team(args: argparse.Namespace) -> int:
         env.close()
     row = res.row()
     if args.json:
-        print(json.dumps(row))
+        print_json(args, row)
     else:
         print("\n".join(f"{k:<17}{row[k]}" for k in row))
     if args.gif:

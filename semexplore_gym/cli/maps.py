@@ -16,6 +16,9 @@ import argparse
 import os
 import sys
 from pathlib import Path
+from typing import Any
+
+from semexplore_gym.cli._output import add_json_flag, print_json
 
 MIRROR_ENV = "SEMEXPLORE_MAPS_MIRROR"
 
@@ -70,6 +73,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     path.add_argument("name", nargs="?", default=None, metavar="NAME")
     p.set_defaults(_maps_parser=p)
+    add_json_flag(lst, "the catalogue (each map's name, size, licence, source and files)")
+    add_json_flag(get, "each map's name and the world file it now loads")
+    add_json_flag(path, "the path")
     for action in (lst, get, path):
         action.set_defaults(_prog=action.prog)  # errors read "semexplore maps get: error: ..."
     return p
@@ -79,9 +85,14 @@ def _size(n_bytes: int) -> str:
     return f"{n_bytes / 1024:.0f} KB" if n_bytes < 1024 * 1024 else f"{n_bytes / 2**20:.1f} MB"
 
 
-def _list(files: bool = False) -> int:
+def _list(args: argparse.Namespace) -> int:
     from semexplore_gym.maps.catalogue import CATALOGUE
 
+    if args.json:
+        maps = [_entry_record(m) for m in CATALOGUE.values()]
+        print_json(args, {"maps": maps})
+        return 0
+    files = args.files
     rows = [(m.name, _size(m.size_bytes), m.licence, m.source) for m in CATALOGUE.values()]
     widths = [max(len(r[i]) for r in rows) for i in range(3)]
     for entry, (name, size, licence, source) in zip(CATALOGUE.values(), rows, strict=True):
@@ -90,6 +101,18 @@ def _list(files: bool = False) -> int:
             where = entry.url(f) or "written by this package (the source has none)"
             print(f"    {f.filename}  sha256 {f.sha256}  {where}")
     return 0
+
+
+def _entry_record(entry: Any) -> dict[str, Any]:
+    """A catalogue entry for ``maps list --json``."""
+    files = [{"filename": f.filename, "sha256": f.sha256, "url": entry.url(f)} for f in entry.files]
+    return {
+        "name": entry.name,
+        "size_bytes": entry.size_bytes,
+        "licence": entry.licence,
+        "source": entry.source,
+        "files": files,
+    }
 
 
 def _expand_patterns(names: list[str]) -> list[str]:
@@ -124,6 +147,7 @@ def _get(args: argparse.Namespace) -> int:
     for name in args.names:
         get_catalogue_map(name)  # unknown names fail before anything is fetched
     root = Path(args.dir).expanduser() if args.dir else maps_cache_dir()
+    fetched: dict[str, str] = {}
     for name in args.names:
         try:
             if args.from_dir:
@@ -140,20 +164,28 @@ def _get(args: argparse.Namespace) -> int:
 
             print(f"{error_prefix(args)} {e}", file=sys.stderr)
             return 1
-        print(f"{name}: {world}")
+        fetched[name] = str(world)
+        if not args.json:
+            print(f"{name}: {world}")
+    if args.json:
+        print_json(args, {"maps": fetched})
     return 0
 
 
 def _path(args: argparse.Namespace) -> int:
     from semexplore_gym.maps.catalogue import maps_cache_dir, resolve_map_file
 
-    print(resolve_map_file(args.name) if args.name else maps_cache_dir())
+    where = resolve_map_file(args.name) if args.name else maps_cache_dir()
+    if args.json:
+        print_json(args, {"path": str(where)})
+    else:
+        print(where)
     return 0
 
 
 def run(args: argparse.Namespace) -> int:
     if args.maps_action == "list":
-        return _list(args.files)
+        return _list(args)
     if args.maps_action == "get":
         return _get(args)
     if args.maps_action == "path":

@@ -18,9 +18,10 @@ Example::
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from typing import Any
+
+from semexplore_gym.cli._output import print_json
 
 #: Keys of the ``--json`` object, in order.
 JSON_KEYS: tuple[str, ...] = (
@@ -129,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
     except ImportError as e:  # the optional solver: one line saying what to install
         raise ValueError(str(e)) from None
     if args.json:
-        print(json.dumps(out))
+        print_json(args, out)
     else:
         print(
             f"{out['world']} (start seed {out['start_seed']}): tour {out['tour_length_m']} m, "

@@ -16,7 +16,8 @@ Example::
 from __future__ import annotations
 
 import argparse
-import json
+
+from semexplore_gym.cli._output import print_json
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     models = pretrained_models()
     if args.json:
-        print(json.dumps([m.to_dict() for m in models], indent=2))
+        print_json(args, [m.to_dict() for m in models], indent=2)
         return 0
     for i, m in enumerate(models):
         if args.details:

@@ -24,6 +24,7 @@ import numpy as np
 
 from semexplore_gym.cli import describe
 from semexplore_gym.cli._flags import check_output_flag
+from semexplore_gym.cli._output import print_json
 from semexplore_gym.core.grid import FREE, OCCUPIED, GridGeometry
 from semexplore_gym.core.validation import short_repr
 
@@ -217,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
         Path(args.export).write_text(json.dumps(to_json_dict(tmap)))
         print(f"wrote {args.export}", file=sys.stderr)
     if args.json:
-        print(json.dumps(summary(tmap, name)))
+        print_json(args, summary(tmap, name))
     else:
         c = tmap.counts()
         print(

@@ -11,7 +11,6 @@ Example::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from typing import TYPE_CHECKING, cast
@@ -19,6 +18,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from semexplore_gym.cli import describe
+from semexplore_gym.cli._output import print_json
 
 if TYPE_CHECKING:
     from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         "out": args.out,
     }
     if args.json:
-        print(json.dumps(facts))
+        print_json(args, facts)
     else:
         print(
             f"{world.name}: {facts['size_m'][0]} x {facts['size_m'][1]} m, {world.n_segments} wall segments, "

@@ -43,6 +43,7 @@ from typing import Any
 import yaml
 
 from semexplore_gym.cli._flags import add_renamed_flag
+from semexplore_gym.cli._output import add_json_flag, print_result
 from semexplore_gym.config import ConfigError, to_dict
 from semexplore_gym.evaluation.errors import ParameterError
 
@@ -82,6 +83,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="override a config key, e.g. bc.epochs=5 (repeatable)",
     )
     p.add_argument("--no-progress", action="store_true", help="no tqdm progress bars")
+    add_json_flag(p, "the run's metrics (as in OUT/metrics.json) and the model's path")
     add_renamed_flag(p, "--config", "use --train-config FILE (agent training config YAML)")
     add_renamed_flag(p, "--set", "use --train-set KEY=VALUE (training config override)")
     return p
@@ -132,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
     metrics["total_s"] = time.perf_counter() - t0
     metrics["model"] = str(out / "model.zip")
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
-    print(json.dumps({k: v for k, v in metrics.items() if k != "dagger_rounds"}, default=float))
+    print_result(args, {k: v for k, v in metrics.items() if k != "dagger_rounds"})
     return 0
 
 
@@ -176,7 +178,7 @@ def _run_without_torch(args: argparse.Namespace, load: Any, train: Any) -> int:
     final = train(cfg, out, log=lambda line: print(line, flush=True))
     metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
-    print(json.dumps(metrics, default=float))
+    print_result(args, metrics)
     return 0
 
 

@@ -41,6 +41,7 @@ inter-process messaging; on a busy 2-core machine it is slower than a plain loop
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from copy import deepcopy
 from typing import Any, cast
 
@@ -421,6 +422,7 @@ def make_vector_env(
     autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
     max_episode_steps: int | None = None,
     env_id: str = "SemanticExplore-v0",
+    wrappers: Sequence[Callable[[gym.Env], gym.Env]] = (),
     **env_kwargs: Any,
 ) -> FastSyncVectorEnv:
     """``gym.make_vec("SemanticExplore-v0", num_envs=4, ...)``: the registered vector entry point.
@@ -430,9 +432,17 @@ def make_vector_env(
     batch; their maps must have the same shape, as every batch's). A procedural spelling without
     ``seed=`` (``"maze:size_m=6"``) already gives each env its own world, drawn from its reset
     seed. gymnasium's vector options come as keywords here (``make_vec`` refuses
-    ``vector_kwargs`` and ``wrappers`` for a vector entry point): ``copy`` and
-    ``autoreset_mode``. For wrappers per env, use ``vectorization_mode="sync"`` (gymnasium's
-    ``SyncVectorEnv``) or build ``FastSyncVectorEnv([...])`` yourself.
+    ``vector_kwargs`` and ``wrappers`` for a vector entry point, before this function runs):
+    ``copy`` and ``autoreset_mode``.
+
+    Wrappers per env: ``gym.make_vec(..., vectorization_mode="sync", wrappers=[...])``
+    (gymnasium's ``SyncVectorEnv``), or, with this batching, call this function directly::
+
+        make_vector_env(4, wrappers=[lambda e: FixedSizeMap(e, map_size=128)], world="maze2")
+
+    Args:
+        wrappers: Applied in order to each env after ``gym.make`` (as ``make_vec``'s
+            ``wrappers``); with any, the batch takes the general path, not the direct one.
     """
     if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
         raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
@@ -446,8 +456,15 @@ def make_vector_env(
     if max_episode_steps is not None:
         env_kwargs["max_episode_steps"] = max_episode_steps
 
-    def maker(world: Any) -> Any:
+    def maker(world: Any) -> Callable[[], gym.Env]:
         kwargs = env_kwargs if world is None else {**env_kwargs, "world": world}
-        return lambda: gym.make(env_id, **kwargs)
+
+        def make() -> gym.Env:
+            env = gym.make(env_id, **kwargs)
+            for wrap in wrappers:
+                env = wrap(env)
+            return env
+
+        return make
 
     return FastSyncVectorEnv([maker(w) for w in per_env], copy=copy, autoreset_mode=autoreset_mode)

@@ -298,9 +298,14 @@ def run_mission(
     | None = None,
     *,
     gif: GifOptions | None = None,
-    ignore_terminated: bool = False,
+    ignore_terminated: bool = True,
 ) -> MissionResult:
     """Run one mission of ``policy`` in ``env``.
+
+    By default the mission ends when the policy stops (``policy.done``), the env truncates or
+    ``max_time_s`` passes, not when the env's coverage goal is reached: the same stop as
+    ``semexplore explore`` and the benchmark harness, so one world, policy and seed give one
+    result everywhere. ``ignore_terminated=False`` ends it at the env's coverage goal instead.
 
     Args:
         env: A SemanticExplore env (``gym.make`` result, possibly wrapped, raw observations).
@@ -313,7 +318,8 @@ def run_mission(
         gif: Write an animated GIF of the mission (the env needs ``render_mode="rgb_array"``).
         ignore_terminated: Keep going when the env terminates (its coverage goal is reached),
             so that the mission lasts until the policy stops (or the time limit): the mission
-            time is then the policy's own. Truncation still ends the mission.
+            time is then the policy's own (the default). Truncation still ends the mission.
+            False: the env's coverage goal ends the mission too.
 
     Returns:
         The :class:`MissionResult`.

@@ -359,8 +359,13 @@ class TeamStudyRequest:
     plots: bool = True
 
 
-def run_team_study(req: TeamStudyRequest) -> int:
-    """Run the team benchmark of ``req``, write ``manifest.json`` and ``summary.md``, print them."""
+def run_team_study(req: TeamStudyRequest) -> dict[str, Any]:
+    """Run the team benchmark of ``req`` and write ``manifest.json`` and ``summary.md``.
+
+    Returns:
+        ``ran``, ``skipped``, ``failed`` (a count) and ``summary`` (the path of
+        ``summary.md``), what ``semexplore benchmark --robots`` prints.
+    """
     from semexplore_gym.policies.team import make_team_policy
 
     counts = list(req.robot_counts)
@@ -420,9 +425,7 @@ def run_team_study(req: TeamStudyRequest) -> int:
     summary = write_team_summary(out_dir)
     if req.plots:
         write_team_plot(out_dir)
-    print(json.dumps({**res, "failed": len(res["failed"]), "summary": str(summary)}))
-    print(summary.read_text())
-    return 1 if res["failed"] else 0
+    return {**res, "failed": len(res["failed"]), "summary": str(summary)}
 
 
 def _record_run(path: Path, entry: dict[str, Any]) -> None:

@@ -169,8 +169,14 @@ def evaluate_weights(
             env = make_env(resolve_world(world, int(seed)))
             try:
                 policy = make_policy("semantic", **dict(weights))
+                # The tuning objective is the time to the env's coverage goal.
                 res = run_mission(
-                    env, policy, seed=int(seed), max_time_s=max_time_s, progress=False
+                    env,
+                    policy,
+                    seed=int(seed),
+                    max_time_s=max_time_s,
+                    progress=False,
+                    ignore_terminated=False,
                 )
             finally:
                 env.close()

@@ -158,9 +158,10 @@ def test_compare_weights_tests_on_a_suite_as_benchmark_runs_it(tmp_path: Path, c
     argv = [
         "compare-weights", "--train-worlds", "maze:seed=*,size_m=4", "--test-suite", str(suite),
         "--trials", "1", "--train-runs", "1", "--train-max-time-s", "5", "--out", str(out),
+        "--json",
     ]  # fmt: skip
     assert main(argv) == 0  # progress bars on, as users run it
-    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    report = json.loads(capsys.readouterr().out)
     rows = list(csv.DictReader((out / "test" / "runs.csv").open()))
     # Every set on both worlds with the suite's runs (2) and start seeds (0, 1), not 1000+.
     assert len(rows) == 2 * 2 * len(weight_sets({}))

@@ -111,3 +111,26 @@ def test_explore_with_a_team_writes_a_team_gif(tmp_path, capsys):
     assert gif.stat().st_size > 0
     assert main(["explore", "--robots", "2", "--policy", "frontier", "--no-progress"]) == 2
     assert "team policy" in capsys.readouterr().err
+
+
+def test_explore_and_run_mission_give_one_answer_for_one_mission(capsys):
+    """Same world, policy and seed: the CLI's JSON and ``run_mission`` with its defaults agree.
+    On this world the env's coverage goal (99 %) comes before the expert stops itself: a
+    run_mission that stopped at the env's goal would report less coverage and time."""
+    import gymnasium as gym
+
+    from semexplore_gym import make_policy, run_mission
+
+    world = "maze:seed=3,size_m=4"
+    argv = ["explore", "--world", world, "--policy", "semantic", "--seed", "0"]
+    assert main([*argv, "--max-time-s", "300", "--json", "--no-progress"]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    env = gym.make("SemanticExplore-v0", world=world)
+    try:
+        res = run_mission(env, make_policy("semantic"), seed=0, max_time_s=300.0)
+    finally:
+        env.close()
+    assert cli["self_stopped"] and res.self_stopped
+    assert res.coverage == pytest.approx(cli["coverage"], abs=1e-4)
+    assert res.mission_time_s == pytest.approx(cli["mission_time_s"], abs=1e-6)
+    assert res.stop_reason == cli["stop_reason"]

@@ -218,3 +218,52 @@ def test_direct_steps_keep_each_env_map_in_its_batch_row(copy) -> None:
     finally:
         fast.close()
         ref.close()
+
+
+def _fixed_size(env: gym.Env) -> gym.Env:
+    from semexplore_gym.wrappers import FixedSizeMap
+
+    return FixedSizeMap(env, map_size=96)
+
+
+def test_make_vec_without_wrappers_keeps_the_batched_entry_point() -> None:
+    venv = gym.make_vec("SemanticExplore-v0", num_envs=2, world="maze:seed=3,size_m=4")
+    try:
+        assert type(venv) is FastSyncVectorEnv
+    finally:
+        venv.close()
+
+
+@pytest.mark.parametrize("mode", ["sync", "async", "make_vector_env"])
+def test_wrapped_envs_batch_in_every_mode_with_the_same_results(mode) -> None:
+    """``wrappers=`` in gymnasium's sync and async modes and in ``make_vector_env`` (the
+    project's batching) give the same wrapped batches as a loop over wrapped envs."""
+    from semexplore_gym.envs.vector import make_vector_env
+
+    world = "maze:seed=3,size_m=4"
+    if mode == "make_vector_env":
+        venv = make_vector_env(2, wrappers=[_fixed_size], world=world)
+        assert isinstance(venv, FastSyncVectorEnv)
+    else:
+        venv = gym.make_vec(
+            "SemanticExplore-v0",
+            num_envs=2,
+            vectorization_mode=mode,
+            wrappers=[_fixed_size],
+            world=world,
+        )
+    singles = [_fixed_size(gym.make("SemanticExplore-v0", world=world)) for _ in range(2)]
+    try:
+        obs, _ = venv.reset(seed=[3, 4])
+        expected = [e.reset(seed=s)[0] for e, s in zip(singles, (3, 4), strict=True)]
+        assert obs["map"].shape == (2, 1, 96, 96)
+        actions = np.tile(np.array([[0.6, 0.3]], dtype=np.float32), (2, 1))
+        for _ in range(5):
+            obs, *_ = venv.step(actions)
+            expected = [e.step(a)[0] for e, a in zip(singles, actions, strict=True)]
+        for key in obs:
+            assert np.array_equal(obs[key], np.stack([o[key] for o in expected])), key
+    finally:
+        venv.close()
+        for e in singles:
+            e.close()

@@ -27,9 +27,10 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
         "--out",
         str(out),
         "--no-progress",
+        "--json",
     ]
     assert main(argv) == 0
-    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    report = json.loads(capsys.readouterr().out)
     assert report["ran"] == 12 and report["failed"] == 0
     rows = read_runs(out / "runs.csv")
     assert len(rows) == 12
@@ -77,7 +78,7 @@ def test_small_benchmark_end_to_end(tmp_path, capsys) -> None:
     assert not np.allclose(start("semantic", 0), start("semantic", 1))
     # Same command again: everything is skipped.
     assert main(argv) == 0
-    assert json.loads(capsys.readouterr().out.splitlines()[0])["skipped"] == 12
+    assert json.loads(capsys.readouterr().out)["skipped"] == 12
 
 
 @pytest.mark.slow

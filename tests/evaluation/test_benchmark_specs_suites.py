@@ -210,9 +210,9 @@ def test_a_user_suite_runs_end_to_end_with_family_tables(tmp_path, capsys) -> No
     suite.write_text(SUITE_YAML)
     out = tmp_path / "s"
     argv = _bench(out, "--suite", str(suite), "--policies", "semantic,nearest")
-    argv_short = [*argv, "--max-time-s", "4"]
+    argv_short = [*argv, "--max-time-s", "4", "--json"]
     assert main(argv_short) == 0
-    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    report = json.loads(capsys.readouterr().out)
     assert report["ran"] == 8 and report["failed"] == 0  # 2 worlds x 2 policies x 2 runs
     rows = read_runs(out / "runs.csv")
     assert {r["world"] for r in rows} == {"maze:seed=1,size_m=4", "cave:seed=2,size_m=6"}
@@ -234,7 +234,7 @@ def test_a_user_suite_runs_end_to_end_with_family_tables(tmp_path, capsys) -> No
     assert fingerprint["suites"] == [{"name": "tiny", "version": 2}]
     # Resumes; a changed suite version is refused.
     assert main(argv_short) == 0
-    assert json.loads(capsys.readouterr().out.splitlines()[0])["skipped"] == 8
+    assert json.loads(capsys.readouterr().out)["skipped"] == 8
     suite.write_text(SUITE_YAML.replace("version: 2", "version: 3"))
     assert main(argv_short) == 2
     assert "suite tiny" in capsys.readouterr().err

@@ -91,8 +91,8 @@ def test_benchmark_with_the_oracle_writes_the_regret(tmp_path, capsys):
     assert main([*base, "--out", str(tmp_path / "plain")]) == 0
     assert not (tmp_path / "plain" / "regret.csv").exists()  # off by default without --suite
     capsys.readouterr()
-    assert main([*base, "--oracle", "--out", str(tmp_path / "with")]) == 0
-    report = json.loads(capsys.readouterr().out.splitlines()[0])
+    assert main([*base, "--oracle", "--out", str(tmp_path / "with"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
     assert report["failed"] == 0
     rows = read_runs(tmp_path / "with" / "runs.csv")
     oracle = next(r for r in rows if r["policy"] == "oracle")

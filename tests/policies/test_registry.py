@@ -47,6 +47,7 @@ def user_file(tmp_path):
 def test_py_spec_loads_a_class_from_a_file_with_overrides(user_file) -> None:
     p = make_policy(f"py:{user_file}:Spinner", turn=-0.75)
     assert isinstance(p, Policy) and p.name == "spinner"
+    p.reset({}, {})
     assert p.act({}, {}).tolist() == [0.0, -0.75]
     # the file is imported once per process: a second policy shares the class
     q = make_policy(f"py:{user_file}:Spinner")
@@ -56,6 +57,7 @@ def test_py_spec_loads_a_class_from_a_file_with_overrides(user_file) -> None:
 def test_py_spec_loads_a_factory_from_a_module(user_file, monkeypatch) -> None:
     monkeypatch.syspath_prepend(str(user_file.parent))
     p = make_policy("py:my_planner:make_spinner[mine]")
+    p.reset({}, {})
     assert p.act({}, {}).tolist() == [0.0, 0.25]
 
 
@@ -89,8 +91,8 @@ def test_benchmark_runs_a_user_policy_next_to_a_builtin(user_file, tmp_path, cap
     spec = f"py:{user_file}:Spinner[spin]"
     argv = ["benchmark", "--worlds", "maze:size_m=3", "--policies", f"random,{spec}"]
     argv += ["--runs", "1", "--max-time-s", "4", "--out", str(out), "--no-progress", "--no-plots"]
-    assert main(argv) == 0
-    assert json.loads(capsys.readouterr().out.splitlines()[0])["failed"] == 0
+    assert main([*argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["failed"] == 0
     rows = {r["policy"]: r for r in read_runs(out / "runs.csv")}
     assert set(rows) == {"random", spec}
     # spinning on the spot: no distance travelled, unlike the random policy
