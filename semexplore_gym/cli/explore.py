@@ -23,6 +23,8 @@ from semexplore_gym.evaluation.warmup import COMPILE_ESTIMATE
 JSON_KEYS: tuple[str, ...] = (
     "coverage",
     "mission_time_s",
+    "T90_s",
+    "T99_s",
     "self_stopped",
     "stop_reason",
     "path_length_m",

@@ -156,6 +156,7 @@ def merge_runs(
     A key new to the table gets an entry from its best mission (its bounds stay empty).
     """
     new = {k: dict(v) for k, v in table.items()}
+    rows = [{**r, "policy": versioned_spec(r)} for r in rows]
     beats: list[dict[str, Any]] = []
     for r in rows:
         key = (str(r["world"]), int(r["seed"]), start)
@@ -175,6 +176,16 @@ def merge_runs(
         if d99 is not None and (entry["D99_m"] is None or d99 < entry["D99_m"]):
             entry["D99_m"], entry["D99_policy"] = round(d99, 3), r["policy"]
     return new, beats
+
+
+def versioned_spec(row: dict[str, Any]) -> str:
+    """The row's policy spec with the expert's version name for ``semantic`` (which moves on
+    to each newer version): ``semantic[cost.w_v=2]`` that ran ``semantic-v3`` is
+    ``semantic-v3[cost.w_v=2]``, which means the same in every later release."""
+    spec, version = str(row["policy"]), row.get("policy_version")
+    if version and (spec == "semantic" or spec.startswith("semantic[")):
+        return str(version) + spec[len("semantic") :]
+    return spec
 
 
 def reproduce_command(row: dict[str, Any]) -> str:

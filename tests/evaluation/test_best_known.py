@@ -103,6 +103,19 @@ def test_merging_keeps_the_best_and_lists_what_beat_the_table():
     assert merge_runs(TABLE, rows, "fixed")[1] == []
 
 
+def test_the_table_names_the_expert_version_a_mission_ran():
+    rows = [
+        {
+            **_row("maze:seed=1", "semantic[cost.w_v=2]", 0, 100.0, 5.0),
+            "policy_version": "semantic-v3",
+        },
+        {**_row("cave:seed=2", "semantic", 0, 50.0, 10.0), "policy_version": "semantic-v3"},
+    ]
+    merged, _ = merge_runs(TABLE, rows, "random")
+    assert merged[("maze:seed=1", 0, "random")]["T99_policy"] == "semantic-v3[cost.w_v=2]"
+    assert merged[("cave:seed=2", 0, "random")]["D99_policy"] == "semantic-v3"
+
+
 def test_ratios_flag_a_mission_below_the_bound():
     rows = [
         _row("maze:seed=1", "semantic", 0, 300.0, 66.0),
