@@ -26,6 +26,7 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.evaluation.backends import mission_stream
 from semexplore_gym.evaluation.errors import ParameterError
 from semexplore_gym.evaluation.mission_task import mission_row, run_task
@@ -78,6 +79,8 @@ __all__ = [
 def _check_run_args(tasks: list[Task], workers: int, backend: str) -> None:
     if backend not in ("process", "ray"):
         raise ParameterError("backend", f"{{param}} must be 'process' or 'ray', got {backend!r}")
+    if backend == "ray":
+        require_extra("ray", 'backend "ray"', "ray")  # before any output or mission
     if workers < 1:
         raise ParameterError("workers", f"{{param}} must be >= 1, got {workers!r}")
     if len({t.key for t in tasks}) != len(tasks):
