@@ -417,6 +417,28 @@ def test_the_readme_shows_the_users_commands() -> None:
     assert not [c for c in commands if any("../shared" in a for a in c)]
 
 
+def test_getting_started_lists_every_extra() -> None:
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    extras = set(project["optional-dependencies"]) - {"dev"}
+    text = (REPO / "docs" / "getting-started.md").read_text(encoding="utf-8")
+    listed = re.search(r"^The extras:(.*?)\n\n", text, re.S | re.M)
+    assert listed is not None, "docs/getting-started.md has no 'The extras:' paragraph"
+    missing = sorted(e for e in extras if f"`{e}` (" not in listed.group(1))
+    assert not missing, f"getting-started's extras list lacks {missing}"
+    dev = re.search(r"`dev` = (.*?) and the tools", text, re.S)
+    assert dev is not None and all(f"`{e}`" in dev.group(1) for e in extras), dev
+
+
+def test_user_docs_carry_no_notes_about_the_projects_own_machines() -> None:
+    """Notes about this project's machines (a torch wheel on disk) live in DEVELOPERS.md."""
+    for page in doc_pages():
+        text = page.read_text(encoding="utf-8")
+        assert "torch==2.13.0" not in text and "project's own" not in text, _rel(page)
+    assert "torch==2.13.0" in (REPO / "DEVELOPERS.md").read_text(encoding="utf-8")
+
+
 def test_real_map_commands_are_recognised() -> None:
     assert needs_real_maps(["semexplore", "benchmark", "--suite", "paper,real"])
     assert needs_real_maps(["semexplore", "explore", "--world", "map:tb3-world"])
