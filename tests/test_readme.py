@@ -439,6 +439,36 @@ def test_user_docs_carry_no_notes_about_the_projects_own_machines() -> None:
     assert "torch==2.13.0" in (REPO / "DEVELOPERS.md").read_text(encoding="utf-8")
 
 
+#: Flags whose value is a path a command writes.
+OUTPUT_FLAGS = ("--out", "--gif", "--figure", "--out-dir", "--csv", "--json-out")
+
+
+def _writes_into_docs(argv: list[str]) -> list[str]:
+    """The paths under ``docs/`` that a documented command would write (given or by default)."""
+    paths = [v for flag, v in zip(argv, argv[1:], strict=False) if flag in OUTPUT_FLAGS]
+    paths += [a.split("=", 1)[1] for a in argv if "=" in a and a.split("=", 1)[0] in OUTPUT_FLAGS]
+    bad = [p for p in paths if Path(os.path.normpath(p)).parts[:1] == ("docs",)]
+    if argv[0] == "python":  # a script's own default output paths
+        source = (REPO / argv[1]).read_text(encoding="utf-8")
+        bad += re.findall(r"default=[\"'](docs/[^\"']*)", source)
+    return bad
+
+
+def test_no_documented_command_writes_into_docs() -> None:
+    """Docs commands write under runs/; the committed figures change only through
+    scripts/make_figures.py."""
+    assert _writes_into_docs(["semexplore", "explore", "--gif", "docs/figures/x.gif"])
+    assert _writes_into_docs(["semexplore", "benchmark", "--out=./docs/r"])
+    assert not _writes_into_docs(["semexplore", "explore", "--gif", "runs/x.gif"])
+    found = []
+    for b in all_blocks():
+        if b.lang == "bash":
+            for argv in bash_commands(b.body):
+                if is_runnable(argv) and _writes_into_docs(argv):
+                    found.append(f"{b.page}:{b.line}: {shlex.join(argv)}")
+    assert not found, "documented commands write into docs/:\n" + "\n".join(found)
+
+
 def test_real_map_commands_are_recognised() -> None:
     assert needs_real_maps(["semexplore", "benchmark", "--suite", "paper,real"])
     assert needs_real_maps(["semexplore", "explore", "--world", "map:tb3-world"])
