@@ -348,7 +348,7 @@ def run_mission(
         )
         if bar is not None:  # the mission is over: the bar ends full, at the time reached
             bar.total = max(bar.n, 1e-9)
-            bar.set_postfix({"coverage": f"{info['coverage']:.3f}"}, refresh=True)
+            bar.refresh()
     except BaseException:
         if recorder is not None:
             recorder.abort()
