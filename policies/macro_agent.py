@@ -33,6 +33,7 @@ from semexplore_gym.policies.expert_driver import ExpertDriver
 from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 
 from semexplore_gym.config import build_params
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.core.features.macro import (
     MacroParams,
     action_mask,
@@ -122,6 +123,7 @@ class MacroAgentPolicy(Policy):
     ) -> None:
         super().__init__()
         path = Path(model_path)
+        require_extra("rl", f"the macro-action agent {str(path)!r}", "torch", "stable_baselines3")
         if not path.is_file():
             raise FileNotFoundError(f"no model file at {path}")
         run = run if run is not None else read_macro_run(path)
@@ -136,6 +138,7 @@ class MacroAgentPolicy(Policy):
             th.set_num_threads(int(num_threads))
         algo_cls: Any
         if run["algo"] == "maskable_ppo":
+            require_extra("rl", f"the macro-action agent {str(path)!r}", "sb3_contrib")
             from sb3_contrib import MaskablePPO
 
             algo_cls = MaskablePPO

@@ -31,6 +31,7 @@ import numpy as np
 from semexplore_gym.policies.base import Policy, StepStats
 from semexplore_gym.policies.sb3_model import learner_action, load_model
 
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.core.features.egocentric import EgocentricEncoder, EgocentricParams
 from semexplore_gym.core.features.map_window import MAP_ANCHORS, map_window, window_origin
 from semexplore_gym.core.grid import GridGeometry
@@ -136,6 +137,7 @@ class SB3Policy(Policy):
         map_anchor: str = "world",
     ) -> None:
         super().__init__()
+        require_extra("rl", f"the trained model {str(model_path)!r}", "torch", "stable_baselines3")
         if map_anchor not in MAP_ANCHORS:
             raise ValueError(f"map_anchor must be one of {MAP_ANCHORS}, got {map_anchor!r}")
         if num_threads is not None:

@@ -269,8 +269,9 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--quick", action="store_true", help="only the 7 m maze and the 10 m office")
-    ap.add_argument("--out", default="docs/figures/compute_scaling.csv")
-    ap.add_argument("--figure", default="docs/figures/compute_scaling.png")
+    # The committed copies in docs/figures/ are drawn by scripts/make_figures.py.
+    ap.add_argument("--out", default="runs/compute_scaling.csv")
+    ap.add_argument("--figure", default="runs/compute_scaling.png")
     args = ap.parse_args(argv)
     if args.worlds:
         worlds = list(args.worlds)

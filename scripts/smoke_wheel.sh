@@ -2,8 +2,9 @@
 # The package as a user gets it: build the wheel, install it (not editable) in a fresh venv, and
 # run the documented commands from a directory outside the repository, where nothing of the
 # checkout can be imported or read. Proves that the wheel carries its data (configs, suites,
-# pretrained models) and finds it through importlib.resources. Torch is not installed: the
-# tiny `train` is the torch-free frontier_value algorithm, run from the reproduce line that
+# pretrained models) and finds it through importlib.resources. No extra is installed (the
+# core dependencies only): the commands that need one must say which in one line and exit 2;
+# the tiny `train` is the torch-free frontier_value algorithm, run from the reproduce line that
 # `semexplore pretrained` prints.
 #
 #   scripts/smoke_wheel.sh            # .ci/run calls it; about 3 min on 2 idle cores
@@ -75,6 +76,34 @@ semexplore pretrained
 semexplore pretrained --json > pretrained.json
 semexplore explore --world 'maze:seed=2,size_m=4' --policy pretrained:frontier_value --max-time-s 10 \
   --no-progress --json
+
+step "a missing extra: one error line naming it, exit 2 (this venv has the core dependencies only)"
+"$VPY" -c "import importlib.util as u; m = [n for n in ('torch', 'stable_baselines3', 'optuna', 'pettingzoo', 'ray') if u.find_spec(n)]; assert not m, m"
+needs_extra() {  # needs_extra EXTRA semexplore ARGS...: exit 2, one stderr line naming EXTRA
+  local extra=$1 rc=0
+  shift
+  "$@" --no-progress 2> err.txt || rc=$?
+  if [ "$rc" -ne 2 ] || [ "$(grep -c . err.txt)" -ne 1 ] \
+    || ! grep -qF "needs the '$extra' extra" err.txt || ! grep -qF "pip install 'semexplore-gym[$extra]'" err.txt; then
+    echo "expected exit 2 and one line naming the '$extra' extra from: $* (exit $rc)"; cat err.txt; exit 1
+  fi
+}
+needs_extra rl semexplore explore --world maze1 --policy pretrained:dagger_maze
+needs_extra rl semexplore explore --world maze1 --policy sb3:x.zip
+needs_extra multi semexplore explore --world maze1 --robots 2
+needs_extra rl semexplore benchmark --policies pretrained:frontier_choice_maze --worlds maze1 --out extra1
+needs_extra ray semexplore benchmark --policies semantic --worlds maze1 --backend ray --out extra2
+needs_extra rl semexplore compare-weights --train-worlds maze1 --test-worlds maze2 --out extra3
+"$VPY" -c "
+from semexplore_gym import make_policy
+from semexplore_gym.config.extras import MissingExtraError
+try:
+    make_policy('pretrained:dagger_maze')
+except MissingExtraError as e:
+    assert e.extra == 'rl' and \"semexplore-gym[rl]\" in str(e), e
+else:
+    raise AssertionError('make_policy loaded a torch model without torch')
+"
 
 step "semexplore train (tiny), from the reproduce line of pretrained:frontier_value"
 REPRODUCE=$("$VPY" -c "import json; print(next(m['command'] for m in json.load(open('pretrained.json')) if m['name'] == 'frontier_value'))")

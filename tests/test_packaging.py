@@ -76,8 +76,9 @@ def test_the_command_runs_as_a_module() -> None:
 
 # -------------------------------------------------------------------------------------- wheel
 @pytest.fixture(scope="module")
-def wheel(tmp_path_factory: pytest.TempPathFactory) -> zipfile.ZipFile:
-    """The wheel, built from a copy of the sources (the checkout gets no build/ folder)."""
+def wheel_build(tmp_path_factory: pytest.TempPathFactory) -> tuple[zipfile.ZipFile, str]:
+    """The wheel, built from a copy of the sources (the checkout gets no build/ folder), and the
+    build's verbose output."""
     src = tmp_path_factory.mktemp("src")
     skip = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
     for name in ("semexplore_gym", "policies", "configs"):
@@ -85,7 +86,7 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> zipfile.ZipFile:
     for name in ("setup.py", "pyproject.toml", "README.md", "LICENSE"):
         shutil.copy(REPO / name, src / name)
     dist = tmp_path_factory.mktemp("dist")
-    cmd = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q"]
+    cmd = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-v"]
     out = subprocess.run(
         [*cmd, "-w", str(dist), str(src)], capture_output=True, text=True, timeout=600
     )
@@ -93,7 +94,22 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> zipfile.ZipFile:
         pytest.skip(f"cannot build a wheel here: {out.stderr.strip()[-300:]}")
     assert out.returncode == 0, out.stderr[-2000:]
     (path,) = dist.glob("semexplore_gym-*.whl")
-    return zipfile.ZipFile(path)
+    return zipfile.ZipFile(path), out.stdout + out.stderr
+
+
+@pytest.fixture(scope="module")
+def wheel(wheel_build: tuple[zipfile.ZipFile, str]) -> zipfile.ZipFile:
+    return wheel_build[0]
+
+
+def test_the_wheel_build_is_quiet_about_the_data_folders(
+    wheel_build: tuple[zipfile.ZipFile, str],
+) -> None:
+    """configs/ and policies/pretrained/ folders are declared, so setuptools does not print its
+    forty-line "Package would be ignored" notice for each of them."""
+    log = wheel_build[1]
+    assert "running build_py" in log  # the verbose output of setuptools is there
+    assert "would be ignored" not in log and "absent from the `packages`" not in log, log[-3000:]
 
 
 def test_the_wheel_installs_one_top_level_package(wheel: zipfile.ZipFile) -> None:

@@ -13,6 +13,8 @@ import re
 import sys
 from collections.abc import Sequence
 
+from semexplore_gym.config.extras import MissingExtraError
+
 #: Subcommand name -> module under ``semexplore_gym.cli``.
 SUBCOMMANDS: dict[str, str] = {
     "show-world": "show_world",
@@ -78,6 +80,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except MissingExtraError as e:
+        # An optional extra is not installed: its name and the pip line, no traceback.
+        print(f"{error_prefix(args)} {e}", file=sys.stderr)
+        return 2
     except (ValueError, OSError, KeyError, RecursionError, MemoryError) as e:
         # Bad input ends here as one short line; never a traceback or a flood of output.
         from semexplore_gym.core.validation import one_line

@@ -73,6 +73,18 @@ MAX_RUNS = 100_000
 MAX_WORKERS = 256
 
 
+def default_out(args: argparse.Namespace, now: float | None = None) -> str:
+    """``runs/<suite, split or worlds>-<YYYYmmdd-HHMMSS>``: where a run without ``--out``
+    writes (a new directory each time; the name says what ran)."""
+    import re
+    import time
+
+    what = args.suite or getattr(args, "split", None) or args.worlds or "bench"
+    slug = re.sub(r"[^A-Za-z0-9.]+", "_", str(what)).strip("_.")[:40] or "bench"
+    stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(now))
+    return f"runs/{slug}-{stamp}"
+
+
 def validate_args(args: argparse.Namespace) -> None:
     """Check the numbers and the output path before anything is loaded or run.
 
@@ -87,6 +99,9 @@ def validate_args(args: argparse.Namespace) -> None:
         raise ValueError(f"--seed0 must be in 0..2**32-1-runs, got {args.seed0}")
     if not (1 <= args.workers <= MAX_WORKERS):
         raise ValueError(f"--workers must be in 1..{MAX_WORKERS}, got {args.workers}")
+    if args.out is None:
+        args.out = default_out(args)
+        print(f"semexplore benchmark: writing to {args.out} (--out to choose)", file=sys.stderr)
     if args.max_time_s is not None and not (0 < args.max_time_s <= 1e7):
         raise ValueError(f"--max-time-s must be in (0, 1e7] s, got {args.max_time_s!r}")
     out = Path(args.out)
@@ -139,7 +154,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--seed0", type=int, default=0, help="first seed (default: %(default)s)")
     p.add_argument(
-        "--out", required=True, help="output directory; rerunning the same command resumes"
+        "--out",
+        default=None,
+        help="output directory; rerunning a command with the same --out resumes (default: "
+        "runs/<suite, split or worlds>-<date>-<time>, said on stderr)",
     )
     p.add_argument(
         "--max-time-s",

@@ -4,7 +4,7 @@ Example::
 
     semexplore maps list
     semexplore maps get tb3-world                       # into the cache, sha256-checked
-    semexplore maps get tb3-world --from ../shared/maps # offline: copy from a local directory
+    semexplore maps get tb3-world --from ~/maps         # offline: copy from your own folder
     semexplore maps get 'dungeon-test-*'                # a pattern: the 100 DungeonMaps test maps
     semexplore maps path tb3-world                      # where map:tb3-world is read from
     semexplore explore --world map:tb3-world
@@ -56,7 +56,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         dest="from_dir",
         default=None,
         metavar="DIR",
-        help="copy from a local directory (e.g. ../shared/maps) instead of downloading",
+        help="copy from a local directory holding the map's files (DIR/NAME/FILE or DIR/FILE) "
+        "instead of downloading",
     )
     get.add_argument(
         "--mirror",

@@ -45,6 +45,7 @@ import yaml
 from semexplore_gym.cli._flags import add_renamed_flag
 from semexplore_gym.cli._output import add_json_flag, print_result
 from semexplore_gym.config import ConfigError, to_dict
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.evaluation.errors import ParameterError
 
 ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value", "oracle_student")
@@ -106,15 +107,9 @@ def run(args: argparse.Namespace) -> int:
         return _run_frontier_value(args)
     if args.algo == "oracle_student":
         return _run_oracle_student(args)
-    try:
-        import stable_baselines3  # noqa: F401
-        import torch
-    except ImportError as e:
-        print(
-            f"semexplore train needs the rl extra: pip install 'semexplore-gym[rl]' ({e})",
-            file=sys.stderr,
-        )
-        return 2
+    require_extra("rl", f"semexplore train --algo {args.algo}", "torch", "stable_baselines3")
+    import torch
+
     from semexplore_gym.training.train_config import check_train_config, load_train_config
 
     try:

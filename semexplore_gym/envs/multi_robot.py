@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 from gymnasium.utils import seeding
-from pettingzoo import ParallelEnv
 
+from semexplore_gym.config.extras import MissingExtraError
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.disc_cast import DiscObstacles
 from semexplore_gym.core.mapping.map_merge import merge_grids
@@ -45,6 +45,13 @@ from semexplore_gym.envs.semantic_explore import (
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.team import TeamSim, sense_with_teammates
+
+try:
+    from pettingzoo import ParallelEnv
+except ModuleNotFoundError as e:  # PettingZoo is the multi extra
+    raise MissingExtraError(
+        "SemanticExploreMulti-v0 (the multi-robot env)", "multi", e.name or "pettingzoo"
+    ) from e
 
 ENV_ID = "SemanticExploreMulti-v0"
 #: Per-agent ``info`` numbers besides ``reward_terms`` (see ``_agent_info``).

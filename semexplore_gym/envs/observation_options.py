@@ -6,6 +6,9 @@ env's docstring, *Arguments* and *Speed*).
 
 from __future__ import annotations
 
+import difflib
+import inspect
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -56,13 +59,39 @@ class ObservationOptions:
         object.__setattr__(self, "map_window_cells", int(cells))
 
     @classmethod
-    def from_flags(cls, base: ObservationOptions | None, **flags: Any) -> ObservationOptions:
+    def from_flags(
+        cls,
+        base: ObservationOptions | None,
+        flags: Mapping[str, Any],
+        constructor: Callable[..., Any] | None = None,
+    ) -> ObservationOptions:
         """``base`` (or the defaults) with the fields named in ``flags`` replaced: the
         ``gym.make("SemanticExplore-v0", map_observation=...)`` spelling.
 
-        Raises:
-            TypeError: a name that is not a field.
-        """
-        from dataclasses import replace
+        Args:
+            base: The options to start from (None: the defaults).
+            flags: Option fields by name: the env's keyword arguments that it does not name.
+            constructor: The env's ``__init__``, whose named parameters the error lists.
 
+        Raises:
+            TypeError: a name that is neither a field nor a keyword of ``constructor``; the
+                message names it, a close match, and every valid keyword.
+        """
+        from dataclasses import fields, replace
+
+        options = [f.name for f in fields(cls)]
+        unknown = [name for name in flags if name not in options]
+        if unknown:
+            named = inspect.signature(constructor).parameters.values() if constructor else ()
+            valid = [
+                p.name
+                for p in named
+                if p.name != "self" and p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)
+            ] + options
+            close = difflib.get_close_matches(unknown[0], valid, n=1)
+            guess = f" (did you mean {close[0]!r}?)" if close else ""
+            raise TypeError(
+                f"unexpected keyword argument {unknown[0]!r}{guess}; the keywords are "
+                f"{', '.join(valid)}"
+            )
         return replace(base or cls(), **flags) if flags else (base or cls())

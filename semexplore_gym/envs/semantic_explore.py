@@ -246,7 +246,9 @@ class SemanticExploreEnv(gym.Env):
     ) -> None:
         super().__init__()
         self.privileged = bool(privileged)
-        opts = ObservationOptions.from_flags(observation_options, **option_fields)
+        opts = ObservationOptions.from_flags(
+            observation_options, option_fields, type(self).__init__
+        )
         self.observation_options = opts
         # Read by wrappers and tools; the options object is the one source.
         self.map_observation = opts.map_observation

@@ -13,6 +13,8 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
+from semexplore_gym.config.extras import require_extra
+
 #: A mission to run: the single-robot benchmark's ``Task`` or the team benchmark's
 #: ``TeamTask`` (frozen dataclasses, so they pickle and hash).
 Task = TypeVar("Task")
@@ -86,10 +88,9 @@ def run_ray(
 ) -> Iterator[Outcome[Task]]:
     """Missions as Ray tasks of one CPU each, on the cluster at ``address`` or a local Ray with
     ``workers`` CPUs (started here and shut down when the stream ends)."""
-    try:
-        import ray
-    except ImportError as e:
-        raise ImportError('backend "ray" needs Ray: pip install "semexplore-gym[ray]"') from e
+    require_extra("ray", 'backend "ray"', "ray")
+    import ray
+
     started = False
     if not ray.is_initialized():
         kwargs: dict[str, Any] = (

@@ -26,9 +26,10 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.evaluation.backends import mission_stream
 from semexplore_gym.evaluation.errors import ParameterError
-from semexplore_gym.evaluation.mission_task import mission_row, run_task
+from semexplore_gym.evaluation.mission_task import mission_row, run_task, warm_up_task
 from semexplore_gym.evaluation.progress_bar import MissionsBar
 from semexplore_gym.evaluation.resume import (
     FINGERPRINT_FILE,
@@ -78,6 +79,8 @@ __all__ = [
 def _check_run_args(tasks: list[Task], workers: int, backend: str) -> None:
     if backend not in ("process", "ray"):
         raise ParameterError("backend", f"{{param}} must be 'process' or 'ray', got {backend!r}")
+    if backend == "ray":
+        require_extra("ray", 'backend "ray"', "ray")  # before any output or mission
     if workers < 1:
         raise ParameterError("workers", f"{{param}} must be >= 1, got {workers!r}")
     if len({t.key for t in tasks}) != len(tasks):
@@ -131,6 +134,14 @@ def run_benchmark(
     skipped = len(tasks) - len(todo)
     failed: list[tuple[tuple[str, str, int], str]] = []
     ran = 0
+    if progress and backend == "process" and task_fn is run_task:
+        # Compile here, before the bar is drawn: the compile notice gets lines of its own, and
+        # worker processes load the kernels from the disk cache instead of compiling them each.
+        for task in todo:
+            try:
+                warm_up_task(task)
+            except Exception:  # noqa: BLE001 - the mission itself fails and is reported
+                continue
     bar = MissionsBar(progress, total=len(tasks), done=skipped)
     try:
         for task, result in mission_stream(todo, backend, workers, ray_address, task_fn, run_task):

@@ -59,6 +59,19 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     )
 
 
+def warm_up_task(task: Task) -> None:
+    """Load (or compile) the kernels of ``task``'s policy and env config in this process, once
+    per policy, config and overrides (see :func:`~semexplore_gym.evaluation.warmup.warm_up`)."""
+    from semexplore_gym.evaluation.warmup import warm_up
+    from semexplore_gym.policies.registry import make_policy
+
+    warm_up(
+        lambda: make_policy(task.policy, **task.policy_overrides),
+        task.env_config,
+        key=(task.policy, _warm_up_config_key(task.env_config), repr(task.policy_overrides)),
+    )
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Run one mission in this process; returns a picklable record (row + trace + trajectory)."""
     from semexplore_gym.evaluation.planner_coverage import coverage_at_planner_clearance
@@ -67,15 +80,9 @@ def run_task(task: Task) -> dict[str, Any]:
         map_observation_for,
         run_mission,
     )
-    from semexplore_gym.evaluation.warmup import warm_up
     from semexplore_gym.policies.registry import make_policy
 
-    # Kernels compiled or loaded before the mission's clocks start.
-    warm_up(
-        lambda: make_policy(task.policy, **task.policy_overrides),
-        task.env_config,
-        key=(task.policy, _warm_up_config_key(task.env_config), repr(task.policy_overrides)),
-    )
+    warm_up_task(task)  # kernels compiled or loaded before the mission's clocks start
     policy = make_policy(task.policy, **task.policy_overrides)
     env = make_mission_env(task.resolved_world, task.env_config, **map_observation_for(policy))
     try:

@@ -352,6 +352,9 @@ def run_mission(
         info, terminated, truncated = _drive(
             env, policy, obs, info, log, recorder, bar, on_step, limit_s, ignore_terminated
         )
+        if bar is not None:  # the mission is over: the bar ends full, at the time reached
+            bar.total = max(bar.n, 1e-9)
+            bar.refresh()
     except BaseException:
         if recorder is not None:
             recorder.abort()

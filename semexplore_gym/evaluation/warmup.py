@@ -25,7 +25,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable, Hashable
-from typing import Any, TextIO, cast
+from typing import Any, TextIO
 
 #: The world of the warm-up mission: a 3 m maze the semantic expert finishes in 53 s, passing
 #: through its semantic plans, grid-frontier fallback, a stuck recovery and its stop.
@@ -50,7 +50,10 @@ PRUNED_WORLD = "office:seed=0,size_m=8"
 #: for the semantic expert on an empty cache), so about a minute when that core is free; 3-6 min
 #: of wall time on a 2-core machine shared by ~8 jobs. The warm-up prints the real figure.
 COMPILE_ESTIMATE = "about 1 min on an idle machine, more under load"
-COMPILE_MESSAGE = f"compiling numba kernels (first run only, {COMPILE_ESTIMATE})..."
+#: The notice on stderr when numba starts compiling (``{n}``: kernels of the imported modules
+#: that have nothing in the disk cache yet; a later run may compile a few more, for new code or
+#: argument types).
+COMPILE_MESSAGE = f"compiling {{n}} numba kernels not yet cached ({COMPILE_ESTIMATE})..."
 #: Keys of the warm-ups this process has done (a process loads a kernel once; the set only
 #: saves repeating the warm-up mission, it changes no result).
 _WARMED_UP: set[Hashable] = set()
@@ -98,7 +101,9 @@ def warm_up(
         def on_start(self, ev: Any) -> None:
             nonlocal compiled
             if compiled == 0:
-                print(COMPILE_MESSAGE, file=out, flush=True)
+                n = count_uncached_kernels()
+                text = COMPILE_MESSAGE.format(n=n) if n else COMPILE_MESSAGE.replace("{n} ", "")
+                notice(text, out)
             compiled += 1
 
         def on_end(self, ev: Any) -> None:
@@ -203,30 +208,63 @@ def reach_rare_kernels() -> None:
     shortest_clear_path_m(clear_cells(room, geo, 0.1), geo, (0.3, 0.3), (0.85, 0.75), 0.2)
 
 
+def notice(text: str, out: TextIO) -> None:
+    """Print ``text`` as a line of its own: above a tqdm bar this process is drawing on ``out``
+    (never after it on the bar's line), else plainly."""
+    try:
+        from tqdm import tqdm
+
+        active = bool(tqdm._instances)  # tqdm.write clears and redraws the bars on ``out``
+    except (ImportError, AttributeError):  # pragma: no cover - tqdm is a dependency
+        active = False
+    if active:
+        tqdm.write(text, file=out)
+    else:
+        print(text, file=out, flush=True)
+
+
+def _cached_signatures(dispatcher: Any) -> list[Any] | None:
+    """The signatures numba's disk cache holds for ``dispatcher`` (None: not cached on disk)."""
+    if dispatcher._cache is None:
+        return None
+    try:  # numba internals: the cache index maps (signature, ...) -> data file
+        return [key[0] for key in dispatcher._cache._cache_file._load_index()]
+    except Exception:  # noqa: BLE001 - no disk cache, or another numba version
+        return None
+
+
+def _kernels(prefixes: tuple[str, ...]) -> list[Any]:
+    """The numba dispatchers of the imported modules named ``prefixes...``."""
+    from numba.core.dispatcher import Dispatcher
+
+    return [
+        obj
+        for name, module in list(sys.modules.items())
+        if module is not None and name.startswith(prefixes)
+        for obj in list(vars(module).values())
+        if isinstance(obj, Dispatcher)
+    ]
+
+
+def count_uncached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym",)) -> int:
+    """How many disk-cached kernels of the imported modules have no signature in the cache."""
+    return sum(1 for k in _kernels(prefixes) if _cached_signatures(k) == [])
+
+
 def load_cached_kernels(prefixes: tuple[str, ...] = ("semexplore_gym",)) -> int:
     """Load every signature the disk cache holds for the kernels of the imported modules.
 
     Returns:
         How many were loaded (0 where numba's cache layout is not the one this reads).
     """
-    from numba.core.dispatcher import Dispatcher
-
     n = 0
-    for name, module in list(sys.modules.items()):
-        if module is None or not name.startswith(prefixes):
-            continue
-        for obj in list(vars(module).values()):
-            if not isinstance(obj, Dispatcher) or cast(Any, obj)._cache is None:
-                continue
-            try:  # numba internals: the cache index maps (signature, ...) -> data file
-                signatures = [key[0] for key in cast(Any, obj)._cache._cache_file._load_index()]
-            except Exception:  # noqa: BLE001 - another numba version: the mission loads lazily
-                continue
-            for sig in signatures:
-                if tuple(sig) not in obj.overloads:
-                    try:
-                        obj.compile(sig)
-                    except Exception:  # noqa: BLE001 - a stale entry: compiled lazily if used
-                        continue
-                    n += 1
+    for obj in _kernels(prefixes):
+        # None: another numba version or no disk cache; the mission loads lazily
+        for sig in _cached_signatures(obj) or []:
+            if tuple(sig) not in obj.overloads:
+                try:
+                    obj.compile(sig)
+                except Exception:  # noqa: BLE001 - a stale entry: compiled lazily if used
+                    continue
+                n += 1
     return n

@@ -108,9 +108,12 @@ def _write_sidecar(file: MapFile, dest: Path) -> None:
 
 
 def _offline_hint(entry: CatalogueMap) -> str:
+    """Where a user's own copy of the map's files would be: ``--from DIR`` and DIR's layout."""
+    names = ", ".join(f.filename for f in entry.files if f.upstream_path is not None)
     return (
-        f"copy it from a local directory instead: semexplore maps get {entry.name} --from DIR "
-        "(e.g. a checkout's ../shared/maps)"
+        f"copy it from a local directory instead: semexplore maps get {entry.name} --from DIR, "
+        f"with DIR a folder holding {names} (in DIR/{entry.name}/, DIR/{entry.shared_subdir}/ "
+        f"or DIR itself), e.g. downloaded from {entry.source} on a machine with a network"
     )
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from semexplore_gym.config.extras import require_extra
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams
 from semexplore_gym.evaluation.harness import resolve_world
@@ -291,10 +292,8 @@ def tune_weights(
         The :class:`TuningResult`.
     """
     settings = study_settings if study_settings is not None else StudySettings()
-    try:
-        import optuna
-    except ImportError as e:  # pragma: no cover - optuna is in the rl extra
-        raise ImportError('weight tuning needs Optuna: pip install "semexplore-gym[rl]"') from e
+    require_extra("rl", "weight tuning (Optuna)", "optuna")
+    import optuna
 
     if n_trials < 1:
         raise ValueError(f"n_trials must be >= 1, got {n_trials!r}")

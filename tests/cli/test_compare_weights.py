@@ -215,3 +215,17 @@ def test_test_suite_and_test_worlds_exclude_each_other(tmp_path: Path, capsys) -
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--test-suite" in err[0] and "no_such_suite" in err[0]
     assert not (tmp_path / "tuning").exists()  # rejected before any tuning trial
+
+
+def test_help_says_the_default_budget_is_a_demo_and_gives_the_documented_one(capsys) -> None:
+    with pytest.raises(SystemExit):
+        main(["compare-weights", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "default budget" in text and "is a demo" in text
+    budget = "--trials 16 --runs 10 --max-time-s 600"
+    assert budget in text
+    # The budget is the one the documented table was measured with.
+    docs = Path(__file__).resolve().parents[2] / "docs" / "learning.md"
+    learning = " ".join(docs.read_text(encoding="utf-8").split())
+    measured = learning.split("## Hand-tuned vs learned weights", 1)[1].split("|", 1)[0]
+    assert budget in measured and "is a demo" in measured

@@ -83,3 +83,16 @@ def test_benchmark_runs_pretrained_specs(
     assert main(argv) == 0
     summary = (tmp_path / "summary.md").read_text()
     assert all(f"| {m.spec} | 1 |" in summary for m in pretrained_models())
+
+
+@pytest.mark.slow
+def test_the_readmes_learned_driver_maps_its_world_without_a_collision(capsys) -> None:
+    """The README's pretrained:dagger_maze command, as written: it does not look broken."""
+    pytest.importorskip("stable_baselines3")
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    (line,) = [s for s in readme.splitlines() if "--policy pretrained:dagger_maze" in s]
+    argv = shlex.split(line, comments=True)
+    assert argv[:2] == ["semexplore", "explore"] and "--max-time-s" in argv
+    assert main([*argv[1:], "--json", "--no-progress"]) == 0
+    result = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert result["coverage"] >= 0.99 and result["collisions"] == 0, result

@@ -216,3 +216,13 @@ def test_the_options_object_and_the_keywords_are_one_setting() -> None:
         ObservationOptions(map_observation="full")
     with pytest.raises(TypeError):
         gym.make("SemanticExplore-v0", world="maze1", map_obs="copy")
+
+
+def test_a_misspelled_keyword_names_itself_and_the_envs_keywords() -> None:
+    with pytest.raises(TypeError) as info:
+        gym.make("SemanticExplore-v0", wrold="maze1")
+    message = str(info.value)
+    assert "unexpected keyword argument 'wrold' (did you mean 'world'?)" in message
+    assert "ObservationOptions" not in message and "__init__" not in message
+    keywords = "world, config, overrides, render_mode, observation_options, privileged"
+    assert keywords in message and "map_observation, static_info, map_window_cells" in message

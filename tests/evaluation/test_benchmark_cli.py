@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import argparse
 import json
+import re
+import time
 
 import pytest
 
@@ -139,3 +142,25 @@ def test_policy_label_shortens_model_and_file_specs_only() -> None:
     assert policy_label("py:/home/me/planner.py:Mine") == "py:planner.py:Mine"
     assert policy_label("semantic[paper]") == "semantic[paper]"
     assert policy_label("nearest") == "nearest"
+
+
+def test_without_out_it_writes_under_runs_and_says_where(tmp_path, monkeypatch, capsys) -> None:
+    monkeypatch.chdir(tmp_path)
+    argv = ["benchmark", "--worlds", "maze:seed=0,size_m=3", "--policies", "random", "--runs", "1"]
+    assert main([*argv, "--max-time-s", "1", "--no-plots", "--no-progress"]) == 0
+    (out,) = (tmp_path / "runs").iterdir()
+    assert re.fullmatch(r"maze_seed_0_size_m_3-\d{8}-\d{6}", out.name), out.name
+    assert (out / "runs.csv").is_file()
+    assert f"writing to runs/{out.name}" in capsys.readouterr().err
+
+
+def test_the_default_out_names_the_suite_or_the_worlds() -> None:
+    from semexplore_gym.cli.benchmark import default_out
+
+    def args(**kw: object) -> argparse.Namespace:
+        return argparse.Namespace(**{"suite": None, "split": None, "worlds": None, **kw})
+
+    now = time.mktime((2026, 12, 4, 21, 5, 9, 0, 0, -1))
+    assert default_out(args(suite="paper,mazes"), now) == "runs/paper_mazes-20261204-210509"
+    assert default_out(args(split="mazes:test"), now) == "runs/mazes_test-20261204-210509"
+    assert default_out(args(worlds="maze1,maze2"), now) == "runs/maze1_maze2-20261204-210509"

@@ -162,3 +162,11 @@ def test_policy_columns_come_from_mission_metrics(env):
     assert plain.policy_metrics == {}
     row = mission_row(Task("maze1", "plain", 0), plain).to_dict()
     assert row["scored_replans"] is None and row["semantic_share"] is None
+
+
+def test_the_progress_bar_ends_full_when_the_mission_ends(env, capsys):
+    # The policy stops after 3 actions (0.6 s) of a 100 s limit: the bar ends at 100 %, not 1 %.
+    res = run_mission(env, StopAfter(3), seed=0, max_time_s=100.0, progress=True)
+    assert res.mission_time_s < 1.0
+    drawings = [s for s in capsys.readouterr().err.split("\r") if s.strip()]
+    assert "100%" in drawings[-1], drawings

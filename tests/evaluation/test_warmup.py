@@ -68,7 +68,8 @@ def test_compile_message_only_when_numba_compiles() -> None:
     out = io.StringIO()
     res = warm_up(_FreshKernelPolicy, stream=out)
     assert res["compiled"] >= 1
-    assert COMPILE_MESSAGE in out.getvalue()
+    assert "numba kernels not yet cached" in out.getvalue()
+    assert "first run only" not in out.getvalue()
 
     quiet = io.StringIO()
     res = warm_up(lambda: make_policy("random"), stream=quiet)
@@ -86,3 +87,62 @@ def test_warm_up_with_a_key_runs_once_per_process() -> None:
     warm_up(factory, key=("test-key", 1), stream=io.StringIO())
     warm_up(factory, key=("test-key", 1), stream=io.StringIO())
     assert len(calls) == 1
+
+
+def test_the_compile_notice_gets_a_line_of_its_own_above_a_bar() -> None:
+    from tqdm import tqdm
+
+    out = io.StringIO()
+    bar = tqdm(total=10, file=out, desc="missions")  # drawn at 0 %, no newline after it
+    try:
+        warm_up(_FreshKernelPolicy, stream=out)
+    finally:
+        bar.close()
+    text = out.getvalue()
+    assert "missions:   0%" in text
+    start = text.index("compiling")
+    assert text[start - 1] in "\r\n", repr(text[max(0, start - 60) : start + 20])
+    notice = text[start:].split("\n", 1)[0]
+    assert notice.endswith("...") and "missions" not in notice
+
+
+def test_uncached_kernels_are_counted(tmp_path, monkeypatch) -> None:
+    import importlib
+    import sys
+
+    from semexplore_gym.evaluation.warmup import count_uncached_kernels
+
+    (tmp_path / "semexplore_kernel_probe.py").write_text(
+        "from numba import njit\n\n@njit(cache=True)\ndef twice(x):\n    return 2 * x\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    module = importlib.import_module("semexplore_kernel_probe")
+    try:
+        assert count_uncached_kernels(("semexplore_kernel_probe",)) == 1
+        assert COMPILE_MESSAGE.format(n=1).startswith("compiling 1 numba kernels not yet cached")
+        module.twice(1.0)  # compiled and written to the disk cache
+        assert count_uncached_kernels(("semexplore_kernel_probe",)) == 0
+    finally:
+        sys.modules.pop("semexplore_kernel_probe", None)
+
+
+def test_the_benchmark_compiles_before_its_bar_starts(tmp_path, monkeypatch) -> None:
+    from semexplore_gym.evaluation import harness
+
+    order: list[str] = []
+    monkeypatch.setattr(harness, "warm_up_task", lambda task: order.append("warm up"))
+
+    class _Bar:
+        def __init__(self, *args, **kwargs) -> None:
+            order.append("bar")
+
+        def finished(self, task) -> None:
+            pass
+
+        def close(self) -> None:
+            pass
+
+    monkeypatch.setattr(harness, "MissionsBar", _Bar)
+    tasks = harness.expand_tasks(["maze:seed=0,size_m=3"], ["random"], [0, 1], max_time_s=1.0)
+    harness.run_benchmark(tasks, tmp_path / "out", progress=True)
+    assert order[0] == "warm up" and order.index("bar") == len(tasks)

@@ -194,6 +194,9 @@ def test_offline_error_suggests_from(tmp_path, monkeypatch) -> None:
         download_map(entry.name, dest, base_url=f"http://127.0.0.1:{port}", timeout_s=5)
     message = str(exc.value)
     assert "cannot download test-room" in message and "--from DIR" in message
+    # Where a user's own copy would be, not a folder only this project's checkouts have.
+    assert "../shared" not in message and "with DIR a folder holding" in message
+    assert all(f.filename in message for f in entry.files if f.upstream_path is not None)
     assert "\n" not in message
     assert not dest.exists()
 
