@@ -45,14 +45,11 @@ from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
     held_karp_route,
     khop_distances,
-    region_stats,
 )
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.geometry import segment_distance_field
 
-#: Selection orders the bound tries (each gives a valid bound; the larger wins).
-SELECTIONS = ("region", "cells", "far")
 _EIGHT = np.ones((3, 3), dtype=bool)
 _VISIBILITY_TOL_M = 1e-6
 _CLEARANCE_TOL_M = 1e-4
@@ -64,29 +61,37 @@ class LowerBoundParams:
 
     Attributes:
         hop_cells: K of the K-hop metric (open space: about (K - 1) / K of the straight line).
-        group_size_m: Side of the lattice blocks whose coverage-mask cells form a group.
+        distance_cell_factor: Distance cells are this many map cells on a side (a coarse cell
+            is allowed when any of its map cells is).
+        group_scales: Group block sides to try, as multiples of the side whose square holds one
+            more cell than the skip budget (the largest bound wins).
         max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
-        selections: Group selection orders to try (of :data:`SELECTIONS`).
     """
 
-    hop_cells: int = 12
-    group_size_m: float = 1.0
+    hop_cells: int = 8
+    distance_cell_factor: int = 2
+    group_scales: tuple[float, ...] = (1.0, 2.0)
     max_groups: int = 13
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
     coverage_share: float | None = None
-    selections: tuple[str, ...] = SELECTIONS
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.hop_cells, int) and 1 <= self.hop_cells <= 64):
-            raise ValueError(f"hop_cells must be an integer in 1..64, got {self.hop_cells!r}")
-        if not (math.isfinite(self.group_size_m) and self.group_size_m > 0):
-            raise ValueError(f"group_size_m must be positive, got {self.group_size_m!r}")
-        if not (isinstance(self.max_groups, int) and 1 <= self.max_groups <= 18):
-            raise ValueError(f"max_groups must be an integer in 1..18, got {self.max_groups!r}")
+        for name, lo, hi in (
+            ("hop_cells", 1, 64),
+            ("distance_cell_factor", 1, 8),
+            ("max_groups", 1, 18),
+        ):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and lo <= v <= hi):
+                raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+        if not self.group_scales or not all(
+            math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
+        ):
+            raise ValueError(f"group_scales must be in [0.05, 20], got {self.group_scales!r}")
         for name in ("penetration_tolerance_m", "mount_offset_m"):
             v = getattr(self, name)
             if not (math.isfinite(v) and 0 <= v <= 0.5):
@@ -94,9 +99,6 @@ class LowerBoundParams:
         share = self.coverage_share
         if share is not None and not (0 < share <= 1):
             raise ValueError(f"coverage_share must be in (0, 1], got {share!r}")
-        bad = [s for s in self.selections if s not in SELECTIONS]
-        if bad or not self.selections:
-            raise ValueError(f"selections must be among {SELECTIONS}, got {self.selections!r}")
 
 
 @dataclass(frozen=True)
@@ -108,10 +110,11 @@ class LowerBound:
         time_s: ``distance_m`` at top speed.
         n_groups: Groups in the route's problem.
         group_cells: Coverage-mask cells of each group.
-        group_centres_m: ``(x, y)`` centre of each group's block.
+        group_centres_m: ``(x, y)`` centre of each group's bounding box.
+        region_cells: Distance cells of each group's region.
         route: Group indices in the order of the bound's route (the groups it visits).
         budget_cells: Mask cells the goal lets an explorer leave unseen.
-        selection: The selection order that gave the bound.
+        block_cells: Side of the lattice blocks (map cells) of the groups.
         planning_s: Wall time spent.
     """
 
@@ -120,9 +123,10 @@ class LowerBound:
     n_groups: int
     group_cells: tuple[int, ...]
     group_centres_m: tuple[tuple[float, float], ...]
+    region_cells: tuple[int, ...]
     route: tuple[int, ...]
     budget_cells: int
-    selection: str
+    block_cells: int
     planning_s: float
 
 
@@ -219,7 +223,9 @@ def mask_groups(
     np.minimum.at(cmin, inverse, cols)
     np.maximum.at(cmax, inverse, cols)
     h, x0, y0 = geometry.resolution_m, geometry.origin_x_m, geometry.origin_y_m
-    rects = np.column_stack([x0 + cmin * h, y0 + rmin * h, x0 + (cmax + 1) * h, y0 + (rmax + 1) * h])
+    rects = np.column_stack(
+        [x0 + cmin * h, y0 + rmin * h, x0 + (cmax + 1) * h, y0 + (rmax + 1) * h]
+    )
     nb = -(-mask.shape[1] // b)
     br, bc = ids // nb, ids % nb
     centres = np.column_stack([x0 + (bc + 0.5) * b * h, y0 + (br + 0.5) * b * h])
@@ -228,17 +234,29 @@ def mask_groups(
 
 @dataclass(frozen=True)
 class _Problem:
+    """The fixed parts: allowed map cells, walls, the coarse distance grid."""
+
     allowed: np.ndarray
+    coarse: np.ndarray
+    factor: int
     walls: np.ndarray
     geometry: GridGeometry
     reach_m: float
     widen_m: float
     hop_cells: int
-    rects: np.ndarray
+
+    def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
+        """The coarse cell of each map cell (flat indices)."""
+        r, c = np.divmod(np.asarray(flat, dtype=np.int64), self.geometry.width)
+        return (r // self.factor) * self.coarse.shape[1] + c // self.factor
+
+    def to_coarse(self, flat: np.ndarray) -> np.ndarray:
+        return np.unique(self.to_coarse_each(flat))
 
     def region(self, rect: np.ndarray) -> np.ndarray:
+        """Coarse cells of the region of the group in ``rect``."""
         g = self.geometry
-        return group_region(
+        fine = group_region(
             self.allowed,
             rect,
             self.walls,
@@ -249,11 +267,22 @@ class _Problem:
             self.widen_m,
             _VISIBILITY_TOL_M,
         )
+        return self.to_coarse(fine)
 
-    def distances(self, sources: np.ndarray) -> np.ndarray:
-        src = np.asarray(sources, dtype=np.int64)
-        d = khop_distances(self.allowed, src, self.hop_cells, self.geometry.resolution_m)
-        return d.reshape(-1)
+    def distances(self, coarse_sources: np.ndarray) -> np.ndarray:
+        src = np.asarray(coarse_sources, dtype=np.int64)
+        res = self.geometry.resolution_m * self.factor
+        return khop_distances(self.coarse, src, self.hop_cells, res).reshape(-1)
+
+
+def coarsen(allowed: np.ndarray, factor: int) -> np.ndarray:
+    """``factor`` x ``factor`` blocks of ``allowed``: True where any cell is."""
+    f = int(factor)
+    h, w = allowed.shape
+    hp, wp = -(-h // f) * f, -(-w // f) * f
+    pad = np.zeros((hp, wp), dtype=bool)
+    pad[:h, :w] = allowed
+    return np.asarray(pad.reshape(hp // f, f, wp // f, f).any(axis=(1, 3)), dtype=bool)
 
 
 def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) -> LowerBound:
@@ -267,117 +296,112 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
     t0 = time.perf_counter()
     geo = facts.geometry
     mask = np.asarray(facts.reachable_mask, dtype=bool)
+    if mask.shape != geo.shape:
+        raise ValueError(f"reachable mask shape {mask.shape} != map grid {geo.shape}")
     n_mask = int(mask.sum())
     if n_mask == 0:
         raise ValueError("nothing to cover: the reachable mask has no cell")
     allowed, (sr, sc) = allowed_cells(facts, p.penetration_tolerance_m)
-    block = max(1, int(round(p.group_size_m / geo.resolution_m)))
-    rects, cells, centres = mask_groups(mask, geo, block)
     share = facts.coverage_goal if p.coverage_share is None else p.coverage_share
     budget = skip_budget_cells(n_mask, share)
+    f = p.distance_cell_factor
     prob = _Problem(
         allowed=allowed,
+        coarse=coarsen(allowed, f),
+        factor=f,
         walls=merge_walls(facts.world.segments_m),
         geometry=geo,
         reach_m=facts.sensor.max_range_m + _VISIBILITY_TOL_M,
         widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
         hop_cells=p.hop_cells,
-        rects=rects,
     )
-    from_start = prob.distances(np.array([sr * geo.width + sc]))
-    sizes, near = region_stats(
-        allowed,
-        rects,
-        prob.walls,
-        geo.origin_x_m,
-        geo.origin_y_m,
-        geo.resolution_m,
-        prob.reach_m,
-        prob.widen_m,
-        _VISIBILITY_TOL_M,
-        from_start.reshape(allowed.shape),
-    )
-    # Groups no allowed cell can see stay unseen: their cells come off the budget.
-    budget_left = budget - int(cells[sizes == 0].sum())
-    best = (0.0, (), "none", np.zeros(0, dtype=np.int64))
-    if budget_left < 0:
-        best = (math.inf, (), "unseeable", np.zeros(0, dtype=np.int64))
-    else:
-        useful = np.flatnonzero((sizes > 0) & (near > 0) & np.isfinite(near))
-        legs_cache: dict[int, np.ndarray] = {}
-        for how in p.selections:
-            chosen = _select(prob, useful, how, sizes, cells, near, p.max_groups)
-            if chosen.size == 0:
-                continue
-            length, order = _route(prob, chosen, near, cells, budget_left, legs_cache)
-            if length > best[0]:
-                best = (length, tuple(int(chosen[i]) for i in order), how, chosen)
-    length, route_ids, how, chosen = best
-    index = {int(g): i for i, g in enumerate(chosen)}
+    from_start = prob.distances(prob.to_coarse(np.array([sr * geo.width + sc])))
+    best: _Route | None = None
+    for scale in p.group_scales:
+        block = max(1, int(math.ceil(scale * math.sqrt(budget + 1))))
+        found = _bound_for_blocks(prob, mask, block, from_start, budget, p.max_groups)
+        if best is None or found.length_m > best.length_m:
+            best = found
+    assert best is not None
     return LowerBound(
-        distance_m=float(length),
-        time_s=float(length) / facts.max_linear_speed_mps,
-        n_groups=int(chosen.size),
-        group_cells=tuple(int(cells[g]) for g in chosen),
-        group_centres_m=tuple((float(centres[g, 0]), float(centres[g, 1])) for g in chosen),
-        route=tuple(index[g] for g in route_ids),
+        distance_m=best.length_m,
+        time_s=best.length_m / facts.max_linear_speed_mps,
+        n_groups=len(best.cells),
+        group_cells=best.cells,
+        group_centres_m=best.centres_m,
+        region_cells=best.region_cells,
+        route=best.route,
         budget_cells=budget,
-        selection=how,
+        block_cells=best.block_cells,
         planning_s=time.perf_counter() - t0,
     )
 
 
-def _select(
-    prob: _Problem,
-    useful: np.ndarray,
-    how: str,
-    sizes: np.ndarray,
-    cells: np.ndarray,
-    near: np.ndarray,
-    cap: int,
-) -> np.ndarray:
-    """Groups with pairwise disjoint regions, greedily in the order ``how``; the ``cap``
-    farthest from the start if more."""
-    if how == "region":
-        order = useful[np.lexsort((-cells[useful], sizes[useful]))]
-    elif how == "cells":
-        order = useful[np.lexsort((sizes[useful], -cells[useful]))]
-    else:
-        order = useful[np.lexsort((sizes[useful], -near[useful]))]
-    taken = np.zeros(prob.allowed.size, dtype=bool)
+@dataclass(frozen=True)
+class _Route:
+    length_m: float
+    cells: tuple[int, ...]
+    centres_m: tuple[tuple[float, float], ...]
+    region_cells: tuple[int, ...]
+    route: tuple[int, ...]
+    block_cells: int
+
+
+def _bound_for_blocks(
+    prob: _Problem, mask: np.ndarray, block: int, from_start: np.ndarray, budget: int, cap: int
+) -> _Route:
+    """Groups of ``block``-cell lattice blocks, chosen farthest first (from the start and the
+    groups chosen so far, by distance to the group's own cells: a choice, not a proof step),
+    then the exact route over them."""
+    rects, cells, _ = mask_groups(mask, prob.geometry, block)
+    rows, cols = np.nonzero(mask)
+    bw = -(-mask.shape[1] // block)
+    _, group_of = np.unique((rows // block) * bw + cols // block, return_inverse=True)
+    coarse_of = prob.to_coarse_each(rows * mask.shape[1] + cols)
+    score = np.full(rects.shape[0], np.inf)
+    np.minimum.at(score, group_of, from_start[coarse_of])
+    # Well-filled groups only (a scrap of a block is cheap to leave unseen).
+    score[cells < 0.5 * block * block] = 0.0
+    centres = 0.5 * (rects[:, :2] + rects[:, 2:])
     chosen: list[int] = []
-    for g in order:
-        region = prob.region(prob.rects[g])
-        if taken[region].any():
-            continue
-        taken[region] = True
-        chosen.append(int(g))
-    out = np.array(chosen, dtype=np.int64)
-    if out.size > cap:
-        out = out[np.argsort(-near[out], kind="stable")[:cap]]
-    return out
-
-
-def _route(
-    prob: _Problem,
-    chosen: np.ndarray,
-    near: np.ndarray,
-    cells: np.ndarray,
-    budget: int,
-    cache: dict[int, np.ndarray],
-) -> tuple[float, np.ndarray]:
-    """Held-Karp over the chosen groups: start legs ``near``, legs by K-hop distance fields."""
-    m = chosen.size
-    regions = [prob.region(prob.rects[g]) for g in chosen]
-    legs = np.zeros((m, m), dtype=np.float64)
-    for i, g in enumerate(chosen):
-        if int(g) not in cache:
-            cache[int(g)] = prob.distances(regions[i])
-        field = cache[int(g)]
-        for j in range(m):
-            if j != i:
-                legs[i, j] = float(field[regions[j]].min()) if regions[j].size else math.inf
-    length, order = held_karp_route(
-        near[chosen].astype(np.float64), legs, cells[chosen].astype(np.int64), int(budget)
+    regions: list[np.ndarray] = []
+    fields: list[np.ndarray] = []
+    while len(chosen) < min(cap, rects.shape[0]):
+        g = int(np.argmax(score))
+        if not score[g] > 0:
+            break
+        chosen.append(g)
+        regions.append(prob.region(rects[g]))
+        fields.append(prob.distances(regions[-1]))
+        np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
+    m = len(chosen)
+    first = np.array([_least(from_start, r) for r in regions], dtype=np.float64)
+    legs = np.array(
+        [[0.0 if i == j else _least(fields[i], regions[j]) for j in range(m)] for i in range(m)],
+        dtype=np.float64,
+    ).reshape(m, m)
+    idx = np.array(chosen, dtype=np.int64)
+    # A group's region is a set: a route may enter it at one cell and leave from another, so a
+    # group can shorten the route; each prefix of the choice is a valid problem: keep the best.
+    length, order, m_best = 0.0, np.zeros(0, dtype=np.int64), 0
+    for k in range(1, m + 1):
+        got, got_order = held_karp_route(
+            first[:k], legs[:k, :k].copy(), cells[idx[:k]].astype(np.int64), int(budget)
+        )
+        if got > length:
+            length, order, m_best = float(got), got_order, k
+    idx = idx[:m_best]
+    regions = regions[:m_best]
+    return _Route(
+        length_m=float(length),
+        cells=tuple(int(c) for c in cells[idx]),
+        centres_m=tuple((float(x), float(y)) for x, y in centres[idx]),
+        region_cells=tuple(int(r.size) for r in regions),
+        route=tuple(int(i) for i in order),
+        block_cells=block,
     )
-    return float(length), order
+
+
+def _least(field: np.ndarray, cells: np.ndarray) -> float:
+    """Least of ``field`` over ``cells`` (inf for none: a region nothing can stand in)."""
+    return float(field[cells].min()) if cells.size else math.inf

@@ -239,23 +239,6 @@ def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  #
 
 
 @njit(cache=True)
-def region_stats(allowed, rects, walls, gx0, gy0, res, reach_m, widen_m, tol, dist):
-    # pragma: no cover - numba
-    """Per rectangle: the number of cells of its :func:`group_region` and their least ``dist``."""
-    g = rects.shape[0]
-    sizes = np.zeros(g, dtype=np.int64)
-    nearest = np.full(g, np.inf)
-    flat = dist.reshape(dist.size)
-    for i in range(g):
-        cells = group_region(allowed, rects[i], walls, gx0, gy0, res, reach_m, widen_m, tol)
-        sizes[i] = cells.size
-        for q in cells:
-            if flat[q] < nearest[i]:
-                nearest[i] = flat[q]
-    return sizes, nearest
-
-
-@njit(cache=True)
 def held_karp_route(first, legs, cells, budget):  # pragma: no cover - numba
     """Shortest route from the start through a subset S of the groups, over every S whose
     unvisited groups hold at most ``budget`` cells. ``first[i]``: start to group i; ``legs[i, j]``:
