@@ -10,6 +10,10 @@ The tour is an upper bound on the shortest drive that sees that share with the e
 set cover (greedy) and the tour (LKH) are solved approximately, on a lattice of viewpoints; the
 time ignores turning, so it is a lower bound on driving this tour.
 
+Beside the tour it prints a certified lower bound (``lower_bound_m``, ``lower_bound_s``): no
+explorer with this robot and LiDAR reaches the env's coverage goal from this start after a
+shorter drive, or sooner at top speed (see docs/oracle.md; ``--no-bound`` skips it).
+
 Example::
 
     semexplore oracle 'office:seed=1,size_m=20' --start-seed 0 --json
@@ -19,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from typing import Any
 
@@ -34,6 +39,10 @@ JSON_KEYS: tuple[str, ...] = (
     "coverable_share",
     "n_candidates",
     "planning_s",
+    "lower_bound_m",
+    "lower_bound_s",
+    "lower_bound_groups",
+    "bound_planning_s",
 )
 
 
@@ -73,6 +82,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="env config override, e.g. lidar.max_range_m=5 (repeatable)",
     )
     p.add_argument(
+        "--no-bound",
+        action="store_true",
+        help="skip the certified lower bound (its keys are then null)",
+    )
+    p.add_argument(
         "--json",
         action="store_true",
         help="print one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
@@ -85,15 +99,25 @@ def static_bound(
     start_seed: int = 0,
     env_config: Any = None,
     env_overrides: list[str] | None = None,
+    bound: bool = True,
 ) -> dict[str, Any]:
     """The static tour of ``world`` from the start of ``env.reset(seed=start_seed)``, as the
     ``--json`` object of ``semexplore oracle``.
 
+    With ``bound``, also the certified lower bound
+    (:func:`~semexplore_gym.core.coverage_tour.lower_bound`); otherwise its keys are None.
+
     Raises:
-        ValueError: an unknown world, or a start the robot cannot stand at.
+        ValueError: an unknown world, a start the robot cannot stand at, or a world where no
+            bound can be computed.
         ImportError: the tour solver (``elkai``) is missing.
     """
-    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, plan_coverage_tour
+    from semexplore_gym.core.coverage_tour import (
+        PRIVILEGED_INFO_KEY,
+        LowerBoundParams,
+        lower_bound,
+        plan_coverage_tour,
+    )
     from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 
     if not 0 <= start_seed <= 2**32 - 1:
@@ -104,6 +128,11 @@ def static_bound(
     finally:
         env.close()
     facts = info[PRIVILEGED_INFO_KEY]
+    lb = None
+    if bound:
+        _check_bound_applies(env.config)
+        mount_m = math.hypot(env.config.lidar.mount_x_m, env.config.lidar.mount_y_m)
+        lb = lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m))
     t0 = time.perf_counter()
     tour = plan_coverage_tour(facts)
     planning_s = time.perf_counter() - t0
@@ -118,14 +147,36 @@ def static_bound(
         "coverable_share": round(tour.coverable_share, 5),
         "n_candidates": tour.n_candidates,
         "planning_s": round(planning_s, 2),
+        "lower_bound_m": None if lb is None else _finite_or_none(lb.distance_m, 3),
+        "lower_bound_s": None if lb is None else _finite_or_none(lb.time_s, 2),
+        "lower_bound_groups": None if lb is None else lb.n_groups,
+        "bound_planning_s": None if lb is None else round(lb.planning_s, 2),
     }
+
+
+def _check_bound_applies(config: Any) -> None:
+    """The bound models a noise-free LiDAR fused at the true pose."""
+    odo = config.odometry
+    drift = (odo.rot_from_rot, odo.rot_from_trans, odo.trans_from_trans, odo.trans_from_rot)
+    if config.lidar.range_noise_std_m > 0 or any(v > 0 for v in drift):
+        raise ValueError(
+            "the lower bound assumes a noise-free LiDAR and odometry (lidar.range_noise_std_m=0, "
+            "no odometry noise); pass --no-bound"
+        )
+
+
+def _finite_or_none(value: float, digits: int) -> float | None:
+    """``value`` rounded; None when infinite (no explorer reaches the goal)."""
+    return round(value, digits) if math.isfinite(value) else None
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         start = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
         overrides = start + args.env_overrides
-        out = static_bound(args.world, args.start_seed, args.env_config, overrides)
+        out = static_bound(
+            args.world, args.start_seed, args.env_config, overrides, bound=not args.no_bound
+        )
     except ImportError as e:  # the optional solver: one line saying what to install
         raise ValueError(str(e)) from None
     if args.json:
@@ -136,4 +187,11 @@ def run(args: argparse.Namespace) -> int:
             f"{out['time_at_top_speed_s']} s at top speed, {out['n_viewpoints']} viewpoints, "
             f"covered {float(out['covered_share']):.2%} (planned in {out['planning_s']} s)"
         )
+        if out["bound_planning_s"] is not None:
+            m, s = out["lower_bound_m"], out["lower_bound_s"]
+            said = "no explorer reaches the goal" if m is None else f"{m} m, {s} s"
+            print(
+                f"lower bound: {said} ({out['lower_bound_groups']} groups, computed in "
+                f"{out['bound_planning_s']} s)"
+            )
     return 0

@@ -131,9 +131,10 @@ class LowerBound:
 
 
 def skip_budget_cells(n_cells: int, share: float) -> int:
-    """Most of ``n_cells`` that may stay unseen with coverage ``count / n_cells >= share``."""
-    need = min(n_cells, max(0, math.ceil(share * n_cells) - 1))
-    while need < n_cells and need / n_cells < share:
+    """Most of ``n_cells`` that may stay unseen with coverage ``count / n_cells`` at ``share``
+    (compared as the mission's T99 is, with a 1e-12 tolerance)."""
+    need = min(n_cells, max(0, math.ceil(share * n_cells) - 2))
+    while need < n_cells and need / n_cells < share - 1e-12:
         need += 1
     return n_cells - need
 
