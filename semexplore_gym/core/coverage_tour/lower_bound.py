@@ -61,8 +61,8 @@ class LowerBoundParams:
 
     Attributes:
         hop_cells: K of the K-hop metric (open space: about (K - 1) / K of the straight line).
-        distance_cell_factor: Distance cells are this many map cells on a side (a coarse cell
-            is allowed when any of its map cells is).
+        distance_cell_factor: Distance cells are this many map cells on a side (one passes
+            to a neighbour where their map cells do).
         group_scales: Group block sides to try, as multiples of the side whose square holds one
             more cell than the skip budget (the largest bound wins).
         max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
@@ -235,7 +235,7 @@ def mask_groups(
 
 @dataclass(frozen=True)
 class _Problem:
-    """The fixed parts: allowed map cells, walls, the coarse distance grid."""
+    """The fixed parts: allowed map cells, walls, the coarse distance grid's moves."""
 
     allowed: np.ndarray
     coarse: np.ndarray
@@ -276,14 +276,29 @@ class _Problem:
         return khop_distances(self.coarse, src, self.hop_cells, res).reshape(-1)
 
 
-def coarsen(allowed: np.ndarray, factor: int) -> np.ndarray:
-    """``factor`` x ``factor`` blocks of ``allowed``: True where any cell is."""
+def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
+    """The moves between ``factor`` x ``factor`` blocks of ``allowed`` (uint8 bit masks, see
+    :func:`~.lower_bound_kernels.khop_distances`): block A passes to its neighbour B when an
+    allowed cell of A is 8-adjacent to one of B (bit 4: A holds an allowed cell). A path's
+    blocks thus step along moves, and blocks never join across a wall the cells do not."""
     f = int(factor)
     h, w = allowed.shape
-    hp, wp = -(-h // f) * f, -(-w // f) * f
-    pad = np.zeros((hp, wp), dtype=bool)
-    pad[:h, :w] = allowed
-    return np.asarray(pad.reshape(hp // f, f, wp // f, f).any(axis=(1, 3)), dtype=bool)
+    hc, wc = -(-h // f), -(-w // f)
+    out = np.zeros(hc * wc, dtype=np.uint8)
+    rows, cols = np.nonzero(allowed)
+    own = (rows // f) * wc + cols // f
+    np.bitwise_or.at(out, own, np.uint8(1 << 4))
+    for dr in (-1, 0, 1):
+        for dc in (-1, 0, 1):
+            r2, c2 = rows + dr, cols + dc
+            ok = (r2 >= 0) & (r2 < h) & (c2 >= 0) & (c2 < w)
+            ok[ok] &= allowed[r2[ok], c2[ok]]
+            br, bc = rows[ok] // f, cols[ok] // f
+            sr, sc = r2[ok] // f - br, c2[ok] // f - bc
+            step = (sr != 0) | (sc != 0)
+            bit = (3 * (sr[step] + 1) + sc[step] + 1).astype(np.uint8)
+            np.bitwise_or.at(out, br[step] * wc + bc[step], np.left_shift(np.uint8(1), bit))
+    return out.reshape(hc, wc)
 
 
 def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) -> LowerBound:
@@ -308,7 +323,7 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
     f = p.distance_cell_factor
     prob = _Problem(
         allowed=allowed,
-        coarse=coarsen(allowed, f),
+        coarse=coarse_moves(allowed, f),
         factor=f,
         walls=merge_walls(facts.world.segments_m),
         geometry=geo,

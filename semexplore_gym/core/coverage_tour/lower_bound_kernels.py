@@ -57,11 +57,12 @@ def _heap_pop(keys, vals, n):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def khop_distances(allowed, sources, k, res):  # pragma: no cover - numba
-    """K-hop lower-bound distances from ``sources`` (flat cell indices) over ``allowed`` cells.
+def khop_distances(moves, sources, k, res):  # pragma: no cover - numba
+    """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
-    A settled cell ``a`` (a checkpoint) reaches, by a breadth-first search over allowed cells
-    8-connected inside its Chebyshev ball of radius ``k`` that expands only cells strictly inside
+    ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
+    ``(r, c)`` to ``(r + dr, c + dc)`` (bit 4: the cell itself is allowed). A settled cell ``a``
+    (a checkpoint) reaches, by a breadth-first search along moves inside its Chebyshev ball of radius ``k`` that expands only cells strictly inside
     the ball, every cell ``b`` a path can reach before first leaving the ball's interior; the
     edge costs the distance between the squares of ``a`` and ``b``. Cells on the ball's rim are
     the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
@@ -69,8 +70,8 @@ def khop_distances(allowed, sources, k, res):  # pragma: no cover - numba
     Returns:
         ``allowed.shape`` float64 distances (inf where unreached).
     """
-    h, w = allowed.shape
-    flat_allowed = allowed.reshape(h * w)
+    h, w = moves.shape
+    flat_moves = moves.reshape(h * w)
     side = 2 * k + 1
     cost = np.empty(side * side, dtype=np.float64)
     for i in range(side):
@@ -85,7 +86,7 @@ def khop_distances(allowed, sources, k, res):  # pragma: no cover - numba
     vals = np.empty(1024, dtype=np.int64)
     n = 0
     for s in sources:
-        if flat_allowed[s] and chain[s] > 0.0:
+        if (flat_moves[s] >> 4) & 1 and chain[s] > 0.0:
             chain[s] = 0.0
             best[s] = 0.0
             keys, vals, n = _heap_push(keys, vals, n, 0.0, s)
@@ -119,8 +120,11 @@ def khop_distances(allowed, sources, k, res):  # pragma: no cover - numba
                     chain[g] = e
                     keys, vals, n = _heap_push(keys, vals, n, e, g)
                 continue
+            bits = flat_moves[g]
             for di in range(-1, 2):
                 for dj in range(-1, 2):
+                    if not (bits >> (3 * (di + 1) + dj + 1)) & 1 or (di == 0 and dj == 0):
+                        continue
                     ni = li + di
                     nj = lj + dj
                     gr = ar + ni - k
@@ -128,7 +132,7 @@ def khop_distances(allowed, sources, k, res):  # pragma: no cover - numba
                     if gr < 0 or gc < 0 or gr >= h or gc >= w:
                         continue
                     nl = ni * side + nj
-                    if stamp[nl] == sid or not flat_allowed[gr * w + gc]:
+                    if stamp[nl] == sid:
                         continue
                     stamp[nl] = sid
                     queue[tail] = nl

@@ -16,6 +16,7 @@ from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
 from semexplore_gym.core.coverage_tour.lower_bound import (
     _Problem,
     allowed_cells,
+    coarse_moves,
     mask_groups,
     merge_walls,
     skip_budget_cells,
@@ -88,14 +89,28 @@ def test_khop_distance_never_exceeds_the_geodesic_on_an_l_corridor():
     a = (6, 2)
     b = (117, 114)
     k = 8
-    d = khop_distances(allowed, np.array([a[0] * w + a[1]]), k, RES)
+    d = khop_distances(coarse_moves(allowed, 1), np.array([a[0] * w + a[1]]), k, RES)
     corner = np.array([11.0, 108.0])
     path_cells = np.hypot(*(corner - a)) + np.hypot(*(np.array(b) - corner))
     assert 0.7 * path_cells * RES <= d[b] <= path_cells * RES
     # open space: about (K - 1) / K of the straight line, never above it
-    d_open = khop_distances(np.ones((200, 200), dtype=bool), np.array([100 * 200]), k, RES)
+    open_moves = coarse_moves(np.ones((200, 200), dtype=bool), 1)
+    d_open = khop_distances(open_moves, np.array([100 * 200]), k, RES)
     straight = 199 * RES
     assert (k - 1) / k * straight - 2 * RES <= d_open[100, 199] <= straight
+
+
+def test_coarse_distance_cells_do_not_join_across_a_thin_wall():
+    # Two corridors 10 cells wide, a band of 2 forbidden cells between them (a wall with the
+    # robot's clearance), joined only at the right end: with 2 x 2 distance cells the band
+    # lies inside blocks whose cells on either side are allowed, yet no move crosses it.
+    allowed = np.zeros((22, 100), dtype=bool)
+    allowed[0:10, :] = True
+    allowed[12:22, :] = True
+    allowed[:, 90:100] = True
+    moves = coarse_moves(allowed, 2)
+    d = khop_distances(moves, np.array([2 * moves.shape[1] + 0]), 4, 2 * RES)
+    assert d[8, 0] >= 0.7 * 2 * 90 * RES  # around the wall's end, not through it
 
 
 def test_skip_budget_matches_the_missions_coverage_rule():
@@ -144,7 +159,7 @@ def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(sp
     allowed, _ = allowed_cells(facts, 0.01)
     prob = _Problem(
         allowed=allowed,
-        coarse=allowed,
+        coarse=coarse_moves(allowed, 1),
         factor=1,
         walls=merge_walls(facts.world.segments_m),
         geometry=geo,
