@@ -112,27 +112,10 @@ def static_bound(
             bound can be computed.
         ImportError: the tour solver (``elkai``) is missing.
     """
-    from semexplore_gym.core.coverage_tour import (
-        PRIVILEGED_INFO_KEY,
-        LowerBoundParams,
-        lower_bound,
-        plan_coverage_tour,
-    )
-    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+    from semexplore_gym.core.coverage_tour import plan_coverage_tour
 
-    if not 0 <= start_seed <= 2**32 - 1:
-        raise ValueError(f"--start-seed must be in 0..2**32-1, got {start_seed}")
-    env = SemanticExploreEnv(world, config=env_config, overrides=env_overrides, privileged=True)
-    try:
-        _, info = env.reset(seed=start_seed)
-    finally:
-        env.close()
-    facts = info[PRIVILEGED_INFO_KEY]
-    lb = None
-    if bound:
-        _check_bound_applies(env.config)
-        mount_m = math.hypot(env.config.lidar.mount_x_m, env.config.lidar.mount_y_m)
-        lb = lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m))
+    facts, config = privileged_facts(world, start_seed, env_config, env_overrides)
+    lb = _bound_of(facts, config) if bound else None
     t0 = time.perf_counter()
     tour = plan_coverage_tour(facts)
     planning_s = time.perf_counter() - t0
@@ -154,8 +137,51 @@ def static_bound(
     }
 
 
-def _check_bound_applies(config: Any) -> None:
-    """The bound models a noise-free LiDAR fused at the true pose."""
+def privileged_facts(
+    world: str,
+    start_seed: int = 0,
+    env_config: Any = None,
+    env_overrides: list[str] | None = None,
+) -> tuple[Any, Any]:
+    """The :class:`~semexplore_gym.core.coverage_tour.PrivilegedWorld` of ``world`` after
+    ``env.reset(seed=start_seed)`` (the start a benchmark's seed gets), and the env config.
+
+    Raises:
+        ValueError: an unknown world, a bad seed, or a start the robot cannot stand at.
+    """
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    if not 0 <= start_seed <= 2**32 - 1:
+        raise ValueError(f"--start-seed must be in 0..2**32-1, got {start_seed}")
+    env = SemanticExploreEnv(world, config=env_config, overrides=env_overrides, privileged=True)
+    try:
+        _, info = env.reset(seed=start_seed)
+    finally:
+        env.close()
+    return info[PRIVILEGED_INFO_KEY], env.config
+
+
+def certified_bound(
+    world: str,
+    start_seed: int = 0,
+    env_config: Any = None,
+    env_overrides: list[str] | None = None,
+) -> Any:
+    """The certified :class:`~semexplore_gym.core.coverage_tour.LowerBound` of ``world`` from
+    the start of ``env.reset(seed=start_seed)``, with the env's LiDAR mount offset.
+
+    Raises:
+        ValueError: as :func:`privileged_facts`, a noisy LiDAR or odometry, or a world where
+            no bound can be computed.
+    """
+    return _bound_of(*privileged_facts(world, start_seed, env_config, env_overrides))
+
+
+def _bound_of(facts: Any, config: Any) -> Any:
+    """The bound for the env's LiDAR, which it models noise-free and fused at the true pose."""
+    from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+
     odo = config.odometry
     drift = (odo.rot_from_rot, odo.rot_from_trans, odo.trans_from_trans, odo.trans_from_rot)
     if config.lidar.range_noise_std_m > 0 or any(v > 0 for v in drift):
@@ -163,6 +189,8 @@ def _check_bound_applies(config: Any) -> None:
             "the lower bound assumes a noise-free LiDAR and odometry (lidar.range_noise_std_m=0, "
             "no odometry noise); pass --no-bound"
         )
+    mount_m = math.hypot(config.lidar.mount_x_m, config.lidar.mount_y_m)
+    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m))
 
 
 def _finite_or_none(value: float, digits: int) -> float | None:
