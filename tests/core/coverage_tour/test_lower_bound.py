@@ -220,3 +220,29 @@ def test_params_reject_bad_values():
     with pytest.raises(ValueError, match="coverage_share"):
         LowerBoundParams(coverage_share=1.5)
     assert math.isfinite(LowerBoundParams().group_scales[0])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "spec",
+    [
+        "maze:seed=1,size_m=5",
+        "office:seed=2,size_m=8",
+        "cave:seed=3,size_m=6",
+        "forest:seed=4,size_m=6",
+    ],
+)
+def test_missions_never_reach_99_percent_sooner_or_shorter_than_the_bound(spec, short_mission):
+    from semexplore_gym.cli.oracle import certified_bound
+
+    seed = 5
+    bound = certified_bound(spec, seed, env_overrides=["episode.random_start=true"])
+    assert bound.distance_m > 0
+    for policy in ("semantic", "nearest"):
+        res, _ = short_mission(spec, policy, seed, 600.0)
+        assert res.t99_s is not None, (spec, policy)
+        assert res.t99_s >= bound.time_s, (spec, policy, res.t99_s, bound.time_s)
+        hit = next(i for i, (_, c, _) in enumerate(res.coverage_trace) if c >= 0.99 - 1e-12)
+        steps = np.diff(res.trajectory[: hit + 1, :2], axis=0)
+        drive_m = float(np.hypot(steps[:, 0], steps[:, 1]).sum())
+        assert drive_m >= bound.distance_m, (spec, policy, drive_m, bound.distance_m)
