@@ -4,7 +4,8 @@ For each (world, start seed) of ``RUN_DIR/runs.csv`` it computes the bound from 
 the benchmark used (``benchmark.json``: random or fixed start, env config), writes one row per
 pair to a CSV as it goes (rerunning resumes), then reports how many missions reached 99 %
 coverage sooner than the bound's time, or after a shorter drive than its distance (the drive
-to 99 % read from the mission's trace and trajectory when the folder has them), which must be
+to 99 % read from the mission's trace and trajectory when the folder has them; ``seed=*``
+worlds take the mission's seed), which must be
 none, and the median T99 / bound per policy and world family.
 
     python scripts/check_lower_bound.py runs/paper
@@ -70,6 +71,7 @@ def compute_bounds(
 ) -> dict[tuple[str, int], dict[str, str]]:
     """The bound of each (world, seed) of ``runs``, read from ``out`` or computed and appended."""
     from semexplore_gym.cli.oracle import certified_bound
+    from semexplore_gym.evaluation.tasks import resolve_world
 
     done: dict[tuple[str, int], dict[str, str]] = {}
     if out.is_file():
@@ -88,7 +90,7 @@ def compute_bounds(
             env_config, suite_random, fixed = settings
             random_start = suite_random.get(world, True) and not fixed
             start = [f"episode.random_start={'true' if random_start else 'false'}"]
-            b = certified_bound(world, seed, env_config, start)
+            b = certified_bound(resolve_world(world, seed), seed, env_config, start)
             row = {
                 "world": world,
                 "seed": str(seed),
@@ -107,7 +109,9 @@ def compute_bounds(
 
 def drive_to_99_m(run_dir: Path, world: str, policy: str, seed: int) -> float | None:
     """Path length up to the first trace row at coverage >= 0.99 (None without the files)."""
-    stem = f"{world}__{policy}__{seed}"
+    from semexplore_gym.evaluation.run_writer import task_stem
+
+    stem = task_stem(world, policy, seed)
     trace, traj = run_dir / "traces" / f"{stem}.csv", run_dir / "trajectories" / f"{stem}.npy"
     if not (trace.is_file() and traj.is_file()):
         return None
