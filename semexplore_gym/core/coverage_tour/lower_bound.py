@@ -270,10 +270,20 @@ class _Problem:
         )
         return self.to_coarse(fine)
 
-    def distances(self, coarse_sources: np.ndarray) -> np.ndarray:
+    def distances(
+        self, coarse_sources: np.ndarray, targets: list[np.ndarray] | None = None
+    ) -> np.ndarray:
+        """K-hop distances from the sources; with ``targets`` (coarse cell sets), exact only
+        as far as each set's least value needs."""
         src = np.asarray(coarse_sources, dtype=np.int64)
         res = self.geometry.resolution_m * self.factor
-        return khop_distances(self.coarse, src, self.hop_cells, res).reshape(-1)
+        target_of = np.full(self.coarse.shape, -1, dtype=np.int64)
+        flat = target_of.reshape(-1)
+        sets = [t for t in (targets or []) if t.size]
+        for j, t in enumerate(sets):
+            flat[t] = j
+        d = khop_distances(self.coarse, src, self.hop_cells, res, target_of, len(sets))
+        return d.reshape(-1)
 
 
 def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
@@ -381,21 +391,23 @@ def _bound_for_blocks(
     centres = 0.5 * (rects[:, :2] + rects[:, 2:])
     chosen: list[int] = []
     regions: list[np.ndarray] = []
-    fields: list[np.ndarray] = []
     while len(chosen) < min(cap, rects.shape[0]):
         g = int(np.argmax(score))
         if not score[g] > 0:
             break
         chosen.append(g)
         regions.append(prob.region(rects[g]))
-        fields.append(prob.distances(regions[-1]))
         np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
     m = len(chosen)
     first = np.array([_least(from_start, r) for r in regions], dtype=np.float64)
-    legs = np.array(
-        [[0.0 if i == j else _least(fields[i], regions[j]) for j in range(m)] for i in range(m)],
-        dtype=np.float64,
-    ).reshape(m, m)
+    legs = np.zeros((m, m), dtype=np.float64)
+    for i in range(m):
+        others = [regions[j] for j in range(m) if j != i]
+        field = prob.distances(regions[i], others) if regions[i].size else None
+        for j in range(m):
+            legs[i, j] = 0.0 if i == j else math.inf if field is None else _least(field, regions[j])
+    # A path from region i to j, reversed, runs from j to i: either direction bounds it.
+    legs = np.maximum(legs, legs.T)
     idx = np.array(chosen, dtype=np.int64)
     # A group's region is a set: a route may enter it at one cell and leave from another, so a
     # group can shorten the route; each prefix of the choice is a valid problem: keep the best.

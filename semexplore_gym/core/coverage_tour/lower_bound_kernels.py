@@ -57,7 +57,7 @@ def _heap_pop(keys, vals, n):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def khop_distances(moves, sources, k, res):  # pragma: no cover - numba
+def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no cover - numba
     """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
     ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
@@ -67,8 +67,11 @@ def khop_distances(moves, sources, k, res):  # pragma: no cover - numba
     edge costs the distance between the squares of ``a`` and ``b``. Cells on the ball's rim are
     the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
 
+    With ``n_targets`` > 0 it stops once each target set (``target_of[cell]``, -1 for none)
+    holds its final least distance: every later value is at least the popped one.
+
     Returns:
-        ``allowed.shape`` float64 distances (inf where unreached).
+        ``moves.shape`` float64 distances (inf where unreached, or not needed for the targets).
     """
     h, w = moves.shape
     flat_moves = moves.reshape(h * w)
@@ -93,10 +96,17 @@ def khop_distances(moves, sources, k, res):  # pragma: no cover - numba
     stamp = np.zeros(side * side, dtype=np.int64)
     queue = np.empty(side * side, dtype=np.int64)
     sid = 0
+    flat_target = target_of.reshape(h * w)
+    tbest = np.full(max(n_targets, 1), np.inf)
+    for s in sources:
+        if flat_target[s] >= 0 and best[s] < tbest[flat_target[s]]:
+            tbest[flat_target[s]] = best[s]
     while n > 0:
         d, a, n = _heap_pop(keys, vals, n)
         if settled[a] or d > chain[a]:
             continue
+        if n_targets > 0 and d >= tbest.max():
+            break
         settled[a] = True
         ar = a // w
         ac = a - ar * w
@@ -115,6 +125,9 @@ def khop_distances(moves, sources, k, res):  # pragma: no cover - numba
             e = d + cost[loc]
             if e < best[g]:
                 best[g] = e
+                t = flat_target[g]
+                if t >= 0 and e < tbest[t]:
+                    tbest[t] = e
             if abs(li - k) == k or abs(lj - k) == k:
                 if e < chain[g] and not settled[g]:
                     chain[g] = e

@@ -33,6 +33,12 @@ RADIUS = 0.105
 RANGE_M = 1.0
 
 
+def _khop(moves, sources, k, res):
+    """The full K-hop field (no targets to stop at)."""
+    none = np.full(moves.shape, -1, dtype=np.int64)
+    return khop_distances(moves, np.asarray(sources, dtype=np.int64), k, res, none, 0)
+
+
 def _world(rects, size_m, start):
     h, w = int(round(size_m[1] / RES)), int(round(size_m[0] / RES))
     free = np.zeros((h, w), dtype=bool)
@@ -89,13 +95,13 @@ def test_khop_distance_never_exceeds_the_geodesic_on_an_l_corridor():
     a = (6, 2)
     b = (117, 114)
     k = 8
-    d = khop_distances(coarse_moves(allowed, 1), np.array([a[0] * w + a[1]]), k, RES)
+    d = _khop(coarse_moves(allowed, 1), np.array([a[0] * w + a[1]]), k, RES)
     corner = np.array([11.0, 108.0])
     path_cells = np.hypot(*(corner - a)) + np.hypot(*(np.array(b) - corner))
     assert 0.7 * path_cells * RES <= d[b] <= path_cells * RES
     # open space: about (K - 1) / K of the straight line, never above it
     open_moves = coarse_moves(np.ones((200, 200), dtype=bool), 1)
-    d_open = khop_distances(open_moves, np.array([100 * 200]), k, RES)
+    d_open = _khop(open_moves, np.array([100 * 200]), k, RES)
     straight = 199 * RES
     assert (k - 1) / k * straight - 2 * RES <= d_open[100, 199] <= straight
 
@@ -109,8 +115,24 @@ def test_coarse_distance_cells_do_not_join_across_a_thin_wall():
     allowed[12:22, :] = True
     allowed[:, 90:100] = True
     moves = coarse_moves(allowed, 2)
-    d = khop_distances(moves, np.array([2 * moves.shape[1] + 0]), 4, 2 * RES)
+    d = _khop(moves, np.array([2 * moves.shape[1] + 0]), 4, 2 * RES)
     assert d[8, 0] >= 0.7 * 2 * 90 * RES  # around the wall's end, not through it
+
+
+def test_stopping_at_the_targets_keeps_their_least_distance_exact():
+    rng = np.random.default_rng(1)
+    allowed = rng.random((60, 60)) > 0.25
+    allowed[30, :] = True
+    moves = coarse_moves(allowed, 1)
+    src = np.array([30 * 60 + 0])
+    full = _khop(moves, src, 5, RES)
+    targets = [np.array([30 * 60 + 59, 10 * 60 + 40]), np.array([31 * 60 + 5])]
+    target_of = np.full(allowed.shape, -1, dtype=np.int64)
+    for j, t in enumerate(targets):
+        target_of.reshape(-1)[t] = j
+    early = khop_distances(moves, src, 5, RES, target_of, 2).reshape(-1)
+    for t in targets:
+        assert early[t].min() == full.reshape(-1)[t].min()
 
 
 def test_skip_budget_matches_the_missions_coverage_rule():
