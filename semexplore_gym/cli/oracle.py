@@ -10,6 +10,10 @@ The tour is an upper bound on the shortest drive that sees that share with the e
 set cover (greedy) and the tour (LKH) are solved approximately, on a lattice of viewpoints; the
 time ignores turning, so it is a lower bound on driving this tour.
 
+Beside the tour it prints a certified lower bound (``lower_bound_m``, ``lower_bound_s``): no
+explorer with this robot and LiDAR reaches the env's coverage goal from this start after a
+shorter drive, or sooner at top speed (see docs/oracle.md; ``--no-bound`` skips it).
+
 Example::
 
     semexplore oracle 'office:seed=1,size_m=20' --start-seed 0 --json
@@ -18,6 +22,7 @@ Example::
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from typing import Any
 
@@ -35,6 +40,10 @@ JSON_KEYS: tuple[str, ...] = (
     "coverable_share",
     "n_candidates",
     "planning_s",
+    "lower_bound_m",
+    "lower_bound_s",
+    "lower_bound_groups",
+    "bound_planning_s",
 )
 
 
@@ -74,6 +83,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="env config override, e.g. lidar.max_range_m=5 (repeatable)",
     )
     p.add_argument(
+        "--no-bound",
+        action="store_true",
+        help="skip the certified lower bound (its keys are then null)",
+    )
+    p.add_argument(
         "--json",
         action="store_true",
         help="print one JSON object (keys: " + ", ".join(JSON_KEYS) + ")",
@@ -86,25 +100,23 @@ def static_bound(
     start_seed: int = 0,
     env_config: Any = None,
     env_overrides: list[str] | None = None,
+    bound: bool = True,
 ) -> dict[str, Any]:
     """The static tour of ``world`` from the start of ``env.reset(seed=start_seed)``, as the
     ``--json`` object of ``semexplore oracle``.
 
+    With ``bound``, also the certified lower bound
+    (:func:`~semexplore_gym.core.coverage_tour.lower_bound`); otherwise its keys are None.
+
     Raises:
-        ValueError: an unknown world, or a start the robot cannot stand at.
+        ValueError: an unknown world, a start the robot cannot stand at, or a world where no
+            bound can be computed.
         ImportError: the tour solver (``elkai``) is missing.
     """
-    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY, plan_coverage_tour
-    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+    from semexplore_gym.core.coverage_tour import plan_coverage_tour
 
-    if not 0 <= start_seed <= 2**32 - 1:
-        raise ValueError(f"--start-seed must be in 0..2**32-1, got {start_seed}")
-    env = SemanticExploreEnv(world, config=env_config, overrides=env_overrides, privileged=True)
-    try:
-        _, info = env.reset(seed=start_seed)
-    finally:
-        env.close()
-    facts = info[PRIVILEGED_INFO_KEY]
+    facts, config = privileged_facts(world, start_seed, env_config, env_overrides)
+    lb = _bound_of(facts, config) if bound else None
     t0 = time.perf_counter()
     tour = plan_coverage_tour(facts)
     planning_s = time.perf_counter() - t0
@@ -119,14 +131,81 @@ def static_bound(
         "coverable_share": round(tour.coverable_share, 5),
         "n_candidates": tour.n_candidates,
         "planning_s": round(planning_s, 2),
+        "lower_bound_m": None if lb is None else _finite_or_none(lb.distance_m, 3),
+        "lower_bound_s": None if lb is None else _finite_or_none(lb.time_s, 2),
+        "lower_bound_groups": None if lb is None else lb.n_groups,
+        "bound_planning_s": None if lb is None else round(lb.planning_s, 2),
     }
+
+
+def privileged_facts(
+    world: str,
+    start_seed: int = 0,
+    env_config: Any = None,
+    env_overrides: list[str] | None = None,
+) -> tuple[Any, Any]:
+    """The :class:`~semexplore_gym.core.coverage_tour.PrivilegedWorld` of ``world`` after
+    ``env.reset(seed=start_seed)`` (the start a benchmark's seed gets), and the env config.
+
+    Raises:
+        ValueError: an unknown world, a bad seed, or a start the robot cannot stand at.
+    """
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    if not 0 <= start_seed <= 2**32 - 1:
+        raise ValueError(f"--start-seed must be in 0..2**32-1, got {start_seed}")
+    env = SemanticExploreEnv(world, config=env_config, overrides=env_overrides, privileged=True)
+    try:
+        _, info = env.reset(seed=start_seed)
+    finally:
+        env.close()
+    return info[PRIVILEGED_INFO_KEY], env.config
+
+
+def certified_bound(
+    world: str,
+    start_seed: int = 0,
+    env_config: Any = None,
+    env_overrides: list[str] | None = None,
+) -> Any:
+    """The certified :class:`~semexplore_gym.core.coverage_tour.LowerBound` of ``world`` from
+    the start of ``env.reset(seed=start_seed)``, with the env's LiDAR mount offset.
+
+    Raises:
+        ValueError: as :func:`privileged_facts`, a noisy LiDAR or odometry, or a world where
+            no bound can be computed.
+    """
+    return _bound_of(*privileged_facts(world, start_seed, env_config, env_overrides))
+
+
+def _bound_of(facts: Any, config: Any) -> Any:
+    """The bound for the env's LiDAR, which it models noise-free and fused at the true pose."""
+    from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+
+    odo = config.odometry
+    drift = (odo.rot_from_rot, odo.rot_from_trans, odo.trans_from_trans, odo.trans_from_rot)
+    if config.lidar.range_noise_std_m > 0 or any(v > 0 for v in drift):
+        raise ValueError(
+            "the lower bound assumes a noise-free LiDAR and odometry (lidar.range_noise_std_m=0, "
+            "no odometry noise); pass --no-bound"
+        )
+    mount_m = math.hypot(config.lidar.mount_x_m, config.lidar.mount_y_m)
+    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m))
+
+
+def _finite_or_none(value: float, digits: int) -> float | None:
+    """``value`` rounded; None when infinite (no explorer reaches the goal)."""
+    return round(value, digits) if math.isfinite(value) else None
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         start = [f"episode.random_start={'false' if args.fixed_start else 'true'}"]
         overrides = start + args.env_overrides
-        out = static_bound(args.world, args.start_seed, args.env_config, overrides)
+        out = static_bound(
+            args.world, args.start_seed, args.env_config, overrides, bound=not args.no_bound
+        )
     except ImportError as e:  # the optional solver: one line saying what to install
         raise ValueError(str(e)) from None
     if args.json:
@@ -137,4 +216,11 @@ def run(args: argparse.Namespace) -> int:
             f"{out['time_at_top_speed_s']} s at top speed, {out['n_viewpoints']} viewpoints, "
             f"covered {float(out['covered_share']):.2%} (planned in {out['planning_s']} s)"
         )
+        if out["bound_planning_s"] is not None:
+            m, s = out["lower_bound_m"], out["lower_bound_s"]
+            said = "no explorer reaches the goal" if m is None else f"{m} m, {s} s"
+            print(
+                f"lower bound: {said} ({out['lower_bound_groups']} groups, computed in "
+                f"{out['bound_planning_s']} s)"
+            )
     return 0

@@ -19,6 +19,23 @@ def test_oracle_json_prints_the_documented_keys(capsys):
     assert out["start_seed"] == 3 and out["n_viewpoints"] >= 1
     assert out["covered_share"] >= 0.995
     assert out["time_at_top_speed_s"] == pytest.approx(out["tour_length_m"] / 0.22, rel=1e-3)
+    # the certified lower bound sits below the tour (a feasible drive of the goal's share)
+    assert 0 < out["lower_bound_m"] <= out["tour_length_m"]
+    assert out["lower_bound_s"] == pytest.approx(out["lower_bound_m"] / 0.22, rel=1e-3)
+    assert out["lower_bound_groups"] >= 1 and out["bound_planning_s"] >= 0
+
+
+def test_no_bound_leaves_the_bound_keys_null(capsys):
+    argv = ["oracle", "maze:seed=1,size_m=5", "--json", "--no-bound"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert out["lower_bound_m"] is None and out["bound_planning_s"] is None
+    assert out["tour_length_m"] > 0
+
+
+def test_the_text_line_says_the_bound(capsys):
+    assert main(["oracle", "maze:seed=1,size_m=5"]) == 0
+    assert "lower bound:" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
@@ -26,6 +43,10 @@ def test_oracle_json_prints_the_documented_keys(capsys):
     [
         (["oracle", "nosuch:seed=1"], "unknown world"),
         (["oracle", "maze1", "--env-set", "episode.start_pose=[0.0,0.0,0.0]"], "start pose"),
+        (
+            ["oracle", "maze:seed=1,size_m=5", "--env-set", "lidar.range_noise_std_m=0.01"],
+            "noise-free LiDAR",
+        ),
     ],
 )
 def test_bad_input_gets_one_clear_line(argv, words, capsys):

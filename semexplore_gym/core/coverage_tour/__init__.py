@@ -3,9 +3,16 @@
 * :mod:`.problem`: :class:`PrivilegedWorld` (the ground truth a privileged env hands out) and
   :class:`SensorModel`;
 * :mod:`.viewpoints`: standing mask, candidate viewpoints, visible sets (the env's LiDAR model);
-* :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`.
+* :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`;
+* :mod:`.lower_bound`: :func:`lower_bound`, a certified lower bound on the drive (and time) any
+  explorer needs to reach the coverage goal.
 """
 
+from semexplore_gym.core.coverage_tour.lower_bound import (
+    LowerBound,
+    LowerBoundParams,
+    lower_bound,
+)
 from semexplore_gym.core.coverage_tour.problem import (
     PRIVILEGED_INFO_KEY,
     PrivilegedWorld,
@@ -25,11 +32,14 @@ __all__ = [
     "PRIVILEGED_INFO_KEY",
     "SOLVER_HINT",
     "CoverageTour",
+    "LowerBound",
+    "LowerBoundParams",
     "PrivilegedWorld",
     "SensorModel",
     "TourParams",
     "geodesic_matrix",
     "greedy_cover",
+    "lower_bound",
     "open_tour_order",
     "plan_coverage_tour",
 ]

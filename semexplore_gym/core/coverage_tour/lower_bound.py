@@ -1,0 +1,435 @@
+"""A certified lower bound on the drive (and time) any explorer needs to reach the coverage goal.
+
+:func:`lower_bound` relaxes the exploration problem in steps, each of which can only lower the
+optimum, so the result is below the path length of every explorer with this robot and LiDAR:
+
+1. **Robot cells.** Pymunk keeps the robot's centre ``radius_m`` (circle of ``radius - skin``
+   plus the wall's ``skin``) from every wall, less a penetration tolerance (0.01 m; the physics'
+   collision slop is at most 0.005 m): clearance ``c_min``. A cell that holds such a point has
+   its centre at least ``c_min - h/sqrt(2)`` from every wall, so the robot's centre only ever
+   lies in cells meeting that test, 8-connected to the start's cell (the allowed cells).
+2. **K-hop distances never exceed a real path.** Checkpoint a continuous path each time it first
+   reaches Chebyshev distance K (cells) from the last checkpoint's cell: each piece stays in the
+   previous checkpoint's ball, so a breadth-first search over allowed cells inside the ball
+   finds it, and the piece is at least as long as the distance between the two cells' squares.
+   The Dijkstra distance over such hops (the last hop may end inside a ball) is <= the length.
+3. **Where a group can be seen from (a superset).** A scan marks a cell FREE only along a beam
+   from the sensor that reaches a point of the cell's square within the LiDAR's range and
+   crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when its
+   square (widened by the LiDAR's mount offset) is farther than the range from A, or one wall
+   (collinear touching walls merged) meets every segment from U to A: its line separates them
+   strictly and the 16 corner-pair segments cross it inside the wall (the segments from U to A
+   fill the convex hull of both, whose crossing with the line is spanned by the corner pairs).
+4. **Route through must-see groups.** Groups are the coverage-mask cells of the blocks of a
+   lattice. If the explorer never entered a group's region, none of its cells is FREE; the goal
+   leaves at most ``budget`` mask cells unseen, so the explorer enters the regions of a set S
+   of the chosen groups whose others hold at most ``budget`` cells, in order of first entry,
+   each leg at least the K-hop distance between the regions. The bound is the least such route
+   over every feasible S (Held-Karp, exact), with any choice of groups (disjoint regions only
+   make it tighter); cells no allowed cell can see at all are taken off the budget first.
+
+Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
+LiDAR fused at the true pose (the env's default: no range noise, no odometry drift).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
+    group_region,
+    held_karp_route,
+    khop_distances,
+)
+from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.worlds.geometry import segment_distance_field
+
+_EIGHT = np.ones((3, 3), dtype=bool)
+_VISIBILITY_TOL_M = 1e-6
+_CLEARANCE_TOL_M = 1e-4
+
+
+@dataclass(frozen=True)
+class LowerBoundParams:
+    """Knobs of :func:`lower_bound` (any values give a valid bound; they trade speed for tightness).
+
+    Attributes:
+        hop_cells: K of the K-hop metric (open space: about (K - 1) / K of the straight line).
+        distance_cell_factor: Distance cells are this many map cells on a side (one passes
+            to a neighbour where their map cells do).
+        group_scales: Group block sides to try, as multiples of the side whose square holds one
+            more cell than the skip budget (the largest bound wins).
+        max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
+        penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
+        mount_offset_m: LiDAR distance from the robot centre.
+        coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
+    """
+
+    hop_cells: int = 8
+    distance_cell_factor: int = 2
+    group_scales: tuple[float, ...] = (1.0, 2.0)
+    max_groups: int = 13
+    penetration_tolerance_m: float = 0.01
+    mount_offset_m: float = 0.0
+    coverage_share: float | None = None
+
+    def __post_init__(self) -> None:
+        for name, lo, hi in (
+            ("hop_cells", 1, 64),
+            ("distance_cell_factor", 1, 8),
+            ("max_groups", 1, 18),
+        ):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and lo <= v <= hi):
+                raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+        if not self.group_scales or not all(
+            math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
+        ):
+            raise ValueError(f"group_scales must be in [0.05, 20], got {self.group_scales!r}")
+        for name in ("penetration_tolerance_m", "mount_offset_m"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and 0 <= v <= 0.5):
+                raise ValueError(f"{name} must be in [0, 0.5] m, got {v!r}")
+        share = self.coverage_share
+        if share is not None and not (0 < share <= 1):
+            raise ValueError(f"coverage_share must be in (0, 1], got {share!r}")
+
+
+@dataclass(frozen=True)
+class LowerBound:
+    """A certified lower bound on the drive to the coverage goal, with what it is made of.
+
+    Attributes:
+        distance_m: No explorer reaches the goal after a shorter drive (inf: none can).
+        time_s: ``distance_m`` at top speed.
+        n_groups: Groups in the route's problem.
+        group_cells: Coverage-mask cells of each group.
+        group_centres_m: ``(x, y)`` centre of each group's bounding box.
+        region_cells: Distance cells of each group's region.
+        route: Group indices in the order of the bound's route (the groups it visits).
+        budget_cells: Mask cells the goal lets an explorer leave unseen.
+        block_cells: Side of the lattice blocks (map cells) of the groups.
+        planning_s: Wall time spent.
+    """
+
+    distance_m: float
+    time_s: float
+    n_groups: int
+    group_cells: tuple[int, ...]
+    group_centres_m: tuple[tuple[float, float], ...]
+    region_cells: tuple[int, ...]
+    route: tuple[int, ...]
+    budget_cells: int
+    block_cells: int
+    planning_s: float
+
+
+def skip_budget_cells(n_cells: int, share: float) -> int:
+    """Most of ``n_cells`` that may stay unseen with coverage ``count / n_cells`` at ``share``
+    (compared as the mission's T99 is, with a 1e-12 tolerance)."""
+    need = min(n_cells, max(0, math.ceil(share * n_cells) - 2))
+    while need < n_cells and need / n_cells < share - 1e-12:
+        need += 1
+    return n_cells - need
+
+
+def allowed_cells(facts: PrivilegedWorld, tolerance_m: float) -> tuple[np.ndarray, tuple[int, int]]:
+    """The cells the robot's centre can lie in (step 1) and the start's cell.
+
+    Raises:
+        ValueError: a start outside the grid or too close to a wall, or free space that reaches
+            the edge of the grid (the map is larger than the grid holds).
+    """
+    geo = facts.geometry
+    h = geo.resolution_m
+    c_min = facts.radius_m - tolerance_m
+    need = c_min - h / math.sqrt(2.0) - _CLEARANCE_TOL_M
+    field = segment_distance_field(facts.world.segments_m, geo, max(need, 0.0) + h)
+    ok = field >= need
+    x, y = facts.start_pose[0], facts.start_pose[1]
+    row, col = (int(v) for v in geo.world_to_grid(x, y))
+    if not (0 <= row < geo.height and 0 <= col < geo.width):
+        raise ValueError(f"start ({x:g}, {y:g}) lies outside the map grid")
+    if not ok[row, col]:
+        raise ValueError(
+            f"start ({x:g}, {y:g}) is inside a wall: closer than the robot's radius "
+            f"({facts.radius_m:g} m) to one"
+        )
+    labels, _ = ndimage.label(ok, structure=_EIGHT)
+    allowed = labels == labels[row, col]
+    if allowed[0, :].any() or allowed[-1, :].any() or allowed[:, 0].any() or allowed[:, -1].any():
+        raise ValueError(
+            "the free space around the start reaches the edge of the map grid: the world is "
+            "larger than the grid holds (or not closed by walls)"
+        )
+    return allowed, (row, col)
+
+
+def merge_walls(segments_m: np.ndarray, tol_m: float = 1e-9) -> np.ndarray:
+    """Collinear walls that touch or overlap, merged into maximal segments ``(M, 4)``."""
+    seg = np.asarray(segments_m, dtype=np.float64).reshape(-1, 4)
+    d = seg[:, 2:] - seg[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    keep = length > 0
+    seg, d, length = seg[keep], d[keep], length[keep]
+    u = d / length[:, None]
+    flip = (u[:, 0] < -1e-12) | ((np.abs(u[:, 0]) <= 1e-12) & (u[:, 1] < 0))
+    u[flip] *= -1.0
+    offset = seg[:, 0] * -u[:, 1] + seg[:, 1] * u[:, 0]
+    key = np.round(np.column_stack([u[:, 0], u[:, 1], offset]) * 1e9).astype(np.int64)
+    out: list[np.ndarray] = []
+    _, inverse = np.unique(key, axis=0, return_inverse=True)
+    for g in np.unique(inverse):
+        idx = np.flatnonzero(inverse == g)
+        ug = u[idx[0]]
+        base = seg[idx[0], :2]
+        s0 = (seg[idx, :2] - base) @ ug
+        s1 = (seg[idx, 2:] - base) @ ug
+        lo, hi = np.minimum(s0, s1), np.maximum(s0, s1)
+        order = np.argsort(lo)
+        cur_lo, cur_hi = lo[order[0]], hi[order[0]]
+        for i in order[1:]:
+            if lo[i] <= cur_hi + tol_m:
+                cur_hi = max(cur_hi, hi[i])
+            else:
+                out.append(np.concatenate([base + cur_lo * ug, base + cur_hi * ug]))
+                cur_lo, cur_hi = lo[i], hi[i]
+        out.append(np.concatenate([base + cur_lo * ug, base + cur_hi * ug]))
+    return np.array(out, dtype=np.float64).reshape(-1, 4)
+
+
+def mask_groups(
+    mask: np.ndarray, geometry: GridGeometry, block_cells: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mask cells of each ``block_cells`` lattice block: ``(rects, cells, centres)``:
+    the bounding rectangle ``x0, y0, x1, y1`` of each non-empty group, its cell count and the
+    centre of its block."""
+    b = max(1, int(block_cells))
+    rows, cols = np.nonzero(mask)
+    block = (rows // b) * (-(-mask.shape[1] // b)) + cols // b
+    ids, inverse, cells = np.unique(block, return_inverse=True, return_counts=True)
+    n = ids.size
+    rmin = np.full(n, np.iinfo(np.int64).max)
+    rmax = np.full(n, -1)
+    cmin = np.full(n, np.iinfo(np.int64).max)
+    cmax = np.full(n, -1)
+    np.minimum.at(rmin, inverse, rows)
+    np.maximum.at(rmax, inverse, rows)
+    np.minimum.at(cmin, inverse, cols)
+    np.maximum.at(cmax, inverse, cols)
+    h, x0, y0 = geometry.resolution_m, geometry.origin_x_m, geometry.origin_y_m
+    rects = np.column_stack(
+        [x0 + cmin * h, y0 + rmin * h, x0 + (cmax + 1) * h, y0 + (rmax + 1) * h]
+    )
+    nb = -(-mask.shape[1] // b)
+    br, bc = ids // nb, ids % nb
+    centres = np.column_stack([x0 + (bc + 0.5) * b * h, y0 + (br + 0.5) * b * h])
+    return rects.astype(np.float64), cells.astype(np.int64), centres
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """The fixed parts: allowed map cells, walls, the coarse distance grid's moves."""
+
+    allowed: np.ndarray
+    coarse: np.ndarray
+    factor: int
+    walls: np.ndarray
+    geometry: GridGeometry
+    reach_m: float
+    widen_m: float
+    hop_cells: int
+
+    def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
+        """The coarse cell of each map cell (flat indices)."""
+        r, c = np.divmod(np.asarray(flat, dtype=np.int64), self.geometry.width)
+        return (r // self.factor) * self.coarse.shape[1] + c // self.factor
+
+    def to_coarse(self, flat: np.ndarray) -> np.ndarray:
+        return np.unique(self.to_coarse_each(flat))
+
+    def region(self, rect: np.ndarray) -> np.ndarray:
+        """Coarse cells of the region of the group in ``rect``."""
+        g = self.geometry
+        fine = group_region(
+            self.allowed,
+            rect,
+            self.walls,
+            g.origin_x_m,
+            g.origin_y_m,
+            g.resolution_m,
+            self.reach_m,
+            self.widen_m,
+            _VISIBILITY_TOL_M,
+        )
+        return self.to_coarse(fine)
+
+    def distances(
+        self, coarse_sources: np.ndarray, targets: list[np.ndarray] | None = None
+    ) -> np.ndarray:
+        """K-hop distances from the sources; with ``targets`` (coarse cell sets), exact only
+        as far as each set's least value needs."""
+        src = np.asarray(coarse_sources, dtype=np.int64)
+        res = self.geometry.resolution_m * self.factor
+        target_of = np.full(self.coarse.shape, -1, dtype=np.int64)
+        flat = target_of.reshape(-1)
+        sets = [t for t in (targets or []) if t.size]
+        for j, t in enumerate(sets):
+            flat[t] = j
+        d = khop_distances(self.coarse, src, self.hop_cells, res, target_of, len(sets))
+        return d.reshape(-1)
+
+
+def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
+    """The moves between ``factor`` x ``factor`` blocks of ``allowed`` (uint8 bit masks, see
+    :func:`~.lower_bound_kernels.khop_distances`): block A passes to its neighbour B when an
+    allowed cell of A is 8-adjacent to one of B (bit 4: A holds an allowed cell). A path's
+    blocks thus step along moves, and blocks never join across a wall the cells do not."""
+    f = int(factor)
+    h, w = allowed.shape
+    hc, wc = -(-h // f), -(-w // f)
+    out = np.zeros(hc * wc, dtype=np.uint8)
+    rows, cols = np.nonzero(allowed)
+    own = (rows // f) * wc + cols // f
+    np.bitwise_or.at(out, own, np.uint8(1 << 4))
+    for dr in (-1, 0, 1):
+        for dc in (-1, 0, 1):
+            r2, c2 = rows + dr, cols + dc
+            ok = (r2 >= 0) & (r2 < h) & (c2 >= 0) & (c2 < w)
+            ok[ok] &= allowed[r2[ok], c2[ok]]
+            br, bc = rows[ok] // f, cols[ok] // f
+            sr, sc = r2[ok] // f - br, c2[ok] // f - bc
+            step = (sr != 0) | (sc != 0)
+            bit = (3 * (sr[step] + 1) + sc[step] + 1).astype(np.uint8)
+            np.bitwise_or.at(out, br[step] * wc + bc[step], np.left_shift(np.uint8(1), bit))
+    return out.reshape(hc, wc)
+
+
+def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) -> LowerBound:
+    """A certified lower bound on the drive to the coverage goal from ``facts.start_pose``.
+
+    Raises:
+        ValueError: nothing reachable to cover, a start inside a wall or outside the grid, or a
+            map larger than its grid.
+    """
+    p = params or LowerBoundParams()
+    t0 = time.perf_counter()
+    geo = facts.geometry
+    mask = np.asarray(facts.reachable_mask, dtype=bool)
+    if mask.shape != geo.shape:
+        raise ValueError(f"reachable mask shape {mask.shape} != map grid {geo.shape}")
+    n_mask = int(mask.sum())
+    if n_mask == 0:
+        raise ValueError("nothing to cover: the reachable mask has no cell")
+    allowed, (sr, sc) = allowed_cells(facts, p.penetration_tolerance_m)
+    share = facts.coverage_goal if p.coverage_share is None else p.coverage_share
+    budget = skip_budget_cells(n_mask, share)
+    f = p.distance_cell_factor
+    prob = _Problem(
+        allowed=allowed,
+        coarse=coarse_moves(allowed, f),
+        factor=f,
+        walls=merge_walls(facts.world.segments_m),
+        geometry=geo,
+        reach_m=facts.sensor.max_range_m + _VISIBILITY_TOL_M,
+        widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
+        hop_cells=p.hop_cells,
+    )
+    from_start = prob.distances(prob.to_coarse(np.array([sr * geo.width + sc])))
+    best: _Route | None = None
+    for scale in p.group_scales:
+        block = max(1, int(math.ceil(scale * math.sqrt(budget + 1))))
+        found = _bound_for_blocks(prob, mask, block, from_start, budget, p.max_groups)
+        if best is None or found.length_m > best.length_m:
+            best = found
+    assert best is not None
+    return LowerBound(
+        distance_m=best.length_m,
+        time_s=best.length_m / facts.max_linear_speed_mps,
+        n_groups=len(best.cells),
+        group_cells=best.cells,
+        group_centres_m=best.centres_m,
+        region_cells=best.region_cells,
+        route=best.route,
+        budget_cells=budget,
+        block_cells=best.block_cells,
+        planning_s=time.perf_counter() - t0,
+    )
+
+
+@dataclass(frozen=True)
+class _Route:
+    length_m: float
+    cells: tuple[int, ...]
+    centres_m: tuple[tuple[float, float], ...]
+    region_cells: tuple[int, ...]
+    route: tuple[int, ...]
+    block_cells: int
+
+
+def _bound_for_blocks(
+    prob: _Problem, mask: np.ndarray, block: int, from_start: np.ndarray, budget: int, cap: int
+) -> _Route:
+    """Groups of ``block``-cell lattice blocks, chosen farthest first (from the start and the
+    groups chosen so far, by distance to the group's own cells: a choice, not a proof step),
+    then the exact route over them."""
+    rects, cells, _ = mask_groups(mask, prob.geometry, block)
+    rows, cols = np.nonzero(mask)
+    bw = -(-mask.shape[1] // block)
+    _, group_of = np.unique((rows // block) * bw + cols // block, return_inverse=True)
+    coarse_of = prob.to_coarse_each(rows * mask.shape[1] + cols)
+    score = np.full(rects.shape[0], np.inf)
+    np.minimum.at(score, group_of, from_start[coarse_of])
+    # Well-filled groups only (a scrap of a block is cheap to leave unseen).
+    score[cells < 0.5 * block * block] = 0.0
+    centres = 0.5 * (rects[:, :2] + rects[:, 2:])
+    chosen: list[int] = []
+    regions: list[np.ndarray] = []
+    while len(chosen) < min(cap, rects.shape[0]):
+        g = int(np.argmax(score))
+        if not score[g] > 0:
+            break
+        chosen.append(g)
+        regions.append(prob.region(rects[g]))
+        np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
+    m = len(chosen)
+    first = np.array([_least(from_start, r) for r in regions], dtype=np.float64)
+    legs = np.zeros((m, m), dtype=np.float64)
+    for i in range(m):
+        others = [regions[j] for j in range(m) if j != i]
+        field = prob.distances(regions[i], others) if regions[i].size else None
+        for j in range(m):
+            legs[i, j] = 0.0 if i == j else math.inf if field is None else _least(field, regions[j])
+    # A path from region i to j, reversed, runs from j to i: either direction bounds it.
+    legs = np.maximum(legs, legs.T)
+    idx = np.array(chosen, dtype=np.int64)
+    # A group's region is a set: a route may enter it at one cell and leave from another, so a
+    # group can shorten the route; each prefix of the choice is a valid problem: keep the best.
+    length, order, m_best = 0.0, np.zeros(0, dtype=np.int64), 0
+    for k in range(1, m + 1):
+        got, got_order = held_karp_route(
+            first[:k], legs[:k, :k].copy(), cells[idx[:k]].astype(np.int64), int(budget)
+        )
+        if got > length:
+            length, order, m_best = float(got), got_order, k
+    idx = idx[:m_best]
+    regions = regions[:m_best]
+    return _Route(
+        length_m=float(length),
+        cells=tuple(int(c) for c in cells[idx]),
+        centres_m=tuple((float(x), float(y)) for x, y in centres[idx]),
+        region_cells=tuple(int(r.size) for r in regions),
+        route=tuple(int(i) for i in order),
+        block_cells=block,
+    )
+
+
+def _least(field: np.ndarray, cells: np.ndarray) -> float:
+    """Least of ``field`` over ``cells`` (inf for none: a region nothing can stand in)."""
+    return float(field[cells].min()) if cells.size else math.inf

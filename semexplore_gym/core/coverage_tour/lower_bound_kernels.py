@@ -1,0 +1,313 @@
+"""Numba kernels of :mod:`.lower_bound`: the K-hop distance field, visibility regions of cell
+groups (one wall at a time), and the Held-Karp route over groups with a skip budget.
+
+Grid cell ``(r, c)`` is the square ``[gx0 + c*res, gx0 + (c+1)*res] x [gy0 + r*res, ...]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _heap_push(keys, vals, n, key, val):  # pragma: no cover - numba
+    if n == keys.shape[0]:
+        bigger_k = np.empty(2 * n, dtype=np.float64)
+        bigger_v = np.empty(2 * n, dtype=np.int64)
+        bigger_k[:n] = keys[:n]
+        bigger_v[:n] = vals[:n]
+        keys = bigger_k
+        vals = bigger_v
+    i = n
+    keys[i] = key
+    vals[i] = val
+    while i > 0:
+        p = (i - 1) // 2
+        if keys[p] <= keys[i]:
+            break
+        keys[p], keys[i] = keys[i], keys[p]
+        vals[p], vals[i] = vals[i], vals[p]
+        i = p
+    return keys, vals, n + 1
+
+
+@njit(cache=True)
+def _heap_pop(keys, vals, n):  # pragma: no cover - numba
+    key = keys[0]
+    val = vals[0]
+    n -= 1
+    keys[0] = keys[n]
+    vals[0] = vals[n]
+    i = 0
+    while True:
+        a = 2 * i + 1
+        if a >= n:
+            break
+        b = a + 1
+        m = a if (b >= n or keys[a] <= keys[b]) else b
+        if keys[i] <= keys[m]:
+            break
+        keys[m], keys[i] = keys[i], keys[m]
+        vals[m], vals[i] = vals[i], vals[m]
+        i = m
+    return key, val, n
+
+
+@njit(cache=True)
+def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no cover - numba
+    """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
+
+    ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
+    ``(r, c)`` to ``(r + dr, c + dc)`` (bit 4: the cell itself is allowed). A settled cell ``a``
+    (a checkpoint) reaches, by a breadth-first search along moves inside its Chebyshev ball of radius ``k`` that expands only cells strictly inside
+    the ball, every cell ``b`` a path can reach before first leaving the ball's interior; the
+    edge costs the distance between the squares of ``a`` and ``b``. Cells on the ball's rim are
+    the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
+
+    With ``n_targets`` > 0 it stops once each target set (``target_of[cell]``, -1 for none)
+    holds its final least distance: every later value is at least the popped one.
+
+    Returns:
+        ``moves.shape`` float64 distances (inf where unreached, or not needed for the targets).
+    """
+    h, w = moves.shape
+    flat_moves = moves.reshape(h * w)
+    side = 2 * k + 1
+    cost = np.empty(side * side, dtype=np.float64)
+    for i in range(side):
+        for j in range(side):
+            dr = max(abs(i - k) - 1, 0)
+            dc = max(abs(j - k) - 1, 0)
+            cost[i * side + j] = res * math.sqrt(dr * dr + dc * dc)
+    chain = np.full(h * w, np.inf)
+    best = np.full(h * w, np.inf)
+    settled = np.zeros(h * w, dtype=np.bool_)
+    keys = np.empty(1024, dtype=np.float64)
+    vals = np.empty(1024, dtype=np.int64)
+    n = 0
+    for s in sources:
+        if (flat_moves[s] >> 4) & 1 and chain[s] > 0.0:
+            chain[s] = 0.0
+            best[s] = 0.0
+            keys, vals, n = _heap_push(keys, vals, n, 0.0, s)
+    stamp = np.zeros(side * side, dtype=np.int64)
+    queue = np.empty(side * side, dtype=np.int64)
+    sid = 0
+    flat_target = target_of.reshape(h * w)
+    tbest = np.full(max(n_targets, 1), np.inf)
+    for s in sources:
+        if flat_target[s] >= 0 and best[s] < tbest[flat_target[s]]:
+            tbest[flat_target[s]] = best[s]
+    while n > 0:
+        d, a, n = _heap_pop(keys, vals, n)
+        if settled[a] or d > chain[a]:
+            continue
+        if n_targets > 0 and d >= tbest.max():
+            break
+        settled[a] = True
+        ar = a // w
+        ac = a - ar * w
+        sid += 1
+        centre = k * side + k
+        stamp[centre] = sid
+        queue[0] = centre
+        head = 0
+        tail = 1
+        while head < tail:
+            loc = queue[head]
+            head += 1
+            li = loc // side
+            lj = loc - li * side
+            g = (ar + li - k) * w + (ac + lj - k)
+            e = d + cost[loc]
+            if e < best[g]:
+                best[g] = e
+                t = flat_target[g]
+                if t >= 0 and e < tbest[t]:
+                    tbest[t] = e
+            if abs(li - k) == k or abs(lj - k) == k:
+                if e < chain[g] and not settled[g]:
+                    chain[g] = e
+                    keys, vals, n = _heap_push(keys, vals, n, e, g)
+                continue
+            bits = flat_moves[g]
+            for di in range(-1, 2):
+                for dj in range(-1, 2):
+                    if not (bits >> (3 * (di + 1) + dj + 1)) & 1 or (di == 0 and dj == 0):
+                        continue
+                    ni = li + di
+                    nj = lj + dj
+                    gr = ar + ni - k
+                    gc = ac + nj - k
+                    if gr < 0 or gc < 0 or gr >= h or gc >= w:
+                        continue
+                    nl = ni * side + nj
+                    if stamp[nl] == sid:
+                        continue
+                    stamp[nl] = sid
+                    queue[tail] = nl
+                    tail += 1
+    return best.reshape(h, w)
+
+
+@njit(cache=True)
+def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - numba
+    """Whether ``wall`` meets every segment between the rectangles with corners ``(ax, ay)``
+    and ``(ux, uy)``: its line separates them strictly and all 16 corner-pair segments cross
+    the line inside the wall (the union of the segments is the convex hull of the two)."""
+    x0 = walls[q, 0]
+    y0 = walls[q, 1]
+    dx = walls[q, 2] - x0
+    dy = walls[q, 3] - y0
+    length = math.sqrt(dx * dx + dy * dy)
+    if length <= 2.0 * tol:
+        return False
+    nx = -dy / length
+    ny = dx / length
+    for i in range(4):
+        fa[i] = (ax[i] - x0) * nx + (ay[i] - y0) * ny
+        fu[i] = (ux[i] - x0) * nx + (uy[i] - y0) * ny
+    a_lo = min(min(fa[0], fa[1]), min(fa[2], fa[3]))
+    a_hi = max(max(fa[0], fa[1]), max(fa[2], fa[3]))
+    u_lo = min(min(fu[0], fu[1]), min(fu[2], fu[3]))
+    u_hi = max(max(fu[0], fu[1]), max(fu[2], fu[3]))
+    if not ((a_lo > tol and u_hi < -tol) or (a_hi < -tol and u_lo > tol)):
+        return False
+    for i in range(4):
+        for j in range(4):
+            t = fa[i] / (fa[i] - fu[j])
+            px = ax[i] + t * (ux[j] - ax[i])
+            py = ay[i] + t * (uy[j] - ay[i])
+            s = ((px - x0) * dx + (py - y0) * dy) / length
+            if s < tol or s > length - tol:
+                return False
+    return True
+
+
+@njit(cache=True)
+def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  # pragma: no cover
+    """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
+    (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
+    rectangle and no single wall of ``walls`` meets every segment between the two."""
+    h, w = allowed.shape
+    c_lo = max(0, int(math.floor((rect[0] - reach_m - widen_m - gx0) / res)) - 1)
+    c_hi = min(w - 1, int(math.floor((rect[2] + reach_m + widen_m - gx0) / res)) + 1)
+    r_lo = max(0, int(math.floor((rect[1] - reach_m - widen_m - gy0) / res)) - 1)
+    r_hi = min(h - 1, int(math.floor((rect[3] + reach_m + widen_m - gy0) / res)) + 1)
+    near = np.empty(walls.shape[0], dtype=np.int64)
+    m = 0
+    bx0 = rect[0] - reach_m - widen_m
+    bx1 = rect[2] + reach_m + widen_m
+    by0 = rect[1] - reach_m - widen_m
+    by1 = rect[3] + reach_m + widen_m
+    for q in range(walls.shape[0]):
+        wx0 = min(walls[q, 0], walls[q, 2])
+        wx1 = max(walls[q, 0], walls[q, 2])
+        wy0 = min(walls[q, 1], walls[q, 3])
+        wy1 = max(walls[q, 1], walls[q, 3])
+        if wx1 >= bx0 and wx0 <= bx1 and wy1 >= by0 and wy0 <= by1:
+            near[m] = q
+            m += 1
+    ax = np.array([rect[0], rect[2], rect[2], rect[0]])
+    ay = np.array([rect[1], rect[1], rect[3], rect[3]])
+    ux = np.empty(4)
+    uy = np.empty(4)
+    fa = np.empty(4)
+    fu = np.empty(4)
+    out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
+    count = 0
+    last = 0
+    for r in range(r_lo, r_hi + 1):
+        y0 = gy0 + r * res - widen_m
+        y1 = gy0 + (r + 1) * res + widen_m
+        gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
+        for c in range(c_lo, c_hi + 1):
+            if not allowed[r, c]:
+                continue
+            x0 = gx0 + c * res - widen_m
+            x1 = gx0 + (c + 1) * res + widen_m
+            gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
+            if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
+                continue
+            ux[0] = x0
+            ux[1] = x1
+            ux[2] = x1
+            ux[3] = x0
+            uy[0] = y0
+            uy[1] = y0
+            uy[2] = y1
+            uy[3] = y1
+            blind = False
+            if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
+                blind = True
+            else:
+                for p in range(m):
+                    if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
+                        blind = True
+                        last = p
+                        break
+            if not blind:
+                out[count] = r * w + c
+                count += 1
+    return out[:count].copy()
+
+
+@njit(cache=True)
+def held_karp_route(first, legs, cells, budget):  # pragma: no cover - numba
+    """Shortest route from the start through a subset S of the groups, over every S whose
+    unvisited groups hold at most ``budget`` cells. ``first[i]``: start to group i; ``legs[i, j]``:
+    group i to group j. Returns ``(length, order)`` (inf and an empty order if none is finite)."""
+    m = first.shape[0]
+    full = 1 << m
+    dp = np.full((full, max(m, 1)), np.inf)
+    parent = np.full((full, max(m, 1)), -1, dtype=np.int64)
+    held = np.zeros(full, dtype=np.int64)
+    total = 0
+    for i in range(m):
+        total += cells[i]
+        dp[1 << i, i] = first[i]
+    best = np.inf
+    best_set = -1
+    best_end = -1
+    if total <= budget:
+        best = 0.0
+        best_set = 0
+    for s in range(1, full):
+        low = s & (-s)
+        b = 0
+        while (1 << b) != low:
+            b += 1
+        held[s] = held[s ^ low] + cells[b]
+        ok = total - held[s] <= budget
+        for i in range(m):
+            v = dp[s, i]
+            if not ((s >> i) & 1) or v == np.inf:
+                continue
+            if ok and v < best:
+                best = v
+                best_set = s
+                best_end = i
+            if v >= best:
+                continue
+            for j in range(m):
+                if (s >> j) & 1:
+                    continue
+                t = s | (1 << j)
+                nv = v + legs[i, j]
+                if nv < dp[t, j]:
+                    dp[t, j] = nv
+                    parent[t, j] = i
+    order = np.empty(m, dtype=np.int64)
+    n = 0
+    s = best_set
+    e = best_end
+    while e >= 0:
+        order[n] = e
+        n += 1
+        p = parent[s, e]
+        s = s ^ (1 << e)
+        e = p
+    return best, order[:n][::-1].copy()

@@ -1,0 +1,274 @@
+"""The certified lower bound on worlds whose optimum is known, and its proof steps one by one.
+
+Every check is one-sided where the bound's guarantee is (never above a feasible drive, the
+K-hop metric never above a true path, every cell a scan maps FREE inside a region holding the
+scan's cell) and loose on the other side: the bound is a relaxation, not an estimate.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+from semexplore_gym.core.coverage_tour.lower_bound import (
+    _Problem,
+    allowed_cells,
+    coarse_moves,
+    mask_groups,
+    merge_walls,
+    skip_budget_cells,
+)
+from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
+    held_karp_route,
+    khop_distances,
+)
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.worlds.build import world_from_free_mask
+
+RES = 0.05
+RADIUS = 0.105
+RANGE_M = 1.0
+
+
+def _khop(moves, sources, k, res):
+    """The full K-hop field (no targets to stop at)."""
+    none = np.full(moves.shape, -1, dtype=np.int64)
+    return khop_distances(moves, np.asarray(sources, dtype=np.int64), k, res, none, 0)
+
+
+def _world(rects, size_m, start):
+    h, w = int(round(size_m[1] / RES)), int(round(size_m[0] / RES))
+    free = np.zeros((h, w), dtype=bool)
+    for x0, y0, x1, y1 in rects:
+        rows = slice(int(round(y0 / RES)), int(round(y1 / RES)))
+        free[rows, int(round(x0 / RES)) : int(round(x1 / RES))] = True
+    return world_from_free_mask("test", free, GridGeometry(RES, 0.0, 0.0, h, w), start_pose=start)
+
+
+def _facts(pw, rects, size_m, start, range_m=RANGE_M):
+    return pw(_world(rects, size_m, start), start, RADIUS, range_m, RES)
+
+
+def test_a_straight_corridor_bound_is_below_its_one_way_drive_and_close(privileged_world):
+    # 8 m x 0.6 m, start 0.3 m from the left end: the far end's cells are seen from R before
+    # it, so a drive of 8 - 0.3 - R reaches full coverage; 99 % needs a little less.
+    facts = _facts(privileged_world, [(0.0, 0.0, 8.0, 0.6)], (8.0, 0.6), (0.3, 0.3, 0.0))
+    b = lower_bound(facts)
+    drive = 8.0 - 0.3 - RANGE_M
+    assert 0.6 * drive <= b.distance_m <= drive
+    assert b.time_s == pytest.approx(b.distance_m / facts.max_linear_speed_mps)
+    assert b.n_groups >= 1 and len(b.route) >= 1
+
+
+def test_a_ring_bound_is_below_driving_round_once(privileged_world):
+    # A square ring corridor 0.6 m wide around a 4 m x 4 m block; its centre line is 4 x 4.6
+    # m long. Driving once round (less what the LiDAR sees ahead and behind) covers it all.
+    rects = [(0.0, 0.0, 5.2, 0.6), (0.0, 4.6, 5.2, 5.2), (0.0, 0.0, 0.6, 5.2), (4.6, 0.0, 5.2, 5.2)]
+    facts = _facts(privileged_world, rects, (5.2, 5.2), (2.6, 0.3, 0.0))
+    b = lower_bound(facts)
+    once_round = 4 * 4.6 - 2 * RANGE_M
+    assert 0.0 < b.distance_m <= once_round
+
+
+def test_a_comb_bound_is_below_a_drive_that_visits_every_tooth(privileged_world):
+    # A spine 7 m long (y in [0, 0.6]) with 4 teeth 3 m deep every 2 m; start at the spine's
+    # left end. Feasible: along the spine, into and out of each tooth to R of its end, the
+    # last one not driven back.
+    teeth = [(x, 0.0, x + 0.6, 3.6) for x in (0.0, 2.0, 4.0, 6.0)]
+    facts = _facts(privileged_world, [(0.0, 0.0, 6.6, 0.6), *teeth], (6.6, 3.6), (0.3, 0.3, 0.0))
+    b = lower_bound(facts)
+    depth = 3.3 - RANGE_M
+    feasible = 6.0 + 2 * depth * 4 - depth
+    assert 2.0 <= b.distance_m <= feasible
+
+
+def test_khop_distance_never_exceeds_the_geodesic_on_an_l_corridor():
+    # L of two 0.6 m corridors; cells 0.05 m. The true shortest path between the two far ends'
+    # centres hugs the inner corner: at most the polyline through the corner's cell.
+    h, w = 120, 120
+    allowed = np.zeros((h, w), dtype=bool)
+    allowed[0:12, 0:120] = True
+    allowed[0:120, 108:120] = True
+    a = (6, 2)
+    b = (117, 114)
+    k = 8
+    d = _khop(coarse_moves(allowed, 1), np.array([a[0] * w + a[1]]), k, RES)
+    corner = np.array([11.0, 108.0])
+    path_cells = np.hypot(*(corner - a)) + np.hypot(*(np.array(b) - corner))
+    assert 0.7 * path_cells * RES <= d[b] <= path_cells * RES
+    # open space: about (K - 1) / K of the straight line, never above it
+    open_moves = coarse_moves(np.ones((200, 200), dtype=bool), 1)
+    d_open = _khop(open_moves, np.array([100 * 200]), k, RES)
+    straight = 199 * RES
+    assert (k - 1) / k * straight - 2 * RES <= d_open[100, 199] <= straight
+
+
+def test_coarse_distance_cells_do_not_join_across_a_thin_wall():
+    # Two corridors 10 cells wide, a band of 2 forbidden cells between them (a wall with the
+    # robot's clearance), joined only at the right end: with 2 x 2 distance cells the band
+    # lies inside blocks whose cells on either side are allowed, yet no move crosses it.
+    allowed = np.zeros((22, 100), dtype=bool)
+    allowed[0:10, :] = True
+    allowed[12:22, :] = True
+    allowed[:, 90:100] = True
+    moves = coarse_moves(allowed, 2)
+    d = _khop(moves, np.array([2 * moves.shape[1] + 0]), 4, 2 * RES)
+    assert d[8, 0] >= 0.7 * 2 * 90 * RES  # around the wall's end, not through it
+
+
+def test_stopping_at_the_targets_keeps_their_least_distance_exact():
+    rng = np.random.default_rng(1)
+    allowed = rng.random((60, 60)) > 0.25
+    allowed[30, :] = True
+    moves = coarse_moves(allowed, 1)
+    src = np.array([30 * 60 + 0])
+    full = _khop(moves, src, 5, RES)
+    targets = [np.array([30 * 60 + 59, 10 * 60 + 40]), np.array([31 * 60 + 5])]
+    target_of = np.full(allowed.shape, -1, dtype=np.int64)
+    for j, t in enumerate(targets):
+        target_of.reshape(-1)[t] = j
+    early = khop_distances(moves, src, 5, RES, target_of, 2).reshape(-1)
+    for t in targets:
+        assert early[t].min() == full.reshape(-1)[t].min()
+
+
+def test_skip_budget_matches_the_missions_coverage_rule():
+    for n in (1, 99, 100, 101, 18481, 147300):
+        b = skip_budget_cells(n, 0.99)
+        assert (n - b) / n >= 0.99 - 1e-12
+        assert b == n or (n - b - 1) / n < 0.99 - 1e-12
+
+
+def test_collinear_touching_walls_merge_and_others_do_not():
+    walls = np.array(
+        [[0, 0, 1, 0], [1, 0, 2, 0], [2.5, 0, 3, 0], [0, 1, 0, 2], [0, 0, 0, 1], [1, 1, 2, 2]],
+        dtype=np.float64,
+    )
+    merged = {tuple(np.round(s, 9)) for s in merge_walls(walls)}
+    assert (0.0, 0.0, 2.0, 0.0) in merged and (2.5, 0.0, 3.0, 0.0) in merged
+    assert (0.0, 0.0, 0.0, 2.0) in merged and len(merged) == 4
+
+
+def test_held_karp_takes_the_cheapest_feasible_subset():
+    first = np.array([1.0, 5.0, 2.0])
+    legs = np.array([[0.0, 1.0, 10.0], [1.0, 0.0, 10.0], [10.0, 10.0, 0.0]])
+    cells = np.array([10, 10, 3], dtype=np.int64)
+    # budget 3: group 2 may be skipped, 0 and 1 not: start -> 0 -> 1 = 2
+    length, order = held_karp_route(first, legs, cells, 3)
+    assert length == pytest.approx(2.0) and list(order) == [0, 1]
+    length, order = held_karp_route(first, legs, cells, 0)
+    assert length == pytest.approx(12.0)
+    assert held_karp_route(first, legs, cells, 23)[0] == 0.0
+
+
+@pytest.mark.parametrize(
+    "spec", ["maze:seed=1,size_m=5", "office:seed=2,size_m=10", "cave:seed=3,size_m=8"]
+)
+def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(spec):
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+    from semexplore_gym.core.coverage_tour.viewpoints import visible_sets
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    env = SemanticExploreEnv(spec, privileged=True, overrides=["episode.random_start=true"])
+    try:
+        facts = env.reset(seed=4)[1][PRIVILEGED_INFO_KEY]
+    finally:
+        env.close()
+    geo = facts.geometry
+    allowed, _ = allowed_cells(facts, 0.01)
+    prob = _Problem(
+        allowed=allowed,
+        coarse=coarse_moves(allowed, 1),
+        factor=1,
+        walls=merge_walls(facts.world.segments_m),
+        geometry=geo,
+        reach_m=facts.sensor.max_range_m + 1e-6,
+        widen_m=1e-6,
+        hop_cells=4,
+    )
+    block = 10
+    rects, _, _ = mask_groups(facts.reachable_mask, geo, block)
+    rows, cols = np.nonzero(facts.reachable_mask)
+    _, group_of = np.unique(
+        (rows // block) * -(-geo.width // block) + cols // block, return_inverse=True
+    )
+    group_at = np.full(geo.height * geo.width, -1)
+    group_at[rows * geo.width + cols] = group_of
+    rng = np.random.default_rng(0)
+    ar, ac = np.nonzero(allowed & facts.reachable_mask)
+    pick = rng.choice(ar.size, 25, replace=False)
+    poses = np.column_stack([ar[pick], ac[pick]])
+    seen = visible_sets(facts.world, geo, poses, facts.sensor, facts.reachable_mask)
+    flat = np.flatnonzero(facts.reachable_mask)
+    checked = 0
+    for i, (r, c) in enumerate(poses):
+        for g in np.unique(group_at[flat[seen[i].indices]]):
+            assert r * geo.width + c in set(prob.region(rects[g]).tolist())
+            checked += 1
+    assert checked > 25
+
+
+def test_a_start_inside_a_wall_is_one_clear_error(privileged_world):
+    facts = _facts(privileged_world, [(0.0, 0.0, 4.0, 0.6)], (4.0, 0.6), (0.3, 0.3, 0.0))
+    moved = type(facts)(**{**facts.__dict__, "start_pose": (0.3, 0.02, 0.0)})
+    with pytest.raises(ValueError, match="inside a wall"):
+        lower_bound(moved)
+
+
+def test_nothing_to_cover_is_one_clear_error(privileged_world):
+    facts = _facts(privileged_world, [(0.0, 0.0, 4.0, 0.6)], (4.0, 0.6), (0.3, 0.3, 0.0))
+    empty = type(facts)(**{**facts.__dict__, "reachable_mask": np.zeros_like(facts.reachable_mask)})
+    with pytest.raises(ValueError, match="nothing to cover"):
+        lower_bound(empty)
+
+
+def test_a_map_larger_than_its_grid_is_one_clear_error(privileged_world):
+    facts = _facts(privileged_world, [(0.0, 0.0, 4.0, 0.6)], (4.0, 0.6), (0.3, 0.3, 0.0))
+    g = facts.geometry
+    small = GridGeometry(g.resolution_m, g.origin_x_m + 0.6, g.origin_y_m, g.height, g.width - 30)
+    cut = type(facts)(
+        **{**facts.__dict__, "geometry": small, "reachable_mask": facts.reachable_mask[:, 12:-18]}
+    )
+    with pytest.raises(ValueError, match="edge of the map grid"):
+        lower_bound(cut)
+
+
+def test_params_reject_bad_values():
+    with pytest.raises(ValueError, match="hop_cells"):
+        LowerBoundParams(hop_cells=0)
+    with pytest.raises(ValueError, match="coverage_share"):
+        LowerBoundParams(coverage_share=1.5)
+    assert math.isfinite(LowerBoundParams().group_scales[0])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "spec",
+    [
+        "maze:seed=1,size_m=5",
+        "office:seed=2,size_m=8",
+        "cave:seed=3,size_m=6",
+        "forest:seed=4,size_m=6",
+    ],
+)
+def test_missions_never_reach_99_percent_sooner_or_shorter_than_the_bound(spec, short_mission):
+    from semexplore_gym.cli.oracle import certified_bound
+
+    seed = 5
+    bound = certified_bound(spec, seed, env_overrides=["episode.random_start=true"])
+    assert bound.distance_m > 0
+    reached = 0
+    for policy in ("semantic", "nearest"):
+        res, _ = short_mission(spec, policy, seed, 600.0)
+        if res.t99_s is None:  # stopped short of 99 %: nothing to compare
+            continue
+        reached += 1
+        assert res.t99_s >= bound.time_s, (spec, policy, res.t99_s, bound.time_s)
+        hit = next(i for i, (_, c, _) in enumerate(res.coverage_trace) if c >= 0.99 - 1e-12)
+        steps = np.diff(res.trajectory[: hit + 1, :2], axis=0)
+        drive_m = float(np.hypot(steps[:, 0], steps[:, 1]).sum())
+        assert drive_m >= bound.distance_m, (spec, policy, drive_m, bound.distance_m)
+    assert reached >= 1

@@ -1,0 +1,50 @@
+"""scripts/check_lower_bound.py: the bound per (world, start) of a benchmark folder, resumed."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+SCRIPT = REPO / "scripts" / "check_lower_bound.py"
+
+
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=600, env=env
+    )
+
+
+def _fake_runs(folder: Path, t99_s: list[str]) -> None:
+    """A runs.csv of one world (seed=* resolved per seed) and a benchmark.json."""
+    folder.mkdir()
+    (folder / "benchmark.json").write_text(json.dumps({"fixed_start": False, "suites": None}))
+    with (folder / "runs.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["world", "policy", "seed", "T99_s"])
+        w.writeheader()
+        for i, t in enumerate(t99_s):
+            w.writerow({"world": "maze:seed=*,size_m=5", "policy": "p", "seed": i % 2, "T99_s": t})
+
+
+def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path) -> None:
+    run_dir = tmp_path / "bench"
+    _fake_runs(run_dir, ["0.5", "1e6", "", "1e6"])
+    first = _run(str(run_dir), "--no-progress")
+    assert first.returncode == 0, first.stderr
+    assert "with T99: 3, T99 below the bound: 1" in first.stdout
+    rows = list(csv.DictReader((run_dir / "lower_bounds.csv").open()))
+    assert sorted(int(r["seed"]) for r in rows) == [0, 1]
+    assert all(float(r["lower_bound_s"]) > 0.5 for r in rows)
+    again = _run(str(run_dir), "--no-progress")  # resumed: nothing recomputed
+    assert again.returncode == 0 and again.stdout == first.stdout
+    assert len(list(csv.DictReader((run_dir / "lower_bounds.csv").open()))) == 2
+
+
+def test_a_folder_without_runs_is_one_clear_line(tmp_path) -> None:
+    res = _run(str(tmp_path))
+    assert res.returncode == 2 and res.stderr.strip().startswith("error: no runs.csv")
