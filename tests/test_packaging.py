@@ -121,7 +121,11 @@ def test_the_wheel_installs_one_top_level_package(wheel: zipfile.ZipFile) -> Non
 
 def test_the_wheel_carries_every_config_and_pretrained_model(wheel: zipfile.ZipFile) -> None:
     names = set(wheel.namelist())
-    configs = [p.relative_to(REPO).as_posix() for p in (REPO / "configs").rglob("*.y*ml")]
+    configs = [
+        p.relative_to(REPO).as_posix()
+        for pattern in ("*.y*ml", "*.csv")
+        for p in (REPO / "configs").rglob(pattern)
+    ]
     assert len(configs) >= 10
     missing = [c for c in configs if f"semexplore_gym/{c}" not in names]
     assert not missing, f"configs not in the wheel: {missing}"
