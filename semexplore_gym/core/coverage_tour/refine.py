@@ -52,6 +52,10 @@ class LegVisibility:
         sample_m: Scans are taken this far apart along the path (its ends excluded: they are
             the tour's nodes, counted on their own).
         index: The world's :class:`SegmentIndex` if already built.
+        robust_cells: A pose sees what the scans from its cell and from the four cells this
+            many cells away along the axes (those on ``drive_cost``'s finite cells) all see:
+            the robot passes near its poses, not on them, and a view through a gap between two
+            walls can vanish 0.1 m aside (0: the one scan).
     """
 
     def __init__(
@@ -63,33 +67,60 @@ class LegVisibility:
         drive_cost: np.ndarray,
         sample_m: float,
         index: SegmentIndex | None = None,
+        robust_cells: int = 0,
     ) -> None:
         self._world, self._geo, self._sensor = world, geometry, sensor
         self._mask = count_mask
         self._cost = drive_cost
         self._index = index if index is not None else SegmentIndex(world.segments_m)
         self._step_cells = max(1, int(round(sample_m / geometry.resolution_m)))
+        self._robust = int(robust_cells)
+        self._scans: dict[tuple[int, int], np.ndarray] = {}
         self._cells: dict[tuple[int, int], np.ndarray] = {}
         self._legs: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
 
     def cells(self, cells_rc: np.ndarray) -> list[np.ndarray]:
-        """Per cell, the sorted columns one scan from its centre maps FREE."""
+        """Per cell, the sorted columns its pose sees (see ``robust_cells``)."""
         keys = [(int(r), int(c)) for r, c in np.asarray(cells_rc, dtype=np.int64).reshape(-1, 2)]
         todo = sorted({k for k in keys if k not in self._cells})
         if todo:
-            vis = visible_sets(
-                self._world,
-                self._geo,
-                np.array(todo, dtype=np.int64),
-                self._sensor,
-                self._mask,
-                self._index,
-            )
-            for i, k in enumerate(todo):
-                self._cells[k] = np.sort(vis.indices[vis.indptr[i] : vis.indptr[i + 1]]).astype(
-                    np.int64
-                )
+            groups = [self._around(k) for k in todo]
+            self._scan(sorted({a for g in groups for a in g}))
+            for k, g in zip(todo, groups, strict=True):
+                seen = self._scans[g[0]]
+                for other in g[1:]:
+                    seen = np.intersect1d(seen, self._scans[other], assume_unique=True)
+                self._cells[k] = seen
         return [self._cells[k] for k in keys]
+
+    def _around(self, rc: tuple[int, int]) -> list[tuple[int, int]]:
+        """The cell and its offsets on finite cost (see ``robust_cells``)."""
+        out = [rc]
+        d = self._robust
+        if d <= 0:
+            return out
+        h, w = self._cost.shape
+        for dr, dc in ((d, 0), (-d, 0), (0, d), (0, -d)):
+            r, c = rc[0] + dr, rc[1] + dc
+            if 0 <= r < h and 0 <= c < w and np.isfinite(self._cost[r, c]):
+                out.append((r, c))
+        return out
+
+    def _scan(self, cells: list[tuple[int, int]]) -> None:
+        todo = [k for k in cells if k not in self._scans]
+        if not todo:
+            return
+        vis = visible_sets(
+            self._world,
+            self._geo,
+            np.array(todo, dtype=np.int64),
+            self._sensor,
+            self._mask,
+            self._index,
+        )
+        for i, k in enumerate(todo):
+            cols = vis.indices[vis.indptr[i] : vis.indptr[i + 1]]
+            self._scans[k] = np.sort(cols).astype(np.int64)
 
     def leg(self, a_rc: tuple[int, int], b_rc: tuple[int, int]) -> np.ndarray:
         """Sorted columns seen by the scans along the driven path from ``a_rc`` to ``b_rc``."""
@@ -103,7 +134,9 @@ class LegVisibility:
         else:
             inner = found[0][1:-1]
             samples = inner[self._step_cells // 2 :: self._step_cells]
-            parts = self.cells(samples)
+            keys = [(int(r), int(c)) for r, c in samples]
+            self._scan(keys)
+            parts = [self._scans[k] for k in keys]
             seen = np.unique(np.concatenate(parts)) if parts else _EMPTY
         self._legs[key] = seen
         return seen
@@ -128,10 +161,11 @@ def refine_tour(
     covered0: np.ndarray,
     required: int,
     legs: LegVisibility,
-    candidates_rc: np.ndarray,
+    candidates: tuple[np.ndarray, sparse.csr_matrix],
     solve_order: Callable[[np.ndarray], list[int]],
     geo_cost: np.ndarray,
     max_rounds: int = 4,
+    move_tries: int = 12,
 ) -> np.ndarray:
     """Shorten the open tour ``nodes_rc`` (row 0: the start) keeping ``required`` columns seen.
 
@@ -140,10 +174,11 @@ def refine_tour(
         covered0: ``(M,)`` bool columns the start scan sees.
         required: Columns the tour must see (start, viewpoints and legs together).
         legs: The leg and viewpoint visibility.
-        candidates_rc: ``(N, 2)`` cells a viewpoint may move to.
+        candidates: ``(N, 2)`` cells a viewpoint may move to, and ``(N, M)`` what each sees.
         solve_order: Open tour order (node 0 first) of a distance matrix (LKH).
         geo_cost: ``(H, W)`` cost for the tour's distances (metres per cell on the standing mask).
         max_rounds: Rounds of drop, move and re-solve at most.
+        move_tries: Candidates tried per viewpoint in the move step (least detour first).
 
     Returns:
         ``(K' + 1, 2)`` the refined tour, start first.
@@ -155,12 +190,16 @@ def refine_tour(
         count.add(cols, 1)
     for a, b in zip(tour[:-1], tour[1:], strict=True):
         count.add(legs.leg(a, b), 1)
-    if count.covered() < required:  # the plain cover already fell short: nothing to give away
-        return np.array(tour, dtype=np.int64)
+    cand = np.asarray(candidates[0], dtype=np.int64).reshape(-1, 2)
+    if count.covered() < required:  # robust views see less than the cover counted
+        _fill(tour, count, required, legs, dist, (cand, candidates[1]))
+        if count.covered() < required:
+            return np.array(tour, dtype=np.int64)
+    moves = (cand, candidates[1].tocsc())
     for _ in range(max_rounds):
         before = dist.length(tour)
         _drop_pass(tour, count, required, legs, dist)
-        _move_pass(tour, count, required, legs, dist, candidates_rc)
+        _move_pass(tour, count, required, legs, dist, moves, move_tries)
         _resolve(tour, count, required, legs, dist, solve_order)
         if dist.length(tour) >= before - 1e-6:
             break
@@ -266,19 +305,31 @@ def _move_pass(
     required: int,
     legs: LegVisibility,
     dist: _Distances,
-    candidates_rc: np.ndarray,
-    tries: int = 4,
+    candidates: tuple[np.ndarray, sparse.csc_matrix],
+    tries: int,
 ) -> None:
-    """Move each viewpoint to the candidate of least detour that keeps the target seen."""
-    cand = np.asarray(candidates_rc, dtype=np.int64).reshape(-1, 2)
+    """Move each viewpoint to the candidate of least detour that keeps the target seen.
+
+    Only candidates that see enough of what the viewpoint alone sees (all but the tour's
+    surplus over ``required``) are tried, least detour first, ``tries`` at most.
+    """
+    cand, sets_csc = candidates
     for i in range(1, len(tour)):
         prev, cur = tour[i - 1], tour[i]
         nxt = tour[i + 1] if i + 1 < len(tour) else None
-        detour = dist.field(prev)[cand[:, 0], cand[:, 1]]
+        detour = dist.field(prev)[cand[:, 0], cand[:, 1]].astype(np.float64)
         if nxt is not None:
             detour = detour + dist.field(nxt)[cand[:, 0], cand[:, 1]]
         now = dist.d(prev, cur) + (dist.d(cur, nxt) if nxt is not None else 0.0)
         better = np.flatnonzero(detour < now - 0.05)
+        if better.size == 0:
+            continue
+        own = legs.cells(np.array([cur]))[0]
+        unique = own[count.count[own] == 1]
+        need = unique.size - (count.covered() - required)
+        if need > 0:
+            hits = np.asarray(sets_csc[:, unique].sum(axis=1)).ravel()
+            better = better[hits[better] >= need]
         for k in better[np.argsort(detour[better], kind="stable")][:tries]:
             new = (int(cand[k, 0]), int(cand[k, 1]))
             if new in tour:
@@ -287,6 +338,56 @@ def _move_pass(
             if count.covered() >= required:
                 break
             _swap(tour, i, cur, count, legs)
+
+
+def _fill(
+    tour: list[tuple[int, int]],
+    count: _CoverCount,
+    required: int,
+    legs: LegVisibility,
+    dist: _Distances,
+    candidates: tuple[np.ndarray, sparse.csr_matrix],
+    offset_m: float = 1.0,
+) -> None:
+    """Insert candidates (most unseen cells per metre of insertion, ``offset_m`` added to the
+    metres) where they cost least, until ``required`` columns are seen or none adds any."""
+    cand, sets = candidates
+    to_cand = [dist.field(n)[cand[:, 0], cand[:, 1]].astype(np.float64) for n in tour]
+    tried = np.zeros(cand.shape[0], dtype=bool)
+    while count.covered() < required:
+        gains = np.asarray(sets.dot((count.count == 0).astype(np.int32))).ravel()
+        ins, where = _insertion_costs(tour, to_cand, dist)
+        score = np.where((gains > 0) & ~tried & np.isfinite(ins), gains / (ins + offset_m), -1.0)
+        k = int(np.argmax(score))
+        if score[k] <= 0.0:
+            return
+        tried[k] = True
+        node = (int(cand[k, 0]), int(cand[k, 1]))
+        if node in tour:
+            continue
+        pos = int(where[k]) + 1
+        tour.insert(pos, node)
+        to_cand.insert(pos, dist.field(node)[cand[:, 0], cand[:, 1]].astype(np.float64))
+        count.add(legs.cells(np.array([node]))[0], 1)
+        if pos + 1 < len(tour):
+            count.add(legs.leg(tour[pos - 1], tour[pos + 1]), -1)
+            count.add(legs.leg(node, tour[pos + 1]), 1)
+        count.add(legs.leg(tour[pos - 1], node), 1)
+
+
+def _insertion_costs(
+    tour: list[tuple[int, int]], to_cand: list[np.ndarray], dist: _Distances
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per candidate, the least extra length of inserting it into the open tour, and after
+    which tour position."""
+    best = to_cand[-1].copy()  # appended at the end
+    where = np.full(best.shape, len(tour) - 1, dtype=np.int64)
+    for p in range(len(tour) - 1):
+        extra = to_cand[p] + to_cand[p + 1] - dist.d(tour[p], tour[p + 1])
+        better = extra < best
+        best[better] = extra[better]
+        where[better] = p
+    return best, where
 
 
 def _resolve(

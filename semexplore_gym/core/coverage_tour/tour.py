@@ -35,7 +35,11 @@ import numpy as np
 from scipy import sparse
 
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
-from semexplore_gym.core.coverage_tour.refine import LegVisibility, refine_tour, tour_visible
+from semexplore_gym.core.coverage_tour.refine import (
+    LegVisibility,
+    refine_tour,
+    tour_visible,
+)
 from semexplore_gym.core.coverage_tour.viewpoints import (
     candidate_viewpoints,
     nearest_allowed_cell,
@@ -73,6 +77,8 @@ class TourParams:
         leg_prefer_clearance_m: The legs are the paths the oracle drives: least cost where a
             cell nearer a wall than this costs up to ...
         leg_wall_cost: ... this much more per metre (the oracle policy's path cost).
+        robust_cells: The refined tour counts a cell seen from a pose only when the scans from
+            the four cells this far aside see it too (:class:`~.refine.LegVisibility`).
     """
 
     coverage_target: float = 0.993
@@ -85,6 +91,7 @@ class TourParams:
     leg_sample_m: float = 0.25
     leg_prefer_clearance_m: float = 0.35
     leg_wall_cost: float = 4.0
+    robust_cells: int = 2
 
     def __post_init__(self) -> None:
         if not 0.0 < self.coverage_target <= 1.0:
@@ -115,6 +122,10 @@ class TourParams:
                 raise ValueError(f"TourParams.{name} must be positive, got {value!r}")
         if not (math.isfinite(self.leg_wall_cost) and self.leg_wall_cost >= 0):
             raise ValueError(f"TourParams.leg_wall_cost must be >= 0, got {self.leg_wall_cost!r}")
+        if not (isinstance(self.robust_cells, int) and self.robust_cells >= 0):
+            raise ValueError(
+                f"TourParams.robust_cells must be an integer >= 0, got {self.robust_cells!r}"
+            )
         if not (isinstance(self.lkh_runs, int) and self.lkh_runs >= 1):
             raise ValueError(f"TourParams.lkh_runs must be an integer >= 1, got {self.lkh_runs!r}")
 
@@ -137,6 +148,7 @@ class CoverageTour:
         distances_m: ``(K, K)`` geodesic distances between the tour viewpoints.
         candidates_rc: ``(N, 2)`` all candidate viewpoints (for replanning).
         seen: ``(M,)`` bool: the columns the start scan, the viewpoints and the legs see.
+        candidate_visible: ``(N, M)`` what one scan from each candidate sees (for shortcuts).
     """
 
     viewpoints_rc: np.ndarray
@@ -154,6 +166,7 @@ class CoverageTour:
         repr=False, default_factory=lambda: np.zeros((0, 2), np.int64)
     )
     seen: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0, dtype=bool))
+    candidate_visible: sparse.csr_matrix | None = field(repr=False, default=None)
 
     @property
     def n_viewpoints(self) -> int:
@@ -368,16 +381,6 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
     coverable[vis.indices] = True
     n_mask = max(1, mask_flat.size)
     required = min(int(math.ceil(prm.coverage_target * n_mask)), int(coverable.sum()))
-    if prm.detour_m > 0:
-        chosen = travel_aware_cover(
-            vis, required, covered0, candidates, standing, start_rc, res, prm.detour_m
-        )
-    else:
-        chosen = greedy_cover(vis, required, covered0)
-    nodes = np.vstack([np.array([start_rc], dtype=np.int64), candidates[chosen]])
-    dist = geodesic_matrix(standing, geo, nodes)
-    order = open_tour_order(dist, prm.lkh_runs)
-    nodes = nodes[order]
     legs = LegVisibility(
         facts.world,
         geo,
@@ -386,6 +389,10 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
         _drive_cost(standing, clearance, res, prm),
         prm.leg_sample_m,
         index,
+        prm.robust_cells,
+    )
+    nodes, dist = _cover_then_order(
+        vis, required, covered0, candidates, standing, start_rc, geo, prm
     )
     if prm.refine_rounds > 0 and nodes.shape[0] > 1:
         nodes = refine_tour(
@@ -393,14 +400,12 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
             covered0,
             required,
             legs,
-            candidates,
+            (candidates, vis),
             lambda d: open_tour_order(d, prm.lkh_runs),
             np.where(standing, res, np.inf),
             prm.refine_rounds,
         )
         dist = geodesic_matrix(standing, geo, nodes)
-    else:
-        dist = dist[np.ix_(order, order)]
     k = nodes.shape[0]
     legs_m = np.asarray(dist[np.arange(k - 1), np.arange(1, k)], dtype=np.float64)
     cells = nodes[1:]
@@ -424,6 +429,7 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
         distances_m=dist[1:, 1:],
         candidates_rc=candidates,
         seen=covered,
+        candidate_visible=vis,
     )
 
 
@@ -433,3 +439,33 @@ def _drive_cost(
     """Cost per cell of the paths the oracle drives: wall-averse within the preferred clearance."""
     pref = np.clip(1.0 - clearance / prm.leg_prefer_clearance_m, 0.0, 1.0)
     return np.where(standing, resolution_m * (1.0 + prm.leg_wall_cost * pref), np.inf)
+
+
+def _cover_then_order(
+    vis: sparse.csr_matrix,
+    required: int,
+    covered0: np.ndarray,
+    candidates: np.ndarray,
+    standing: np.ndarray,
+    start_rc: tuple[int, int],
+    geo: GridGeometry,
+    prm: TourParams,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The plain tour: a (travel-aware) cover of the viewpoints alone, ordered by LKH."""
+    if prm.detour_m > 0:
+        chosen = travel_aware_cover(
+            vis,
+            required,
+            covered0,
+            candidates,
+            standing,
+            start_rc,
+            geo.resolution_m,
+            prm.detour_m,
+        )
+    else:
+        chosen = greedy_cover(vis, required, covered0)
+    nodes = np.vstack([np.array([start_rc], dtype=np.int64), candidates[chosen]])
+    dist = geodesic_matrix(standing, geo, nodes)
+    order = open_tour_order(dist, prm.lkh_runs)
+    return nodes[order], dist[np.ix_(order, order)]
