@@ -151,7 +151,7 @@ class OracleParams:
     tour: TourParams = field(default_factory=TourParams)
     potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
     goal_reached_radius_m: float = 0.1
-    check_period_s: float = 1.0
+    check_period_s: float = 0.4
     min_gain_cells: int = 1
     path_prefer_clearance_m: float = 0.35
     path_wall_cost: float = 4.0
