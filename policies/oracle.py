@@ -42,9 +42,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
 from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
+from semexplore_gym.policies.oracle_goals import fallback_cell, repair_cell, shortcut_cell
 
 from semexplore_gym.core.coverage_tour import (
     PRIVILEGED_INFO_KEY,
@@ -58,7 +58,6 @@ from semexplore_gym.core.coverage_tour import (
 from semexplore_gym.core.coverage_tour.tour import row_counts
 from semexplore_gym.core.coverage_tour.viewpoints import (
     nearest_allowed_cell,
-    visible_sets,
     wall_clearance_m,
 )
 from semexplore_gym.core.grid import FREE
@@ -387,68 +386,41 @@ class OraclePolicy(Policy):
             self._path = None
 
     def _repair(self, grid: np.ndarray, pose: tuple[float, float, float], vp: int) -> None:
-        """At a viewpoint just reached: when its scan missed cells the plan counted on, and no
-        viewpoint left would see them, look from the nearby candidate that sees most of them."""
-        tour = self.tour
-        assert tour is not None
+        """At a viewpoint just reached: look again from nearby where its scan fell short."""
+        assert self.tour is not None
         prm = self.params
-        unseen = self._unseen(grid)
-        missed = np.zeros_like(unseen)
-        own = tour.visible[vp].indices
-        missed[own] = unseen[own]
-        later = tour.visible[self._left].indices if self._left else np.zeros(0, dtype=np.int64)
-        missed[later] = False
-        vis = tour.candidate_visible
-        if vis is None or int(missed.sum()) < prm.repair_min_cells:
-            return
-        dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
-        cand = tour.candidates_rc
-        near = np.flatnonzero(dist[cand[:, 0], cand[:, 1]] <= prm.repair_radius_m)
-        if near.size == 0:
-            return
-        sub = vis[near]
-        gains = row_counts(missed, sub.indptr, sub.indices)
-        k = int(np.argmax(gains))
-        rc = (int(cand[near[k], 0]), int(cand[near[k], 1]))
-        if gains[k] < prm.repair_min_cells or rc in self._tried:
-            return
-        self._tried.add(rc)
-        if self._set_goal(rc, "repair", pose):
-            self.counters["repairs"] += 1
+        rc = repair_cell(
+            self.tour,
+            self._unseen(grid),
+            vp,
+            self._left,
+            lambda: distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            (prm.repair_min_cells, prm.repair_radius_m),
+        )
+        if rc is not None and rc not in self._tried:
+            self._tried.add(rc)
+            if self._set_goal(rc, "repair", pose):
+                self.counters["repairs"] += 1
 
     def _shortcut(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
-        """Drive to the nearest candidate that would see what the goal still needs, when it is
-        nearer than the rest of the tour (see ``finish_max_share``)."""
-        tour = self.tour
-        assert tour is not None
-        vis = tour.candidate_visible
+        """Near the end, a shortcut to the goal when one is nearer than the rest of the tour."""
+        assert self.tour is not None
         unseen = self._unseen(grid)
         need = math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum())
-        if vis is None or need <= 0 or need > self.params.finish_max_share * self._n_mask:
+        if need > self.params.finish_max_share * self._n_mask:
             return
-        gains = row_counts(unseen, vis.indptr, vis.indices)
-        ok = np.flatnonzero(gains >= self.params.finish_slack * need)
-        if ok.size == 0:
-            return
-        cand = tour.candidates_rc[ok]
-        dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
-        d = dist[cand[:, 0], cand[:, 1]]
-        k = int(np.argmin(d))
-        rc = (int(cand[k, 0]), int(cand[k, 1]))
-        if not np.isfinite(d[k]) or rc in self._tried or d[k] >= self._tour_left_m(dist) - 0.1:
-            return
-        self._tried.add(rc)
-        if self._set_goal(rc, "finish", pose):
-            self.counters["shortcuts"] += 1
-
-    def _tour_left_m(self, dist_from_robot: np.ndarray) -> float:
-        """The rest of the tour from the robot: to the next viewpoint, then leg by leg."""
-        assert self.tour is not None
-        if not self._left:
-            return math.inf
-        r, c = self._rc(self._left[0])
-        legs = self.tour.distances_m[self._left[:-1], self._left[1:]]
-        return float(dist_from_robot[r, c] + legs.sum())
+        rc = shortcut_cell(
+            self.tour,
+            unseen,
+            need,
+            self._left,
+            lambda: distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            self.params.finish_slack,
+        )
+        if rc is not None and rc not in self._tried:
+            self._tried.add(rc)
+            if self._set_goal(rc, "finish", pose):
+                self.counters["shortcuts"] += 1
 
     def _rc(self, vp: int) -> tuple[int, int]:
         assert self.tour is not None
@@ -504,34 +476,16 @@ class OraclePolicy(Policy):
         unseen = self._unseen(grid)
         if not unseen.any() or self.counters["fallback_goals"] >= self.params.max_fallback_goals:
             return None
-        h, w = self.geometry.shape
-        flat = np.zeros(h * w, dtype=bool)
-        flat[tour.mask_flat[unseen]] = True
-        res = self.geometry.resolution_m
-        reach_m = self.facts.sensor.max_range_m
-        near = ndimage.distance_transform_edt(~flat.reshape(h, w)) * res <= reach_m
-        cand = tour.candidates_rc
-        ok = near[cand[:, 0], cand[:, 1]]
-        ok &= np.array([(int(r), int(c)) not in self._tried for r, c in cand], dtype=bool)
-        cand = cand[ok]
-        if cand.shape[0] == 0:
-            return None
-        vis = visible_sets(
-            self.facts.world, self.geometry, cand, self.facts.sensor, self.facts.reachable_mask
+        rc = fallback_cell(
+            tour,
+            unseen,
+            math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum()),
+            self._tried,
+            distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            self.params.min_gain_cells,
         )
-        gains = row_counts(unseen, vis.indptr, vis.indices)
-        dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
-        d = dist[cand[:, 0], cand[:, 1]]
-        useful = (gains >= self.params.min_gain_cells) & np.isfinite(d)
-        # The nearest one that would reach the goal on its own, else the most cells per metre.
-        needed = math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum())
-        enough = useful & (gains >= needed)
-        score = np.where(enough, 1e9 - d, np.where(useful, gains / (d + 1.0), -1.0))
-        k = int(np.argmax(score))
-        if score[k] < 0:
-            return None
-        rc = (int(cand[k, 0]), int(cand[k, 1]))
-        self._tried.add(rc)
+        if rc is not None:
+            self._tried.add(rc)
         return rc
 
     def _set_goal(self, rc: tuple[int, int], kind: str, pose: tuple[float, float, float]) -> bool:

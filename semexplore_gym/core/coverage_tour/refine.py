@@ -35,6 +35,8 @@ from semexplore_gym.core.planning.grid_search import distance_field, shortest_pa
 from semexplore_gym.core.worlds.world import World
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+#: Candidates tried per viewpoint in the move step (least detour first).
+_MOVE_TRIES = 12
 #: Distance fields kept at once (each is a float32 grid).
 _MAX_FIELDS = 256
 
@@ -165,7 +167,6 @@ def refine_tour(
     solve_order: Callable[[np.ndarray], list[int]],
     geo_cost: np.ndarray,
     max_rounds: int = 4,
-    move_tries: int = 12,
 ) -> np.ndarray:
     """Shorten the open tour ``nodes_rc`` (row 0: the start) keeping ``required`` columns seen.
 
@@ -178,7 +179,6 @@ def refine_tour(
         solve_order: Open tour order (node 0 first) of a distance matrix (LKH).
         geo_cost: ``(H, W)`` cost for the tour's distances (metres per cell on the standing mask).
         max_rounds: Rounds of drop, move and re-solve at most.
-        move_tries: Candidates tried per viewpoint in the move step (least detour first).
 
     Returns:
         ``(K' + 1, 2)`` the refined tour, start first.
@@ -199,7 +199,7 @@ def refine_tour(
     for _ in range(max_rounds):
         before = dist.length(tour)
         _drop_pass(tour, count, required, legs, dist)
-        _move_pass(tour, count, required, legs, dist, moves, move_tries)
+        _move_pass(tour, count, required, legs, dist, moves, _MOVE_TRIES)
         _resolve(tour, count, required, legs, dist, solve_order)
         if dist.length(tour) >= before - 1e-6:
             break

@@ -409,11 +409,7 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
     k = nodes.shape[0]
     legs_m = np.asarray(dist[np.arange(k - 1), np.arange(1, k)], dtype=np.float64)
     cells = nodes[1:]
-    sel = tour_visible(legs, nodes, mask_flat.size)
-    covered = covered0.copy()
-    covered[sel.indices] = True
-    for a, b in zip(nodes[:-1], nodes[1:], strict=True):
-        covered[legs.leg((int(a[0]), int(a[1])), (int(b[0]), int(b[1])))] = True
+    sel, covered = _tour_seen(legs, nodes, covered0)
     xs, ys = geo.grid_to_world(cells[:, 0], cells[:, 1])
     return CoverageTour(
         viewpoints_rc=cells,
@@ -469,3 +465,16 @@ def _cover_then_order(
     dist = geodesic_matrix(standing, geo, nodes)
     order = open_tour_order(dist, prm.lkh_runs)
     return nodes[order], dist[np.ix_(order, order)]
+
+
+def _tour_seen(
+    legs: LegVisibility, nodes: np.ndarray, covered0: np.ndarray
+) -> tuple[sparse.csr_matrix, np.ndarray]:
+    """What each viewpoint of the tour ``nodes`` (start first) sees, and all the tour sees
+    (start scan, viewpoints, legs)."""
+    sel = tour_visible(legs, nodes, covered0.size)
+    covered = covered0.copy()
+    covered[sel.indices] = True
+    for a, b in zip(nodes[:-1], nodes[1:], strict=True):
+        covered[legs.leg((int(a[0]), int(a[1])), (int(b[0]), int(b[1])))] = True
+    return sel, covered
