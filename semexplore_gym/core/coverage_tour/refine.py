@@ -36,7 +36,7 @@ from semexplore_gym.core.worlds.world import World
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 #: Candidates tried per viewpoint in the move step (least detour first).
-_MOVE_TRIES = 12
+_MOVE_TRIES = 4
 #: Distance fields kept at once (each is a float32 grid).
 _MAX_FIELDS = 256
 
@@ -73,6 +73,7 @@ class LegVisibility:
     ) -> None:
         self._world, self._geo, self._sensor = world, geometry, sensor
         self._mask = count_mask
+        self._n_cols = int(np.count_nonzero(count_mask))
         self._cost = drive_cost
         self._index = index if index is not None else SegmentIndex(world.segments_m)
         self._step_cells = max(1, int(round(sample_m / geometry.resolution_m)))
@@ -138,8 +139,10 @@ class LegVisibility:
             samples = inner[self._step_cells // 2 :: self._step_cells]
             keys = [(int(r), int(c)) for r, c in samples]
             self._scan(keys)
-            parts = [self._scans[k] for k in keys]
-            seen = np.unique(np.concatenate(parts)) if parts else _EMPTY
+            flags = np.zeros(self._n_cols, dtype=bool)
+            for k in keys:
+                flags[self._scans[k]] = True
+            seen = np.flatnonzero(flags)
         self._legs[key] = seen
         return seen
 
@@ -167,7 +170,7 @@ def refine_tour(
     solve_order: Callable[[np.ndarray], list[int]],
     geo_cost: np.ndarray,
     max_rounds: int = 4,
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """Shorten the open tour ``nodes_rc`` (row 0: the start) keeping ``required`` columns seen.
 
     Args:
@@ -181,7 +184,8 @@ def refine_tour(
         max_rounds: Rounds of drop, move and re-solve at most.
 
     Returns:
-        ``(K' + 1, 2)`` the refined tour, start first.
+        ``(K' + 1, 2)`` the refined tour, start first, and its ``(K' + 1, K' + 1)`` geodesic
+        distances.
     """
     tour = [(int(r), int(c)) for r, c in np.asarray(nodes_rc, dtype=np.int64)]
     dist = _Distances(geo_cost)
@@ -194,7 +198,7 @@ def refine_tour(
     if count.covered() < required:  # robust views see less than the cover counted
         _fill(tour, count, required, legs, dist, (cand, candidates[1]))
         if count.covered() < required:
-            return np.array(tour, dtype=np.int64)
+            return np.array(tour, dtype=np.int64), dist.matrix(tour).astype(np.float64)
     moves = (cand, candidates[1].tocsc())
     for _ in range(max_rounds):
         before = dist.length(tour)
@@ -203,7 +207,7 @@ def refine_tour(
         _resolve(tour, count, required, legs, dist, solve_order)
         if dist.length(tour) >= before - 1e-6:
             break
-    return np.array(tour, dtype=np.int64)
+    return np.array(tour, dtype=np.int64), dist.matrix(tour).astype(np.float64)
 
 
 class _Distances:

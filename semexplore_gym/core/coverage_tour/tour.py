@@ -395,7 +395,7 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
         vis, required, covered0, candidates, standing, start_rc, geo, prm
     )
     if prm.refine_rounds > 0 and nodes.shape[0] > 1:
-        nodes = refine_tour(
+        nodes, dist = refine_tour(
             nodes,
             covered0,
             required,
@@ -405,7 +405,6 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
             np.where(standing, res, np.inf),
             prm.refine_rounds,
         )
-        dist = geodesic_matrix(standing, geo, nodes)
     k = nodes.shape[0]
     legs_m = np.asarray(dist[np.arange(k - 1), np.arange(1, k)], dtype=np.float64)
     cells = nodes[1:]
