@@ -3,7 +3,8 @@
 * :mod:`.problem`: :class:`PrivilegedWorld` (the ground truth a privileged env hands out) and
   :class:`SensorModel`;
 * :mod:`.viewpoints`: standing mask, candidate viewpoints, visible sets (the env's LiDAR model);
-* :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`.
+* :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`;
+* :mod:`.refine`: the scans along the legs, and the local search over cover and order.
 """
 
 from semexplore_gym.core.coverage_tour.problem import (

@@ -5,7 +5,7 @@
 
 1. candidate viewpoints on the standing mask (:mod:`.viewpoints`), and each one's visible
    cells of the env's reachable mask with the env's LiDAR model;
-2. a **greedy set cover** (:func:`greedy_cover`) of ``coverage_target`` (99.5 %) of the
+2. a **greedy set cover** (:func:`greedy_cover`) of ``coverage_target`` (99.3 %) of the
    reachable mask, counting what the first scan at the start already sees. Greedy picks at
    most ``H(max set size) <= 1 + ln(max set size)`` times the fewest viewpoints possible
    (Chvatal 1979); we take it for speed and determinism (an ILP would be exact on small maps);
@@ -14,13 +14,15 @@
 4. an **open tour** from the start through every viewpoint (:func:`open_tour_order`): LKH
    (Helsgaun's Lin-Kernighan heuristic, through the ``elkai`` package; optional extra
    ``oracle``) on the distance matrix with a dummy node between the path's end and the start
-   (see :func:`open_tour_order`), so the closed tour through it is the open path. LKH with a fixed seed is deterministic.
+   (see :func:`open_tour_order`), so the closed tour through it is the open path. LKH with a fixed seed is deterministic;
+5. **cover and order together** (:func:`~.refine.refine_tour`): the scans along the legs
+   count too; viewpoints are dropped and moved and the order re-solved while the tour shortens.
 
 The tour length is an upper bound on the shortest drive that sees the target share with this
 sensor model: set cover and TSP are both solved approximately, and the viewpoints are limited to
 a lattice. Where the optimum is known (``tests/core/coverage_tour/test_tour.py``, LiDAR range
-1 m) it is close: an 8 m corridor, 6.72 m against 6.70 m; a tree of three corridors, 11.89 m
-against 12.0 m for the best open tour (the closed one is 15.0 m; the cover may leave 0.5 % of
+1 m) it is close: an 8 m corridor, 6.72 m against 6.70 m; a tree of three corridors, 11.80 m
+against 12.0 m for the best open tour (the closed one is 15.0 m; the cover may leave 0.7 % of
 the cells unseen, hence a little below). It ignores turning
 time and the robot's motion limits, so ``time_at_top_speed_s`` is a lower bound on driving it.
 """
