@@ -115,11 +115,10 @@ def test_the_oracle_labels_a_dataset_when_asked_and_the_student_sees_only_featur
         ),
         "cave:seed=1,size_m=6",
         "office:seed=2,size_m=8",
+        "forest:seed=2,size_m=6",
     ],
 )
-def test_an_oracle_mission_stops_itself_at_the_goal_no_later_than_the_expert(
-    world, short_mission
-):
+def test_an_oracle_mission_stops_itself_at_the_goal_no_later_than_the_expert(world, short_mission):
     res, _ = short_mission(world, "oracle", 1, 900)
     assert res.self_stopped and res.stop_reason == "coverage_goal"
     assert res.coverage >= 0.99 and res.collisions == 0
