@@ -11,8 +11,9 @@ sets ``expert.privileged_teacher=true`` by name, and then only the teacher's env
 that knew the building could do with this sensor and this navigation stack.
 
 At ``reset`` it plans the static tour of :func:`~semexplore_gym.core.coverage_tour.plan_coverage_tour`
-(viewpoints that see 99.5 % of the reachable mask, an open LKH tour from the start). While it
-drives:
+(viewpoints whose scans, with the scans along the legs between them, see 99.3 % of the reachable
+mask; an open LKH tour from the start, viewpoints dropped and moved while the tour shortens; the
+legs are the paths it drives, so the tour's path cost is the oracle's own). While it drives:
 
 * every ``check_period_s`` it counts, for each viewpoint left, the cells of its visible set the
   live map (``obs["map"]``) has not mapped FREE yet. When some viewpoint is no longer needed,
@@ -25,6 +26,9 @@ drives:
   parameters) with the expert's stuck recovery (:class:`~semexplore_gym.policies.navigation.BackoffRecovery`,
   :class:`~semexplore_gym.policies.navigation.ProgressWatch`); a viewpoint not reached within
   its time budget is dropped;
+* near the end (fewer than ``finish_max_share`` of the cells still to see) it takes a
+  shortcut when one exists: the nearest candidate whose one scan would see what the goal still
+  needs, with ``finish_slack`` to spare, when it is nearer than the rest of the tour;
 * when the tour runs out below the goal it drives to the nearest standing cell near a cell
   still unseen; it stops once ``info["coverage"]`` reaches the env's coverage goal, or nothing
   is left to see.
@@ -34,13 +38,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
 from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
+from semexplore_gym.policies.oracle_goals import fallback_cell, repair_cell, shortcut_cell
 
 from semexplore_gym.core.coverage_tour import (
     PRIVILEGED_INFO_KEY,
@@ -54,7 +58,6 @@ from semexplore_gym.core.coverage_tour import (
 from semexplore_gym.core.coverage_tour.tour import row_counts
 from semexplore_gym.core.coverage_tour.viewpoints import (
     nearest_allowed_cell,
-    visible_sets,
     wall_clearance_m,
 )
 from semexplore_gym.core.grid import FREE
@@ -104,9 +107,11 @@ class OracleParams:
     """Parameters of :class:`OraclePolicy`.
 
     Attributes:
-        tour: The static tour's settings.
+        tour: The static tour's settings (its legs' path cost is set from ``path_*`` below).
         potential_field: The path follower (the expert's defaults).
-        goal_reached_radius_m: A viewpoint within this distance is reached.
+        goal_reached_radius_m: A viewpoint within this distance is reached. Small: the tour
+            counts on the scan from the viewpoint itself (in a dead end, turning back 0.3 m
+            short of it left cells unseen that the tour had counted).
         check_period_s: How often the viewpoints left are checked against the live map.
         min_gain_cells: A viewpoint that would add fewer unseen cells is not needed.
         path_prefer_clearance_m: Paths keep this far from walls where they can ...
@@ -131,12 +136,21 @@ class OracleParams:
             robot then strays from its path by at most about lookahead x sin(error), 9 mm
             with the defaults: less than the 1 cm margin by which the env's reachable mask
             exceeds the robot's radius.
+        repair_min_cells: At a viewpoint reached, when its scan left at least this many cells
+            unseen that the plan counted on and no viewpoint left sees, the oracle looks again
+            from the candidate within ...
+        repair_radius_m: ... this path distance that sees most of them (before driving on,
+            while it is near: a view through a gap between walls can vanish 0.1 m aside).
+        finish_max_share: Shortcuts to the goal are looked for once the cells still needed are
+            fewer than this share of the reachable mask ...
+        finish_slack: ... at a candidate whose scan would see this many times the cells needed
+            (a single scan's view is fragile: see :class:`~semexplore_gym.core.coverage_tour.refine.LegVisibility`).
     """
 
     tour: TourParams = field(default_factory=TourParams)
     potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
-    goal_reached_radius_m: float = 0.3
-    check_period_s: float = 1.0
+    goal_reached_radius_m: float = 0.1
+    check_period_s: float = 0.4
     min_gain_cells: int = 1
     path_prefer_clearance_m: float = 0.35
     path_wall_cost: float = 4.0
@@ -152,6 +166,10 @@ class OracleParams:
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
+    finish_max_share: float = 0.03
+    repair_min_cells: int = 10
+    repair_radius_m: float = 1.0
+    finish_slack: float = 1.5
 
 
 class OraclePolicy(Policy):
@@ -195,7 +213,12 @@ class OraclePolicy(Policy):
             max_range_m=env.max_range_m,
         )
         t0 = time.perf_counter()
-        self.tour = tour = plan_coverage_tour(facts, prm.tour)
+        tour_params = replace(
+            prm.tour,
+            leg_prefer_clearance_m=prm.path_prefer_clearance_m,
+            leg_wall_cost=prm.path_wall_cost,
+        )
+        self.tour = tour = plan_coverage_tour(facts, tour_params)
         self.planning_s = time.perf_counter() - t0
         res = self.geometry.resolution_m
         clearance = wall_clearance_m(facts.world, self.geometry, prm.path_prefer_clearance_m)
@@ -232,6 +255,8 @@ class OraclePolicy(Policy):
             "recoveries": 0,
             "fallback_goals": 0,
             "tight_steps": 0,
+            "shortcuts": 0,
+            "repairs": 0,
         }
         self._backoff = BackoffRecovery(prm.backoff_duration_s, prm.backoff_speed_fraction)
         self._watch = ProgressWatch(
@@ -313,13 +338,18 @@ class OraclePolicy(Policy):
             d = math.hypot(pose[0] - self._goal_xy[0], pose[1] - self._goal_xy[1])
             if d <= prm.goal_reached_radius_m:
                 self.counters["reached"] += 1
+                passed = self._left[0] if self._goal_kind == "tour" and self._left else None
                 self._drop_goal()
+                if passed is not None:
+                    self._repair(grid, pose, passed)
             elif self._time_s - self._goal_since_s > self._goal_budget_s:
                 self.counters["timeouts"] += 1
                 self._drop_goal()
         if self._goal_xy is None or self._time_s >= self._next_check_s - 1e-9:
             self._next_check_s = self._time_s + prm.check_period_s
             self._prune(grid, pose)
+            if self._goal_kind not in ("finish", "repair"):
+                self._shortcut(grid, pose)
         if self._goal_xy is None:
             self._next_goal(grid, pose)
 
@@ -354,6 +384,43 @@ class OraclePolicy(Policy):
         ):
             self._goal_xy = self._goal_rc = None
             self._path = None
+
+    def _repair(self, grid: np.ndarray, pose: tuple[float, float, float], vp: int) -> None:
+        """At a viewpoint just reached: look again from nearby where its scan fell short."""
+        assert self.tour is not None
+        prm = self.params
+        rc = repair_cell(
+            self.tour,
+            self._unseen(grid),
+            vp,
+            self._left,
+            lambda: distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            (prm.repair_min_cells, prm.repair_radius_m),
+        )
+        if rc is not None and rc not in self._tried:
+            self._tried.add(rc)
+            if self._set_goal(rc, "repair", pose):
+                self.counters["repairs"] += 1
+
+    def _shortcut(self, grid: np.ndarray, pose: tuple[float, float, float]) -> None:
+        """Near the end, a shortcut to the goal when one is nearer than the rest of the tour."""
+        assert self.tour is not None
+        unseen = self._unseen(grid)
+        need = math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum())
+        if need > self.params.finish_max_share * self._n_mask:
+            return
+        rc = shortcut_cell(
+            self.tour,
+            unseen,
+            need,
+            self._left,
+            lambda: distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            self.params.finish_slack,
+        )
+        if rc is not None and rc not in self._tried:
+            self._tried.add(rc)
+            if self._set_goal(rc, "finish", pose):
+                self.counters["shortcuts"] += 1
 
     def _rc(self, vp: int) -> tuple[int, int]:
         assert self.tour is not None
@@ -409,34 +476,16 @@ class OraclePolicy(Policy):
         unseen = self._unseen(grid)
         if not unseen.any() or self.counters["fallback_goals"] >= self.params.max_fallback_goals:
             return None
-        h, w = self.geometry.shape
-        flat = np.zeros(h * w, dtype=bool)
-        flat[tour.mask_flat[unseen]] = True
-        res = self.geometry.resolution_m
-        reach_m = self.facts.sensor.max_range_m
-        near = ndimage.distance_transform_edt(~flat.reshape(h, w)) * res <= reach_m
-        cand = tour.candidates_rc
-        ok = near[cand[:, 0], cand[:, 1]]
-        ok &= np.array([(int(r), int(c)) not in self._tried for r, c in cand], dtype=bool)
-        cand = cand[ok]
-        if cand.shape[0] == 0:
-            return None
-        vis = visible_sets(
-            self.facts.world, self.geometry, cand, self.facts.sensor, self.facts.reachable_mask
+        rc = fallback_cell(
+            tour,
+            unseen,
+            math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum()),
+            self._tried,
+            distance_field(self._geo_cost, self._robot_cell(pose))[0],
+            self.params.min_gain_cells,
         )
-        gains = row_counts(unseen, vis.indptr, vis.indices)
-        dist, _ = distance_field(self._geo_cost, self._robot_cell(pose))
-        d = dist[cand[:, 0], cand[:, 1]]
-        useful = (gains >= self.params.min_gain_cells) & np.isfinite(d)
-        # The nearest one that would reach the goal on its own, else the most cells per metre.
-        needed = math.ceil(self.facts.coverage_goal * self._n_mask) - int((~unseen).sum())
-        enough = useful & (gains >= needed)
-        score = np.where(enough, 1e9 - d, np.where(useful, gains / (d + 1.0), -1.0))
-        k = int(np.argmax(score))
-        if score[k] < 0:
-            return None
-        rc = (int(cand[k, 0]), int(cand[k, 1]))
-        self._tried.add(rc)
+        if rc is not None:
+            self._tried.add(rc)
         return rc
 
     def _set_goal(self, rc: tuple[int, int], kind: str, pose: tuple[float, float, float]) -> bool:

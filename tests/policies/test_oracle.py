@@ -102,19 +102,29 @@ def test_the_oracle_labels_a_dataset_when_asked_and_the_student_sees_only_featur
     assert set(data.obs) == set(make_learner_env(cfg).observation_space.spaces)
 
 
-@pytest.mark.parametrize("world", ["maze:seed=3,size_m=5", "cave:seed=1,size_m=6"])
-def test_an_oracle_mission_stops_itself_at_the_goal_about_when_the_expert_does(
-    world, short_mission
-):
+@pytest.mark.parametrize(
+    "world",
+    [
+        pytest.param(
+            "maze:seed=3,size_m=5",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="in mazes the oracle's tour is the expert's route: from this start it "
+                "reaches 99 % at 101.6 s, the expert at 99.2 s",
+            ),
+        ),
+        "cave:seed=1,size_m=6",
+        "office:seed=2,size_m=8",
+        "forest:seed=2,size_m=6",
+    ],
+)
+def test_an_oracle_mission_stops_itself_at_the_goal_no_later_than_the_expert(world, short_mission):
     res, _ = short_mission(world, "oracle", 1, 900)
     assert res.self_stopped and res.stop_reason == "coverage_goal"
     assert res.coverage >= 0.99 and res.collisions == 0
     expert, _ = short_mission(world, "semantic", 1, 900)
     assert res.t99_s is not None
-    # The oracle's tour is an upper bound on the shortest covering path, not the optimum: on the
-    # 5 m maze the expert (since semantic_grid_route) reaches 99 % at 99.2 s, the oracle at
-    # 101.6 s. A broken oracle (lost, wandering) would be far behind.
-    assert expert.t99_s is None or res.t99_s <= 1.05 * expert.t99_s
+    assert expert.t99_s is None or res.t99_s <= expert.t99_s
 
 
 def test_the_oracle_is_deterministic_for_a_fixed_seed(short_mission):

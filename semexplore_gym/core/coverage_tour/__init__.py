@@ -4,6 +4,7 @@
   :class:`SensorModel`;
 * :mod:`.viewpoints`: standing mask, candidate viewpoints, visible sets (the env's LiDAR model);
 * :mod:`.tour`: greedy set cover, geodesic distances, open tour by LKH, :func:`plan_coverage_tour`;
+* :mod:`.refine`: the scans along the legs, and the local search over cover and order;
 * :mod:`.lower_bound`: :func:`lower_bound`, a certified lower bound on the drive (and time) any
   explorer needs to reach the coverage goal.
 """
