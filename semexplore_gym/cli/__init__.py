@@ -78,6 +78,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except ImportError as e:
+        if "pip install" not in str(e):
+            raise
+        # A missing optional extra (the slam mode's gtsam): one line saying what to install.
+        print(f"{error_prefix(args)} {e}", file=sys.stderr)
+        return 2
     except (ValueError, OSError, KeyError, RecursionError, MemoryError) as e:
         # Bad input ends here as one short line; never a traceback or a flood of output.
         from semexplore_gym.core.validation import one_line

@@ -83,6 +83,9 @@ class MissionResult:
             (policy-specific figures for benchmark rows; empty for most policies).
         path_decomposition: Where the path went (:mod:`.path_decomposition`; None for a
             result built elsewhere).
+        slam_metrics: With the env's SLAM mode: ``ate_m`` (keyframe position RMSE, no
+            alignment: the start pose is shared), ``map_error``, ``loop_closures`` and
+            ``slam_lost`` at the end (:func:`slam_metrics`); empty otherwise.
     """
 
     world: str
@@ -111,6 +114,7 @@ class MissionResult:
     policy_counters: dict[str, int] = field(default_factory=dict)
     policy_metrics: dict[str, Any] = field(default_factory=dict)
     path_decomposition: PathDecomposition | None = field(default=None, repr=False)
+    slam_metrics: dict[str, Any] = field(default_factory=dict)
 
     @property
     def speedup(self) -> float:
@@ -140,6 +144,7 @@ class MissionResult:
             "n_replans": int(self.n_replans),
             "stage_time_s": {k: round(float(v), 4) for k, v in self.stage_time_s.items()},
             "policy_counters": dict(self.policy_counters),
+            **self.slam_metrics,
         }
 
 
@@ -365,9 +370,20 @@ def run_mission(
         recorder.save()
         wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
-    return _mission_result(
+    result = _mission_result(
         world_name, policy, seed, info, (terminated, truncated), reason, (wall, cpu), log
     )
+    result.slam_metrics = slam_metrics(env)
+    return result
+
+
+def slam_metrics(env: Any) -> dict[str, Any]:
+    """The SLAM figures of the env's mission so far (``ate_m``, ``map_error``,
+    ``loop_closures``, ``slam_lost``; :meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`),
+    or ``{}`` when the env does not run SLAM."""
+    unwrapped = getattr(env, "unwrapped", env)
+    slam = getattr(unwrapped, "slam", None)
+    return slam.metrics(unwrapped.grid) if slam is not None else {}
 
 
 def _mission_result(
