@@ -154,7 +154,6 @@ class ScanSlam:
             np.concatenate(world) if world else np.zeros((0, 2)),
             p.match_resolution_m,
             p.likelihood_sigma_m,
-            search_xy_m + self._max_range_m + 4.0 * p.likelihood_sigma_m,
         )
         return match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
 

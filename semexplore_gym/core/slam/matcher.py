@@ -1,7 +1,8 @@
 """A correlative scan matcher (Olson's method, as Karto uses it), compiled with numba.
 
 The local map is a *likelihood field*: a grid at ``resolution_m`` whose value at a cell is
-``exp(-d^2 / (2 sigma^2))``, ``d`` the distance to the nearest occupied point of the map.
+``exp(-d^2 / (2 sigma^2))``, ``d`` the distance from its centre to the centre of the nearest
+cell holding an occupied point of the map (0 beyond ``4 sigma``).
 A candidate pose scores the mean field value at the scan's end points transformed by it
 (cells off the field score 0), so 1 is a perfect overlap. :func:`match_scan` searches an
 ``(x, y, yaw)`` window around a predicted pose exhaustively on a coarse lattice, then refines
@@ -17,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy.ndimage import distance_transform_edt
 
 #: Score temperature of the covariance weights (score units, 0..1).
 _COV_TEMPERATURE = 0.02
@@ -44,24 +44,44 @@ class MatchResult:
 
 
 def build_likelihood_field(
-    points_m: np.ndarray, resolution_m: float, sigma_m: float, margin_m: float
+    points_m: np.ndarray, resolution_m: float, sigma_m: float, margin_m: float = 0.0
 ) -> LikelihoodField:
-    """The likelihood field of occupied ``points_m`` (``(n, 2)`` world x, y), padded by
-    ``margin_m`` on every side. With no points the field is one zero cell."""
-    pts = np.asarray(points_m, dtype=np.float64).reshape(-1, 2)
+    """The likelihood field of occupied ``points_m`` (``(n, 2)`` world x, y) over their
+    bounding box padded by ``margin_m`` plus the field's reach (``4 sigma``; beyond it the
+    field is taken as 0). With no points the field is one zero cell."""
+    pts = np.ascontiguousarray(points_m, dtype=np.float64).reshape(-1, 2)
     if len(pts) == 0:
         return LikelihoodField(np.zeros((1, 1), dtype=np.float32), 0.0, 0.0, resolution_m)
-    lo = pts.min(axis=0) - margin_m
-    hi = pts.max(axis=0) + margin_m
+    reach = int(math.ceil(4.0 * sigma_m / resolution_m))
+    lo = pts.min(axis=0) - margin_m - (reach + 1) * resolution_m
+    hi = pts.max(axis=0) + margin_m + (reach + 1) * resolution_m
     n_cols = int(math.ceil((hi[0] - lo[0]) / resolution_m)) + 1
     n_rows = int(math.ceil((hi[1] - lo[1]) / resolution_m)) + 1
-    cols = np.floor((pts[:, 0] - lo[0]) / resolution_m).astype(np.int64)
-    rows = np.floor((pts[:, 1] - lo[1]) / resolution_m).astype(np.int64)
-    free = np.ones((n_rows, n_cols), dtype=bool)
-    free[rows, cols] = False
-    dist_m = distance_transform_edt(free) * resolution_m
-    values = np.exp(-(dist_m**2) / (2.0 * sigma_m**2)).astype(np.float32)
+    offsets = np.arange(-reach, reach + 1, dtype=np.float64) * resolution_m
+    d2 = offsets[:, None] ** 2 + offsets[None, :] ** 2
+    kernel = np.exp(-d2 / (2.0 * sigma_m**2)).astype(np.float32)
+    values = np.zeros((n_rows, n_cols), dtype=np.float32)
+    _stamp(values, pts, float(lo[0]), float(lo[1]), float(resolution_m), kernel, reach)
     return LikelihoodField(values, float(lo[0]), float(lo[1]), float(resolution_m))
+
+
+@njit(cache=True)
+def _stamp(values, pts, origin_x, origin_y, res, kernel, reach):  # noqa: ANN001, ANN202
+    """The max of the kernel centred on the cell of each point (cell-centre distances)."""
+    n_rows, n_cols = values.shape
+    for i in range(pts.shape[0]):
+        col = int(math.floor((pts[i, 0] - origin_x) / res))
+        row = int(math.floor((pts[i, 1] - origin_y) / res))
+        for a in range(-reach, reach + 1):
+            r = row + a
+            if r < 0 or r >= n_rows:
+                continue
+            for b in range(-reach, reach + 1):
+                c = col + b
+                if 0 <= c < n_cols:
+                    v = kernel[a + reach, b + reach]
+                    if v > values[r, c]:
+                        values[r, c] = v
 
 
 def scan_points(
@@ -160,7 +180,9 @@ def match_scan(
     x0, y0, yaw0 = prediction
     dxs, dys = _steps(search_xy_m, step_xy), _steps(search_xy_m, step_xy)
     dyaws = _steps(search_yaw_rad, step_yaw)
-    scores = _score_lattice(*args, x0, y0, yaw0, dxs, dys, dyaws)
+    # The coarse lattice scores every other end point (neighbours overlap at its step).
+    coarse = (*args[:4], pts[::2] if len(pts) >= 40 else pts)
+    scores = _score_lattice(*coarse, x0, y0, yaw0, dxs, dys, dyaws)
     bx, by, byaw, best = _best(scores, dxs, dys, dyaws)
     floor = np.array([res**2, res**2, (step_yaw / 2.0) ** 2])
     cov = _covariance(scores, dxs, dys, dyaws, floor)

@@ -45,7 +45,7 @@ def _wall_points(spacing_m: float = 0.01) -> np.ndarray:
 
 def test_matcher_recovers_a_known_offset() -> None:
     map_points = _wall_points()
-    field = build_likelihood_field(map_points, 0.025, 0.04, 1.0)
+    field = build_likelihood_field(map_points, 0.025, 0.04)
     truth = (3.0, 0.6, 1.1)
     points = scan_points(_scan(truth), BEAMS, MAX_RANGE_M, (0, 0))
     prediction = (truth[0] + 0.13, truth[1] - 0.09, truth[2] + 0.12)
@@ -66,7 +66,7 @@ def test_matcher_recovers_a_known_offset() -> None:
 
 def test_matcher_scores_a_scan_of_another_place_low() -> None:
     map_points = np.array([[0.0, y] for y in np.arange(0, 3, 0.02)])
-    field = build_likelihood_field(map_points, 0.025, 0.04, 1.0)
+    field = build_likelihood_field(map_points, 0.025, 0.04)
     truth = (3.0, 0.6, 1.1)
     points = scan_points(_scan(truth), BEAMS, MAX_RANGE_M, (0, 0))
     assert match_scan(field, points, truth, 0.2, 0.3).score < 0.35
