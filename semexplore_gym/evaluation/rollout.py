@@ -205,6 +205,7 @@ class _MissionLog:
         self.n_replans = 0
         self.steps = 0
         self.ledger = PathLedger.for_mission(obs, info)
+        self.slam: dict[str, Any] = {}  # the SLAM figures at the end (slam_metrics)
 
     def add_policy_stats(self, st: StepStats, act_s: float) -> None:
         """Split one ``act`` call of ``act_s`` wall seconds into stages by its :class:`StepStats`."""
@@ -370,11 +371,9 @@ def run_mission(
         recorder.save()
         wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
-    result = _mission_result(
+    return _mission_result(
         world_name, policy, seed, info, (terminated, truncated), reason, (wall, cpu), log
     )
-    result.slam_metrics = slam_metrics(env)
-    return result
 
 
 def slam_metrics(env: Any) -> dict[str, Any]:
@@ -426,6 +425,7 @@ def _mission_result(
         policy_counters=dict(getattr(policy, "counters", {}) or {}),
         policy_metrics=policy_mission_metrics(policy),
         path_decomposition=log.ledger.finish(),
+        slam_metrics=log.slam,
     )
 
 
@@ -480,6 +480,7 @@ def _drive(
             break
     if gif is not None:
         gif.grab()
+    log.slam = slam_metrics(env)
     return info, terminated, truncated
 
 
