@@ -110,3 +110,18 @@ def test_same_seed_same_map_bit_for_bit() -> None:
     b, _, _ = _run(SlamParams(enabled=True), seed=2)
     assert np.array_equal(a.grid.log_odds, b.grid.log_odds)
     assert a.keyframe_poses == b.keyframe_poses
+
+
+def test_the_back_end_says_it_is_lost_when_matches_keep_failing() -> None:
+    params = SlamParams(enabled=True, lost_after_keyframes=3)
+    geometry = GridGeometry.covering(-5.0, -5.0, 5.0, 5.0, 0.05, 0.5)
+    slam = ScanSlam(params, geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+    nothing = np.full(360, MAX_RANGE_M, dtype=np.float32)  # open space: no returns at all
+    slam.reset((0.0, 0.0, 0.0), nothing)
+    lost = []
+    for k in range(1, 6):
+        slam.update((0.3 * k, 0.0, 0.0), nothing)
+        lost.append(slam.lost)
+    assert lost == [False, False, True, True, True]
+    # Odometry alone carried the estimate meanwhile.
+    assert slam.estimate == pytest.approx((1.5, 0.0, 0.0))
