@@ -80,7 +80,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
-    except MissingExtraError as e:
+    except ImportError as e:
+        if not isinstance(e, MissingExtraError) and "pip install" not in str(e):
+            raise
         # An optional extra is not installed: its name and the pip line, no traceback.
         print(f"{error_prefix(args)} {e}", file=sys.stderr)
         return 2

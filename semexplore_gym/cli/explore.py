@@ -32,6 +32,8 @@ JSON_KEYS: tuple[str, ...] = (
     "wall_time_s",
     "policy_version",
 )
+#: Added to the ``--json`` object when the env runs SLAM (``--env-config slam``).
+SLAM_JSON_KEYS: tuple[str, ...] = ("ate_m", "map_error", "loop_closures", "slam_lost")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -102,7 +104,7 @@ def _add_config_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--env-config",
         default=None,
-        help="env config: preset name (default, paper) or YAML path; replaces the config file's env section",
+        help="env config: preset name (default, paper, slam) or YAML path; replaces the config file's env section",
     )
     p.add_argument(
         "--policy-set",
@@ -208,7 +210,8 @@ def run(args: argparse.Namespace) -> int:
     # The expert's named version the spec ran ("semantic" runs the newest); "" for other policies.
     summary["policy_version"] = expert_version(spec)
     if args.json:
-        print_json(args, {k: summary[k] for k in JSON_KEYS})
+        keys = JSON_KEYS + tuple(k for k in SLAM_JSON_KEYS if k in summary)
+        print_json(args, {k: summary[k] for k in keys})
     else:
         print(format_result(summary))
     if args.gif:

@@ -11,6 +11,7 @@ from typing import Any
 from semexplore_gym.config import build_params
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryNoiseParams
+from semexplore_gym.core.slam.params import SlamParams
 from semexplore_gym.sim.lidar import LidarParams
 from semexplore_gym.sim.robot import PhysicsParams, RobotParams
 
@@ -109,6 +110,7 @@ class EnvConfig:
     odometry: OdometryNoiseParams = field(default_factory=OdometryNoiseParams)
     reward: RewardParams = field(default_factory=RewardParams)
     episode: EpisodeParams = field(default_factory=EpisodeParams)
+    slam: SlamParams = field(default_factory=SlamParams)
 
     def __post_init__(self) -> None:
         if not self.lidar.max_range_m <= MAX_LIDAR_RANGE_M:
@@ -155,6 +157,10 @@ PRESETS: dict[str, EnvConfig] = {
     "default": EnvConfig(),
     # The paper's TurtleBot3 limits (section IV): 0.15 m/s and 2 rad/s.
     "paper": EnvConfig(robot=RobotParams(max_linear_speed_mps=0.15, max_angular_speed_radps=2.0)),
+    # SLAM in the loop: odometry drift at 0.02 on all four alphas, the map and pose from SLAM.
+    "slam": EnvConfig(
+        odometry=OdometryNoiseParams(0.02, 0.02, 0.02, 0.02), slam=SlamParams(enabled=True)
+    ),
 }
 
 

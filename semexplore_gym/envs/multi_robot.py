@@ -151,6 +151,10 @@ class SemanticExploreMultiEnv(ParallelEnv):
             team_overrides.append(f"n_robots={int(n_robots)}")
         self.team: TeamParams = load_team_params(team, team_overrides)
         self.config: EnvConfig = load_env_config(config, env_overrides)
+        if self.config.slam.enabled:
+            raise ValueError(
+                "slam.enabled: the multi-robot env has no SLAM mode yet; use slam.enabled=false"
+            )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}"

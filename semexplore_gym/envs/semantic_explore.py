@@ -25,6 +25,7 @@ from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
 from semexplore_gym.envs.observation_options import ObservationOptions
+from semexplore_gym.envs.slam_mode import SlamMode
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
@@ -195,6 +196,8 @@ class SemanticExploreEnv(gym.Env):
     ``map_geometry``, ``robot``, ``lidar``, ``dt_s``, ``coverage``, ``explored_area_m2`` (free
     area in the map), ``collisions`` (count so far), ``sim_time_s``, ``path_length_m``,
     ``reward_terms``, ``true_pose`` is *not* given (policies must not see ground truth).
+    With ``slam.enabled`` (preset ``"slam"``, :mod:`~semexplore_gym.envs.slam_mode`) map and pose
+    are SLAM's and ``info`` adds ``slam_pose``, ``slam_pose_error_m``, ``loop_closures``, ``slam_lost``.
 
     ## Notes
     Rendering overlays: ``env.unwrapped.set_overlay(dict)`` draws a policy's semantic areas,
@@ -217,19 +220,14 @@ class SemanticExploreEnv(gym.Env):
     - v0, 0.2: the ``privileged`` option (off by default; nothing changes without it).
 
     ## Speed
-    ``python scripts/bench_env.py`` times the step stage by stage; ``scripts/bench_vector_env.py``
-    compares vector envs with a plain loop. On big real maps the default observation copies the
-    whole map every step; ``map_observation="window"`` copies only the window around the robot
-    and ``"shared"`` copies nothing (Willow Garage: about 2x the steps/s of ``"copy"``).
-    gymnasium's ``SyncVectorEnv`` merges every ``info`` key of every env and stacks the
-    observations at each step (on maze1 about 0.7x a plain loop over the same envs);
-    :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv` returns the same results, stepping
-    these envs directly into its batch, their maps kept in its rows (0.93-0.94x, 0.95-0.96x
-    with ``copy=False``, 0.97-0.98x with ``static_info="reset"`` as well, with 4 envs).
-    ``AsyncVectorEnv`` runs each env in its own
-    process: it pays off only with a free core per worker, and more so the longer a step (large
-    maps), since every step also pays inter-process messaging; on a busy 2-core machine it is
-    2-3x slower than a plain loop (0.3-0.45x, maze1 and Willow Garage).
+    ``scripts/bench_env.py`` times the step by stage, ``scripts/bench_vector_env.py`` vector envs
+    against a plain loop. ``map_observation="window"`` copies only the window around the robot,
+    ``"shared"`` nothing (Willow Garage: about 2x the steps/s of ``"copy"``). gymnasium's
+    ``SyncVectorEnv`` merges every ``info`` key at each step (maze1: about 0.7x a plain loop);
+    :class:`~semexplore_gym.envs.vector.FastSyncVectorEnv` gives the same results stepping these
+    envs straight into its batch (0.93-0.98x with 4 envs, the higher with ``copy=False`` and
+    ``static_info="reset"``). ``AsyncVectorEnv`` pays off only with a free core per worker
+    (0.3-0.45x on a busy 2-core machine).
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 5}
@@ -318,6 +316,7 @@ class SemanticExploreEnv(gym.Env):
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping)
         self.odometry = OdometryDrift(cfg.odometry)
         self._odometry_noisy = not cfg.odometry.is_perfect
+        self.slam = SlamMode.create(cfg, self.map_geometry, self.lidar.beam_angles_rad)
 
     def choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         """The start pose for a reset: ``options["start_pose"]``, else ``episode.start_pose``,
@@ -371,6 +370,7 @@ class SemanticExploreEnv(gym.Env):
         self._overlay = {}
         self._true_pose = self.sim.pose
         self._scan = self._sense_and_map(self._true_pose)
+        self._map_grid = self.slam.reset(pose, self._scan) if self.slam else self.grid
         info = self._info({"free_area_change": 0.0, "time": 0.0, "collision": 0.0}, True)
         if self.privileged:
             info[PRIVILEGED_INFO_KEY] = self._privileged_world(pose, reach)
@@ -433,6 +433,8 @@ class SemanticExploreEnv(gym.Env):
         )
         n_free_before = self.grid.n_free_cells
         self._scan = self._sense_and_map(after)
+        if self.slam is not None:
+            self._est_pose = self.slam.update(self._est_pose, self._scan, after)
         free_area_change_m2 = (self.grid.n_free_cells - n_free_before) * cfg.mapping.resolution_m**2
         rw = cfg.reward
         terms = {
@@ -473,24 +475,23 @@ class SemanticExploreEnv(gym.Env):
         return v, min(1.0, max(-1.0, a1)) * rp.max_angular_speed_radps
 
     def _sense_and_map(self, true_pose: tuple[float, float, float]) -> np.ndarray:
-        return self.lidar.sense_and_map(true_pose, self._est_pose, self.grid, self.np_random)
+        map_pose = self._est_pose if self.slam is None else true_pose  # SLAM maps on its own
+        return self.lidar.sense_and_map(true_pose, map_pose, self.grid, self.np_random)
 
     def _obs(self) -> dict[str, np.ndarray]:
-        x, y, yaw = self._est_pose
-        pose = np.array([x, y, wrap_angle_rad(yaw)], dtype=np.float32)
+        pose = np.array(self._pose_values(), dtype=np.float32)
         if self.map_observation == "window":
             return self._window_obs(pose)
         return {
-            "map": self.grid.encoded
+            "map": self._map_grid.encoded
             if self.map_observation == "shared"
-            else self.grid.encoded_copy(),
+            else self._map_grid.encoded_copy(),
             "pose": pose,
             "scan": self._scan,
         }
 
     def _pose_values(self) -> tuple[float, float, float]:
-        x, y, yaw = self._est_pose
-        return x, y, wrap_angle_rad(yaw)
+        return self._est_pose[0], self._est_pose[1], wrap_angle_rad(self._est_pose[2])
 
     def write_obs_into(self, batch: dict[str, np.ndarray], i: int, map_row: np.ndarray) -> None:
         """Put the observation :meth:`step` would return into row ``i`` of ``batch`` (the same
@@ -498,7 +499,7 @@ class SemanticExploreEnv(gym.Env):
         batch, no fresh arrays. ``map_row`` is ``batch["map"][i]`` (the same view object every
         step): the map is not copied there each step, the grid keeps its cells in it from the
         first call on (:meth:`OccupancyGrid.keep_encoded_in`)."""
-        self.grid.keep_encoded_in(map_row)
+        self._map_grid.keep_encoded_in(map_row)
         batch["pose"][i] = self._pose_values()
         batch["scan"][i] = self._scan
 
@@ -514,6 +515,7 @@ class SemanticExploreEnv(gym.Env):
             info["path_length_m"],
         ) = self.info_numbers()
         info["reward_terms"] = terms
+        info.update(self.slam.info(self._true_pose) if self.slam else {})
         return info
 
     def _window_obs(self, pose: np.ndarray) -> dict[str, np.ndarray]:
@@ -523,7 +525,7 @@ class SemanticExploreEnv(gym.Env):
         col = math.floor((float(pose[0]) - g.origin_x_m) / g.resolution_m)
         origin = window_origin(g.shape, self.map_window_cells, "robot", (row, col))
         return {
-            "map": map_window(self.grid._encoded, origin, self.map_window_cells),
+            "map": map_window(self._map_grid._encoded, origin, self.map_window_cells),
             "pose": pose,
             "scan": self._scan,
             "map_offset_cells": np.array(origin, dtype=np.int32),
@@ -559,7 +561,7 @@ class SemanticExploreEnv(gym.Env):
 
         x, y, yaw = self.sim.pose
         return RenderSnapshot(
-            map=self.grid.encoded.copy(),
+            map=self._map_grid.encoded.copy(),
             geometry=self.map_geometry,
             segments_m=self.world.segments_m,
             pose=(x, y, yaw),

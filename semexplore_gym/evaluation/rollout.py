@@ -83,6 +83,9 @@ class MissionResult:
             (policy-specific figures for benchmark rows; empty for most policies).
         path_decomposition: Where the path went (:mod:`.path_decomposition`; None for a
             result built elsewhere).
+        slam_metrics: With the env's SLAM mode: ``ate_m`` (keyframe position RMSE, no
+            alignment: the start pose is shared), ``map_error``, ``loop_closures`` and
+            ``slam_lost`` at the end (:func:`slam_metrics`); empty otherwise.
     """
 
     world: str
@@ -111,6 +114,7 @@ class MissionResult:
     policy_counters: dict[str, int] = field(default_factory=dict)
     policy_metrics: dict[str, Any] = field(default_factory=dict)
     path_decomposition: PathDecomposition | None = field(default=None, repr=False)
+    slam_metrics: dict[str, Any] = field(default_factory=dict)
 
     @property
     def speedup(self) -> float:
@@ -140,6 +144,7 @@ class MissionResult:
             "n_replans": int(self.n_replans),
             "stage_time_s": {k: round(float(v), 4) for k, v in self.stage_time_s.items()},
             "policy_counters": dict(self.policy_counters),
+            **self.slam_metrics,
         }
 
 
@@ -200,6 +205,7 @@ class _MissionLog:
         self.n_replans = 0
         self.steps = 0
         self.ledger = PathLedger.for_mission(obs, info)
+        self.slam: dict[str, Any] = {}  # the SLAM figures at the end (slam_metrics)
 
     def add_policy_stats(self, st: StepStats, act_s: float) -> None:
         """Split one ``act`` call of ``act_s`` wall seconds into stages by its :class:`StepStats`."""
@@ -373,6 +379,15 @@ def run_mission(
     )
 
 
+def slam_metrics(env: Any) -> dict[str, Any]:
+    """The SLAM figures of the env's mission so far (``ate_m``, ``map_error``,
+    ``loop_closures``, ``slam_lost``; :meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`),
+    or ``{}`` when the env does not run SLAM."""
+    unwrapped = getattr(env, "unwrapped", env)
+    slam = getattr(unwrapped, "slam", None)
+    return slam.metrics(unwrapped.grid) if slam is not None else {}
+
+
 def _mission_result(
     world_name: str,
     policy: Policy,
@@ -413,6 +428,7 @@ def _mission_result(
         policy_counters=dict(getattr(policy, "counters", {}) or {}),
         policy_metrics=policy_mission_metrics(policy),
         path_decomposition=log.ledger.finish(),
+        slam_metrics=log.slam,
     )
 
 
@@ -467,6 +483,7 @@ def _drive(
             break
     if gif is not None:
         gif.grab()
+    log.slam = slam_metrics(env)
     return info, terminated, truncated
 
 

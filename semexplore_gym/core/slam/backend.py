@@ -1,0 +1,193 @@
+"""The SLAM back end: keyframes, scan matching, loop closure, the pose graph and the map.
+
+Each step :meth:`ScanSlam.update` takes the odometry pose and the scan. Between keyframes the
+estimate is the last keyframe's pose moved by the odometry since then. After
+``keyframe_distance_m`` of travel or ``keyframe_angle_rad`` of turning the scan is matched to
+the local map of the recent keyframes (:mod:`.matcher`), the keyframe is linked to the last one
+by the match (or, when the match scores too low, by odometry alone), and an older keyframe
+within ``loop_search_radius_m`` and far back in the chain is tried as a loop closure against
+its own submap. A verified closure adds a robust edge and the pose graph is optimised
+(:mod:`.pose_graph`); the map is then re-rendered from all keyframes at their new poses.
+Otherwise the keyframe's scan is fused into the map incrementally.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
+from semexplore_gym.core.slam.matcher import (
+    MatchResult,
+    build_likelihood_field,
+    match_scan,
+    scan_points,
+    transform_points,
+)
+from semexplore_gym.core.slam.params import SlamParams
+from semexplore_gym.core.slam.pose_graph import Edge, optimise
+
+Pose = tuple[float, float, float]
+
+
+def compose(a: Pose, b: Pose) -> Pose:
+    """``a (+) b``: the pose ``b``, given in the frame of ``a``, in the world frame."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle_rad(a[2] + b[2]))
+
+
+def relative(a: Pose, b: Pose) -> Pose:
+    """``a^-1 (+) b``: the pose ``b`` in the frame of ``a``."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, wrap_angle_rad(b[2] - a[2]))
+
+
+class ScanSlam:
+    """Keyframe SLAM on one robot's odometry and scans (see the module docstring).
+
+    Args:
+        params: The SLAM parameters.
+        geometry: The map frame of the grid it builds.
+        mapping: The occupancy update parameters of that grid.
+        beam_angles_rad: ``(n,)`` beam angles of the scans, relative to the heading.
+        max_range_m: The LiDAR's maximum range (returns at it are "no return").
+        mount_xy_m: The sensor's offset from the robot centre, in the robot frame.
+    """
+
+    def __init__(
+        self,
+        params: SlamParams,
+        geometry: GridGeometry,
+        mapping: MappingParams,
+        beam_angles_rad: np.ndarray,
+        max_range_m: float,
+        mount_xy_m: tuple[float, float] = (0.0, 0.0),
+    ) -> None:
+        self.params = params
+        self.grid = OccupancyGrid(geometry, mapping)
+        self._beams = np.asarray(beam_angles_rad, dtype=np.float64)
+        self._max_range_m = float(max_range_m)
+        self._mount = (float(mount_xy_m[0]), float(mount_xy_m[1]))
+        self.reset((0.0, 0.0, 0.0), np.zeros(len(self._beams), dtype=np.float32))
+
+    # ------------------------------------------------------------------ state
+    def reset(self, pose: Pose, ranges_m: np.ndarray) -> None:
+        """Start again at ``pose`` (the shared start pose) with its first scan fused."""
+        self.grid.reset()
+        self.keyframe_poses: list[Pose] = []
+        self._ranges: list[np.ndarray] = []
+        self._points: list[np.ndarray] = []
+        self.edges: list[Edge] = []
+        self.loop_closures = 0
+        self.low_score_streak = 0
+        self.last_score = 1.0
+        self._cooldown = 0
+        self._last_odom: Pose = tuple(float(v) for v in pose)  # type: ignore[assignment]
+        self.estimate: Pose = self._last_odom
+        self._add_keyframe(self._last_odom, ranges_m)
+        self._fuse(0)
+
+    @property
+    def lost(self) -> bool:
+        """Whether the last ``lost_after_keyframes`` keyframes all matched below the threshold."""
+        return self.low_score_streak >= self.params.lost_after_keyframes
+
+    def _add_keyframe(self, pose: Pose, ranges_m: np.ndarray) -> None:
+        ranges = np.array(ranges_m, dtype=np.float32)
+        self.keyframe_poses.append(pose)
+        self._ranges.append(ranges)
+        self._points.append(scan_points(ranges, self._beams, self._max_range_m, self._mount))
+
+    def _fuse(self, k: int) -> None:
+        sx, sy, syaw = compose(self.keyframe_poses[k], (*self._mount, 0.0))
+        self.grid.integrate_scan(sx, sy, syaw, self._beams, self._ranges[k], self._max_range_m)
+
+    # ------------------------------------------------------------------- step
+    def update(self, odom_pose: Pose, ranges_m: np.ndarray) -> Pose:
+        """One step: the odometry pose and the scan taken there. Returns the new estimate."""
+        delta = relative(self._last_odom, tuple(float(v) for v in odom_pose))  # type: ignore[arg-type]
+        prediction = compose(self.keyframe_poses[-1], delta)
+        p = self.params
+        if (
+            math.hypot(delta[0], delta[1]) < p.keyframe_distance_m
+            and abs(delta[2]) < p.keyframe_angle_rad
+        ):
+            self.estimate = prediction
+            return prediction
+        self._last_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
+        points = scan_points(np.asarray(ranges_m), self._beams, self._max_range_m, self._mount)
+        pose, cov = self._track(prediction, points, delta)
+        n = len(self.keyframe_poses)
+        self.edges.append(Edge(n - 1, n, relative(self.keyframe_poses[-1], pose), cov))
+        self._add_keyframe(pose, ranges_m)
+        if not self._close_loop(points):
+            self._fuse(n)
+        self.estimate = self.keyframe_poses[-1]
+        return self.estimate
+
+    def _track(self, prediction: Pose, points: np.ndarray, delta: Pose) -> tuple[Pose, np.ndarray]:
+        """The keyframe pose and its edge covariance: the scan match to the recent keyframes,
+        or the odometry prediction when the match is not trusted."""
+        p = self.params
+        first = max(0, len(self.keyframe_poses) - p.submap_keyframes)
+        match = self._match(
+            range(first, len(self.keyframe_poses)), points, prediction, p.search_xy_m
+        )
+        self.last_score = match.score
+        if len(points) >= 10 and match.score >= p.match_score_threshold:
+            self.low_score_streak = 0
+            return match.pose, match.covariance
+        self.low_score_streak += 1
+        trans = math.hypot(delta[0], delta[1])
+        sd_xy, sd_yaw = 0.02 + 0.2 * trans, 0.02 + 0.2 * abs(delta[2])
+        return prediction, np.diag([sd_xy**2, sd_xy**2, sd_yaw**2])
+
+    def _match(
+        self, keyframes: range, points: np.ndarray, prediction: Pose, search_xy_m: float
+    ) -> MatchResult:
+        p = self.params
+        world = [transform_points(self._points[k], self.keyframe_poses[k]) for k in keyframes]
+        field = build_likelihood_field(
+            np.concatenate(world) if world else np.zeros((0, 2)),
+            p.match_resolution_m,
+            p.likelihood_sigma_m,
+        )
+        return match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
+
+    def _close_loop(self, points: np.ndarray) -> bool:
+        """Try a loop closure from the newest keyframe; True when one re-rendered the map."""
+        p = self.params
+        n = len(self.keyframe_poses) - 1
+        if self._cooldown > 0:
+            self._cooldown -= 1
+            return False
+        last_old = n - p.loop_min_gap_keyframes
+        if last_old < 0 or len(points) < 10:
+            return False
+        here = np.asarray(self.keyframe_poses[n][:2])
+        old = np.asarray([kp[:2] for kp in self.keyframe_poses[: last_old + 1]])
+        dist = np.hypot(*(old - here).T)
+        i = int(np.argmin(dist))
+        if dist[i] > p.loop_search_radius_m:
+            return False
+        half = p.submap_keyframes // 2
+        sub = range(max(0, i - half), min(last_old + 1, i + half + 1))
+        match = self._match(sub, points, self.keyframe_poses[n], p.loop_search_xy_m)
+        if match.score < p.loop_score_threshold:
+            return False
+        delta = relative(self.keyframe_poses[i], match.pose)
+        self.edges.append(Edge(i, n, delta, match.covariance, robust=True))
+        self.loop_closures += 1
+        self._cooldown = p.submap_keyframes
+        new = optimise(np.asarray(self.keyframe_poses), self.edges)
+        moved = float(np.abs(new - np.asarray(self.keyframe_poses))[:, :2].max())
+        self.keyframe_poses = [(float(x), float(y), wrap_angle_rad(float(t))) for x, y, t in new]
+        if moved < 0.25 * self.grid.geometry.resolution_m:
+            return False
+        self.grid.reset()
+        for k in range(n + 1):
+            self._fuse(k)
+        return True

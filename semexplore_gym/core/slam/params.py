@@ -1,0 +1,78 @@
+"""Parameters of the SLAM back end (the env's ``slam:`` config section)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+#: Inclusive bounds of each numeric parameter: (low, high).
+_BOUNDS: dict[str, tuple[float, float]] = {
+    "keyframe_distance_m": (0.01, 5.0),
+    "keyframe_angle_rad": (0.01, math.pi),
+    "search_xy_m": (0.0, 2.0),
+    "search_yaw_rad": (0.0, math.pi),
+    "match_resolution_m": (0.005, 0.5),
+    "likelihood_sigma_m": (0.005, 1.0),
+    "submap_keyframes": (1, 1000),
+    "match_score_threshold": (0.0, 1.0),
+    "loop_search_radius_m": (0.0, 50.0),
+    "loop_min_gap_keyframes": (1, 100000),
+    "loop_search_xy_m": (0.0, 5.0),
+    "loop_score_threshold": (0.0, 1.0),
+    "lost_after_keyframes": (1, 100000),
+}
+_INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
+
+
+@dataclass(frozen=True)
+class SlamParams:
+    """Scan matching, keyframes, loop closure and the lost judgement of the SLAM mode.
+
+    Attributes:
+        enabled: Build the observed map with SLAM (the mapping mode ``slam``); off: the map is
+            built on the (possibly drifting) odometry pose as before.
+        keyframe_distance_m: A new keyframe (scan match and map update) after this much travel.
+        keyframe_angle_rad: ... or after this much turning since the last keyframe.
+        search_xy_m: Half-width of the scan matcher's x and y search around the odometry
+            prediction.
+        search_yaw_rad: Half-width of its yaw search.
+        match_resolution_m: Cell edge of the matcher's likelihood field (the finest step).
+        likelihood_sigma_m: Standard deviation of the likelihood field around occupied points.
+        submap_keyframes: How many recent keyframes form the local map a scan is matched to.
+        match_score_threshold: A scan match scoring below this (mean likelihood of the
+            scan's end points, 0..1) is not trusted: odometry alone links the keyframe.
+        loop_search_radius_m: Older keyframes this close to the estimate are loop candidates.
+        loop_min_gap_keyframes: ... when at least this many keyframes back in the chain.
+        loop_search_xy_m: Half-width of the x and y search of a loop-closure match.
+        loop_score_threshold: A loop-closure match must score at least this.
+        lost_after_keyframes: The back end reports itself lost after this many keyframes in a
+            row whose match scored below ``match_score_threshold``.
+    """
+
+    enabled: bool = False
+    keyframe_distance_m: float = 0.25
+    keyframe_angle_rad: float = 0.25
+    search_xy_m: float = 0.2
+    search_yaw_rad: float = 0.3
+    match_resolution_m: float = 0.025
+    likelihood_sigma_m: float = 0.04
+    submap_keyframes: int = 12
+    match_score_threshold: float = 0.35
+    loop_search_radius_m: float = 1.5
+    loop_min_gap_keyframes: int = 40
+    loop_search_xy_m: float = 0.5
+    loop_score_threshold: float = 0.6
+    lost_after_keyframes: int = 5
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "enabled":
+                if not isinstance(v, bool):
+                    raise ValueError(f"slam.enabled must be true or false, got {v!r}")
+                continue
+            ok_type = isinstance(v, int) if f.name in _INTS else isinstance(v, (int, float))
+            lo, hi = _BOUNDS[f.name]
+            if isinstance(v, bool) or not ok_type or not (math.isfinite(v) and lo <= v <= hi):
+                kind = "an integer" if f.name in _INTS else "a number"
+                raise ValueError(f"slam.{f.name} must be {kind} in [{lo:g}, {hi:g}], got {v!r}")

@@ -1,0 +1,114 @@
+"""The env's SLAM mapping mode (``slam.enabled``): the observed map and pose come from SLAM.
+
+:class:`SlamMode` runs :class:`~semexplore_gym.core.slam.backend.ScanSlam` on the env's drifting
+odometry pose and the LiDAR scans; the env's own grid, fused at the true pose, stays for
+coverage and rewards. It also keeps the true pose of each keyframe for the trajectory error.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from semexplore_gym.core.grid import UNKNOWN, GridGeometry
+from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
+from semexplore_gym.core.slam.backend import ScanSlam
+from semexplore_gym.core.slam.pose_graph import require_gtsam
+from semexplore_gym.envs.env_config import EnvConfig
+
+Pose = tuple[float, float, float]
+
+#: The per-step ``info`` keys of the SLAM mode.
+SLAM_INFO_KEYS = ("slam_pose", "slam_pose_error_m", "loop_closures", "slam_lost")
+
+
+class SlamMode:
+    """One robot's SLAM in the env (see the module docstring).
+
+    Args:
+        config: The env config (its ``slam``, ``mapping`` and ``lidar`` sections).
+        geometry: The env's map frame.
+        beam_angles_rad: The LiDAR's beam angles.
+
+    Raises:
+        ImportError: one line naming the extra when gtsam is missing.
+    """
+
+    def __init__(
+        self, config: EnvConfig, geometry: GridGeometry, beam_angles_rad: np.ndarray
+    ) -> None:
+        require_gtsam()
+        lidar = config.lidar
+        self.backend = ScanSlam(
+            config.slam,
+            geometry,
+            config.mapping,
+            beam_angles_rad,
+            lidar.max_range_m,
+            (lidar.mount_x_m, lidar.mount_y_m),
+        )
+        self._truth_at_keyframes: list[Pose] = []
+
+    @classmethod
+    def create(
+        cls, config: EnvConfig, geometry: GridGeometry, beam_angles_rad: np.ndarray
+    ) -> SlamMode | None:
+        """The SLAM mode when ``config.slam.enabled``, else None."""
+        return cls(config, geometry, beam_angles_rad) if config.slam.enabled else None
+
+    @property
+    def grid(self) -> OccupancyGrid:
+        """The SLAM map (what the policies see)."""
+        return self.backend.grid
+
+    def reset(self, pose: Pose, scan: np.ndarray) -> OccupancyGrid:
+        """A new episode at the (shared) start ``pose``; returns the SLAM map."""
+        self.backend.reset(pose, scan)
+        self._truth_at_keyframes = [tuple(float(v) for v in pose)]  # type: ignore[list-item]
+        return self.backend.grid
+
+    def update(self, odom_pose: Any, scan: np.ndarray, true_pose: Pose) -> Pose:
+        """One step on the odometry pose and the scan; returns the SLAM estimate."""
+        estimate = self.backend.update(tuple(float(v) for v in odom_pose), scan)  # type: ignore[arg-type]
+        if len(self.backend.keyframe_poses) > len(self._truth_at_keyframes):
+            self._truth_at_keyframes.append(true_pose)
+        return estimate
+
+    def info(self, true_pose: Pose) -> dict[str, Any]:
+        """The per-step ``info`` entries (:data:`SLAM_INFO_KEYS`)."""
+        est = self.backend.estimate
+        return {
+            "slam_pose": est,
+            "slam_pose_error_m": math.hypot(est[0] - true_pose[0], est[1] - true_pose[1]),
+            "loop_closures": self.backend.loop_closures,
+            "slam_lost": self.backend.lost,
+        }
+
+    def ate_m(self) -> float:
+        """Absolute trajectory error: RMSE of the keyframe positions against the true poses
+        there, without alignment (SLAM starts at the true start pose, a shared frame)."""
+        est = np.asarray(self.backend.keyframe_poses)[:, :2]
+        truth = np.asarray(self._truth_at_keyframes)[:, :2]
+        return float(np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1))))
+
+    def map_error(self, truth_grid: OccupancyGrid) -> float:
+        """Share of the SLAM map's known cells whose class (free, occupied) differs from the
+        map the same scans build at the true poses (``truth_grid``; unknown there counts as a
+        difference: ghost space)."""
+        slam = self.backend.grid.encoded
+        known = slam != UNKNOWN
+        n_known = int(np.count_nonzero(known))
+        if n_known == 0:
+            return 0.0
+        return float(np.count_nonzero(known & (slam != truth_grid.encoded)) / n_known)
+
+    def metrics(self, truth_grid: OccupancyGrid) -> dict[str, Any]:
+        """The mission's SLAM figures: ``ate_m``, ``map_error``, ``loop_closures``, ``slam_lost``."""
+        return {
+            "ate_m": round(self.ate_m(), 5),
+            "map_error": round(self.map_error(truth_grid), 5),
+            "loop_closures": int(self.backend.loop_closures),
+            "slam_lost": bool(self.backend.lost),
+        }

@@ -1,0 +1,127 @@
+"""The SLAM back end on a ring world driven around with drifting odometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.mapping.occupancy_grid import MappingParams
+from semexplore_gym.core.mapping.odometry import OdometryDrift, OdometryNoiseParams
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.slam.backend import ScanSlam
+from semexplore_gym.core.slam.params import SlamParams
+
+pytest.importorskip("gtsam")
+
+BEAMS = np.arange(360) * (2 * math.pi / 360)
+MAX_RANGE_M = 3.5
+
+
+def _ring_segments() -> np.ndarray:
+    """A square ring corridor 1.5 m wide around a 3 x 3 m block, with wall stubs as features."""
+    walls = [
+        [0, 0, 6, 0], [6, 0, 6, 6], [6, 6, 0, 6], [0, 6, 0, 0],
+        [1.5, 1.5, 4.5, 1.5], [4.5, 1.5, 4.5, 4.5], [4.5, 4.5, 1.5, 4.5], [1.5, 4.5, 1.5, 1.5],
+    ]  # fmt: skip
+    for t in (1.3, 2.9, 4.1):
+        walls += [[t, 0, t, 0.3], [6, t, 5.7, t], [6 - t, 6, 6 - t, 5.7], [0, 6 - t, 0.3, 6 - t]]
+    walls += [
+        [2.2, 1.5, 2.2, 1.25],
+        [4.5, 3.6, 4.75, 3.6],
+        [3.1, 4.5, 3.1, 4.8],
+        [1.5, 2.5, 1.2, 2.5],
+    ]
+    return np.array(walls, dtype=np.float64)
+
+
+def _drive(corners: list[tuple[float, float]], step_m: float = 0.044, turn_rad: float = 0.5):
+    """True poses driving straight between ``corners``, turning in place at each one."""
+    x, y = corners[0]
+    yaw = math.atan2(corners[1][1] - y, corners[1][0] - x)
+    poses = [(x, y, yaw)]
+    for tx, ty in corners[1:]:
+        goal = math.atan2(ty - y, tx - x)
+        while abs(d := math.remainder(goal - yaw, 2 * math.pi)) > 1e-9:
+            yaw += max(-turn_rad, min(turn_rad, d))
+            poses.append((x, y, yaw))
+        while (left := math.hypot(tx - x, ty - y)) > 1e-9:
+            s = min(step_m, left)
+            x, y = x + s * math.cos(yaw), y + s * math.sin(yaw)
+            poses.append((x, y, yaw))
+    return poses
+
+
+def _run(params: SlamParams, seed: int):
+    index = SegmentIndex(_ring_segments())
+    geometry = GridGeometry.covering(0.0, 0.0, 6.0, 6.0, 0.05, 0.5)
+    corners = [(0.75, 0.75), (5.25, 0.75), (5.25, 5.25), (0.75, 5.25), (0.75, 0.75), (3.5, 0.75)]
+    truth = _drive(corners)
+    rng = np.random.default_rng(seed)
+    odom = OdometryDrift(OdometryNoiseParams(0.02, 0.02, 0.02, 0.02))
+    odom.reset(truth[0])
+
+    def scan(p):
+        return np.minimum(cast_scan(index, p[0], p[1], p[2], BEAMS, MAX_RANGE_M), MAX_RANGE_M)
+
+    slam = ScanSlam(params, geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+    slam.reset(truth[0], scan(truth[0]))
+    at_keyframes = [truth[0]]
+    for before, after in zip(truth[:-1], truth[1:], strict=True):
+        est_odom = tuple(odom.update(before, after, rng))
+        slam.update(est_odom, scan(after))
+        if len(slam.keyframe_poses) > len(at_keyframes):
+            at_keyframes.append(after)
+    end = truth[-1]
+    odom_err = math.hypot(odom.estimate[0] - end[0], odom.estimate[1] - end[1])
+    d = np.asarray(slam.keyframe_poses)[:, :2] - np.asarray(at_keyframes)[:, :2]
+    ate_m = float(np.sqrt(np.mean(np.sum(d**2, axis=1))))
+    return slam, odom_err, ate_m
+
+
+#: A coarse front end (a blurred field, a short local map): its drift builds up around the
+#: ring, and only a loop closure takes it out.
+COARSE = {"match_resolution_m": 0.05, "likelihood_sigma_m": 0.1, "submap_keyframes": 4}
+
+
+@pytest.mark.parametrize("seed", [1, 4])
+def test_a_loop_closure_is_found_and_reduces_the_error(seed: int) -> None:
+    with_loops, odom_err, ate_m = _run(SlamParams(enabled=True, **COARSE), seed)
+    no_loops = SlamParams(enabled=True, loop_search_radius_m=0.0, **COARSE)
+    without, _, open_ate_m = _run(no_loops, seed)
+    assert with_loops.loop_closures >= 1
+    assert without.loop_closures == 0
+    assert any(e.robust for e in with_loops.edges)
+    assert ate_m < 0.7 * open_ate_m
+    assert ate_m < odom_err / 5
+    assert not with_loops.lost
+
+
+def test_the_default_front_end_tracks_the_ring() -> None:
+    slam, odom_err, ate_m = _run(SlamParams(enabled=True), seed=3)
+    assert ate_m < 0.05 < odom_err
+    assert slam.last_score > 0.8
+
+
+def test_same_seed_same_map_bit_for_bit() -> None:
+    a, _, _ = _run(SlamParams(enabled=True), seed=2)
+    b, _, _ = _run(SlamParams(enabled=True), seed=2)
+    assert np.array_equal(a.grid.log_odds, b.grid.log_odds)
+    assert a.keyframe_poses == b.keyframe_poses
+
+
+def test_the_back_end_says_it_is_lost_when_matches_keep_failing() -> None:
+    params = SlamParams(enabled=True, lost_after_keyframes=3)
+    geometry = GridGeometry.covering(-5.0, -5.0, 5.0, 5.0, 0.05, 0.5)
+    slam = ScanSlam(params, geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+    nothing = np.full(360, MAX_RANGE_M, dtype=np.float32)  # open space: no returns at all
+    slam.reset((0.0, 0.0, 0.0), nothing)
+    lost = []
+    for k in range(1, 6):
+        slam.update((0.3 * k, 0.0, 0.0), nothing)
+        lost.append(slam.lost)
+    assert lost == [False, False, True, True, True]
+    # Odometry alone carried the estimate meanwhile.
+    assert slam.estimate == pytest.approx((1.5, 0.0, 0.0))
