@@ -129,7 +129,20 @@ def test_every_file_the_docs_link_is_tracked_by_git(doc: str) -> None:
 # ------------------------------------------------------------------------- what users read
 def test_readme_is_short() -> None:
     lines = (REPO / "README.md").read_text(encoding="utf-8").count("\n")
-    assert lines <= 200, f"README.md has {lines} lines; move detail into docs/"
+    assert lines <= 150, f"README.md has {lines} lines; move detail into docs/"
+
+
+def test_readme_results_are_short_and_name_versions() -> None:
+    """At most 10 rows of results, each naming the expert it measured; no long specs."""
+    import re
+
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Headline results") :].split("\n## ", 1)[0]
+    rows = [ln for ln in section.splitlines() if ln.startswith("| ") and "---" not in ln][1:]
+    assert 1 <= len(rows) <= 10, f"{len(rows)} result rows; keep at most 10"
+    assert all(ln.rstrip().endswith(("| v2 |", "| v3 |", "| team |", "| – |")) for ln in rows)
+    long_specs = re.findall(r"[\w-]+\[[^\]\s]*;[^\]\s]*;[^\]\s]*\]", text)
+    assert not long_specs, f"specs with more than two overrides: {long_specs}"
 
 
 def _catalogue_hashes() -> set[str]:
