@@ -297,7 +297,8 @@ def test_commands_are_found() -> None:
     )
     assert "path/to/your_map.yaml" not in " ".join(shrink(bench, []))
     readme = code_blocks((REPO / "README.md").read_text(encoding="utf-8"))
-    assert any(b.lang == "python" and "record_expert_dataset" in b.body for b in readme)
+    assert any(b.lang == "python" and "run_mission" in b.body for b in readme)
+    assert any(b.lang == "python" and "record_expert_dataset" in b.body for b in blocks)
 
 
 # ------------------------------------------------------------------------- running commands

@@ -37,11 +37,8 @@ from semexplore_gym.envs.multi_robot_config import (
     load_team_params,
     split_team_overrides,
 )
-from semexplore_gym.envs.semantic_explore import (
-    SemanticExploreEnv,
-    is_unseeded_procedural,
-    static_info_of,
-)
+from semexplore_gym.envs.semantic_explore import SemanticExploreEnv, is_unseeded_procedural
+from semexplore_gym.envs.static_info import static_info_of
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.team import TeamSim, sense_with_teammates

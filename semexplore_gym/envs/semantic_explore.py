@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterator, Mapping
 from typing import Any
 
 import gymnasium as gym
@@ -26,6 +25,8 @@ from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSE
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
 from semexplore_gym.envs.observation_options import ObservationOptions
 from semexplore_gym.envs.slam_mode import SlamMode
+from semexplore_gym.envs.static_info import FrozenInfo as FrozenInfo
+from semexplore_gym.envs.static_info import static_info_of
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.robot import RobotSim
@@ -41,63 +42,6 @@ def is_unseeded_procedural(spec: Any) -> bool:
         return False
     family, _, params = spec.partition(":")
     return family in PROCEDURAL_FAMILIES and "seed=" not in params
-
-
-class FrozenInfo(Mapping):
-    """A read-only mapping: the static ``info`` entries, built once per env.
-
-    Every step's ``info`` shares the same instances, so nothing is rebuilt per step and no
-    caller can change what the next step reports. It is not a ``dict``, so gymnasium's vector
-    envs collect it as one object per env instead of one array per field (much cheaper per
-    step). ``dict(info["robot"])`` gives a plain, mutable copy.
-    """
-
-    __slots__ = ("_d",)
-
-    def __init__(self, entries: Mapping[str, Any]) -> None:
-        self._d = dict(entries)
-
-    def __getitem__(self, key: str) -> Any:
-        return self._d[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._d)
-
-    def __len__(self) -> int:
-        return len(self._d)
-
-    def __repr__(self) -> str:
-        return f"FrozenInfo({self._d!r})"
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (FrozenInfo, (self._d,))
-
-
-def static_info_of(config: EnvConfig, geometry: GridGeometry) -> dict[str, Any]:
-    """The ``info`` entries fixed by the config (shared read-only mappings), the same for the
-    single-robot env and each agent of the multi-robot env."""
-    cfg = config
-    return {
-        "map_geometry": FrozenInfo(geometry.to_dict()),
-        "robot": FrozenInfo(
-            {
-                "radius_m": cfg.robot.radius_m,
-                "max_linear_speed_mps": cfg.robot.max_linear_speed_mps,
-                "max_angular_speed_radps": cfg.robot.max_angular_speed_radps,
-            }
-        ),
-        "lidar": FrozenInfo(
-            {
-                "n_beams": cfg.lidar.n_beams,
-                "min_range_m": cfg.lidar.min_range_m,
-                "max_range_m": cfg.lidar.max_range_m,
-                "angle_increment_rad": cfg.lidar.angle_increment_rad,
-                "mount_x_m": cfg.lidar.mount_x_m,
-                "mount_y_m": cfg.lidar.mount_y_m,
-            }
-        ),
-        "dt_s": cfg.episode.dt_s,
-    }
 
 
 class SemanticExploreEnv(gym.Env):

@@ -294,6 +294,21 @@ def _check_mission_args(env: Any, max_time_s: float | None, gif: GifOptions | No
             raise ValueError(f"gif.every_s must be positive, got {gif.every_s!r}")
 
 
+def _gif_recorder(
+    env: Any, policy: Policy, gif: GifOptions | None, stage: dict[str, float]
+) -> _GifRecorder | None:
+    if gif is None:
+        return None
+    return _GifRecorder(env, policy, gif.every_s, stage, gif.path, gif.fps)
+
+
+def _end_bar_full(bar: Any) -> None:
+    """The mission is over: the bar ends full, at the time reached."""
+    if bar is not None:
+        bar.total = max(bar.n, 1e-9)
+        bar.refresh()
+
+
 def run_mission(
     env: Any,
     policy: Policy,
@@ -346,11 +361,7 @@ def run_mission(
 
     world_name = _world_name(env)
     limit_s = max_time_s if max_time_s is not None else math.inf
-    recorder = (
-        _GifRecorder(env, policy, gif.every_s, log.stage, gif.path, gif.fps)
-        if gif is not None
-        else None
-    )
+    recorder = _gif_recorder(env, policy, gif, log.stage)
     bar = _progress_bar(
         progress, limit_s if math.isfinite(limit_s) else None, world_name, policy.name
     )
@@ -358,9 +369,7 @@ def run_mission(
         info, terminated, truncated = _drive(
             env, policy, obs, info, log, recorder, bar, on_step, limit_s, ignore_terminated
         )
-        if bar is not None:  # the mission is over: the bar ends full, at the time reached
-            bar.total = max(bar.n, 1e-9)
-            bar.refresh()
+        _end_bar_full(bar)
     except BaseException:
         if recorder is not None:
             recorder.abort()
