@@ -63,7 +63,7 @@ from semexplore_gym.core.frontiers.viewpoint import (
     unknown_extent_cells,
     unknown_rim,
 )
-from semexplore_gym.core.planning.graph_search import FrontierCandidate
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, metric_cost
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.polyline import heading_angle
 
@@ -306,7 +306,7 @@ def _cheaper_grid_frontier(ctx: PlanContext, chosen: FrontierCandidate) -> Plan 
         return None
     w = ctx.params.cost
     v_rad = heading_angle(found.path_m, ctx.xy_m, ctx.pose[2], w.heading_lookahead_m)
-    cost = found.path_length_m / chosen.l_path_m + w.w_v * v_rad
+    cost = metric_cost(found.path_length_m, v_rad, chosen.l_path_m, w)
     if cost >= chosen.cost:
         return None
     ctx.counts.grid_frontier_plans += 1
