@@ -39,7 +39,7 @@ from semexplore_gym.policies.semantic_expert import (
     SemanticExpertParams,
     SemanticExpertPolicy,
 )
-from semexplore_gym.policies.semantic_expert_params import for_outside_choice
+from semexplore_gym.policies.semantic_expert_params import OUTSIDE_CHOICE_OFF
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
@@ -67,9 +67,12 @@ class ExpertDriver(SemanticExpertPolicy):
     def __init__(
         self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
     ) -> None:
-        # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
+        # The agent chooses the frontier: the grid's nearest frontier must not overrule it. The
+        # callers pass the plain expert's params (switches on by default), so they are turned
+        # off here rather than refused.
         base = params if params is not None else SemanticExpertParams()
-        super().__init__(for_outside_choice(base), segmenter)
+        off = dict.fromkeys(OUTSIDE_CHOICE_OFF, False)
+        super().__init__(replace(base, **off), segmenter)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

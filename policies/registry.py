@@ -46,6 +46,15 @@ def _expert_like(
     return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter)
 
 
+def _outside_choice_layer() -> dict[str, Any]:
+    """The layer below the user's for a policy whose goals an outside choice makes: its expert
+    runs with the :data:`~semexplore_gym.policies.semantic_expert_params.OUTSIDE_CHOICE_OFF`
+    switches off, and a user who sets one on gets an error naming it."""
+    from semexplore_gym.policies.semantic_expert_params import OUTSIDE_CHOICE_OFF
+
+    return {"expert": dict.fromkeys(OUTSIDE_CHOICE_OFF, False)}
+
+
 def _semantic_version(name: str) -> Factory:
     """The factory of a named expert version (``semantic`` = the newest;
     :mod:`semexplore_gym.policies.expert_versions`): its layer below the caller's params."""
@@ -80,7 +89,8 @@ def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
         FrontierValuePolicy,
     )
 
-    return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
+    layers = (FrontierValueParams, _outside_choice_layer())
+    return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, *layers)
 
 
 def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -99,9 +109,8 @@ def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
                 f"policy 'frontier-student:{arg}': give the model file or params, not both"
             )
         overrides["params"] = arg
-    return _expert_like(
-        "frontier-student", "", overrides, FrontierStudentPolicy, FrontierStudentParams
-    )
+    layers = (FrontierStudentParams, _outside_choice_layer())
+    return _expert_like("frontier-student", "", overrides, FrontierStudentPolicy, *layers)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:

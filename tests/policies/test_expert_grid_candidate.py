@@ -104,7 +104,9 @@ def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_miss
 
 def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     """Teams, the learning agents' driver and the learned frontier value make the choice: the
-    grid's nearest frontier never overrules it, whatever the parameters say."""
+    grid's nearest frontier never overrules it. The driver turns it off whatever its caller's
+    params say; the others run without it by default and refuse it when asked
+    (tests/policies/test_outside_choice.py)."""
     from semexplore_gym.policies.expert_driver import ExpertDriver
     from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
     from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
@@ -115,7 +117,8 @@ def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     assert not ExpertDriver(on).params.grid_candidate
     assert not ExpertDriver().params.grid_candidate
     assert not FrontierValuePolicy().params.grid_candidate
-    assert not _ExpertMember(SemanticTeam(), 0, on).params.grid_candidate
+    team = SemanticTeam()
+    assert not _ExpertMember(team, 0, team.params.expert).params.grid_candidate
 
 
 @pytest.mark.parametrize("holds", [True, False])
