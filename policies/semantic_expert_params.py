@@ -141,7 +141,7 @@ What the paper leaves open, and how the expert handles it (parameters in
   the far side, never into a crack whose far side is rock, so it costs nothing where nothing
   lies beyond (``narrow_passages`` comes after it and probes the cracks too).
 
-Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
+Every addition to the paper can be switched off on its own (``configs/expert/paper_method.yaml``
 switches them all off: the paper's method alone).
 
 ``counters`` and ``events`` record how often each behaviour fired.
@@ -563,7 +563,7 @@ def for_outside_choice(params: SemanticExpertParams, policy: str) -> SemanticExp
 
 
 #: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level
-#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_pure.yaml`` restates it
+#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_method.yaml`` restates it
 #: (tests/policies/test_policy_config.py compares them); ``--policy semantic-paper`` uses it.
 PAPER_PURE: dict[str, object] = {
     "prune_by": "area",

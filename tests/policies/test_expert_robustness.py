@@ -297,7 +297,7 @@ def test_side_approach_comes_from_away_from_the_failure() -> None:
 def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
     from semexplore_gym.policies.specs import load_policy_config
 
-    cfg = load_policy_config(REPO / "configs" / "expert" / "paper_pure.yaml")
+    cfg = load_policy_config(REPO / "configs" / "expert" / "paper_method.yaml")
     from_yaml = build_params(SemanticExpertParams, cfg.params)
     assert from_yaml == build_params(SemanticExpertParams, PAPER_PURE)
     pol = make_policy("semantic-paper")
