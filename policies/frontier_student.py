@@ -30,15 +30,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
-from semexplore_gym.policies.expert_plan_context import PlanContext, PlanSource
-from semexplore_gym.policies.expert_plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
-from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import (
+from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
     SemanticExpertParams,
     for_outside_choice,
     outside_choice_params,
 )
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
+from semexplore_gym.policies.expert.plan_context import PlanContext, PlanSource
+from semexplore_gym.policies.expert.plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
 
 from semexplore_gym.core.features.frontier_option_features import (
     OPTION_FEATURE_NAMES,

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import (
+from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
     SemanticExpertParams,
     for_outside_choice,
     outside_choice_params,

@@ -57,7 +57,7 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
     team: TeamPolicy
     try:
         if base in SEMANTIC_TEAM_POLICIES:
-            from semexplore_gym.policies.semantic_expert_params import OUTSIDE_CHOICE_OFF
+            from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
             from semexplore_gym.policies.team.semantic_team import (
                 SemanticTeam,
                 SemanticTeamParams,

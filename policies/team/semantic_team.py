@@ -1,6 +1,6 @@
 """The coordinated semantic expert: the paper's expert on every robot, frontiers divided.
 
-Each robot runs :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy` (its
+Each robot runs :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy` (its
 semantic topometric map, Algorithm 1's cost ``C`` per frontier, the potential field). Only the
 goal choice is the team's, through the expert's ``choose_goal`` plug-in point: a candidate's
 cost becomes
@@ -38,8 +38,8 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import (
+from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
     SemanticExpertParams,
     for_outside_choice,
     outside_choice_params,

@@ -9,11 +9,11 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import PAPER_PURE
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
 from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
 import semexplore_gym  # noqa: F401
 from semexplore_gym.config import build_params

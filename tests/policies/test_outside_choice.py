@@ -10,12 +10,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert_params import (
+from semexplore_gym.policies.expert.params import (
     OUTSIDE_CHOICE_OFF,
     SemanticExpertParams,
     for_outside_choice,
 )
+from semexplore_gym.policies.registry import make_policy
 from semexplore_gym.policies.team import make_team_policy
 
 SPECS = ("frontier-student", "frontier-value")

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from semexplore_gym.policies.expert.expert import SemanticExpertParams
 from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.policies.specs import load_policy_config
 
 from semexplore_gym.config import ConfigError, build_params

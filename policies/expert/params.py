@@ -1,4 +1,4 @@
-"""Parameters of the semantic expert (:class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`).
+"""Parameters of the semantic expert (:class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`).
 
 What the paper leaves open, and how the expert handles it (parameters in
 :class:`SemanticExpertParams`, all times in simulated seconds):
@@ -174,7 +174,7 @@ _Group = TypeVar("_Group")
 class PathFollowingParams:
     """The path follower's group of :class:`SemanticExpertParams` (same names and meaning).
 
-    :class:`~semexplore_gym.policies.expert_path_following.PathFollower` reads these: the
+    :class:`~semexplore_gym.policies.expert.path_following.PathFollower` reads these: the
     potential field, the local-minimum escape, the progress watch and the stuck recovery.
     """
 
@@ -204,7 +204,7 @@ class PathFollowingParams:
 class GoalMemoryParams:
     """The goal memory's group of :class:`SemanticExpertParams` (same names and meaning).
 
-    :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` reads these: dropping,
+    :class:`~semexplore_gym.policies.expert.goal_memory.GoalMemory` reads these: dropping,
     retrying and reviving goals, the oscillation guard and the stop reason.
     """
 

@@ -1,6 +1,6 @@
 """The sources that propose the semantic expert's plans.
 
-A :class:`~semexplore_gym.policies.expert_plan.Plan` is where the robot drives and along which
+A :class:`~semexplore_gym.policies.expert.plan.Plan` is where the robot drives and along which
 path. At each replan the expert asks its :class:`PlanSource` objects in order
 (``SemanticExpertPolicy.plan_sources``); the first plan proposed is adopted, and when every
 source passes the expert waits a step and, after ``stop_confirmations`` such replans, stops.
@@ -20,7 +20,7 @@ source                  proposes
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
 ``room_beyond_gap``     through a gap narrower than the clearance into room the map shows
                         beyond it, with a frontier (``room_beyond_gaps``; in
-                        :mod:`~semexplore_gym.policies.expert_narrow_sources`)
+                        :mod:`~semexplore_gym.policies.expert.narrow_sources`)
 ``narrow_fallback``     the nearest frontier a grid search reaches with a thinner clearance
                         (``narrow_passages``), through passages followed slowly and exactly
 ``look``                close to a frontier too narrow to reach, to look again
@@ -36,14 +36,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from semexplore_gym.policies.expert_goal_memory import TRAIL_CELL_M
-from semexplore_gym.policies.expert_narrow_sources import (
+from semexplore_gym.policies.expert.goal_memory import TRAIL_CELL_M
+from semexplore_gym.policies.expert.narrow_sources import (
     NARROW_REACHED_M,
     NarrowFallback,
     RoomBeyondGap,
 )
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
-from semexplore_gym.policies.expert_plan_context import (
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
+from semexplore_gym.policies.expert.plan_context import (
     PlanContext,
     PlanSource,
     goal_open,
@@ -72,13 +72,11 @@ __all__ = [
     "CommandedGoal",
     "CommittedFallback",
     "LookAtNarrowFrontier",
-    "NarrowFallback",
     "NearestFallback",
     "PlanContext",
     "PlanSource",
     "PocketEscape",
     "RetryFailedGoal",
-    "RoomBeyondGap",
     "SemanticFrontier",
     "ViewFrontier",
     "goal_open",
@@ -361,7 +359,7 @@ class PocketEscape(PlanSource):
     where it stands, so it leaves over cells with the clearance of its radius plus
     ``pocket_clearance_margin_m`` to the nearest region that is not a pocket, and the check
     runs again from there with the full clearance (see
-    :mod:`semexplore_gym.policies.semantic_expert_params`). The plan is both legs; none when the
+    :mod:`semexplore_gym.policies.expert.params`). The plan is both legs; none when the
     check from outside finds nothing either.
     """
 
