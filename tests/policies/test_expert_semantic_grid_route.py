@@ -88,8 +88,8 @@ def test_the_robust_expert_has_it_and_the_paper_pure_preset_does_not() -> None:
 
 def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     """Teams, the learning agents' driver, the frontier student and the learned frontier value
-    were trained and measured driving the map's paths: they keep them, whatever the
-    parameters say."""
+    were trained and measured driving the map's paths: they keep them (the driver whatever
+    its caller's params say; the others refuse the switch: tests/policies/test_outside_choice.py)."""
     from semexplore_gym.policies.expert.driver import ExpertDriver
     from semexplore_gym.policies.expert.params import SemanticExpertParams
     from semexplore_gym.policies.frontier_student import FrontierStudentPolicy
@@ -101,7 +101,8 @@ def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     assert not ExpertDriver().params.semantic_grid_route
     assert not FrontierValuePolicy().params.semantic_grid_route
     assert not FrontierStudentPolicy().params.semantic_grid_route
-    assert not _ExpertMember(SemanticTeam(), 0, on).params.semantic_grid_route
+    team = SemanticTeam()
+    assert not _ExpertMember(team, 0, team.params.expert).params.semantic_grid_route
 
 
 def test_in_a_maze_the_expert_drives_less_over_the_grids_routes(short_mission) -> None:

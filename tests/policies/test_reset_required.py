@@ -30,6 +30,8 @@ class Spinner(Policy):
 SPECS = {
     "semantic": "semantic",
     "semantic-paper": "semantic-paper",
+    "semantic-v2": "semantic-v2",
+    "semantic-v3": "semantic-v3",
     "frontier-value": "frontier-value",
     "frontier-student": "frontier-student",
     "frontier": "frontier",
