@@ -30,11 +30,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
-from semexplore_gym.policies.expert_plan_context import PlanContext, PlanSource
-from semexplore_gym.policies.expert_plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
-from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
+from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
+    SemanticExpertParams,
+    for_outside_choice,
+    outside_choice_params,
+)
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
+from semexplore_gym.policies.expert.plan_context import PlanContext, PlanSource
+from semexplore_gym.policies.expert.plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
 
 from semexplore_gym.core.features.frontier_option_features import (
     OPTION_FEATURE_NAMES,
@@ -89,7 +93,7 @@ class FrontierStudentParams:
     Attributes:
         expert: The semantic expert's parameters (navigation, memory, stop rule; its
             frontier choice is not used while the student has options; ``grid_candidate`` and
-            ``semantic_grid_route`` are always off).
+            ``semantic_grid_route`` are off, and setting either is an error).
         model: The learned score.
         keep_goal: Keep the current goal while it is still one of the options (reached,
             mapped or unreachable goals end it); the choice is made only then. False: choose
@@ -98,7 +102,7 @@ class FrontierStudentParams:
             within this of the best.
     """
 
-    expert: SemanticExpertParams = field(default_factory=SemanticExpertParams)
+    expert: SemanticExpertParams = field(default_factory=outside_choice_params)
     model: FrontierStudentModel = field(default_factory=FrontierStudentModel)
     keep_goal: bool = True
     switch_margin: float = 0.5
@@ -180,7 +184,7 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         chooser: OptionChooser | None = None,
     ) -> None:
         self.student_params = params if params is not None else FrontierStudentParams()
-        expert = for_outside_choice(self.student_params.expert)
+        expert = for_outside_choice(self.student_params.expert, self.name)
         sources = insert_plan_source(
             DEFAULT_PLAN_SOURCES, StudentFrontier(self._decide), before="semantic"
         )

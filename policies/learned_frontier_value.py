@@ -24,8 +24,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.semantic_expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
+from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
+    SemanticExpertParams,
+    for_outside_choice,
+    outside_choice_params,
+)
 
 from semexplore_gym.core.features.frontier_features import FEATURE_NAMES, frontier_value_features
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
@@ -75,12 +79,12 @@ class FrontierValueParams:
 
     Attributes:
         expert: The semantic expert's parameters (its cost weights and switch margin included;
-            ``grid_candidate`` and ``semantic_grid_route`` are always off: the learned ranking
-            decides, driven as it was measured).
+            ``grid_candidate`` and ``semantic_grid_route`` are off, and setting either is an
+            error: the learned ranking decides, driven as it was measured).
         value: The learned value's weights.
     """
 
-    expert: SemanticExpertParams = field(default_factory=SemanticExpertParams)
+    expert: SemanticExpertParams = field(default_factory=outside_choice_params)
     value: FrontierValueWeights = field(default_factory=FrontierValueWeights)
 
 
@@ -98,7 +102,7 @@ class FrontierValuePolicy(SemanticExpertPolicy):
     ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
         # The learned ranking chooses: the grid's nearest frontier must not overrule it.
-        expert = for_outside_choice(self.value_params.expert)
+        expert = for_outside_choice(self.value_params.expert, self.name)
         super().__init__(expert, segmenter=segmenter)
         self._obs: dict[str, np.ndarray] | None = None
 

@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.base import Policy
-from semexplore_gym.policies.expert_driver import ExpertDriver
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams
+from semexplore_gym.policies.expert.driver import ExpertDriver
+from semexplore_gym.policies.expert.expert import SemanticExpertParams
 
 from semexplore_gym.config import build_params
 from semexplore_gym.config.extras import require_extra

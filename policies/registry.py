@@ -1,7 +1,7 @@
 """Build any policy from a short spec string: ``make_policy("semantic", **overrides)``.
 
 Specs: ``"semantic"`` (the scripted expert, its newest version), ``"semantic-v2"``,
-``"semantic-v3"`` (its named versions, :mod:`semexplore_gym.policies.expert_versions`),
+``"semantic-v3"`` (its named versions, :mod:`semexplore_gym.policies.expert.versions`),
 ``"semantic-paper"``  (the paper's method alone,
 every addition of ours off), ``"frontier-value"`` (the expert choosing frontiers by a learned
 value, :mod:`semexplore_gym.policies.learned_frontier_value`), ``"frontier-student"`` (the expert's
@@ -46,16 +46,25 @@ def _expert_like(
     return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter)
 
 
+def _outside_choice_layer() -> dict[str, Any]:
+    """The layer below the user's for a policy whose goals an outside choice makes: its expert
+    runs with the :data:`~semexplore_gym.policies.expert.params.OUTSIDE_CHOICE_OFF`
+    switches off, and a user who sets one on gets an error naming it."""
+    from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
+
+    return {"expert": dict.fromkeys(OUTSIDE_CHOICE_OFF, False)}
+
+
 def _semantic_version(name: str) -> Factory:
     """The factory of a named expert version (``semantic`` = the newest;
-    :mod:`semexplore_gym.policies.expert_versions`): its layer below the caller's params."""
+    :mod:`semexplore_gym.policies.expert.versions`): its layer below the caller's params."""
 
     def factory(arg: str, overrides: dict[str, Any]) -> Policy:
-        from semexplore_gym.policies.expert_versions import version_layer
-        from semexplore_gym.policies.semantic_expert import (
+        from semexplore_gym.policies.expert.expert import (
             SemanticExpertParams,
             SemanticExpertPolicy,
         )
+        from semexplore_gym.policies.expert.versions import version_layer
 
         layer = version_layer(name)
         layers = (SemanticExpertParams, layer) if layer else (SemanticExpertParams,)
@@ -65,9 +74,9 @@ def _semantic_version(name: str) -> Factory:
 
 
 def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
-    """The paper's method alone: :data:`~semexplore_gym.policies.semantic_expert_params.PAPER_PURE`."""
-    from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
+    """The paper's method alone: :data:`~semexplore_gym.policies.expert.params.PAPER_PURE`."""
+    from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
+    from semexplore_gym.policies.expert.params import PAPER_PURE
 
     layers = (SemanticExpertParams, PAPER_PURE)
     return _expert_like("semantic-paper", arg, overrides, SemanticExpertPolicy, *layers)
@@ -80,7 +89,8 @@ def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
         FrontierValuePolicy,
     )
 
-    return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, FrontierValueParams)
+    layers = (FrontierValueParams, _outside_choice_layer())
+    return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, *layers)
 
 
 def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -99,9 +109,8 @@ def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
                 f"policy 'frontier-student:{arg}': give the model file or params, not both"
             )
         overrides["params"] = arg
-    return _expert_like(
-        "frontier-student", "", overrides, FrontierStudentPolicy, FrontierStudentParams
-    )
+    layers = (FrontierStudentParams, _outside_choice_layer())
+    return _expert_like("frontier-student", "", overrides, FrontierStudentPolicy, *layers)
 
 
 def _frontier_baseline(kind: str, arg: str, overrides: dict[str, Any]) -> Policy:
@@ -277,7 +286,7 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
 
 def policy_factories() -> dict[str, Factory]:
     """The known policy names and their factories ``(argument, overrides) -> Policy``."""
-    from semexplore_gym.policies.expert_versions import EXPERT_VERSIONS, NEWEST_ALIAS
+    from semexplore_gym.policies.expert.versions import EXPERT_VERSIONS, NEWEST_ALIAS
 
     return {
         NEWEST_ALIAS: _semantic_version(NEWEST_ALIAS),

@@ -13,7 +13,7 @@ A policy's parameters are then built like every other parameter set, by
 :func:`semexplore_gym.config.build_params`: layers (a mapping with nested or dotted
 keys, a YAML file, a parameter object) then ``key=value`` overrides.
 
-An explore/benchmark config file (e.g. ``configs/expert/paper.yaml``) has up to three sections::
+An explore/benchmark config file (e.g. ``configs/expert/robust_paper_weights.yaml``) has up to three sections::
 
     env: paper                  # env config: a preset name, a YAML path or a mapping (optional)
     policy: semantic            # policy spec for make_policy (optional)

@@ -27,7 +27,7 @@ import sys, zipfile
 names = zipfile.ZipFile(sys.argv[1]).namelist()
 tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
 assert tops == {"semexplore_gym"}, tops
-for need in ("semexplore_gym/configs/suites/paper.yaml", "semexplore_gym/configs/expert/paper.yaml",
+for need in ("semexplore_gym/configs/suites/paper.yaml", "semexplore_gym/configs/expert/robust_paper_weights.yaml",
              "semexplore_gym/configs/agents/frontier_value.yml", "semexplore_gym/policies/pretrained/index.yaml"):
     assert need in names, need
 EOF
@@ -63,7 +63,7 @@ semexplore --version
 
 step "semexplore explore (compiles the numba kernels once)"
 semexplore explore --world maze1 --max-time-s 20 --no-progress
-semexplore explore --world 'maze:seed=1,size_m=4' --policy-config configs/expert/paper_pure.yaml \
+semexplore explore --world 'maze:seed=1,size_m=4' --policy-config configs/expert/paper_method.yaml \
   --max-time-s 10 --no-progress --json
 
 step "semexplore benchmark --suite paper (tiny)"

@@ -23,8 +23,8 @@ from typing import Any
 
 from semexplore_gym.config import build_params
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
-from semexplore_gym.policies.expert_driver import ExpertDriver
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams
+from semexplore_gym.policies.expert.driver import ExpertDriver
+from semexplore_gym.policies.expert.expert import SemanticExpertParams
 from semexplore_gym.wrappers.frontier_choice import FrontierChoice, MacroParams, PlannerWeights
 
 

@@ -275,9 +275,9 @@ def short_mission():
 def _plan_context(grid, geometry, params, pose, candidates=(), current=None):
     """A plan source's context on ``grid`` (the robot at ``pose``, the planners' clearance
     0.155 m, fresh counters and goal memory, ``choose_goal`` taking the first candidate)."""
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.expert_plan_context import PlanContext
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.plan_context import PlanContext
 
     counts = ExpertCounters()
     memory = GoalMemory(params.goal_memory, counts, lambda *_: None)

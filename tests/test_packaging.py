@@ -168,7 +168,11 @@ def test_configs_paths_resolve_to_the_shipped_files_from_any_directory(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.chdir(tmp_path)
-    for rel in ("configs/suites/paper.yaml", "configs/expert/paper.yaml", "configs/paper.yaml"):
+    for rel in (
+        "configs/suites/paper.yaml",
+        "configs/expert/robust_paper_weights.yaml",
+        "configs/paper.yaml",
+    ):
         assert resolve_config_path(rel) == REPO / rel
     assert (
         resolve_config_path("./configs/agents/bc_maze.yml") == REPO / "configs/agents/bc_maze.yml"
@@ -206,7 +210,7 @@ def test_every_reader_of_a_config_finds_the_shipped_one_from_elsewhere(
     assert {"paper", "mazes", "real"} <= set(list_suites())
     assert load_suite("paper").name == "paper"
     assert load_suite("configs/suites/mazes.yaml").name == "mazes"
-    assert load_policy_config("configs/expert/paper_pure.yaml").params
+    assert load_policy_config("configs/expert/paper_method.yaml").params
     assert load_env_config("configs/paper.yaml").robot.max_linear_speed_mps == 0.15
     assert load_train_config("configs/agents/bc_maze.yml", []).bc.epochs > 0
 
@@ -216,7 +220,7 @@ def test_benchmark_suite_and_policy_config_run_from_another_directory(
 ) -> None:
     monkeypatch.chdir(tmp_path)
     argv = ["explore", "--world", "maze:seed=0,size_m=3", "--max-time-s", "2", "--no-progress"]
-    assert main([*argv, "--policy-config", "configs/expert/paper_pure.yaml", "--json"]) == 0
+    assert main([*argv, "--policy-config", "configs/expert/paper_method.yaml", "--json"]) == 0
     argv = ["benchmark", "--suite", "paper", "--policies", "random", "--runs", "1"]
     argv += ["--max-time-s", "2", "--no-plots", "--no-progress", "--out", "bench"]
     assert main(argv) == 0

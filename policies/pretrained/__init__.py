@@ -57,7 +57,7 @@ class PretrainedModel:
         results: Its measured results on unseen worlds, and how they were measured.
         expert_version: The expert version its results were compared with: the expert of its
             time (``semantic-v2`` for the models measured before the 0.3.0 release, unless its
-            entry says otherwise; :mod:`semexplore_gym.policies.expert_versions`).
+            entry says otherwise; :mod:`semexplore_gym.policies.expert.versions`).
     """
 
     name: str
@@ -116,7 +116,7 @@ def pretrained_models() -> list[PretrainedModel]:
     Raises:
         ValueError: the index is malformed (a missing or unknown field).
     """
-    from semexplore_gym.policies.expert_versions import EXPERT_VERSIONS
+    from semexplore_gym.policies.expert.versions import EXPERT_VERSIONS
 
     from semexplore_gym.config.loading import load_yaml_file
 

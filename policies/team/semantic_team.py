@@ -1,6 +1,6 @@
 """The coordinated semantic expert: the paper's expert on every robot, frontiers divided.
 
-Each robot runs :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy` (its
+Each robot runs :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy` (its
 semantic topometric map, Algorithm 1's cost ``C`` per frontier, the potential field). Only the
 goal choice is the team's, through the expert's ``choose_goal`` plug-in point: a candidate's
 cost becomes
@@ -38,8 +38,12 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams, for_outside_choice
+from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import (
+    SemanticExpertParams,
+    for_outside_choice,
+    outside_choice_params,
+)
 from semexplore_gym.policies.team.base import TeamPolicy
 from semexplore_gym.policies.team.frontier_teams import yield_action
 
@@ -63,9 +67,10 @@ class SemanticTeamParams:
         idle_recheck_s: A stopped robot looks again this often while teammates work.
         yield_distance_m: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         yield_cone_rad: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
-        expert: Each robot's expert parameters (``grid_candidate`` is always off: the team's
-            coordinated choice, not each robot's nearest frontier, decides; so is
-            ``semantic_grid_route``: the teams were measured driving the map's paths).
+        expert: Each robot's expert parameters (``grid_candidate`` is off, and setting it is
+            an error: the team's coordinated choice, not each robot's nearest frontier,
+            decides; so is ``semantic_grid_route``: the teams were measured driving the map's
+            paths).
     """
 
     semantic: bool = True
@@ -77,14 +82,14 @@ class SemanticTeamParams:
     idle_recheck_s: float = 5.0
     yield_distance_m: float = 0.7
     yield_cone_rad: float = 1.2
-    expert: SemanticExpertParams = dataclasses.field(default_factory=SemanticExpertParams)
+    expert: SemanticExpertParams = dataclasses.field(default_factory=outside_choice_params)
 
 
 class _ExpertMember(SemanticExpertPolicy):
     """One robot's expert; its goal choice is the team's."""
 
     def __init__(self, team: SemanticTeam, index: int, params: SemanticExpertParams) -> None:
-        super().__init__(for_outside_choice(params))
+        super().__init__(for_outside_choice(params, "the semantic team"))
         self.team = team
         self.index = index
         self.goal_intersection_xy: tuple[float, float] | None = None
@@ -122,6 +127,7 @@ class SemanticTeam(TeamPolicy):
             p = dataclasses.replace(
                 p, expert=dataclasses.replace(p.expert, cost=_metric_only(p.expert))
             )
+        for_outside_choice(p.expert, "the semantic team")
         self.params = p
         self.name = "team_semantic" if p.semantic else "team_semantic_nosem"
         self.members: list[_ExpertMember] = []

@@ -154,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     import semexplore_gym  # noqa: F401  (registers the env)
     from semexplore_gym.evaluation.rollout import GifOptions, map_observation_for, run_mission
     from semexplore_gym.evaluation.warmup import warm_up
-    from semexplore_gym.policies.expert_versions import expert_version
+    from semexplore_gym.policies.expert.versions import expert_version
     from semexplore_gym.policies.registry import make_policy
     from semexplore_gym.policies.specs import load_policy_config
 

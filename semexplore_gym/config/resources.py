@@ -14,12 +14,21 @@ so that a command written with ``configs/...`` (the docs, the reproduce lines of
 
 from __future__ import annotations
 
+import functools
 import importlib.resources
 import os
+import warnings
 from pathlib import Path
 
 #: The first component of a path that names a shipped config file.
 CONFIGS_PREFIX = "configs"
+
+#: Shipped expert configs renamed to say what they hold: old file name -> new one. The old
+#: names still load, with a warning, for one release.
+RENAMED_EXPERT_CONFIGS: dict[str, str] = {
+    "paper.yaml": "robust_paper_weights.yaml",
+    "paper_pure.yaml": "paper_method.yaml",
+}
 
 
 def configs_dir() -> Path:
@@ -41,6 +50,9 @@ def resolve_config_path(path: str | os.PathLike) -> Path:
     "not found" message.
     """
     p = Path(path)
+    if p.exists():
+        return p
+    p = _renamed_expert_config(p)
     if p.exists() or p.is_absolute():
         return p
     parts = p.parts
@@ -49,6 +61,25 @@ def resolve_config_path(path: str | os.PathLike) -> Path:
         if shipped.is_file():
             return shipped
     return p
+
+
+def _renamed_expert_config(p: Path) -> Path:
+    """``p`` under its new name when it names a renamed expert config, else ``p``."""
+    new = RENAMED_EXPERT_CONFIGS.get(p.name)
+    if new is None or p.parent.name != "expert":
+        return p
+    _warn_renamed(p.as_posix(), p.with_name(new).as_posix())
+    return p.with_name(new)
+
+
+@functools.cache
+def _warn_renamed(old: str, new: str) -> None:
+    """A FutureWarning, once per process and old path, that ``old`` is now ``new``."""
+    warnings.warn(
+        f"{old} was renamed {new}; the old name stops working in the next release",
+        FutureWarning,
+        stacklevel=2,
+    )
 
 
 def shipped_configs(kind: str) -> list[str]:

@@ -51,7 +51,7 @@ class SemanticExploreEnv(gym.Env):
     A disc robot (TurtleBot3 Burger, radius 0.105 m) drives in a 2D world of walls simulated
     with pymunk. Each control step (0.2 s) a 360-beam LiDAR scans the walls and the scan is
     fused into a log-odds occupancy grid. The task is to map the reachable free space; the
-    scripted expert (``semexplore_gym.policies.semantic_expert``) does it with the semantic topometric method
+    scripted expert (``semexplore_gym.policies.expert.expert``) does it with the semantic topometric method
     of Fredriksson, Saradagi and Nikolakopoulos.
 
     ## Action Space

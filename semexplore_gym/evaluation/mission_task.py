@@ -31,7 +31,7 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
     which still holds the env), the path decomposition's from the result's (None without one),
     ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert_versions.expert_version`)."""
-    from semexplore_gym.policies.expert_versions import expert_version
+    from semexplore_gym.policies.expert.versions import expert_version
 
     parts = getattr(res, "path_decomposition", None)
     decomposition = parts.columns() if parts is not None else dict.fromkeys(DECOMPOSITION_COLUMNS)

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 from semexplore_gym.envs.coverage_mask import coverage_mask, map_coverage
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.expert.params import SemanticExpertParams
 
 
 def planner_clearance_margin_m(policy: Any) -> float:

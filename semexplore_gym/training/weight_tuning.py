@@ -155,8 +155,8 @@ def evaluate_weights(
         ``MissionResult.summary()`` dicts, world-major.
     """
     from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
     from semexplore_gym.policies.registry import make_policy
-    from semexplore_gym.policies.semantic_expert import SemanticExpertPolicy
 
     if not worlds:
         raise ValueError("no worlds given")

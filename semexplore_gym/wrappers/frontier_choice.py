@@ -14,7 +14,7 @@ a **driver** (the scripted expert's navigation stack) steps the base env until t
   for ``decision_period_s``.
 
 Layering: wrappers may not import ``policies``, so the driver is injected. Any object with the
-:class:`FrontierDriver` methods works; ``semexplore_gym.policies.expert_driver.ExpertDriver`` is the expert's, and
+:class:`FrontierDriver` methods works; ``semexplore_gym.policies.expert.driver.ExpertDriver`` is the expert's, and
 the entry points in :mod:`semexplore_gym.expert_driven_envs` build base env + driver + wrapper.
 
 Reward of a decision: ``area_reward_per_m2 * (new mapped free area, m^2) - time_penalty_per_s *
@@ -49,7 +49,7 @@ from semexplore_gym.core.planning.graph_search import FrontierCandidate, Frontie
 
 
 class FrontierDriver(Protocol):
-    """What the wrappers need from a driver (``semexplore_gym.policies.expert_driver.ExpertDriver`` has it)."""
+    """What the wrappers need from a driver (``semexplore_gym.policies.expert.driver.ExpertDriver`` has it)."""
 
     done: bool
     goal_finished: bool

@@ -37,7 +37,7 @@ def test_explore_json_prints_the_documented_keys(capsys):
 
 
 def test_explore_text_output_with_paper_config(capsys):
-    cfg = REPO / "configs" / "expert" / "paper.yaml"
+    cfg = REPO / "configs" / "expert" / "robust_paper_weights.yaml"
     code = main(
         [
             "explore",

@@ -7,7 +7,7 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
-from semexplore_gym.policies.expert_driver import ExpertDriver
+from semexplore_gym.policies.expert.driver import ExpertDriver
 
 import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights

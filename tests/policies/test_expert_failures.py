@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
+from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
 
 from semexplore_gym.core.frontiers.viewpoint import (
     ViewSearch,
@@ -111,8 +111,8 @@ def test_a_goal_shuttle_slower_than_the_oscillation_window_is_caught_and_broken(
 
 
 def test_goals_adopted_again_after_the_map_grew_are_no_shuttle() -> None:
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
 
     prm = SemanticExpertParams()
     mem = GoalMemory(prm.goal_memory, ExpertCounters(), lambda *_: None)

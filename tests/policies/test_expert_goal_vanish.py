@@ -25,7 +25,7 @@ def _walled_room(opening: bool) -> tuple[np.ndarray, GridGeometry]:
 
 
 def test_unknown_behind_a_wall_is_no_frontier() -> None:
-    from semexplore_gym.policies.expert_plan_context import frontier_near, unknown_near
+    from semexplore_gym.policies.expert.plan_context import frontier_near, unknown_near
 
     grid, geometry = _walled_room(opening=False)
     assert unknown_near(grid, geometry, GOAL_XY_M, 0.5)  # the box reaches across the wall
@@ -37,12 +37,12 @@ def test_unknown_behind_a_wall_is_no_frontier() -> None:
 
 
 def _committed_fallback_keeps(grid: np.ndarray, geometry: GridGeometry, **params) -> bool:
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.expert_plan import Plan, PlanKind
-    from semexplore_gym.policies.expert_plan_context import PlanContext
-    from semexplore_gym.policies.expert_plan_sources import CommittedFallback
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
+    from semexplore_gym.policies.expert.plan import Plan, PlanKind
+    from semexplore_gym.policies.expert.plan_context import PlanContext
+    from semexplore_gym.policies.expert.plan_sources import CommittedFallback
 
     prm = SemanticExpertParams(**params)
     counts = ExpertCounters()

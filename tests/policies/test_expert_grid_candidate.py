@@ -24,7 +24,7 @@ def _corridor() -> tuple[np.ndarray, GridGeometry]:
 
 
 def _context(plan_context, chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     grid, geometry = _corridor()
     prm = SemanticExpertParams(**params)
@@ -40,13 +40,13 @@ def _context(plan_context, chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
 
 
 def _propose(ctx):
-    from semexplore_gym.policies.expert_plan_sources import SemanticFrontier
+    from semexplore_gym.policies.expert.plan_sources import SemanticFrontier
 
     return SemanticFrontier().propose(ctx)
 
 
 def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice(plan_context) -> None:
-    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     # The unseen end is about 3.4 m ahead: C = 3.4 / 2 + w_v * 0 = 1.7 < 5.
     ctx = _context(plan_context, chosen_cost=5.0)
@@ -61,7 +61,7 @@ def test_algorithm_1s_choice_stands_when_the_grid_frontier_is_not_cheaper(
     plan_context,
     chosen_cost: float,
 ) -> None:
-    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     ctx = _context(plan_context, chosen_cost=chosen_cost)  # the grid frontier costs about 1.7
     plan = _propose(ctx)
@@ -70,7 +70,7 @@ def test_algorithm_1s_choice_stands_when_the_grid_frontier_is_not_cheaper(
 
 
 def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal(plan_context) -> None:
-    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     ctx = _context(
         plan_context, chosen_cost=5.0, goal_xy_m=(4.0, 1.8)
@@ -80,8 +80,8 @@ def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal(plan_context
 
 
 def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone(plan_context) -> None:
-    from semexplore_gym.policies.expert_plan import PlanKind
-    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
+    from semexplore_gym.policies.expert.params import PAPER_PURE
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     assert PAPER_PURE["grid_candidate"] is False
     ctx = _context(plan_context, chosen_cost=5.0, grid_candidate=False)
@@ -104,10 +104,12 @@ def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_miss
 
 def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     """Teams, the learning agents' driver and the learned frontier value make the choice: the
-    grid's nearest frontier never overrules it, whatever the parameters say."""
-    from semexplore_gym.policies.expert_driver import ExpertDriver
+    grid's nearest frontier never overrules it. The driver turns it off whatever its caller's
+    params say; the others run without it by default and refuse it when asked
+    (tests/policies/test_outside_choice.py)."""
+    from semexplore_gym.policies.expert.driver import ExpertDriver
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
     from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
     from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
 
     assert SemanticExpertParams().grid_candidate  # the robust expert's default
@@ -115,7 +117,8 @@ def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     assert not ExpertDriver(on).params.grid_candidate
     assert not ExpertDriver().params.grid_candidate
     assert not FrontierValuePolicy().params.grid_candidate
-    assert not _ExpertMember(SemanticTeam(), 0, on).params.grid_candidate
+    team = SemanticTeam()
+    assert not _ExpertMember(team, 0, team.params.expert).params.grid_candidate
 
 
 @pytest.mark.parametrize("holds", [True, False])
@@ -124,7 +127,7 @@ def test_the_goal_the_shuttle_guard_holds_is_kept_against_the_grid_frontier(
 ) -> None:
     """A goal adopted again without progress is seen through: the grid's frontier does not
     take turns with it (else the two sources shuttle, as on a real SLAM map for 2,000 s)."""
-    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     ctx = _context(
         plan_context, chosen_cost=5.0, shuttle_guard_holds_grid=holds

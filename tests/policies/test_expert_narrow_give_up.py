@@ -58,9 +58,9 @@ def test_the_narrow_tier_gives_up_on_slots_that_map_almost_nothing(ros_map_file,
 
 
 def test_narrow_goal_gives_up_on_new_goals_after_goals_that_added_no_room():
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     memory = GoalMemory(SemanticExpertParams().goal_memory, ExpertCounters(), lambda *_: None)
 
@@ -81,16 +81,16 @@ def test_narrow_goal_gives_up_on_new_goals_after_goals_that_added_no_room():
 
 @pytest.mark.parametrize("bad", [-1, 1.5, True])
 def test_narrow_give_up_goals_is_checked(bad):
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     with pytest.raises(ValueError, match="narrow_give_up_goals"):
         SemanticExpertParams(narrow_give_up_goals=bad)
 
 
 def test_narrow_goal_gives_up_once_the_map_gained_no_room_for_a_while():
-    from semexplore_gym.policies.expert_counters import ExpertCounters
-    from semexplore_gym.policies.expert_goal_memory import GoalMemory
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     memory = GoalMemory(SemanticExpertParams().goal_memory, ExpertCounters(), lambda *_: None)
 
@@ -127,7 +127,7 @@ def test_the_narrow_tier_gives_up_after_a_while_without_new_room(ros_map_file, s
 
 @pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "30"])
 def test_narrow_give_up_s_is_checked(bad):
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     with pytest.raises(ValueError, match="narrow_give_up_s"):
         SemanticExpertParams(narrow_give_up_s=bad)

@@ -75,7 +75,7 @@ def test_a_gap_narrower_than_the_robot_ends_the_mission_without_a_collision(
 
 
 def test_narrow_passages_is_off_by_default_and_its_parameters_are_checked():
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     assert SemanticExpertParams().narrow_passages is False
     assert SemanticExpertParams().room_beyond_gaps is True

@@ -9,11 +9,11 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
+from semexplore_gym.policies.expert.params import PAPER_PURE
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
 from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams, SemanticExpertPolicy
-from semexplore_gym.policies.semantic_expert_params import PAPER_PURE
 
 import semexplore_gym  # noqa: F401
 from semexplore_gym.config import build_params
@@ -297,7 +297,7 @@ def test_side_approach_comes_from_away_from_the_failure() -> None:
 def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
     from semexplore_gym.policies.specs import load_policy_config
 
-    cfg = load_policy_config(REPO / "configs" / "expert" / "paper_pure.yaml")
+    cfg = load_policy_config(REPO / "configs" / "expert" / "paper_method.yaml")
     from_yaml = build_params(SemanticExpertParams, cfg.params)
     assert from_yaml == build_params(SemanticExpertParams, PAPER_PURE)
     pol = make_policy("semantic-paper")

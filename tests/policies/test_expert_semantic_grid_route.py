@@ -26,7 +26,7 @@ def _room() -> tuple[np.ndarray, GridGeometry]:
 
 
 def _context(plan_context, grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M, **params):
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     prm = SemanticExpertParams(**{"grid_candidate": False, **params})
     path = MAP_PATH_M.copy()
@@ -40,13 +40,13 @@ def _length_m(path: np.ndarray) -> float:
 
 
 def _propose(ctx):
-    from semexplore_gym.policies.expert_plan_sources import SemanticFrontier
+    from semexplore_gym.policies.expert.plan_sources import SemanticFrontier
 
     return SemanticFrontier().propose(ctx)
 
 
 def test_the_goal_is_driven_to_over_the_grids_route(plan_context) -> None:
-    from semexplore_gym.policies.expert_plan import PlanKind
+    from semexplore_gym.policies.expert.plan import PlanKind
 
     ctx = _context(plan_context, *_room(), semantic_grid_route=True)
     plan = _propose(ctx)
@@ -80,7 +80,7 @@ def test_where_the_grid_has_no_route_the_maps_path_stands(plan_context) -> None:
 
 
 def test_the_robust_expert_has_it_and_the_paper_pure_preset_does_not() -> None:
-    from semexplore_gym.policies.semantic_expert_params import PAPER_PURE, SemanticExpertParams
+    from semexplore_gym.policies.expert.params import PAPER_PURE, SemanticExpertParams
 
     assert SemanticExpertParams().semantic_grid_route
     assert PAPER_PURE["semantic_grid_route"] is False
@@ -88,12 +88,12 @@ def test_the_robust_expert_has_it_and_the_paper_pure_preset_does_not() -> None:
 
 def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     """Teams, the learning agents' driver, the frontier student and the learned frontier value
-    were trained and measured driving the map's paths: they keep them, whatever the
-    parameters say."""
-    from semexplore_gym.policies.expert_driver import ExpertDriver
+    were trained and measured driving the map's paths: they keep them (the driver whatever
+    its caller's params say; the others refuse the switch: tests/policies/test_outside_choice.py)."""
+    from semexplore_gym.policies.expert.driver import ExpertDriver
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
     from semexplore_gym.policies.frontier_student import FrontierStudentPolicy
     from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
-    from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
     from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
 
     on = SemanticExpertParams(semantic_grid_route=True)
@@ -101,7 +101,8 @@ def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     assert not ExpertDriver().params.semantic_grid_route
     assert not FrontierValuePolicy().params.semantic_grid_route
     assert not FrontierStudentPolicy().params.semantic_grid_route
-    assert not _ExpertMember(SemanticTeam(), 0, on).params.semantic_grid_route
+    team = SemanticTeam()
+    assert not _ExpertMember(team, 0, team.params.expert).params.semantic_grid_route
 
 
 def test_in_a_maze_the_expert_drives_less_over_the_grids_routes(short_mission) -> None:

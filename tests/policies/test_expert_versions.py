@@ -9,13 +9,13 @@ from dataclasses import fields, replace
 from pathlib import Path
 
 import pytest
-from semexplore_gym.policies.expert_versions import (
+from semexplore_gym.policies.expert.params import SemanticExpertParams
+from semexplore_gym.policies.expert.versions import (
     EXPERT_VERSIONS,
     LATEST_EXPERT,
     expert_version,
 )
 from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.cli import main
 

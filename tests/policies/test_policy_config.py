@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from semexplore_gym.policies.expert.expert import SemanticExpertParams
 from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert import SemanticExpertParams
 from semexplore_gym.policies.specs import load_policy_config
 
 from semexplore_gym.config import ConfigError, build_params
@@ -18,7 +18,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def test_paper_config_holds_the_paper_values():
-    cfg = load_policy_config(REPO / "configs" / "expert" / "paper.yaml")
+    cfg = load_policy_config(REPO / "configs" / "expert" / "robust_paper_weights.yaml")
     assert cfg.env == "paper" and cfg.policy == "semantic"
     p = build_params(SemanticExpertParams, cfg.params)
     assert (p.cost.w_v, p.cost.w_p, p.cost.w_i) == (4.0, 0.2, 0.1)
@@ -59,8 +59,8 @@ def test_overrides_and_unknown_keys_name_the_dotted_path(tmp_path):
 
 
 def test_paper_yaml_is_the_paper_preset():
-    """configs/expert/paper.yaml restates the defaults, which are the paper's values."""
-    cfg = load_policy_config(REPO / "configs" / "expert" / "paper.yaml")
+    """configs/expert/robust_paper_weights.yaml restates the defaults, which are the paper's values."""
+    cfg = load_policy_config(REPO / "configs" / "expert" / "robust_paper_weights.yaml")
     paper = SemanticExpertParams()
     assert build_params(SemanticExpertParams, cfg.params) == paper
     assert paper.cost == FrontierCostWeights() and paper.potential_field == PotentialFieldParams()
@@ -85,7 +85,7 @@ def test_make_policy_layers_params_then_keyword_overrides():
 
 
 def test_policy_kwargs_put_set_items_on_the_files_params():
-    cfg = load_policy_config(REPO / "configs" / "expert" / "paper.yaml")
+    cfg = load_policy_config(REPO / "configs" / "expert" / "robust_paper_weights.yaml")
     kwargs = cfg.policy_kwargs(["cost.w_v=2.5", "cost.w_p=0.5"])
     assert kwargs == {"cost": {"w_v": 2.5, "w_p": 0.5}, "params": cfg.params}
     assert make_policy("semantic", **kwargs).params.cost.w_v == 2.5

@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 import pytest
-from semexplore_gym.policies.registry import make_policy
-from semexplore_gym.policies.semantic_expert import (
+from semexplore_gym.policies.expert.expert import (
     SemanticExpertParams,
     SemanticExpertPolicy,
     area_type_raster,
 )
+from semexplore_gym.policies.registry import make_policy
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.topometric.types import (
@@ -210,7 +210,7 @@ def test_commitment_keeps_the_current_goal_against_a_slightly_cheaper_one():
         )
 
     pol = SemanticExpertPolicy(SemanticExpertParams(switch_margin=0.5))
-    from semexplore_gym.policies.semantic_expert import Plan, PlanKind
+    from semexplore_gym.policies.expert.expert import Plan, PlanKind
 
     current = cand(3.0, 1.0, 7)
     pol._plan = Plan(PlanKind.SEMANTIC, current.goal_xy_m, current.path_m, current)
@@ -404,7 +404,7 @@ def test_a_ranker_reorders_the_frontiers_before_goal_commitment():
 
 
 def test_plan_sources_are_an_ordered_list_that_can_take_a_new_source():
-    from semexplore_gym.policies.semantic_expert import (
+    from semexplore_gym.policies.expert.expert import (
         DEFAULT_PLAN_SOURCES,
         Plan,
         PlanKind,

@@ -147,6 +147,24 @@ def resolve_path_length_m(tmap: TopometricMap, weights: FrontierCostWeights) -> 
     return weights.fallback_path_length_m
 
 
+def metric_cost(
+    path_length_m: float, heading_angle_rad: float, l_path_m: float, weights: FrontierCostWeights
+) -> float:
+    """The metric part of the frontier cost ``C``: ``d / L_path + w_v * v``.
+
+    Algorithm 1 seeds its search with it (one first leg, then each further leg adds its length
+    over ``L_path``), and the expert scores a grid frontier with it, so both compare goals in
+    the same normalised units.
+
+    Args:
+        path_length_m: ``d``, the path's length.
+        heading_angle_rad: ``v``, the angle between the robot's heading and the path's start.
+        l_path_m: ``L_path`` (see :func:`resolve_path_length_m`).
+        weights: The cost weights (``w_v`` is read).
+    """
+    return path_length_m / l_path_m + weights.w_v * heading_angle_rad
+
+
 def semantic_terms(tmap: TopometricMap, frontier: Frontier) -> tuple[float, int, int]:
     """``(p_l, O(I), P_u(I))`` of a frontier; ``O`` and ``P_u`` are 0 when it has no intersection."""
     iid = frontier.intersection_id
@@ -281,7 +299,7 @@ def _seed(
         v = heading_angle(leg, robot_xy, yaw, w.heading_lookahead_m)
         leg_start_angle[node] = v
         leg_m = polyline_length(leg)
-        cost = w.w_v * v + leg_m / l_path
+        cost = metric_cost(leg_m, v, l_path, w)
         key = slot(node, None)
         if a_cost.get(key, math.inf) <= cost:
             n_pruned += 1

@@ -12,6 +12,7 @@ from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.graph_search import (
     FrontierCostWeights,
     find_frontier_paths,
+    metric_cost,
     search_frontier_paths,
 )
 from semexplore_gym.core.planning.polyline import project_onto_polyline
@@ -221,6 +222,18 @@ def test_candidate_terms_and_polyline():
     east = cands[3]
     assert east.v_rad == pytest.approx(math.pi)
     np.testing.assert_allclose(east.path_m, [[0, 0], [1, 0], [2, 0]], atol=1e-9)
+
+
+def test_metric_cost_is_the_metric_part_of_every_candidates_cost():
+    w = FrontierCostWeights(w_v=2.0)
+    assert metric_cost(6.0, 0.5, 4.0, w) == 6.0 / 4.0 + 2.0 * 0.5
+    assert metric_cost(6.0, 0.5, 4.0, FrontierCostWeights(w_v=0.0)) == 1.5
+    tmap = build_map(OPENINGS, AREAS, l_path_m=4.0)
+    cands = find_frontier_paths(tmap, (0.0, 0.0), math.pi, w)
+    assert cands
+    for c in cands:
+        # the search adds leg by leg, so the sum matches up to rounding
+        assert c.metric_cost == pytest.approx(metric_cost(c.d_m, c.v_rad, c.l_path_m, w))
 
 
 def test_angle_term_changes_the_choice():

@@ -1,4 +1,4 @@
-"""Parameters of the semantic expert (:class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`).
+"""Parameters of the semantic expert (:class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`).
 
 What the paper leaves open, and how the expert handles it (parameters in
 :class:`SemanticExpertParams`, all times in simulated seconds):
@@ -141,7 +141,7 @@ What the paper leaves open, and how the expert handles it (parameters in
   the far side, never into a crack whose far side is rock, so it costs nothing where nothing
   lies beyond (``narrow_passages`` comes after it and probes the cracks too).
 
-Every addition to the paper can be switched off on its own (``configs/expert/paper_pure.yaml``
+Every addition to the paper can be switched off on its own (``configs/expert/paper_method.yaml``
 switches them all off: the paper's method alone).
 
 ``counters`` and ``events`` record how often each behaviour fired.
@@ -149,7 +149,7 @@ switches them all off: the paper's method alone).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 from typing import Literal, TypeVar
 
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
@@ -158,11 +158,13 @@ from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.validation import require_finite
 
 __all__ = [
+    "OUTSIDE_CHOICE_OFF",
     "PAPER_PURE",
     "GoalMemoryParams",
     "PathFollowingParams",
     "SemanticExpertParams",
     "for_outside_choice",
+    "outside_choice_params",
 ]
 
 _Group = TypeVar("_Group")
@@ -172,7 +174,7 @@ _Group = TypeVar("_Group")
 class PathFollowingParams:
     """The path follower's group of :class:`SemanticExpertParams` (same names and meaning).
 
-    :class:`~semexplore_gym.policies.expert_path_following.PathFollower` reads these: the
+    :class:`~semexplore_gym.policies.expert.path_following.PathFollower` reads these: the
     potential field, the local-minimum escape, the progress watch and the stuck recovery.
     """
 
@@ -202,7 +204,7 @@ class PathFollowingParams:
 class GoalMemoryParams:
     """The goal memory's group of :class:`SemanticExpertParams` (same names and meaning).
 
-    :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` reads these: dropping,
+    :class:`~semexplore_gym.policies.expert.goal_memory.GoalMemory` reads these: dropping,
     retrying and reviving goals, the oscillation guard and the stop reason.
     """
 
@@ -538,16 +540,30 @@ class SemanticExpertParams:
         return _group(GoalMemoryParams, self)
 
 
-def for_outside_choice(params: SemanticExpertParams) -> SemanticExpertParams:
-    """``params`` for an expert whose goals an outside choice makes (teams, the learning agents'
-    driver, the frontier student, the learned frontier value): ``grid_candidate`` off (the
-    grid's nearest frontier must not overrule that choice) and ``semantic_grid_route`` off
-    (those policies were trained and measured on the map's paths)."""
-    return replace(params, grid_candidate=False, semantic_grid_route=False)
+#: The switches an expert whose goals an outside choice makes (teams, the learning agents'
+#: driver, the frontier student, the learned frontier value) runs with off, and why.
+OUTSIDE_CHOICE_OFF: dict[str, str] = {
+    "grid_candidate": "the grid's nearest frontier would overrule the outside choice",
+    "semantic_grid_route": "it was trained and measured driving the map's paths",
+}
+
+
+def outside_choice_params() -> SemanticExpertParams:
+    """The expert's defaults with the :data:`OUTSIDE_CHOICE_OFF` switches off."""
+    return SemanticExpertParams(grid_candidate=False, semantic_grid_route=False)
+
+
+def for_outside_choice(params: SemanticExpertParams, policy: str) -> SemanticExpertParams:
+    """``params`` for ``policy``, whose goals an outside choice makes; a ValueError naming the
+    key when one of the :data:`OUTSIDE_CHOICE_OFF` switches is on (it cannot be honoured)."""
+    for key, why in OUTSIDE_CHOICE_OFF.items():
+        if getattr(params, key):
+            raise ValueError(f"{policy} cannot honour expert.{key}=true: {why}; leave it out")
+    return params
 
 
 #: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level
-#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_pure.yaml`` restates it
+#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_method.yaml`` restates it
 #: (tests/policies/test_policy_config.py compares them); ``--policy semantic-paper`` uses it.
 PAPER_PURE: dict[str, object] = {
     "prune_by": "area",

@@ -13,24 +13,24 @@ Each replanning step (section II of Fredriksson et al.):
 
 The policy is honest: it reads only the observation and the static facts of ``info``, never
 ground truth. What the paper leaves open, and the parameters for it:
-:mod:`semexplore_gym.policies.semantic_expert_params`.
+:mod:`semexplore_gym.policies.expert.params`.
 
 The parts
 ---------
 :class:`SemanticExpertPolicy` schedules replans and holds three parts, each with its own
 module and parameter group (a view of :class:`SemanticExpertParams`, whose flat YAML keys stay):
 
-* ``plan_sources``: an ordered tuple of :class:`~semexplore_gym.policies.expert_plan_sources.
+* ``plan_sources``: an ordered tuple of :class:`~semexplore_gym.policies.expert.plan_sources.
   PlanSource` objects (commanded goal, retry, view, semantic frontier, committed fallback,
-  nearest fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert_plan_sources`).
-  At each replan the first :class:`~semexplore_gym.policies.expert_plan.Plan` proposed is adopted;
+  nearest fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert.plan_sources`).
+  At each replan the first :class:`~semexplore_gym.policies.expert.plan.Plan` proposed is adopted;
   when all pass, the expert waits, and stops after ``stop_confirmations`` such replans.
-* ``goal_memory``: a :class:`~semexplore_gym.policies.expert_goal_memory.GoalMemory` (drops,
+* ``goal_memory``: a :class:`~semexplore_gym.policies.expert.goal_memory.GoalMemory` (drops,
   reaches, retries, revivals, the trail, the commanded goal, the stop reason).
-* ``follower``: a :class:`~semexplore_gym.policies.expert_path_following.PathFollower`
+* ``follower``: a :class:`~semexplore_gym.policies.expert.path_following.PathFollower`
   (potential field, path progress, local-minimum escape, progress watch, back-off recovery).
 
-``counts`` (an :class:`~semexplore_gym.policies.expert_counters.ExpertCounters`) and
+``counts`` (an :class:`~semexplore_gym.policies.expert.counters.ExpertCounters`) and
 ``events`` record what fired; ``counters`` gives the counts as a ``{name: int}`` dict.
 
 Plug-in points
@@ -68,7 +68,7 @@ commanded_goal_xy_m` turns None once the goal is reached, failed or unreachable:
         obs, *_ = env.step(expert.act(obs, info))
 
 Also: ``on_replan_due``, ``on_replanned``, ``request_replan`` (replans), ``frontier_candidates``
-(score any observation's frontiers); ``expert_driver`` and ``learned_frontier_value`` use them.
+(score any observation's frontiers); the expert's driver (``driver.py``) and ``learned_frontier_value`` use them.
 """
 
 from __future__ import annotations
@@ -80,18 +80,18 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
-from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_goal_memory import GoalMemory
-from semexplore_gym.policies.expert_path_following import PathFollower
-from semexplore_gym.policies.expert_plan import ExpertMode, Plan, PlanKind
-from semexplore_gym.policies.expert_plan_sources import (
+from semexplore_gym.policies.expert.counters import ExpertCounters
+from semexplore_gym.policies.expert.goal_memory import GoalMemory
+from semexplore_gym.policies.expert.params import SemanticExpertParams
+from semexplore_gym.policies.expert.path_following import PathFollower
+from semexplore_gym.policies.expert.plan import ExpertMode, Plan, PlanKind
+from semexplore_gym.policies.expert.plan_sources import (
     DEFAULT_PLAN_SOURCES,
     PlanContext,
     PlanSource,
     goal_open,
     insert_plan_source,
 )
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
 
 from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,

@@ -1,6 +1,6 @@
 """The sources that propose the semantic expert's plans.
 
-A :class:`~semexplore_gym.policies.expert_plan.Plan` is where the robot drives and along which
+A :class:`~semexplore_gym.policies.expert.plan.Plan` is where the robot drives and along which
 path. At each replan the expert asks its :class:`PlanSource` objects in order
 (``SemanticExpertPolicy.plan_sources``); the first plan proposed is adopted, and when every
 source passes the expert waits a step and, after ``stop_confirmations`` such replans, stops.
@@ -20,7 +20,7 @@ source                  proposes
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
 ``room_beyond_gap``     through a gap narrower than the clearance into room the map shows
                         beyond it, with a frontier (``room_beyond_gaps``; in
-                        :mod:`~semexplore_gym.policies.expert_narrow_sources`)
+                        :mod:`~semexplore_gym.policies.expert.narrow_sources`)
 ``narrow_fallback``     the nearest frontier a grid search reaches with a thinner clearance
                         (``narrow_passages``), through passages followed slowly and exactly
 ``look``                close to a frontier too narrow to reach, to look again
@@ -36,14 +36,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from semexplore_gym.policies.expert_goal_memory import TRAIL_CELL_M
-from semexplore_gym.policies.expert_narrow_sources import (
+from semexplore_gym.policies.expert.goal_memory import TRAIL_CELL_M
+from semexplore_gym.policies.expert.narrow_sources import (
     NARROW_REACHED_M,
     NarrowFallback,
     RoomBeyondGap,
 )
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
-from semexplore_gym.policies.expert_plan_context import (
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
+from semexplore_gym.policies.expert.plan_context import (
     PlanContext,
     PlanSource,
     goal_open,
@@ -63,7 +63,7 @@ from semexplore_gym.core.frontiers.viewpoint import (
     unknown_extent_cells,
     unknown_rim,
 )
-from semexplore_gym.core.planning.graph_search import FrontierCandidate
+from semexplore_gym.core.planning.graph_search import FrontierCandidate, metric_cost
 from semexplore_gym.core.planning.line_of_sight import segment_is_clear
 from semexplore_gym.core.planning.polyline import heading_angle
 
@@ -72,13 +72,11 @@ __all__ = [
     "CommandedGoal",
     "CommittedFallback",
     "LookAtNarrowFrontier",
-    "NarrowFallback",
     "NearestFallback",
     "PlanContext",
     "PlanSource",
     "PocketEscape",
     "RetryFailedGoal",
-    "RoomBeyondGap",
     "SemanticFrontier",
     "ViewFrontier",
     "goal_open",
@@ -306,7 +304,7 @@ def _cheaper_grid_frontier(ctx: PlanContext, chosen: FrontierCandidate) -> Plan 
         return None
     w = ctx.params.cost
     v_rad = heading_angle(found.path_m, ctx.xy_m, ctx.pose[2], w.heading_lookahead_m)
-    cost = found.path_length_m / chosen.l_path_m + w.w_v * v_rad
+    cost = metric_cost(found.path_length_m, v_rad, chosen.l_path_m, w)
     if cost >= chosen.cost:
         return None
     ctx.counts.grid_frontier_plans += 1
@@ -361,7 +359,7 @@ class PocketEscape(PlanSource):
     where it stands, so it leaves over cells with the clearance of its radius plus
     ``pocket_clearance_margin_m`` to the nearest region that is not a pocket, and the check
     runs again from there with the full clearance (see
-    :mod:`semexplore_gym.policies.semantic_expert_params`). The plan is both legs; none when the
+    :mod:`semexplore_gym.policies.expert.params`). The plan is both legs; none when the
     check from outside finds nothing either.
     """
 

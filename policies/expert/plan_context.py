@@ -1,6 +1,6 @@
 """What the semantic expert's plan sources share: the :class:`PlanContext` of one replan, the
 :class:`PlanSource` interface, and the helpers several sources use (see
-:mod:`semexplore_gym.policies.expert_plan_sources` for the sources and their order)."""
+:mod:`semexplore_gym.policies.expert.plan_sources` for the sources and their order)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_goal_memory import GoalMemory
-from semexplore_gym.policies.expert_plan import Plan
-from semexplore_gym.policies.semantic_expert_params import SemanticExpertParams
+from semexplore_gym.policies.expert.counters import ExpertCounters
+from semexplore_gym.policies.expert.goal_memory import GoalMemory
+from semexplore_gym.policies.expert.params import SemanticExpertParams
+from semexplore_gym.policies.expert.plan import Plan
 
 from semexplore_gym.core.frontiers.detection import frontier_cell_mask
 from semexplore_gym.core.frontiers.options import FrontierOptions, reachable_frontier_options

@@ -2,7 +2,7 @@
 clearance (:class:`RoomBeyondGap`, ``room_beyond_gaps``; :class:`NarrowFallback`,
 ``narrow_passages``). Their plans carry the map's clearance along their paths, and the path
 follower tracks the tight stretches slowly and exactly. Both are in
-:data:`~semexplore_gym.policies.expert_plan_sources.DEFAULT_PLAN_SOURCES`, after the pocket
+:data:`~semexplore_gym.policies.expert.plan_sources.DEFAULT_PLAN_SOURCES`, after the pocket
 escape and before the stop rule's look.
 """
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
-from semexplore_gym.policies.expert_plan_context import (
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
+from semexplore_gym.policies.expert.plan_context import (
     PlanContext,
     PlanSource,
     path_clearance_along,
@@ -83,7 +83,7 @@ class NarrowFallback(PlanSource):
     so the nearest frontier a grid search with the robot radius plus
     ``narrow_clearance_margin_m`` reaches. The plan carries the map's clearance along its path:
     where that is below the planners' clearance the path follower tracks it slowly and exactly
-    (see :class:`~semexplore_gym.policies.expert_path_following.PathFollower`).
+    (see :class:`~semexplore_gym.policies.expert.path_following.PathFollower`).
     """
 
     name = "narrow_fallback"

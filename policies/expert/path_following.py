@@ -1,12 +1,12 @@
 """The semantic expert's path following: potential field, progress, escapes, stuck recovery.
 
 :class:`PathFollower` is a part the expert owns. Each step it drives along the current
-:class:`~semexplore_gym.policies.expert_plan.Plan` with the modified potential field (section II
+:class:`~semexplore_gym.policies.expert.plan.Plan` with the modified potential field (section II
 of the paper), moves the plan's progress along the path, lowers the repulsion for a while when
 the field holds the robot still (local-minimum escape), and watches progress: when the robot
 is stuck, its path stopped shrinking or its goal's time budget ran out, it backs off (the
 expert then retries or drops the goal). Its parameters are
-:class:`~semexplore_gym.policies.semantic_expert_params.PathFollowingParams`.
+:class:`~semexplore_gym.policies.expert.params.PathFollowingParams`.
 """
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_plan import Plan
+from semexplore_gym.policies.expert.counters import ExpertCounters
+from semexplore_gym.policies.expert.params import PathFollowingParams
+from semexplore_gym.policies.expert.plan import Plan
 from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
-from semexplore_gym.policies.semantic_expert_params import PathFollowingParams
 
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.planning.path_tracking import (

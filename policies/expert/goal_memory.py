@@ -4,9 +4,9 @@ goal and the stop reason (the rule: never give up on a reachable frontier).
 :class:`GoalMemory` is a part the expert owns. It decides what happens when the approach to a
 goal fails (retry it another way, or drop it), when a goal is reached without clearing its
 frontier, when the map round a dropped goal changes, and why the mission stopped. Its
-parameters are :class:`~semexplore_gym.policies.semantic_expert_params.GoalMemoryParams` (the
+parameters are :class:`~semexplore_gym.policies.expert.params.GoalMemoryParams` (the
 fields of the same names in :class:`SemanticExpertParams`, documented in
-:mod:`semexplore_gym.policies.semantic_expert_params`).
+:mod:`semexplore_gym.policies.expert.params`).
 """
 
 from __future__ import annotations
@@ -18,11 +18,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
-from semexplore_gym.policies.expert_counters import ExpertCounters
-from semexplore_gym.policies.expert_plan import Plan, PlanKind
+from semexplore_gym.policies.expert.counters import ExpertCounters
+from semexplore_gym.policies.expert.params import GoalMemoryParams
+from semexplore_gym.policies.expert.plan import Plan, PlanKind
 from semexplore_gym.policies.navigation.blacklist import GoalBlacklist
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
-from semexplore_gym.policies.semantic_expert_params import GoalMemoryParams
 
 from semexplore_gym.core.grid import GridGeometry
 

@@ -1,6 +1,6 @@
 """The semantic expert as a low-level driver for macro-action agents.
 
-:class:`ExpertDriver` is the scripted :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`
+:class:`ExpertDriver` is the scripted :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`
 with two outside hooks, so that a learning agent makes the high-level choice and the expert's
 navigation stack (potential field, entry detours, local-minimum escape, stuck recovery,
 blacklisting, grid fallback) does the driving:
@@ -17,13 +17,13 @@ The wrappers in :mod:`semexplore_gym.wrappers.frontier_choice` use this class th
 ``FrontierDriver`` protocol; they never import it (wrappers sit below policies in the layering),
 the env-id entry points in :mod:`semexplore_gym.expert_driven_envs` join the two.
 
-It uses only the expert's public plug-in points (see :mod:`semexplore_gym.policies.semantic_expert`):
-it overrides :meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.choose_goal`,
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replan_due` and
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.on_replanned`, and calls
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.request_replan`. To drive to
+It uses only the expert's public plug-in points (see :mod:`semexplore_gym.policies.expert.expert`):
+it overrides :meth:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.choose_goal`,
+:meth:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.on_replan_due` and
+:meth:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.on_replanned`, and calls
+:meth:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.request_replan`. To drive to
 a point rather than a frontier, use the expert's
-:meth:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.drive_to`.
+:meth:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.drive_to`.
 """
 
 from __future__ import annotations
@@ -33,13 +33,13 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.semantic_expert import (
+from semexplore_gym.policies.expert.expert import (
     PlanKind,
     Segmenter,
     SemanticExpertParams,
     SemanticExpertPolicy,
 )
-from semexplore_gym.policies.semantic_expert_params import for_outside_choice
+from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
@@ -54,7 +54,7 @@ class ExpertDriver(SemanticExpertPolicy):
             off (the outside choice, not the grid's nearest frontier, decides), and so is
             ``semantic_grid_route`` (the learned agents were trained and measured driving the
             map's paths).
-        segmenter: See :class:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy`.
+        segmenter: See :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`.
 
     Attributes:
         goal_finished: The commanded goal is done (reached, vanished, blacklisted or gone);
@@ -67,9 +67,12 @@ class ExpertDriver(SemanticExpertPolicy):
     def __init__(
         self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
     ) -> None:
-        # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
+        # The agent chooses the frontier: the grid's nearest frontier must not overrule it. The
+        # callers pass the plain expert's params (switches on by default), so they are turned
+        # off here rather than refused.
         base = params if params is not None else SemanticExpertParams()
-        super().__init__(for_outside_choice(base), segmenter)
+        off = dict.fromkeys(OUTSIDE_CHOICE_OFF, False)
+        super().__init__(replace(base, **off), segmenter)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

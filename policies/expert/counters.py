@@ -1,7 +1,7 @@
 """How often each behaviour of the semantic expert fired in a mission (:class:`ExpertCounters`).
 
 The expert and its parts count into one :class:`ExpertCounters`;
-:attr:`~semexplore_gym.policies.semantic_expert.SemanticExpertPolicy.counters` gives the same
+:attr:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy.counters` gives the same
 numbers as a plain ``{name: int}`` dict (what the mission runners store).
 """
 
