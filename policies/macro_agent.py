@@ -4,7 +4,7 @@
 ``SemanticExploreWeights-v0`` (``--algo ppo``) saves an SB3 model whose actions are decisions,
 not wheel commands: which of the top-``K`` frontier candidates to explore next, or which cost
 weights ``(w_v, w_p, w_I)`` the expert plans with for the next ``decision_period_s``. Between
-decisions the expert's navigation stack drives (:class:`~semexplore_gym.policies.expert_driver.ExpertDriver`).
+decisions the expert's navigation stack drives (:class:`~semexplore_gym.policies.expert.driver.ExpertDriver`).
 
 :class:`MacroAgentPolicy` replays exactly that decision loop inside the ordinary
 :class:`~semexplore_gym.policies.base.Policy` interface, so a macro agent runs wherever a policy spec is

@@ -4,7 +4,7 @@ Example::
 
     semexplore explore --world maze1 --policy semantic --seed 0 --gif maze1.gif
     semexplore explore --world ../shared/maps/turtlebot3/world/map.yaml --json
-    semexplore explore --world maze2 --policy-config configs/expert/paper.yaml --policy-set cost.w_v=2
+    semexplore explore --world maze2 --policy-config configs/expert/robust_paper_weights.yaml --policy-set cost.w_v=2
     semexplore explore --world maze2 --policy 'semantic[cost.w_v=0]'
     semexplore explore --world office:seed=304,size_m=8 --robots 3 --policy coordinated --gif team.gif
 """
@@ -99,7 +99,7 @@ def _add_config_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--policy-config",
         default=None,
-        help="policy config YAML with sections env / policy / params (e.g. configs/expert/paper.yaml)",
+        help="policy config YAML with sections env / policy / params (e.g. configs/expert/robust_paper_weights.yaml)",
     )
     p.add_argument(
         "--env-config",

@@ -30,7 +30,7 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     policy-specific columns come from the policy's ``mission_metrics()`` (None if absent),
     ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
     which still holds the env), the path decomposition's from the result's (None without one),
-    ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert_versions.expert_version`)."""
+    ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert.versions.expert_version`)."""
     from semexplore_gym.policies.expert.versions import expert_version
 
     parts = getattr(res, "path_decomposition", None)
