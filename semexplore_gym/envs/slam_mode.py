@@ -16,6 +16,7 @@ from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.slam.backend import ScanSlam
 from semexplore_gym.core.slam.pose_graph import require_gtsam
+from semexplore_gym.core.slam.trajectory_error import relative_pose_error_m
 from semexplore_gym.envs.env_config import EnvConfig
 
 Pose = tuple[float, float, float]
@@ -93,6 +94,13 @@ class SlamMode:
         truth = np.asarray(self._truth_at_keyframes)[:, :2]
         return float(np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1))))
 
+    def rpe_m(self) -> float | None:
+        """Relative pose error over 1 m of true travel between keyframes (translation RMSE;
+        :func:`~semexplore_gym.core.slam.trajectory_error.relative_pose_error_m`); None when
+        the robot travelled less than 1 m."""
+        est = np.asarray(self.backend.keyframe_poses, dtype=np.float64)
+        return relative_pose_error_m(est, np.asarray(self._truth_at_keyframes), delta_m=1.0)
+
     def map_error(self, truth_grid: OccupancyGrid) -> float:
         """Share of the SLAM map's known cells whose class (free, occupied) differs from the
         map the same scans build at the true poses (``truth_grid``; unknown there counts as a
@@ -105,9 +113,12 @@ class SlamMode:
         return float(np.count_nonzero(known & (slam != truth_grid.encoded)) / n_known)
 
     def metrics(self, truth_grid: OccupancyGrid) -> dict[str, Any]:
-        """The mission's SLAM figures: ``ate_m``, ``map_error``, ``loop_closures``, ``slam_lost``."""
+        """The mission's SLAM figures: ``ate_m``, ``rpe_m``, ``map_error``, ``loop_closures``,
+        ``slam_lost``."""
+        rpe = self.rpe_m()
         return {
             "ate_m": round(self.ate_m(), 5),
+            "rpe_m": None if rpe is None else round(rpe, 5),
             "map_error": round(self.map_error(truth_grid), 5),
             "loop_closures": int(self.backend.loop_closures),
             "slam_lost": bool(self.backend.lost),

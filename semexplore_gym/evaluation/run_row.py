@@ -61,6 +61,7 @@ class RunRow:
     goal_detour_excess_m: float | None = None
     policy_version: str | None = None
     ate_m: float | None = None
+    rpe_m: float | None = None
     map_error: float | None = None
     loop_closures: int | None = None
     slam_lost: bool | None = None
@@ -87,7 +88,7 @@ POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
 #: The SLAM mode's columns (:meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`; empty
 #: for missions on the perfect or odometry-only map).
-SLAM_COLUMNS: tuple[str, ...] = ("ate_m", "map_error", "loop_closures", "slam_lost")
+SLAM_COLUMNS: tuple[str, ...] = ("ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost")
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
 OPTIONAL_COLUMNS: frozenset[str] = frozenset(

@@ -13,6 +13,7 @@ import numpy as np
 #: The table's median columns: (runs.csv column, heading, format).
 _MEDIAN_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("ate_m", "ATE (m)", "{:.3f}"),
+    ("rpe_m", "RPE over 1 m (m)", "{:.3f}"),
     ("map_error", "map error", "{:.3f}"),
     ("loop_closures", "loop closures", "{:.0f}"),
 )
@@ -51,6 +52,7 @@ def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str
         "",
         "Missions in the env's SLAM mode: the policies saw the map and pose the scan matcher and "
         "pose graph built. ATE: RMSE of the keyframe positions against the true positions there; "
+        "RPE: RMSE of the error of the keyframes' motion over 1 m of true travel; "
         "map error: share of the SLAM map's known cells whose class differs from the map the "
         "same scans build at the true poses; lost: missions that ended with the back end "
         "reporting itself lost. Cells: median [IQR].",

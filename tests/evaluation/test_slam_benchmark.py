@@ -35,6 +35,7 @@ def test_a_slam_benchmark_carries_the_slam_figures(tmp_path, capsys, source: str
     assert tuple(header[-len(SLAM_COLUMNS) :]) == SLAM_COLUMNS  # new columns at the end
     (row,) = read_runs(out / "runs.csv")
     assert 0.0 <= row["ate_m"] < 0.5 and 0.0 <= row["map_error"] <= 1.0
+    assert row["rpe_m"] is None or 0.0 <= row["rpe_m"] < 0.5  # None: less than 1 m travelled
     assert isinstance(row["loop_closures"], int) and isinstance(row["slam_lost"], bool)
     summary = (out / "summary.md").read_text()
     assert "## SLAM" in summary
