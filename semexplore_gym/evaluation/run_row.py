@@ -65,6 +65,8 @@ class RunRow:
     map_error: float | None = None
     loop_closures: int | None = None
     slam_lost: bool | None = None
+    slam_lost_events: int | None = None
+    slam_degenerate_matches: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -88,7 +90,15 @@ POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
 #: The SLAM mode's columns (:meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`; empty
 #: for missions on the perfect or odometry-only map).
-SLAM_COLUMNS: tuple[str, ...] = ("ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost")
+SLAM_COLUMNS: tuple[str, ...] = (
+    "ate_m",
+    "rpe_m",
+    "map_error",
+    "loop_closures",
+    "slam_lost",
+    "slam_lost_events",
+    "slam_degenerate_matches",
+)
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
 OPTIONAL_COLUMNS: frozenset[str] = frozenset(
@@ -110,6 +120,8 @@ _INT_COLUMNS = (
     "goals_cleared",
     "goals_abandoned",
     "loop_closures",
+    "slam_lost_events",
+    "slam_degenerate_matches",
 )
 _BOOL_COLUMNS = ("self_stopped", "slam_lost")
 

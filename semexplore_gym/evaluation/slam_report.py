@@ -16,6 +16,7 @@ _MEDIAN_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("rpe_m", "RPE over 1 m (m)", "{:.3f}"),
     ("map_error", "map error", "{:.3f}"),
     ("loop_closures", "loop closures", "{:.0f}"),
+    ("slam_degenerate_matches", "degenerate matches", "{:.0f}"),
 )
 
 
@@ -29,9 +30,9 @@ def _median_iqr(rows: list[dict[str, Any]], key: str, fmt: str) -> str:
 
 
 def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str]:
-    """``summary.md`` lines: per family and policy, median [IQR] of the absolute trajectory
-    error, the map error and the loop closures, and how many missions ended with the back end
-    lost.
+    """``summary.md`` lines: per family and policy, median [IQR] of the trajectory errors,
+    the map error, the loop closures and the degenerate matches, and in how many missions the
+    back end reported itself lost.
 
     Args:
         families: ``{family: {policy: [runs.csv rows]}}``.
@@ -54,8 +55,9 @@ def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str
         "pose graph built. ATE: RMSE of the keyframe positions against the true positions there; "
         "RPE: RMSE of the error of the keyframes' motion over 1 m of true travel; "
         "map error: share of the SLAM map's known cells whose class differs from the map the "
-        "same scans build at the true poses; lost: missions that ended with the back end "
-        "reporting itself lost. Cells: median [IQR].",
+        "same scans build at the true poses; degenerate matches: scan matches that pinned the "
+        "pose only across one direction (a featureless corridor); lost: missions during which "
+        "the back end reported itself lost at least once. Cells: median [IQR].",
         "",
         f"| family | policy | n | {head} | lost |",
         "|---|---|---:|" + "---:|" * (len(_MEDIAN_COLUMNS) + 1),
@@ -64,7 +66,7 @@ def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str
         if not rs:
             continue
         cells = [_median_iqr(rs, key, fmt) for key, _, fmt in _MEDIAN_COLUMNS]
-        lost = sum(1 for r in rs if r.get("slam_lost"))
+        lost = sum(1 for r in rs if r.get("slam_lost") or (r.get("slam_lost_events") or 0) > 0)
         lines.append(
             f"| {fam} | {policy} | {len(rs)} | " + " | ".join(cells) + f" | {lost}/{len(rs)} |"
         )
