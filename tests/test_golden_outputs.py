@@ -25,6 +25,7 @@ import semexplore_gym  # noqa: F401  (registers the env)
 from semexplore_gym.core.topometric import segment_map
 from semexplore_gym.evaluation.harness import Task, run_task
 from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
+from semexplore_gym.evaluation.run_row import SLAM_COLUMNS
 
 GOLDEN = Path(__file__).with_name("golden_outputs.json")
 REGENERATE = os.environ.get("SEMEXPLORE_REGENERATE_GOLDEN") == "1"
@@ -34,8 +35,14 @@ _TIMED = {"mean_map_generation_ms", "mean_global_planning_ms", "wall_time_s"}
 #: Columns added after the pins were taken: missions are pinned by the rest (the same trace,
 #: trajectory and figures mean the same missions); coverage at the planner's clearance
 #: (tests/evaluation/test_planner_coverage.py), the decomposition and the expert's version
-#: (tests/policies/test_expert_versions.py) have their own tests.
-_ADDED_AFTER_PINS = {"coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS, "policy_version"}
+#: (tests/policies/test_expert_versions.py) and the SLAM columns (empty without the SLAM mode;
+#: tests/evaluation/test_slam_benchmark.py) have their own tests.
+_ADDED_AFTER_PINS = {
+    "coverage_at_planner_clearance",
+    *DECOMPOSITION_COLUMNS,
+    "policy_version",
+    *SLAM_COLUMNS,
+}
 
 MISSIONS = [
     ("maze1", "semantic", 0, None),

@@ -33,7 +33,15 @@ JSON_KEYS: tuple[str, ...] = (
     "policy_version",
 )
 #: Added to the ``--json`` object when the env runs SLAM (``--env-config slam``).
-SLAM_JSON_KEYS: tuple[str, ...] = ("ate_m", "map_error", "loop_closures", "slam_lost")
+SLAM_JSON_KEYS: tuple[str, ...] = (
+    "ate_m",
+    "rpe_m",
+    "map_error",
+    "loop_closures",
+    "slam_lost",
+    "slam_lost_events",
+    "slam_degenerate_matches",
+)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -24,7 +24,7 @@ from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
 from semexplore_gym.envs.observation_options import ObservationOptions
-from semexplore_gym.envs.slam_mode import SlamMode
+from semexplore_gym.envs.slam_mode import SlamMode, kidnap_start, slam_reset
 from semexplore_gym.envs.static_info import FrozenInfo as FrozenInfo
 from semexplore_gym.envs.static_info import static_info_of
 from semexplore_gym.maps import make_world
@@ -139,9 +139,9 @@ class SemanticExploreEnv(gym.Env):
     ## Info
     ``map_geometry``, ``robot``, ``lidar``, ``dt_s``, ``coverage``, ``explored_area_m2`` (free
     area in the map), ``collisions`` (count so far), ``sim_time_s``, ``path_length_m``,
-    ``reward_terms``, ``true_pose`` is *not* given (policies must not see ground truth).
-    With ``slam.enabled`` (preset ``"slam"``, :mod:`~semexplore_gym.envs.slam_mode`) map and pose
-    are SLAM's and ``info`` adds ``slam_pose``, ``slam_pose_error_m``, ``loop_closures``, ``slam_lost``.
+    ``reward_terms``; ``true_pose`` is *not* given (policies must not see ground truth). With
+    ``slam.enabled`` (preset ``"slam"``) map and pose are SLAM's, ``info`` adds its figures and
+    ``reset(options={"kidnap_to": pose})`` kidnaps the robot (:mod:`~semexplore_gym.envs.slam_mode`).
 
     ## Notes
     Rendering overlays: ``env.unwrapped.set_overlay(dict)`` draws a policy's semantic areas,
@@ -298,7 +298,7 @@ class SemanticExploreEnv(gym.Env):
             self.world = make_world(f"{family}:{params}")
             self._build_world_state()
         self._started = True
-        pose = self.choose_start(options)
+        pose = self.choose_start(kidnap_start(options, self.slam))
         cfg = self.config
         self.sim.reset(pose)
         self.start_pose = pose
@@ -314,7 +314,7 @@ class SemanticExploreEnv(gym.Env):
         self._overlay = {}
         self._true_pose = self.sim.pose
         self._scan = self._sense_and_map(self._true_pose)
-        self._map_grid = self.slam.reset(pose, self._scan) if self.slam else self.grid
+        self._map_grid, self._est_pose = slam_reset(self.slam, self.grid, pose, self._scan, options)
         info = self._info({"free_area_change": 0.0, "time": 0.0, "collision": 0.0}, True)
         if self.privileged:
             info[PRIVILEGED_INFO_KEY] = self._privileged_world(pose, reach)

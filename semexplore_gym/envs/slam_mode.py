@@ -3,6 +3,17 @@
 :class:`SlamMode` runs :class:`~semexplore_gym.core.slam.backend.ScanSlam` on the env's drifting
 odometry pose and the LiDAR scans; the env's own grid, fused at the true pose, stays for
 coverage and rewards. It also keeps the true pose of each keyframe for the trajectory error.
+
+Faults are reported, never silent: ``info["slam_lost"]`` (now), ``slam_lost_events`` (how often
+the back end became lost) and ``slam_degenerate_matches`` (matches that pinned the pose only
+across one direction, as in a featureless corridor), and the same in the mission record.
+
+Kidnapping: ``env.reset(options={"kidnap_to": (x_m, y_m, yaw_rad)})`` after a first reset
+carries the robot to that pose without telling SLAM (:func:`kidnap_start`). The episode starts
+again there (time, path, coverage on the truth), the odometry reads on from there, but the
+back end keeps its map, its keyframes and its estimate (the last keyframe's pose): it must
+notice from its scans. Not allowed without the SLAM mode, before the first reset, or together
+with ``start_pose``.
 """
 
 from __future__ import annotations
@@ -16,12 +27,60 @@ from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.slam.backend import ScanSlam
 from semexplore_gym.core.slam.pose_graph import require_gtsam
+from semexplore_gym.core.slam.trajectory_error import relative_pose_error_m
 from semexplore_gym.envs.env_config import EnvConfig
 
 Pose = tuple[float, float, float]
 
 #: The per-step ``info`` keys of the SLAM mode.
-SLAM_INFO_KEYS = ("slam_pose", "slam_pose_error_m", "loop_closures", "slam_lost")
+SLAM_INFO_KEYS = (
+    "slam_pose",
+    "slam_pose_error_m",
+    "loop_closures",
+    "slam_lost",
+    "slam_lost_events",
+    "slam_degenerate_matches",
+)
+
+#: The reset option that kidnaps the robot (see the module docstring).
+KIDNAP_OPTION = "kidnap_to"
+
+
+def kidnap_start(options: dict[str, Any] | None, slam: SlamMode | None) -> dict[str, Any] | None:
+    """The reset ``options`` with a kidnap's target as the start pose (see the module
+    docstring); other options unchanged.
+
+    Raises:
+        ValueError: ``kidnap_to`` without the SLAM mode, before the first reset, or with
+            ``start_pose``.
+    """
+    if not options or options.get(KIDNAP_OPTION) is None:
+        return options
+    if slam is None:
+        raise ValueError("reset option kidnap_to needs the SLAM mode (slam.enabled: true)")
+    if not slam.started:
+        raise ValueError("reset option kidnap_to needs a first reset: there is no map to lose")
+    if options.get("start_pose") is not None:
+        raise ValueError("reset options kidnap_to and start_pose exclude each other")
+    return {**options, "start_pose": options[KIDNAP_OPTION]}
+
+
+def slam_reset(
+    slam: SlamMode | None,
+    grid: OccupancyGrid,
+    pose: Pose,
+    scan: np.ndarray,
+    options: dict[str, Any] | None,
+) -> tuple[OccupancyGrid, Pose]:
+    """The observed map and pose after a reset to the true ``pose``: the env's ``grid`` and
+    ``pose`` without SLAM; SLAM's after :meth:`SlamMode.reset` (a kidnap with ``kidnap_to``)."""
+    if slam is None:
+        return grid, pose
+    if options and options.get(KIDNAP_OPTION) is not None:
+        slam.kidnap(pose)
+    else:
+        slam.reset(pose, scan)
+    return slam.grid, slam.backend.estimate
 
 
 class SlamMode:
@@ -50,6 +109,7 @@ class SlamMode:
             (lidar.mount_x_m, lidar.mount_y_m),
         )
         self._truth_at_keyframes: list[Pose] = []
+        self.started = False
 
     @classmethod
     def create(
@@ -67,7 +127,13 @@ class SlamMode:
         """A new episode at the (shared) start ``pose``; returns the SLAM map."""
         self.backend.reset(pose, scan)
         self._truth_at_keyframes = [tuple(float(v) for v in pose)]  # type: ignore[list-item]
+        self.started = True
         return self.backend.grid
+
+    def kidnap(self, pose: Pose) -> None:
+        """The robot now stands at ``pose`` (where the odometry reads on from); the back end
+        is not told (:meth:`~semexplore_gym.core.slam.backend.ScanSlam.kidnap`)."""
+        self.backend.kidnap(pose)
 
     def update(self, odom_pose: Any, scan: np.ndarray, true_pose: Pose) -> Pose:
         """One step on the odometry pose and the scan; returns the SLAM estimate."""
@@ -84,6 +150,8 @@ class SlamMode:
             "slam_pose_error_m": math.hypot(est[0] - true_pose[0], est[1] - true_pose[1]),
             "loop_closures": self.backend.loop_closures,
             "slam_lost": self.backend.lost,
+            "slam_lost_events": self.backend.lost_events,
+            "slam_degenerate_matches": self.backend.degenerate_matches,
         }
 
     def ate_m(self) -> float:
@@ -92,6 +160,13 @@ class SlamMode:
         est = np.asarray(self.backend.keyframe_poses)[:, :2]
         truth = np.asarray(self._truth_at_keyframes)[:, :2]
         return float(np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1))))
+
+    def rpe_m(self) -> float | None:
+        """Relative pose error over 1 m of true travel between keyframes (translation RMSE;
+        :func:`~semexplore_gym.core.slam.trajectory_error.relative_pose_error_m`); None when
+        the robot travelled less than 1 m."""
+        est = np.asarray(self.backend.keyframe_poses, dtype=np.float64)
+        return relative_pose_error_m(est, np.asarray(self._truth_at_keyframes), delta_m=1.0)
 
     def map_error(self, truth_grid: OccupancyGrid) -> float:
         """Share of the SLAM map's known cells whose class (free, occupied) differs from the
@@ -105,10 +180,15 @@ class SlamMode:
         return float(np.count_nonzero(known & (slam != truth_grid.encoded)) / n_known)
 
     def metrics(self, truth_grid: OccupancyGrid) -> dict[str, Any]:
-        """The mission's SLAM figures: ``ate_m``, ``map_error``, ``loop_closures``, ``slam_lost``."""
+        """The mission's SLAM figures: ``ate_m``, ``rpe_m``, ``map_error``, ``loop_closures``,
+        ``slam_lost`` (at the end), ``slam_lost_events``, ``slam_degenerate_matches``."""
+        rpe = self.rpe_m()
         return {
             "ate_m": round(self.ate_m(), 5),
+            "rpe_m": None if rpe is None else round(rpe, 5),
             "map_error": round(self.map_error(truth_grid), 5),
             "loop_closures": int(self.backend.loop_closures),
             "slam_lost": bool(self.backend.lost),
+            "slam_lost_events": int(self.backend.lost_events),
+            "slam_degenerate_matches": int(self.backend.degenerate_matches),
         }

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from semexplore_gym.evaluation.path_decomposition import DECOMPOSITION_COLUMNS
-from semexplore_gym.evaluation.run_row import POLICY_COLUMNS, RunRow
+from semexplore_gym.evaluation.run_row import POLICY_COLUMNS, SLAM_COLUMNS, RunRow
 from semexplore_gym.evaluation.tasks import Task
 
 
@@ -30,7 +30,8 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
     policy-specific columns come from the policy's ``mission_metrics()`` (None if absent),
     ``coverage_at_planner_clearance`` from :mod:`.planner_coverage` (given by the caller,
     which still holds the env), the path decomposition's from the result's (None without one),
-    ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert.versions.expert_version`)."""
+    ``policy_version`` from the spec (:func:`~semexplore_gym.policies.expert.versions.expert_version`),
+    the SLAM columns from the result's ``slam_metrics`` (None without the SLAM mode)."""
     from semexplore_gym.policies.expert.versions import expert_version
 
     parts = getattr(res, "path_decomposition", None)
@@ -56,6 +57,7 @@ def mission_row(task: Task, res: Any, coverage_at_planner_clearance: float | Non
         coverage_at_planner_clearance=coverage_at_planner_clearance,
         **decomposition,
         policy_version=expert_version(task.policy),
+        **{k: getattr(res, "slam_metrics", {}).get(k) for k in SLAM_COLUMNS},
     )
 
 

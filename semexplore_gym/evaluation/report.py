@@ -19,6 +19,7 @@ import numpy as np
 from semexplore_gym.evaluation.path_decomposition import decomposition_table
 from semexplore_gym.evaluation.run_row import read_runs
 from semexplore_gym.evaluation.run_writer import distance_to_coverage_m, file_slug, task_stem
+from semexplore_gym.evaluation.slam_report import slam_table
 
 #: The policy every other one is compared against in ``summary.md``.
 REFERENCE_POLICY = "semantic"
@@ -289,6 +290,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         lines += _policy_table(everything)
         lines += _comparison_table(everything, reference, "(world, seed)")
     lines += decomposition_table(families)
+    lines += slam_table(families)
     for world, by_policy in groups.items():
         lines += [f"## {world}", ""]
         lines += _policy_table(by_policy)

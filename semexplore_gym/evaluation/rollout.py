@@ -84,8 +84,8 @@ class MissionResult:
         path_decomposition: Where the path went (:mod:`.path_decomposition`; None for a
             result built elsewhere).
         slam_metrics: With the env's SLAM mode: ``ate_m`` (keyframe position RMSE, no
-            alignment: the start pose is shared), ``map_error``, ``loop_closures`` and
-            ``slam_lost`` at the end (:func:`slam_metrics`); empty otherwise.
+            alignment: the start pose is shared), ``rpe_m`` (over 1 m of travel),
+            ``map_error``, ``loop_closures`` and ``slam_lost`` at the end (:func:`slam_metrics`); empty otherwise.
     """
 
     world: str

@@ -7,8 +7,10 @@ semantic expert's planning clearance (:mod:`.planner_coverage`; every policy); t
 decomposition's columns (:mod:`.path_decomposition`: the path split into parts that add up to
 ``path_length_m``, goals cleared and abandoned, the goals' detour ratio) come for every policy;
 ``policy_version`` names the semantic expert's version a spec ran (``semantic-v3`` for
-``semantic``; empty for policies without versions). All of these were added after the first
-release, so older files may lack them.
+``semantic``; empty for policies without versions). The SLAM columns (:data:`SLAM_COLUMNS`:
+trajectory errors, map error, loop closures and whether the back end ended lost) come only from
+missions in the env's SLAM mode (``--env-config slam``; empty otherwise). All of these were
+added after the first release, so older files may lack them.
 """
 
 from __future__ import annotations
@@ -58,6 +60,13 @@ class RunRow:
     median_goal_detour_ratio: float | None = None
     goal_detour_excess_m: float | None = None
     policy_version: str | None = None
+    ate_m: float | None = None
+    rpe_m: float | None = None
+    map_error: float | None = None
+    loop_closures: int | None = None
+    slam_lost: bool | None = None
+    slam_lost_events: int | None = None
+    slam_degenerate_matches: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -79,13 +88,42 @@ CSV_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRow))
 #: Policy-specific columns: the policy's ``mission_metrics()`` fills them (None if absent).
 POLICY_COLUMNS: tuple[str, ...] = ("scored_replans", "semantic_share")
 
+#: The SLAM mode's columns (:meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`; empty
+#: for missions on the perfect or odometry-only map).
+SLAM_COLUMNS: tuple[str, ...] = (
+    "ate_m",
+    "rpe_m",
+    "map_error",
+    "loop_closures",
+    "slam_lost",
+    "slam_lost_events",
+    "slam_degenerate_matches",
+)
+
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
 OPTIONAL_COLUMNS: frozenset[str] = frozenset(
-    {*POLICY_COLUMNS, "coverage_at_planner_clearance", *DECOMPOSITION_COLUMNS, "policy_version"}
+    {
+        *POLICY_COLUMNS,
+        "coverage_at_planner_clearance",
+        *DECOMPOSITION_COLUMNS,
+        "policy_version",
+        *SLAM_COLUMNS,
+    }
 )
 
 _TEXT_COLUMNS = ("world", "policy", "stop_reason", "policy_version")
-_INT_COLUMNS = ("seed", "collisions", "steps", "scored_replans", "goals_cleared", "goals_abandoned")
+_INT_COLUMNS = (
+    "seed",
+    "collisions",
+    "steps",
+    "scored_replans",
+    "goals_cleared",
+    "goals_abandoned",
+    "loop_closures",
+    "slam_lost_events",
+    "slam_degenerate_matches",
+)
+_BOOL_COLUMNS = ("self_stopped", "slam_lost")
 
 
 def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
@@ -96,11 +134,9 @@ def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
     for k, v in raw.items():
         if k in _TEXT_COLUMNS:
             row[k] = v
-        elif k == "self_stopped":
+        elif k in _BOOL_COLUMNS and not (k in OPTIONAL_COLUMNS and v in ("", "None")):
             if v not in ("True", "False"):
-                raise ValueError(
-                    f"{where}: self_stopped must be True or False, got {short_repr(v)}"
-                )
+                raise ValueError(f"{where}: {k} must be True or False, got {short_repr(v)}")
             row[k] = v == "True"
         elif v in ("", "None"):
             if k in ("world", "policy", "seed"):

@@ -110,15 +110,16 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert errors[True] < errors[False]
     assert errors[True] < 0.1
     on, off = results[True], results[False]
-    assert {"ate_m", "map_error", "loop_closures", "slam_lost"} <= set(on)
+    assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(on)
     assert "ate_m" not in off
     assert on["ate_m"] < 0.1 and 0 <= on["map_error"] < 0.2
+    assert 0 <= on["rpe_m"] < 0.1  # 400 s of the expert: far more than 1 m of travel
     assert on["collisions"] == 0
     # explore --json carries the SLAM figures when the env runs SLAM.
     args = ["explore", "--world", WORLD, "--env-config", "slam", "--max-time-s", "20"]
     assert main([*args, "--json", "--no-progress"]) == 0
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
-    assert {"ate_m", "map_error", "loop_closures", "slam_lost"} <= set(out)
+    assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(out)
 
 
 def test_the_team_env_refuses_the_slam_mode_in_one_line() -> None:

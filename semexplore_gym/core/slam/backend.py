@@ -9,6 +9,12 @@ within ``loop_search_radius_m`` and far back in the chain is tried as a loop clo
 its own submap. A verified closure adds a robust edge and the pose graph is optimised
 (:mod:`.pose_graph`); the map is then re-rendered from all keyframes at their new poses.
 Otherwise the keyframe's scan is fused into the map incrementally.
+
+Faults are counted, never silent: :attr:`ScanSlam.lost` (and :attr:`ScanSlam.lost_events`, how
+often it became so) when matches keep scoring too low (a kidnapped robot, a scan unlike the
+map), :attr:`ScanSlam.degenerate_matches` when a match pins the pose only across one direction
+(a featureless corridor; see ``SlamParams.degenerate_sd_m``). :meth:`ScanSlam.kidnap` moves the
+odometry's frame without telling the estimate, as a robot picked up and put down elsewhere.
 """
 
 from __future__ import annotations
@@ -83,6 +89,8 @@ class ScanSlam:
         self.edges: list[Edge] = []
         self.loop_closures = 0
         self.low_score_streak = 0
+        self.lost_events = 0
+        self.degenerate_matches = 0
         self.last_score = 1.0
         self._cooldown = 0
         self._last_odom: Pose = tuple(float(v) for v in pose)  # type: ignore[assignment]
@@ -94,6 +102,13 @@ class ScanSlam:
     def lost(self) -> bool:
         """Whether the last ``lost_after_keyframes`` keyframes all matched below the threshold."""
         return self.low_score_streak >= self.params.lost_after_keyframes
+
+    def kidnap(self, odom_pose: Pose) -> None:
+        """The robot was carried elsewhere: the odometry now reads ``odom_pose``, and the
+        back end is told nothing else. Its estimate stays at the last keyframe, where it
+        believes the robot is; only the odometry's jump is not taken as motion."""
+        self._last_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
+        self.estimate = self.keyframe_poses[-1]
 
     def _add_keyframe(self, pose: Pose, ranges_m: np.ndarray) -> None:
         ranges = np.array(ranges_m, dtype=np.float32)
@@ -119,7 +134,8 @@ class ScanSlam:
             return prediction
         self._last_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
         points = scan_points(np.asarray(ranges_m), self._beams, self._max_range_m, self._mount)
-        pose, cov = self._track(prediction, points, delta)
+        pose, cov, trusted = self._track(prediction, points, delta)
+        self._judge(trusted)
         n = len(self.keyframe_poses)
         self.edges.append(Edge(n - 1, n, relative(self.keyframe_poses[-1], pose), cov))
         self._add_keyframe(pose, ranges_m)
@@ -128,9 +144,20 @@ class ScanSlam:
         self.estimate = self.keyframe_poses[-1]
         return self.estimate
 
-    def _track(self, prediction: Pose, points: np.ndarray, delta: Pose) -> tuple[Pose, np.ndarray]:
-        """The keyframe pose and its edge covariance: the scan match to the recent keyframes,
-        or the odometry prediction when the match is not trusted."""
+    def _judge(self, good: bool) -> None:
+        """Count a keyframe towards the lost judgement (``good``: its match was trusted)."""
+        if good:
+            self.low_score_streak = 0
+            return
+        self.low_score_streak += 1
+        if self.low_score_streak == self.params.lost_after_keyframes:
+            self.lost_events += 1
+
+    def _track(
+        self, prediction: Pose, points: np.ndarray, delta: Pose
+    ) -> tuple[Pose, np.ndarray, bool]:
+        """The keyframe pose, its edge covariance and whether the match was trusted: the scan
+        match to the recent keyframes, or the odometry prediction when it is not trusted."""
         p = self.params
         first = max(0, len(self.keyframe_poses) - p.submap_keyframes)
         match = self._match(
@@ -138,12 +165,22 @@ class ScanSlam:
         )
         self.last_score = match.score
         if len(points) >= 10 and match.score >= p.match_score_threshold:
-            self.low_score_streak = 0
-            return match.pose, match.covariance
-        self.low_score_streak += 1
+            return self._unless_degenerate(match, prediction), match.covariance, True
         trans = math.hypot(delta[0], delta[1])
         sd_xy, sd_yaw = 0.02 + 0.2 * trans, 0.02 + 0.2 * abs(delta[2])
-        return prediction, np.diag([sd_xy**2, sd_xy**2, sd_yaw**2])
+        return prediction, np.diag([sd_xy**2, sd_xy**2, sd_yaw**2]), False
+
+    def _unless_degenerate(self, match: MatchResult, prediction: Pose) -> Pose:
+        """The match's pose; for a degenerate match (its worst position standard deviation
+        above ``degenerate_sd_m``: counted) the prediction along that worst direction."""
+        values, vectors = np.linalg.eigh(np.asarray(match.covariance)[:2, :2])
+        if math.sqrt(max(float(values[-1]), 0.0)) <= self.params.degenerate_sd_m:
+            return match.pose
+        self.degenerate_matches += 1
+        axis = vectors[:, -1]
+        shift = np.array(match.pose[:2]) - np.array(prediction[:2])
+        xy = np.array(match.pose[:2]) - axis * float(axis @ shift)
+        return (float(xy[0]), float(xy[1]), match.pose[2])
 
     def _match(
         self, keyframes: range, points: np.ndarray, prediction: Pose, search_xy_m: float

@@ -20,6 +20,7 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "loop_search_xy_m": (0.0, 5.0),
     "loop_score_threshold": (0.0, 1.0),
     "lost_after_keyframes": (1, 100000),
+    "degenerate_sd_m": (0.0, 10.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
 
@@ -47,6 +48,10 @@ class SlamParams:
         loop_score_threshold: A loop-closure match must score at least this.
         lost_after_keyframes: The back end reports itself lost after this many keyframes in a
             row whose match scored below ``match_score_threshold``.
+        degenerate_sd_m: A trusted match whose position standard deviation along its worst
+            direction (from the matcher's covariance) exceeds this is *degenerate*: the scan
+            pins the pose only across that direction (a featureless corridor). It is counted,
+            and along that direction the keyframe keeps the odometry prediction.
     """
 
     enabled: bool = False
@@ -63,6 +68,7 @@ class SlamParams:
     loop_search_xy_m: float = 0.5
     loop_score_threshold: float = 0.6
     lost_after_keyframes: int = 5
+    degenerate_sd_m: float = 0.08
 
     def __post_init__(self) -> None:
         for f in fields(self):

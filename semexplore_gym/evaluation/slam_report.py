@@ -1,0 +1,74 @@
+"""``summary.md``'s SLAM section: per family and policy, the SLAM mode's figures.
+
+Only missions run in the env's SLAM mode (``--env-config slam``) carry them (``runs.csv``'s
+:data:`~semexplore_gym.evaluation.run_row.SLAM_COLUMNS`); without any the section is left out.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+#: The table's median columns: (runs.csv column, heading, format).
+_MEDIAN_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("ate_m", "ATE (m)", "{:.3f}"),
+    ("rpe_m", "RPE over 1 m (m)", "{:.3f}"),
+    ("map_error", "map error", "{:.3f}"),
+    ("loop_closures", "loop closures", "{:.0f}"),
+    ("slam_degenerate_matches", "degenerate matches", "{:.0f}"),
+)
+
+
+def _median_iqr(rows: list[dict[str, Any]], key: str, fmt: str) -> str:
+    v = np.array([float(r[key]) for r in rows if r.get(key) is not None], dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return "–"
+    q1, med, q3 = np.percentile(v, [25, 50, 75])
+    return f"{fmt.format(med)} [{fmt.format(q1)}–{fmt.format(q3)}]"
+
+
+def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str]:
+    """``summary.md`` lines: per family and policy, median [IQR] of the trajectory errors,
+    the map error, the loop closures and the degenerate matches, and in how many missions the
+    back end reported itself lost.
+
+    Args:
+        families: ``{family: {policy: [runs.csv rows]}}``.
+
+    Returns:
+        The section's lines; none when no row has the SLAM columns.
+    """
+    slam_rows = {
+        (fam, policy): [r for r in rs if r.get("ate_m") is not None]
+        for fam, by_policy in families.items()
+        for policy, rs in by_policy.items()
+    }
+    if not any(slam_rows.values()):
+        return []
+    head = " | ".join(label for _, label, _ in _MEDIAN_COLUMNS)
+    lines = [
+        "## SLAM",
+        "",
+        "Missions in the env's SLAM mode: the policies saw the map and pose the scan matcher and "
+        "pose graph built. ATE: RMSE of the keyframe positions against the true positions there; "
+        "RPE: RMSE of the error of the keyframes' motion over 1 m of true travel; "
+        "map error: share of the SLAM map's known cells whose class differs from the map the "
+        "same scans build at the true poses; degenerate matches: scan matches that pinned the "
+        "pose only across one direction (a featureless corridor); lost: missions during which "
+        "the back end reported itself lost at least once. Cells: median [IQR].",
+        "",
+        f"| family | policy | n | {head} | lost |",
+        "|---|---|---:|" + "---:|" * (len(_MEDIAN_COLUMNS) + 1),
+    ]
+    for (fam, policy), rs in slam_rows.items():
+        if not rs:
+            continue
+        cells = [_median_iqr(rs, key, fmt) for key, _, fmt in _MEDIAN_COLUMNS]
+        lost = sum(1 for r in rs if r.get("slam_lost") or (r.get("slam_lost_events") or 0) > 0)
+        lines.append(
+            f"| {fam} | {policy} | {len(rs)} | " + " | ".join(cells) + f" | {lost}/{len(rs)} |"
+        )
+    lines.append("")
+    return lines
