@@ -27,7 +27,7 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-import numpy as np
+from semexplore_gym.evaluation.regret import median_iqr
 
 #: Columns of a best-known table, in order.
 COLUMNS: tuple[str, ...] = (
@@ -208,18 +208,6 @@ def reproduce_command(row: dict[str, Any]) -> str:
     return " ".join(shlex.quote(p) for p in parts) + " --json"
 
 
-def _median_iqr(values: list[float]) -> str:
-    v = np.asarray(values, dtype=np.float64)
-    if v.size == 0:
-        return "–"
-    q1, med, q3 = np.percentile(v, [25, 50, 75], method="lower")
-
-    def f(x: float) -> str:
-        return "∞" if not math.isfinite(x) else f"{x:.2f}"
-
-    return f"{f(med)} [{f(q1)}–{f(q3)}]"
-
-
 def mission_ratios(
     rows: list[dict[str, Any]], table: dict[Key, dict[str, Any]], start: str
 ) -> list[dict[str, Any]]:
@@ -269,7 +257,7 @@ def _policy_table(by_policy: dict[str, list[dict[str, Any]]]) -> list[str]:
     for policy, rs in by_policy.items():
 
         def col(name: str, rs: list[dict[str, Any]] = rs) -> str:
-            return _median_iqr([r[name] for r in rs if r[name] is not None])
+            return median_iqr([r[name] for r in rs if r[name] is not None])
 
         at = sum(1 for r in rs if r["at_best"])
         below = sum(1 for r in rs if r["below_bound"])

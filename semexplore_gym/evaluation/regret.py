@@ -73,7 +73,8 @@ def regret_rows(rows: list[dict[str, Any]], oracle: str = ORACLE_SPEC) -> list[d
     return out
 
 
-def _median_iqr(values: list[float]) -> str:
+def median_iqr(values: list[float | None]) -> str:
+    """``median [q1–q3]`` of the values that are not None (``∞`` for an infinite one)."""
     v = np.asarray([x for x in values if x is not None], dtype=np.float64)
     if v.size == 0:
         return "–"
@@ -94,7 +95,7 @@ def _table(by_policy: dict[str, list[dict[str, Any]]]) -> list[str]:
     for policy, rs in by_policy.items():
         t99 = [r["T99_ratio"] for r in rs if r["T99_ratio"] is not None]
         beat = sum(1 for x in t99 if x >= 1.0)
-        cells = [_median_iqr([r[name] for r in rs if r[name] is not None]) for name, _ in RATIOS]
+        cells = [median_iqr([r[name] for r in rs if r[name] is not None]) for name, _ in RATIOS]
         lines.append(f"| {policy} | {len(rs)} | " + " | ".join(cells) + f" | {beat}/{len(t99)} |")
     return lines
 
