@@ -96,7 +96,8 @@ COMPARED_METRICS: tuple[tuple[str, str], ...] = (
 )
 
 
-def _policy_table(by_policy: dict[str, list[dict[str, Any]]]) -> list[str]:
+def policy_table(by_policy: dict[str, list[dict[str, Any]]]) -> list[str]:
+    """One row per policy: mission count, self-stopped count and each metric's median [IQR]."""
     header = (
         "| policy | n | self-stopped | " + " | ".join(label for _, label in SUMMARY_METRICS) + " |"
     )
@@ -174,7 +175,7 @@ def _comparison_table(
     return lines
 
 
-def _overview_table(
+def overview_table(
     families: dict[str, dict[str, list[dict[str, Any]]]], reference: str
 ) -> list[str]:
     """One row per (family, policy): medians, and the reference's mission time against it."""
@@ -259,6 +260,17 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     rows = read_runs(out / "runs.csv")
     if not rows:
         raise ValueError(f"no finished missions in {out / 'runs.csv'}")
+    path = out / "summary.md"
+    path.write_text("\n".join(summary_lines(out, rows, reference)))
+    return path
+
+
+def summary_lines(
+    out_dir: str | os.PathLike, rows: list[dict[str, Any]], reference: str = REFERENCE_POLICY
+) -> list[str]:
+    """The lines of ``summary.md`` for the missions ``rows`` of the run folder ``out_dir``
+    (each row gains its ``D99_m``, read from the folder's traces and trajectories)."""
+    out = Path(out_dir)
     add_distance_to_99(out, rows)
     groups = group_runs(rows)
     lines = [
@@ -271,7 +283,7 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
     ]
     families = group_by_family(rows)
     if len(groups) > 1:
-        lines += _overview_table(families, reference)
+        lines += overview_table(families, reference)
         lines += [
             "## Per family",
             "",
@@ -281,23 +293,26 @@ def write_summary(out_dir: str | os.PathLike, reference: str = REFERENCE_POLICY)
         for fam, by_policy in families.items():
             worlds = sorted({r["world"] for rs in by_policy.values() for r in rs})
             lines += [f"### {fam} ({len(worlds)} world{'s' if len(worlds) != 1 else ''})", ""]
-            lines += _policy_table(by_policy)
+            lines += policy_table(by_policy)
             lines += _comparison_table(by_policy, reference, "(world, seed)")
-        everything: dict[str, list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            everything[r["policy"]].append(r)
         lines += [f"## All worlds ({len(groups)} worlds)", ""]
-        lines += _policy_table(everything)
-        lines += _comparison_table(everything, reference, "(world, seed)")
+        lines += policy_table(policies_of(rows))
+        lines += _comparison_table(policies_of(rows), reference, "(world, seed)")
     lines += decomposition_table(families)
     lines += slam_table(families)
     for world, by_policy in groups.items():
         lines += [f"## {world}", ""]
-        lines += _policy_table(by_policy)
+        lines += policy_table(by_policy)
         lines += _comparison_table(by_policy, reference, "seed")
-    path = out / "summary.md"
-    path.write_text("\n".join(lines))
-    return path
+    return lines
+
+
+def policies_of(rows: list[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
+    """``{policy: [rows]}`` over every world, in first-seen order."""
+    everything: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for r in rows:
+        everything[r["policy"]].append(r)
+    return everything
 
 
 def add_distance_to_99(out: Path, rows: list[dict[str, Any]]) -> None:
