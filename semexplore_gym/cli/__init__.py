@@ -26,6 +26,7 @@ SUBCOMMANDS: dict[str, str] = {
     "maps": "maps",
     "pretrained": "pretrained",
     "oracle": "oracle",
+    "report": "report",
 }
 
 

@@ -27,6 +27,8 @@ import shlex
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from semexplore_gym.evaluation.regret import median_iqr
 
 #: Columns of a best-known table, in order.
@@ -302,6 +304,42 @@ def summary_lines(
                 f"(best known {float(b['best_known_T99_s']):.1f} s): `{reproduce_command(b)}`"
             )
         lines.append("")
+    return lines
+
+
+def overview_lines(table: dict[Key, dict[str, Any]]) -> list[str]:
+    """The table in brief: per family and start kind, how many starts it holds, the medians
+    [IQR] of the best known T99 and D99 and of their certified lower bounds, and which policies
+    hold the best T99 (``semexplore report configs/best_known/best_known.csv``)."""
+    from semexplore_gym.evaluation.suites import world_family
+
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for (world, _, start), row in table.items():
+        groups.setdefault((world_family(world), start), []).append(row)
+
+    def cell(rows: list[dict[str, Any]], column: str) -> str:
+        v = [float(r[column]) for r in rows if r[column] is not None]
+        if not v:
+            return "–"
+        q1, med, q3 = (float(x) for x in np.percentile(v, [25, 50, 75], method="lower"))
+        return f"{med:.1f} [{q1:.1f}–{q3:.1f}]"
+
+    lines = [
+        "| family | start | starts | best known T99 (s) | lower bound on T99 (s) | "
+        "best known D99 (m) | lower bound on D99 (m) | best T99 held by |",
+        "|---|---|---:|---:|---:|---:|---:|---|",
+    ]
+    for (fam, start), rows in groups.items():
+        holders: dict[str, int] = {}
+        for r in rows:
+            if r["T99_policy"]:
+                holders[r["T99_policy"]] = holders.get(r["T99_policy"], 0) + 1
+        held = ", ".join(f"{p} {n}" for p, n in sorted(holders.items(), key=lambda x: -x[1]))
+        lines.append(
+            f"| {fam} | {start} | {len(rows)} | {cell(rows, 'T99_s')} | "
+            f"{cell(rows, 'lower_bound_s')} | {cell(rows, 'D99_m')} | "
+            f"{cell(rows, 'lower_bound_m')} | {held or '–'} |"
+        )
     return lines
 
 

@@ -1,0 +1,75 @@
+"""``semexplore report``: a result file's tables as Markdown, computed from its data.
+
+RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to
+the columns a table reads is enough), or a best-known table such as
+``configs/best_known/best_known.csv``. For a benchmark, ``--table`` picks the table of its
+``summary.md``: ``overview`` (one row per family and policy, the default), ``policies`` (one
+row per policy over all worlds) or ``summary`` (the whole summary). The docs build renders the
+user guide's result tables with the same function.
+
+Example::
+
+    semexplore report runs/bench10
+    semexplore report runs/bench10 --table policies --out runs/bench10/policies.md
+    semexplore report configs/best_known/best_known.csv --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from semexplore_gym.cli._output import add_json_flag, print_json
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    from semexplore_gym.cli import describe
+    from semexplore_gym.evaluation.tables import RUN_TABLES
+
+    p = sub.add_parser(
+        "report",
+        help="print a benchmark's or a best-known table's results as a Markdown table",
+        description=describe(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "run_dir",
+        metavar="RUN_DIR",
+        help="a benchmark run folder, a runs.csv, or a best-known CSV",
+    )
+    p.add_argument(
+        "--table",
+        choices=RUN_TABLES,
+        default=None,
+        help="which of a benchmark's tables (default: overview; a best-known CSV has one)",
+    )
+    p.add_argument(
+        "--reference",
+        default=None,
+        metavar="POLICY",
+        help="the policy spec every other one is compared with (default: semantic)",
+    )
+    p.add_argument(
+        "--out", default=None, metavar="FILE", help="write the Markdown to FILE instead of stdout"
+    )
+    add_json_flag(p, "the tables (columns and rows) and their Markdown")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    from semexplore_gym.cli._flags import check_output_flag
+    from semexplore_gym.evaluation.tables import report_tables
+
+    if args.out is not None:
+        check_output_flag("--out", args.out)
+    result = report_tables(args.run_dir, args.table, args.reference)
+    if args.out is not None:
+        with open(args.out, "w", encoding="utf-8") as f:
+            f.write(result.markdown)
+    if args.json:
+        print_json(args, {**result.to_dict(), "out": args.out}, ensure_ascii=False)
+    elif args.out is not None:
+        print(f"wrote {args.out} ({result.rows} rows of {result.source})", file=sys.stderr)
+    else:
+        sys.stdout.write(result.markdown)
+    return 0

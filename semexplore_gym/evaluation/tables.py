@@ -1,0 +1,168 @@
+"""Markdown tables from result files: a benchmark's ``runs.csv`` or a best-known table.
+
+One function, :func:`report_tables`, serves ``semexplore report`` and the docs build, which
+renders the user guide's result tables from the small result files under ``docs/results/`` (a
+table in the guide is computed from its data, never pasted). A benchmark's tables are those of
+its ``summary.md`` (:mod:`.report`); a ``runs.csv`` trimmed to the columns a table needs is
+enough for that table.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: The tables of a benchmark's ``runs.csv``: the summary's overview (one row per family and
+#: policy), its per-policy table over all worlds, or the whole ``summary.md``.
+RUN_TABLES: tuple[str, ...] = ("overview", "policies", "summary")
+_KEYS = ("world", "policy", "seed", "self_stopped")
+#: The ``runs.csv`` columns each table reads (the others may be absent).
+NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
+    "overview": (*_KEYS, "coverage", "mission_time_s", "T90_s"),
+    "policies": (*_KEYS, "coverage", "mission_time_s"),
+    "summary": (
+        *_KEYS,
+        "coverage",
+        "mission_time_s",
+        "path_length_m",
+        "T90_s",
+        "T99_s",
+        "mean_map_generation_ms",
+        "mean_global_planning_ms",
+    ),
+}
+
+
+@dataclass(frozen=True)
+class TableReport:
+    """What :func:`report_tables` read and the Markdown it made."""
+
+    kind: str  # "benchmark" or "best_known"
+    source: Path  # the CSV file read
+    table: str  # a name of RUN_TABLES, or "best_known"
+    rows: int  # rows read (missions, or best-known entries)
+    markdown: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the fields, and each Markdown table as ``{"columns", "rows"}``."""
+        return {
+            "kind": self.kind,
+            "source": str(self.source),
+            "table": self.table,
+            "rows": self.rows,
+            "tables": markdown_tables(self.markdown),
+            "markdown": self.markdown,
+        }
+
+
+def report_tables(
+    path: str | Path, table: str | None = None, reference: str | None = None
+) -> TableReport:
+    """The Markdown tables of a result file.
+
+    Args:
+        path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv``, or a
+            best-known table (``configs/best_known/best_known.csv``, told by its columns).
+        table: for a ``runs.csv``, one of :data:`RUN_TABLES` (default ``overview``); a
+            best-known table has one table and takes None.
+        reference: the policy the others are compared with (default ``semantic``).
+
+    Raises:
+        ValueError: one line naming the problem: no such file, no ``runs.csv`` in the folder,
+            an unknown table, a column the table needs that the file lacks, no rows.
+    """
+    from semexplore_gym.evaluation import best_known
+
+    source = _csv_of(Path(path))
+    header = _header(source)
+    if set(best_known.COLUMNS) <= set(header):
+        if table is not None:
+            raise ValueError(
+                f"{source} is a best-known table, which has one table (got --table {table})"
+            )
+        entries = best_known.read_table(source)
+        if not entries:
+            raise ValueError(f"{source} holds no best-known entries")
+        md = "\n".join(best_known.overview_lines(entries)) + "\n"
+        return TableReport("best_known", source, "best_known", len(entries), md)
+    name = table or "overview"
+    if name not in RUN_TABLES:
+        raise ValueError(f"unknown table {name!r}: choose one of {', '.join(RUN_TABLES)}")
+    rows = read_trimmed_runs(source, NEEDED_COLUMNS[name], name)
+    md = "\n".join(_run_table_lines(source, rows, name, reference)).strip() + "\n"
+    return TableReport("benchmark", source, name, len(rows), md)
+
+
+def _csv_of(p: Path) -> Path:
+    if p.is_dir():
+        if not (p / "runs.csv").is_file():
+            raise ValueError(
+                f"{p} has no runs.csv (give a benchmark run folder, a runs.csv or a "
+                "best-known CSV)"
+            )
+        return p / "runs.csv"
+    if not p.is_file():
+        raise ValueError(f"{p} does not exist")
+    return p
+
+
+def _header(source: Path) -> list[str]:
+    with source.open(newline="", encoding="utf-8", errors="replace") as f:
+        first = f.readline()
+    return next(csv.reader([first]), []) if first.strip() else []
+
+
+def read_trimmed_runs(source: Path, needed: tuple[str, ...], table: str) -> list[dict[str, Any]]:
+    """The rows of a ``runs.csv`` that may lack columns other than ``needed`` (absent cells
+    read as empty), numbers parsed as :func:`~.run_row.read_runs` parses them."""
+    from semexplore_gym.evaluation.run_row import CSV_COLUMNS, complete_csv_bytes, parse_cells
+
+    text = source.read_bytes()[: complete_csv_bytes(source)].decode("utf-8", errors="replace")
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    columns = reader.fieldnames or []
+    missing = [c for c in needed if c not in columns]
+    if missing:
+        s = "s" if len(missing) > 1 else ""
+        raise ValueError(
+            f"{source} has no column{s} {', '.join(missing)} (the {table} table reads "
+            f"{', '.join(needed)})"
+        )
+    blank = {c: "" for c in CSV_COLUMNS if c not in columns}
+    rows = [
+        parse_cells({**blank, **raw}, f"{source} line {i}")
+        for i, raw in enumerate(reader, start=2)
+    ]
+    if not rows:
+        raise ValueError(f"no finished missions in {source}")
+    return rows
+
+
+def _run_table_lines(
+    source: Path, rows: list[dict[str, Any]], table: str, reference: str | None
+) -> list[str]:
+    from semexplore_gym.evaluation import report
+
+    ref = reference or report.REFERENCE_POLICY
+    if table == "summary":
+        return report.summary_lines(source.parent, rows, ref)
+    if table == "policies":
+        return report.policy_table(report.policies_of(rows))
+    lines = report.overview_table(report.group_by_family(rows), ref)
+    return lines[lines.index("") + 1 :]  # without the section's heading
+
+
+def markdown_tables(markdown: str) -> list[dict[str, Any]]:
+    """Each pipe table of ``markdown`` as ``{"columns": [...], "rows": [[...], ...]}``."""
+    tables: list[dict[str, Any]] = []
+    block: list[list[str]] = []
+    for line in [*markdown.splitlines(), ""]:
+        if line.startswith("|"):
+            block.append([c.strip() for c in line.strip().strip("|").split("|")])
+            continue
+        if len(block) >= 2:
+            tables.append({"columns": block[0], "rows": block[2:]})
+        block = []
+    return tables
