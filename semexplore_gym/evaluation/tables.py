@@ -100,8 +100,7 @@ def _csv_of(p: Path) -> Path:
     if p.is_dir():
         if not (p / "runs.csv").is_file():
             raise ValueError(
-                f"{p} has no runs.csv (give a benchmark run folder, a runs.csv or a "
-                "best-known CSV)"
+                f"{p} has no runs.csv (give a benchmark run folder, a runs.csv or a best-known CSV)"
             )
         return p / "runs.csv"
     if not p.is_file():
@@ -132,8 +131,7 @@ def read_trimmed_runs(source: Path, needed: tuple[str, ...], table: str) -> list
         )
     blank = {c: "" for c in CSV_COLUMNS if c not in columns}
     rows = [
-        parse_cells({**blank, **raw}, f"{source} line {i}")
-        for i, raw in enumerate(reader, start=2)
+        parse_cells({**blank, **raw}, f"{source} line {i}") for i, raw in enumerate(reader, start=2)
     ]
     if not rows:
         raise ValueError(f"no finished missions in {source}")

@@ -53,6 +53,7 @@ def _commands(tmp: Path) -> dict[str, list[list[str]]]:
         "maps": [["maps", "list", "--json"], ["maps", "path", "--json"]],
         "pretrained": [["pretrained", "--json"]],
         "oracle": [["oracle", WORLD, "--start-seed", "0", "--json"]],
+        "report": [["report", str(CONFIGS.parent / "best_known" / "best_known.csv"), "--json"]],
     }
 
 

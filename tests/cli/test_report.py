@@ -1,0 +1,126 @@
+"""``semexplore report``: a run folder's or a best-known table's results as Markdown."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from semexplore_gym.cli import main
+from semexplore_gym.evaluation.best_known import COLUMNS as BEST_KNOWN_COLUMNS
+from semexplore_gym.evaluation.report import write_summary
+from semexplore_gym.evaluation.run_row import CSV_COLUMNS, RunRow
+
+OFFICE = "office:seed=1,size_m=12"
+#: (world, policy, seed) -> (mission time, self-stopped): semantic takes half nearest's time.
+MISSIONS = {
+    (world, policy, seed): (t * (1 if policy == "semantic" else 2), policy == "semantic" or seed)
+    for world in ("maze1", OFFICE)
+    for policy in ("semantic", "nearest")
+    for seed, t in enumerate((100.0, 110.0, 120.0))
+}
+
+
+def _write_runs(path: Path, columns: tuple[str, ...] = ("world", "policy", "seed")) -> Path:
+    """A hand-written runs.csv of :data:`MISSIONS` with ``columns`` (and the overview's)."""
+    path.mkdir(parents=True, exist_ok=True)
+    cols = [*columns, "self_stopped", "coverage", "mission_time_s", "T90_s"]
+    with (path / "runs.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for (world, policy, seed), (t, stopped) in MISSIONS.items():
+            cells = {"world": world, "policy": policy, "seed": seed}
+            cells |= {"self_stopped": bool(stopped), "coverage": 0.99, "mission_time_s": t}
+            w.writerow([cells.get(c, t * 0.8) for c in cols])
+    return path
+
+
+def test_report_prints_the_overview_of_a_trimmed_runs_csv(tmp_path: Path, capsys) -> None:
+    run = _write_runs(tmp_path / "run")
+    assert main(["report", str(run)]) == 0
+    out = capsys.readouterr().out
+    rows = [ln for ln in out.splitlines() if ln.startswith("| ") and "family" not in ln]
+    assert rows == [
+        "| paper mazes | semantic | 3 | 3/3 | 0.990 | 110.0 | 88.0 | – | – | – | – |",
+        "| paper mazes | nearest | 3 | 2/3 | 0.990 | 220.0 | 176.0 | – | 0.50 | 0.1 | 0.25 |",
+        "| office | semantic | 3 | 3/3 | 0.990 | 110.0 | 88.0 | – | – | – | – |",
+        "| office | nearest | 3 | 2/3 | 0.990 | 220.0 | 176.0 | – | 0.50 | 0.1 | 0.25 |",
+    ]
+
+
+def test_report_json_is_one_document_with_the_tables_rows(tmp_path: Path, capsys) -> None:
+    run = _write_runs(tmp_path / "run")
+    assert main(["report", str(run / "runs.csv"), "--table", "policies", "--json"]) == 0
+    out = capsys.readouterr().out
+    result = json.loads(out)
+    assert out.count("\n") == 1
+    assert (result["kind"], result["table"], result["rows"]) == ("benchmark", "policies", 12)
+    (table,) = result["tables"]
+    assert table["columns"][:3] == ["policy", "n", "self-stopped"]
+    assert [r[:3] for r in table["rows"]] == [["semantic", "6", "6/6"], ["nearest", "6", "4/6"]]
+
+
+def test_report_out_writes_the_markdown_to_the_file(tmp_path: Path, capsys) -> None:
+    run = _write_runs(tmp_path / "run")
+    assert main(["report", str(run), "--out", str(tmp_path / "t.md")]) == 0
+    assert capsys.readouterr().out == ""
+    assert "| office | nearest | 3 | 2/3 |" in (tmp_path / "t.md").read_text()
+
+
+def test_report_summary_is_the_benchmarks_summary(tmp_path: Path, capsys) -> None:
+    """With every column, ``--table summary`` prints what the benchmark writes to summary.md."""
+    run = tmp_path / "run"
+    run.mkdir()
+    with (run / "runs.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS))
+        w.writeheader()
+        for (world, policy, seed), (t, stopped) in MISSIONS.items():
+            row = RunRow(world, policy, seed, t, 0.99, bool(stopped), "done", t / 5, 0,
+                         t * 0.8, t * 0.95, 2.0 + seed, 3.0, 1.0, 40.0, 100)  # fmt: skip
+            w.writerow({k: "" if v is None else v for k, v in row.to_dict().items()})
+    assert main(["report", str(run), "--table", "summary"]) == 0
+    printed = capsys.readouterr().out
+    assert printed.strip() == write_summary(run).read_text().strip()
+    assert "## All worlds (2 worlds)" in printed
+
+
+def test_report_of_a_best_known_table(tmp_path: Path, capsys) -> None:
+    table = tmp_path / "best_known.csv"
+    with table.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(BEST_KNOWN_COLUMNS)
+        w.writerow(["maze1", 0, "random", 150.0, "semantic-v3", 30.0, "oracle", 15.0, 3.0])
+        w.writerow(["maze1", 1, "random", 160.0, "oracle", 32.0, "oracle", 16.0, 3.2])
+        w.writerow(["maze2", 0, "random", 170.0, "semantic-v3", 34.0, "oracle", "", ""])
+    assert main(["report", str(table)]) == 0
+    rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("| paper")]
+    assert rows == [
+        "| paper mazes | random | 3 | 160.0 [150.0–160.0] | 15.0 [15.0–15.0] | "
+        "32.0 [30.0–32.0] | 3.0 [3.0–3.0] | semantic-v3 2, oracle 1 |"
+    ]
+
+
+@pytest.mark.parametrize(
+    ("make", "argv_tail", "says"),
+    [
+        (lambda d: d.mkdir(), [], "has no runs.csv"),
+        (lambda d: None, [], "does not exist"),
+        (lambda d: _write_runs(d, ("world", "seed")), [], "has no column policy"),
+        (lambda d: _write_runs(d), ["--table", "summary"], "has no columns path_length_m, T99_s"),
+        (lambda d: _write_runs(d), ["--out", "nowhere/x.md"], "--out"),
+    ],
+    ids=["no runs.csv", "no folder", "missing column", "summary columns", "bad out"],
+)
+def test_bad_input_is_one_error_line_and_exit_2(
+    tmp_path: Path, capsys, make, argv_tail: list[str], says: str
+) -> None:
+    run = tmp_path / "run"
+    make(run)
+    assert main(["report", str(run), *argv_tail, "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("semexplore report: error:")
+    assert says in lines[0]
