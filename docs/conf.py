@@ -16,6 +16,9 @@ sys.path.insert(0, str(ROOT))
 
 import semexplore_gym  # noqa: E402
 
+# The docs' own extension: the user guide's result tables, computed from docs/results/.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "_ext"))
+
 project = "SemanticExplore"
 author = "SemanticExplore developers"
 copyright = "SemanticExplore developers"
@@ -27,10 +30,12 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.viewcode",
+    "generated_tables",
 ]
 source_suffix = {".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+# _generated: tables the pages include; results: the data they are computed from.
+exclude_patterns = ["_build", "_generated", "_ext", "results", "Thumbs.db", ".DS_Store"]
 suppress_warnings: list[str] = []
 if not (Path(__file__).parent / "architecture.md").is_file():
     # A checkout from before docs/architecture.md existed: the toctree's entry is left dangling.

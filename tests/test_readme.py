@@ -281,7 +281,7 @@ def test_every_code_block_is_run_or_marked() -> None:
                 for argv in bash_commands(b.body):
                     if not is_runnable(argv) and argv[0] not in CI_COMMANDS:
                         problems.append(f"{where}: cannot run {shlex.join(argv)!r}")
-            elif b.lang not in ("python", "{toctree}", "{eval-rst}"):
+            elif b.lang not in ("python", "{toctree}", "{eval-rst}", "{include}"):
                 problems.append(f"{where}: a ```{b.lang} block: use bash/python or mark it")
     assert not problems, "\n".join(problems)
     assert len(not_run) <= MAX_NOT_RUN, f"too many illustrative blocks: {not_run}"
