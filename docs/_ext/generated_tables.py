@@ -3,9 +3,9 @@
 Each table of :data:`TABLES` is computed by ``semexplore report``'s own function
 (:func:`semexplore_gym.evaluation.tables.report_tables`) from a small result file shipped
 under ``docs/results/`` (or from a shipped table such as ``configs/best_known/best_known.csv``)
-and written to ``docs/_generated/NAME.md``, which a page pulls in with
-```` ```{include} _generated/NAME.md ```` ````. A table therefore cannot drift from its data: to
-refresh one, replace its result file and rebuild.
+and written to ``docs/_generated/NAME.md`` (git ignores it), which a page pulls in with an
+``{include} _generated/NAME.md`` block. A table therefore cannot drift from its data: to
+refresh one, replace its result file and rebuild (``docs/results/README.md``).
 """
 
 from __future__ import annotations

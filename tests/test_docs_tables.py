@@ -1,0 +1,76 @@
+"""The user guide's result tables are computed from their data when the docs are built
+(``docs/_ext/generated_tables.py``), by the function behind ``semexplore report``."""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import re
+from pathlib import Path
+
+from semexplore_gym.cli import main
+from semexplore_gym.evaluation.suites import world_family
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+INCLUDE = re.compile(r"^```\{include\}\s+_generated/(\S+)\.md\s*$", re.M)
+
+
+def _extension():
+    spec = importlib.util.spec_from_file_location(
+        "generated_tables", DOCS / "_ext/generated_tables.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _included() -> dict[str, list[str]]:
+    """``{generated table: [pages that include it]}`` over the site's pages."""
+    found: dict[str, list[str]] = {}
+    for page in sorted(DOCS.glob("*.md")):
+        for name in INCLUDE.findall(page.read_text(encoding="utf-8")):
+            found.setdefault(name, []).append(page.name)
+    return found
+
+
+def test_the_build_step_writes_every_included_table(tmp_path: Path) -> None:
+    written = _extension().write_tables(DOCS, tmp_path)
+    included = _included()
+    assert {"suites_overview", "best_known"} <= set(included)
+    assert set(included) == set(written), "a page includes a table no step makes, or vice versa"
+    for name, path in written.items():
+        text = path.read_text(encoding="utf-8")
+        assert text.count("\n|") >= 3, f"{name}: no table"
+        assert "*Computed when the docs are built from `" in text
+
+
+def test_the_benchmark_table_has_each_family_and_policy_of_its_runs(tmp_path: Path) -> None:
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["suites_overview"].read_text(encoding="utf-8")
+    source = DOCS / ext.TABLES["suites_overview"][0]
+    with source.open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    for family in {world_family(r["world"]) for r in runs}:
+        for policy in {r["policy"] for r in runs}:
+            n = sum(1 for r in runs if world_family(r["world"]) == family and r["policy"] == policy)
+            assert f"| {family} | {policy} | {n} | " in text, (family, policy)
+
+
+def test_the_best_known_table_has_each_family_of_the_shipped_table(tmp_path: Path) -> None:
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["best_known"].read_text(encoding="utf-8")
+    with (DOCS / ext.TABLES["best_known"][0]).open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    for family in {world_family(r["world"]) for r in rows}:
+        n = sum(1 for r in rows if world_family(r["world"]) == family and r["start"] == "random")
+        assert f"| {family} | random | {n} | " in text, family
+
+
+def test_the_docs_tables_are_what_semexplore_report_prints(tmp_path: Path, capsys) -> None:
+    ext = _extension()
+    written = ext.write_tables(DOCS, tmp_path)
+    for name, (source, table) in ext.TABLES.items():
+        assert main(["report", str(DOCS / source), *(["--table", table] if table else [])]) == 0
+        printed = capsys.readouterr().out
+        assert written[name].read_text(encoding="utf-8").startswith(printed), name
