@@ -41,6 +41,7 @@ SITE_ORDER = (
     "benchmarks",
     "oracle",
     "teams",
+    "slam",
     "results",
     "learning",
     "learned_frontier_value",
