@@ -1,11 +1,12 @@
 """``semexplore report``: a result file's tables as Markdown, computed from its data.
 
 RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to
-the columns a table reads is enough), or a best-known table such as
-``configs/best_known/best_known.csv``. For a benchmark, ``--table`` picks the table of its
-``summary.md``: ``overview`` (one row per family and policy, the default), ``policies`` (one
-row per policy over all worlds) or ``summary`` (the whole summary). The docs build renders the
-user guide's result tables with the same function.
+the columns a table reads is enough), a team benchmark's run folder (``--robots``: its
+summary), or a best-known table such as ``configs/best_known/best_known.csv``. For a
+benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one row per family
+and policy, the default), ``policies`` (one row per policy over all worlds), ``slam`` (the
+SLAM table of a run with ``--env-config slam``) or ``summary`` (the whole summary). The docs
+build renders the user guide's result tables with the same function.
 
 Example::
 
@@ -35,13 +36,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "run_dir",
         metavar="RUN_DIR",
-        help="a benchmark run folder, a runs.csv, or a best-known CSV",
+        help="a benchmark or team benchmark run folder, a runs.csv, or a best-known CSV",
     )
     p.add_argument(
         "--table",
         choices=RUN_TABLES,
         default=None,
-        help="which of a benchmark's tables (default: overview; a best-known CSV has one)",
+        help="which of a benchmark's tables (default: overview; a team run and a best-known CSV "
+        "have one)",
     )
     p.add_argument(
         "--reference",

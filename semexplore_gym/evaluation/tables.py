@@ -1,4 +1,5 @@
-"""Markdown tables from result files: a benchmark's ``runs.csv`` or a best-known table.
+"""Markdown tables from result files: a benchmark's or a team benchmark's ``runs.csv``, or a
+best-known table.
 
 One function, :func:`report_tables`, serves ``semexplore report`` and the docs build, which
 renders the user guide's result tables from the small result files under ``docs/results/`` (a
@@ -16,13 +17,15 @@ from pathlib import Path
 from typing import Any
 
 #: The tables of a benchmark's ``runs.csv``: the summary's overview (one row per family and
-#: policy), its per-policy table over all worlds, or the whole ``summary.md``.
-RUN_TABLES: tuple[str, ...] = ("overview", "policies", "summary")
+#: policy), its per-policy table over all worlds, its SLAM table (missions with SLAM), or the
+#: whole ``summary.md``.
+RUN_TABLES: tuple[str, ...] = ("overview", "policies", "slam", "summary")
 _KEYS = ("world", "policy", "seed", "self_stopped")
 #: The ``runs.csv`` columns each table reads (the others may be absent).
 NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
     "overview": (*_KEYS, "coverage", "mission_time_s", "T90_s"),
     "policies": (*_KEYS, "coverage", "mission_time_s"),
+    "slam": (*_KEYS, "ate_m"),
     "summary": (
         *_KEYS,
         "coverage",
@@ -40,9 +43,9 @@ NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
 class TableReport:
     """What :func:`report_tables` read and the Markdown it made."""
 
-    kind: str  # "benchmark" or "best_known"
+    kind: str  # "benchmark", "team" or "best_known"
     source: Path  # the CSV file read
-    table: str  # a name of RUN_TABLES, or "best_known"
+    table: str  # a name of RUN_TABLES, "team" or "best_known"
     rows: int  # rows read (missions, or best-known entries)
     markdown: str
 
@@ -64,10 +67,12 @@ def report_tables(
     """The Markdown tables of a result file.
 
     Args:
-        path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv``, or a
-            best-known table (``configs/best_known/best_known.csv``, told by its columns).
-        table: for a ``runs.csv``, one of :data:`RUN_TABLES` (default ``overview``); a
-            best-known table has one table and takes None.
+        path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (a team
+            benchmark's is told by its ``n_robots`` column), or a best-known table
+            (``configs/best_known/best_known.csv``, told by its columns).
+        table: for a benchmark's ``runs.csv``, one of :data:`RUN_TABLES` (default
+            ``overview``); a team benchmark's summary and a best-known table are one table
+            each and take None.
         reference: the policy the others are compared with (default ``semantic``).
 
     Raises:
@@ -88,12 +93,53 @@ def report_tables(
             raise ValueError(f"{source} holds no best-known entries")
         md = "\n".join(best_known.overview_lines(entries)) + "\n"
         return TableReport("best_known", source, "best_known", len(entries), md)
+    if "n_robots" in header:
+        return _team_report(source, header, table)
     name = table or "overview"
     if name not in RUN_TABLES:
         raise ValueError(f"unknown table {name!r}: choose one of {', '.join(RUN_TABLES)}")
     rows = read_trimmed_runs(source, NEEDED_COLUMNS[name], name)
     md = "\n".join(_run_table_lines(source, rows, name, reference)).strip() + "\n"
     return TableReport("benchmark", source, name, len(rows), md)
+
+
+#: The columns of a team benchmark's ``runs.csv`` that its summary reads.
+TEAM_COLUMNS: tuple[str, ...] = (
+    "world",
+    "policy",
+    "n_robots",
+    "seed",
+    "coverage",
+    "mission_time_s",
+    "self_stopped",
+    "T90_s",
+    "T99_s",
+    "path_total_m",
+    "path_per_robot_m",
+    "overlap_ratio",
+    "robot_collisions",
+)
+
+
+def _team_report(source: Path, header: list[str], table: str | None) -> TableReport:
+    from semexplore_gym.evaluation.team_report import team_summary_lines
+
+    if table is not None:
+        raise ValueError(
+            f"{source} is a team benchmark's runs.csv, which has one table (got --table {table})"
+        )
+    missing = [c for c in TEAM_COLUMNS if c not in header]
+    if missing:
+        raise ValueError(f"{source} has no column{'s' * (len(missing) > 1)} {', '.join(missing)}")
+    with source.open(newline="", encoding="utf-8", errors="replace") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise ValueError(f"no finished missions in {source}")
+    try:
+        md = "\n".join(team_summary_lines(rows)).strip() + "\n"
+    except (TypeError, IndexError) as e:
+        raise ValueError(f"{source}: a malformed row ({e})") from None
+    return TableReport("team", source, "team", len(rows), md)
 
 
 def _csv_of(p: Path) -> Path:
@@ -142,12 +188,18 @@ def _run_table_lines(
     source: Path, rows: list[dict[str, Any]], table: str, reference: str | None
 ) -> list[str]:
     from semexplore_gym.evaluation import report
+    from semexplore_gym.evaluation.slam_report import slam_table
 
     ref = reference or report.REFERENCE_POLICY
     if table == "summary":
         return report.summary_lines(source.parent, rows, ref)
     if table == "policies":
         return report.policy_table(report.policies_of(rows))
+    if table == "slam":
+        lines = slam_table(report.group_by_family(rows))
+        if not lines:
+            raise ValueError(f"{source} has no mission with SLAM (its ate_m cells are empty)")
+        return lines[lines.index("") + 1 :]  # without the section's heading
     lines = report.overview_table(report.group_by_family(rows), ref)
     return lines[lines.index("") + 1 :]  # without the section's heading
 

@@ -80,7 +80,14 @@ def _table_row(rs: list[dict[str, str]], ratios: list[float], pol: str, n: int) 
 def write_team_summary(out: str | Path) -> Path:
     """``out/summary.md`` from ``out/runs.csv`` (module docstring)."""
     out_dir = Path(out)
-    rows = read_team_runs(out_dir)
+    path = out_dir / "summary.md"
+    path.write_text("\n".join(team_summary_lines(read_team_runs(out_dir))) + "\n")
+    return path
+
+
+def team_summary_lines(rows: list[dict[str, str]]) -> list[str]:
+    """The lines of the team benchmark's ``summary.md`` for the ``runs.csv`` rows ``rows``:
+    per family a table per (policy, team size) and the paired T99 tests."""
     ratios = speedup_ratios(rows)
     lines = ["# Team benchmark", ""]
     for fam in sorted({family(r["world"]) for r in rows}):
@@ -96,9 +103,7 @@ def write_team_summary(out: str | Path) -> Path:
             rs = [r for r in fam_rows if r["policy"] == pol and int(r["n_robots"]) == n]
             lines.append(_table_row(rs, ratios[(fam, pol, n)], pol, n))
         lines += ["", *paired_tests(fam_rows), ""]
-    path = out_dir / "summary.md"
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return lines
 
 
 def paired_tests(rows: list[dict[str, str]]) -> list[str]:

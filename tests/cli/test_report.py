@@ -124,3 +124,37 @@ def test_bad_input_is_one_error_line_and_exit_2(
     lines = captured.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("semexplore report: error:")
     assert says in lines[0]
+
+
+def test_report_of_a_team_benchmark_is_its_summary(tmp_path: Path, capsys) -> None:
+    run = tmp_path / "team"
+    run.mkdir()
+    columns = ["world", "policy", "n_robots", "seed", "coverage", "mission_time_s"]
+    columns += ["self_stopped", "T90_s", "T99_s", "path_total_m", "path_per_robot_m"]
+    columns += ["overlap_ratio", "robot_collisions"]
+    with (run / "runs.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        for seed in range(2):
+            w.writerow(["maze:seed=3,size_m=6", "greedy", 1, seed, 1.0, 200, True, 150, 200,
+                        40, "40", 0.0, 0])  # fmt: skip
+            w.writerow(["maze:seed=3,size_m=6", "greedy", 2, seed, 1.0, 120, True, 90, 100,
+                        44, "20;24", 0.1, 1])  # fmt: skip
+    assert main(["report", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert "| greedy | 2 | 2 | 90.0 | 100.0 | 120.0 | 0.50 | 44.0 | 24.0 | 0.10 | 2 |" in out
+    assert main(["report", str(run), "--table", "overview"]) == 2
+    assert "one table" in capsys.readouterr().err
+
+
+def test_report_slam_table_needs_missions_with_slam(tmp_path: Path, capsys) -> None:
+    run = _write_runs(tmp_path / "run", ("world", "policy", "seed", "ate_m"))
+    assert main(["report", str(run), "--table", "slam"]) == 0
+    rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("| office")]
+    assert [r.split(" | ")[:3] for r in rows] == [
+        ["| office", "semantic", "3"],
+        ["| office", "nearest", "3"],
+    ]
+    plain = _write_runs(tmp_path / "plain")
+    assert main(["report", str(plain), "--table", "slam"]) == 2
+    assert "has no column ate_m" in capsys.readouterr().err
