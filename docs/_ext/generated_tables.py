@@ -34,7 +34,8 @@ def write_tables(docs_dir: Path, out_dir: Path | None = None) -> dict[str, Path]
         shown = Path(source).as_posix().removeprefix("../")
         if not shown.startswith("configs/"):
             shown = f"docs/{shown}"
-        command = f"semexplore report {shown}" + (f" --table {table}" if table else "")
+        folder = shown.removesuffix("/runs.csv")  # a run folder reads its runs.csv
+        command = f"semexplore report {folder}" + (f" --table {table}" if table else "")
         text = (
             f"{result.markdown}\n"
             f"*Computed when the docs are built from `{shown}` ({result.rows} rows), by "
