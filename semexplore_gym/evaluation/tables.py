@@ -17,14 +17,16 @@ from pathlib import Path
 from typing import Any
 
 #: The tables of a benchmark's ``runs.csv``: the summary's overview (one row per family and
-#: policy), its per-policy table over all worlds, its SLAM table (missions with SLAM), or the
-#: whole ``summary.md``.
-RUN_TABLES: tuple[str, ...] = ("overview", "policies", "slam", "summary")
+#: policy), its per-policy table over all worlds, its regret against the oracle (a run with
+#: ``--oracle``), its SLAM table (missions with SLAM), or the whole summary as far as
+#: ``runs.csv`` holds it (the best-known and learning sections read other files).
+RUN_TABLES: tuple[str, ...] = ("overview", "policies", "regret", "slam", "summary")
 _KEYS = ("world", "policy", "seed", "self_stopped")
 #: The ``runs.csv`` columns each table reads (the others may be absent).
 NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
     "overview": (*_KEYS, "coverage", "mission_time_s", "T90_s"),
     "policies": (*_KEYS, "coverage", "mission_time_s"),
+    "regret": (*_KEYS, "coverage", "mission_time_s", "path_length_m", "T90_s", "T99_s"),
     "slam": (*_KEYS, "ate_m"),
     "summary": (
         *_KEYS,
@@ -187,12 +189,19 @@ def read_trimmed_runs(source: Path, needed: tuple[str, ...], table: str) -> list
 def _run_table_lines(
     source: Path, rows: list[dict[str, Any]], table: str, reference: str | None
 ) -> list[str]:
-    from semexplore_gym.evaluation import report
+    from semexplore_gym.evaluation import regret, report
     from semexplore_gym.evaluation.slam_report import slam_table
 
     ref = reference or report.REFERENCE_POLICY
+    has_oracle = any(r["policy"] == regret.ORACLE_SPEC for r in rows)
     if table == "summary":
-        return report.summary_lines(source.parent, rows, ref)
+        lines = report.summary_lines(source.parent, rows, ref)
+        return lines + (regret.summary_lines(rows, regret.regret_rows(rows)) if has_oracle else [])
+    if table == "regret":
+        if not has_oracle:
+            raise ValueError(f"{source} has no {regret.ORACLE_SPEC} missions (run with --oracle)")
+        lines = regret.summary_lines(rows, regret.regret_rows(rows))
+        return lines[lines.index("") + 1 :]  # without the section's heading
     if table == "policies":
         return report.policy_table(report.policies_of(rows))
     if table == "slam":

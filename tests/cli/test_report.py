@@ -158,3 +158,26 @@ def test_report_slam_table_needs_missions_with_slam(tmp_path: Path, capsys) -> N
     plain = _write_runs(tmp_path / "plain")
     assert main(["report", str(plain), "--table", "slam"]) == 2
     assert "has no column ate_m" in capsys.readouterr().err
+
+
+def test_report_regret_compares_each_policy_with_the_oracle(tmp_path: Path, capsys) -> None:
+    run = tmp_path / "run"
+    run.mkdir()
+    cols = ["world", "policy", "seed", "self_stopped", "coverage", "mission_time_s"]
+    cols += ["path_length_m", "T90_s", "T99_s"]
+    with (run / "runs.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for seed in range(3):
+            w.writerow(["maze1", "oracle", seed, True, 0.995, 100, 20, 80, 100])
+            w.writerow(["maze1", "semantic", seed, True, 0.998, 150, 30, 120, 150])
+    assert main(["report", str(run), "--table", "regret"]) == 0
+    out = capsys.readouterr().out
+    assert "Oracle missions: 3; self-stopped 3" in out
+    assert "| semantic | 3 | 1.50 [1.50–1.50] | 1.50 [1.50–1.50] |" in out
+    assert main(["report", str(_write_runs(tmp_path / "plain")), "--table", "regret"]) == 2
+    assert "has no columns path_length_m, T99_s" in capsys.readouterr().err
+    text = (run / "runs.csv").read_text().splitlines()
+    (run / "runs.csv").write_text("\n".join(ln for ln in text if ",oracle," not in ln) + "\n")
+    assert main(["report", str(run), "--table", "regret"]) == 2
+    assert "has no oracle missions (run with --oracle)" in capsys.readouterr().err
