@@ -106,6 +106,36 @@ class ExpertRecipe:
         sources = insert_plan_source(self.plan_sources, source, before=before, after=after)
         return replace(self, plan_sources=sources)
 
+    def without(self, *names: str, name: str | None = None) -> ExpertRecipe:
+        """This recipe without the plan sources so named (a variant; ``name``: its name).
+
+        Raises:
+            ValueError: it lists no source of one of the names.
+        """
+        missing = [n for n in names if n not in self.source_names]
+        if missing:
+            raise ValueError(f"recipe {self.name!r} lists no plan source {missing[0]!r}")
+        kept = tuple(s for s in self.plan_sources if s.name not in names)
+        return replace(self, name=name or self.name, plan_sources=kept)
+
+    def with_rules(self, name: str | None = None, **rules: bool) -> ExpertRecipe:
+        """This recipe with goal rules changed (``shuttle_guard=False``; a variant)."""
+        return replace(self, name=name or self.name, goal_rules=replace(self.goal_rules, **rules))
+
+    def with_semantic(self, name: str | None = None, **variant: bool) -> ExpertRecipe:
+        """This recipe with another variant of its ``semantic`` source (``grid_route=False``).
+
+        Raises:
+            ValueError: it lists no semantic source.
+        """
+        old = self.semantic_source
+        if old is None:
+            raise ValueError(f"recipe {self.name!r} lists no semantic plan source")
+        parts = {k: getattr(old, k) for k in ("grid_candidate", "grid_route", "entry_detour")}
+        new = SemanticFrontier(**{**parts, **variant})
+        sources = tuple(new if s is old else s for s in self.plan_sources)
+        return replace(self, name=name or self.name, plan_sources=sources)
+
 
 #: Today's expert (``semantic``): every plan source, every goal rule.
 SEMANTIC_V3 = ExpertRecipe("semantic-v3", DEFAULT_PLAN_SOURCES)
@@ -174,15 +204,7 @@ PAPER_METHOD = ExpertRecipe(
 #: Today's recipe for an expert whose goals an outside choice makes: the grid's nearest frontier
 #: would overrule that choice, and the learned agents were trained and measured driving the
 #: map's paths.
-OUTSIDE_CHOICE = ExpertRecipe(
-    "outside-choice",
-    tuple(
-        SemanticFrontier(grid_candidate=False, grid_route=False)
-        if isinstance(s, SemanticFrontier)
-        else s
-        for s in DEFAULT_PLAN_SOURCES
-    ),
-)
+OUTSIDE_CHOICE = SEMANTIC_V3.with_semantic("outside-choice", grid_candidate=False, grid_route=False)
 
 
 def for_outside_choice(recipe: ExpertRecipe, policy: str) -> ExpertRecipe:
