@@ -65,7 +65,9 @@ def test_the_team_members_run_the_outside_choice_recipe() -> None:
 
 def test_the_expert_driver_refuses_a_recipe_it_cannot_honour() -> None:
     assert ExpertDriver().recipe is OUTSIDE_CHOICE
-    with pytest.raises(ValueError, match=r"expert driver cannot honour recipe 'semantic-v3'.*grid_"):
+    with pytest.raises(
+        ValueError, match=r"expert driver cannot honour recipe 'semantic-v3'.*grid_"
+    ):
         ExpertDriver(recipe=SEMANTIC_V3)
     # The 0.2.0 expert drove the map's paths without the grid candidate: the driver can run it.
     assert ExpertDriver(recipe=SEMANTIC_V2).recipe is SEMANTIC_V2
