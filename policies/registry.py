@@ -53,7 +53,9 @@ def _expert_like(
 
 def _expert_recipe(name: str, recipe: Any) -> Factory:
     """The factory of an expert made from ``recipe`` (:mod:`semexplore_gym.policies.expert.
-    recipes`): its parameter values below the caller's params."""
+    recipes`): its parameter values below the caller's params. The argument may name a YAML
+    file of parameter values (``semantic:configs/expert/optuna_weights.yaml``), a layer
+    between the recipe's values and the caller's."""
 
     def factory(arg: str, overrides: dict[str, Any]) -> Policy:
         from semexplore_gym.policies.expert.expert import (
@@ -61,12 +63,15 @@ def _expert_recipe(name: str, recipe: Any) -> Factory:
             SemanticExpertPolicy,
         )
 
-        layers = (
-            (SemanticExpertParams, dict(recipe.params))
-            if recipe.params
-            else (SemanticExpertParams,)
-        )
-        return _expert_like(name, arg, overrides, SemanticExpertPolicy, *layers, recipe=recipe)
+        layers: list[Any] = [SemanticExpertParams, dict(recipe.params) or None]
+        if arg:
+            if not arg.endswith((".yaml", ".yml")):
+                raise ValueError(
+                    f"policy {name!r} takes no argument but a parameter file (.yaml), "
+                    f"got '{name}:{arg}'"
+                )
+            layers.append(arg)
+        return _expert_like(name, "", overrides, SemanticExpertPolicy, *layers, recipe=recipe)
 
     return factory
 

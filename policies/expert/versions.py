@@ -77,7 +77,7 @@ def expert_version(spec: str) -> str:
     Raises:
         ValueError: a malformed spec (the message names it).
     """
-    base, _, _ = parse_spec(spec)
+    base = parse_spec(spec)[0].partition(":")[0]
     if base == NEWEST_ALIAS:
         return LATEST_EXPERT
     return base if base in EXPERT_VERSIONS else ""
