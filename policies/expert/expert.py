@@ -29,7 +29,7 @@ The parts
 * ``follower``: a :class:`~semexplore_gym.policies.expert.path_following.PathFollower`
   (potential field, local-minimum escape, progress watch, back-off recovery).
 
-``counts`` (:class:`~semexplore_gym.policies.expert.counters.ExpertCounters`), ``events``: what fired.
+``counts`` (an ``ExpertCounters``) and ``events`` record what fired.
 
 Plug-in points
 --------------

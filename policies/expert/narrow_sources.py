@@ -1,7 +1,7 @@
 """The semantic expert's narrow tier: plan sources through passages narrower than the planners'
 clearance (:class:`RoomBeyondGap`, listed by today's expert's recipe; :class:`NarrowFallback`,
-the user's switch ``narrow_passages``). Their plans carry the map's clearance along their paths, and the path
-follower tracks the tight stretches slowly and exactly. Both are in
+the user's switch ``narrow_passages``). Their plans carry the map's clearance along their
+paths, and the path follower tracks the tight stretches slowly and exactly. Both are in
 :data:`~semexplore_gym.policies.expert.plan_sources.DEFAULT_PLAN_SOURCES`, after the pocket
 escape and before the stop rule's look.
 """

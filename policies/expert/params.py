@@ -7,8 +7,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
   segmentation and search run only every ``replan_period_s``, and at once when the goal is
   reached, when it vanishes (no frontier cell, UNKNOWN next to FREE, is left within
-  ``goal_check_radius_m`` of it: its frontier has been mapped; the goal rule ``vanish_on_frontier`` off, ``semantic-v2``:
-  no UNKNOWN cell at all, which unknown space behind a mapped wall keeps from happening), when
+  ``goal_check_radius_m`` of it: its frontier has been mapped; without the goal rule
+  ``vanish_on_frontier``, as in ``semantic-v2``: no UNKNOWN cell at all, which unknown space
+  behind a mapped wall keeps from happening), when
   the path is used up, or when a recovery ends. A scheduled
   replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
   became known since the last one, e.g. while the robot crosses explored space.
@@ -23,7 +24,8 @@ What the paper leaves open, and how the expert handles it (parameters in
 * **Path entry check**: when the straight first leg from the robot to the map's path crosses
   an occupied cell (the robot stands outside every area), a grid path with the robot's
   clearance leads to the path instead.
-* **Grid-frontier fallback** (sources ``committed_fallback``, ``nearest_fallback``; ``fallback_min_frontier_m``,
+* **Grid-frontier fallback** (sources ``committed_fallback``, ``nearest_fallback``;
+  ``fallback_min_frontier_m``,
   ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
   frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
   space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
@@ -64,8 +66,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``revive_window_m`` of a dropped goal changed since it was dropped (the map around it grew or
   was corrected), it is considered again, at most ``max_revivals`` times. A goal dropped
   within ``blacklist_radius_m`` of an earlier drop is the same place for that count; with
-  the goal rule ``drop_each_point`` (not in ``semantic-v2``) it keeps a point of its own too, so the frontier round it is ignored
-  as well (without, the grid fallback could find the same goal again at once, for ever).
+  the goal rule ``drop_each_point`` (not in ``semantic-v2``) it keeps a point of its own too,
+  so the frontier round it is ignored as well (without, the grid fallback could find the same
+  goal again at once, for ever).
 * **The stop rule**: the mission stops only when the grid fallback (a clearance-aware grid
   search, the final check) finds no frontier the robot's disc can reach, besides dropped goals;
   the stop reason names the rule and counts what was dropped and why.
@@ -81,9 +84,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   discarded: before stopping, the robot drives to a standable point within ``look_reach_m`` of
   one with unknown space behind it to look closer, once per place; if the gap widens it is
   explored, otherwise it is dropped as looked-at.
-* **Oscillation guard** (goal rule ``oscillation_guard``, ``oscillation_window_s``): the robot does not
-  switch back to a goal it abandoned less than ``oscillation_window_s`` ago while its current
-  goal is still a candidate (two far frontiers whose costs trade places as the robot moves
+* **Oscillation guard** (goal rule ``oscillation_guard``, ``oscillation_window_s``): the robot
+  does not switch back to a goal it abandoned less than ``oscillation_window_s`` ago while its
+  current goal is still a candidate (two far frontiers whose costs trade places as the robot moves
   would otherwise keep it shuttling between them, as on open ground).
 
 * **Shuttle guard** (goal rule ``shuttle_guard``, ``shuttle_switches``, ``shuttle_radius_m``,
@@ -131,7 +134,8 @@ What the paper leaves open, and how the expert handles it (parameters in
   that much since (from elsewhere). ``narrow_give_up_s`` > 0 gives up by time instead: no new
   narrow goal once the map has gained less than ``narrow_give_up_m2`` of room to move in the
   last ``narrow_give_up_s`` seconds (both measured in docs/results.md; off by default).
-* **Room beyond a gap** (source ``room_beyond_gap``, ``narrow_min_room_m2``; in ``semantic-v3``): when
+* **Room beyond a gap** (source ``room_beyond_gap``, ``narrow_min_room_m2``; in
+  ``semantic-v3``): when
   nothing is reachable at the planners' clearance, but the map shows room beyond a gap
   narrower than it (at least ``narrow_min_room_m2`` of space with the planners' clearance and a
   frontier next to it, seen through the gap:
