@@ -18,6 +18,8 @@ SPEC = re.compile(
     r"(?<![\w.\-/])((?:semantic|frontier|nearest|random|oracle|team)[\w\-]*)\[([^\]\n]*=[^\]\n]*)\]"
 )
 MAX_OVERRIDES = 2
+#: A ``--policy-set key=value`` flag (the CLI's per-key override).
+POLICY_SET = re.compile(r"--policy-set[ =]'?\"?([\w.]+)=")
 
 
 def specs_in(text: str) -> list[tuple[str, list[str]]]:
@@ -37,6 +39,10 @@ def test_the_scanner_finds_specs_and_their_keys() -> None:
         ("frontier-student[expert.grid_candidate=true]", ["expert.grid_candidate"]),
     ]
     assert specs_in("a list[int] = x; semantic[tuned]") == []
+    assert POLICY_SET.findall("--policy-set grid_candidate=false --policy-set 'cost.w_v=2'") == [
+        "grid_candidate",
+        "cost.w_v",
+    ]
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
@@ -48,4 +54,7 @@ def test_no_spec_has_more_than_two_overrides_or_a_removed_key(page: Path) -> Non
         gone = [k for k in keys if k.rsplit(".", 1)[-1] in REMOVED_SWITCHES]
         if gone:
             bad.append(f"{spec} (removed: {', '.join(gone)})")
+    for key in POLICY_SET.findall(page.read_text(encoding="utf-8")):
+        if key.rsplit(".", 1)[-1] in REMOVED_SWITCHES:
+            bad.append(f"--policy-set {key}=... (removed)")
     assert not bad, f"{page.name}: " + "; ".join(bad)
