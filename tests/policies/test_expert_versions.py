@@ -139,3 +139,17 @@ def test_pretrained_details_name_the_expert_version(capsys: pytest.CaptureFixtur
         models
     )
     assert all(m.to_dict()["expert_version"] == "semantic-v2" for m in models)
+
+
+def test_a_version_takes_its_parameter_values_from_a_file(tmp_path: Path) -> None:
+    """``semantic:FILE.yaml`` is a short spec for many values (the docs' Optuna weights)."""
+    pol = make_policy("semantic:configs/expert/optuna_weights.yaml")
+    assert (pol.params.cost.w_v, pol.params.cost.w_p, pol.params.cost.w_i) == (0.62, 0.051, 0.004)
+    assert expert_version("semantic:configs/expert/optuna_weights.yaml") == "semantic-v3"
+    own = tmp_path / "w.yaml"
+    own.write_text("cost: {w_v: 2.0}\n")
+    v2 = make_policy(f"semantic-v2:{own}[cost.w_p=0.5]")
+    assert (v2.params.cost.w_v, v2.params.cost.w_p) == (2.0, 0.5)  # the bracket wins last
+    assert v2.recipe is EXPERT_VERSIONS["semantic-v2"].recipe
+    with pytest.raises(ValueError, match="takes no argument but a parameter file"):
+        make_policy("semantic:tuned")
