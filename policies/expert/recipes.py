@@ -33,7 +33,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from types import MappingProxyType
 
 from semexplore_gym.policies.expert.goal_memory import GoalRules
 from semexplore_gym.policies.expert.narrow_sources import NarrowFallback
@@ -71,13 +70,14 @@ class ExpertRecipe:
         plan_sources: The plan sources asked at each replan, in order.
         goal_rules: The rules the goal memory follows.
         params: Parameter values (flat or nested keys of ``SemanticExpertParams``) the recipe
-            starts from, below the user's overrides.
+            starts from, below the user's overrides (a plain dict, so that an expert pickles;
+            treat it as read-only).
     """
 
     name: str
     plan_sources: tuple[PlanSource, ...]
     goal_rules: GoalRules = field(default_factory=GoalRules)
-    params: Mapping[str, object] = field(default_factory=lambda: MappingProxyType({}))
+    params: Mapping[str, object] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         names = self.source_names
@@ -162,23 +162,21 @@ SEMANTIC_V2 = ExpertRecipe(
 )
 
 #: The paper's parameter values where ours differ (the weights are the paper's by default).
-PAPER_PARAMS: Mapping[str, object] = MappingProxyType(
-    {
-        "prune_by": "area",
-        "min_frontier_width_m": 0.0,
-        "resegment_min_new_m2": 0.0,
-        "stop_confirmations": 1,
-        "goal_commitment": False,
-        "local_min_escape": False,
-        "stuck_recovery": False,
-        "potential_field": {
-            "lookahead_clearance_m": 0.0,
-            "map_guard_radius_m": 0.0,
-            "guard_steer_max_rad": 0.0,
-            "braking_guard": False,
-        },
-    }
-)
+PAPER_PARAMS: Mapping[str, object] = {
+    "prune_by": "area",
+    "min_frontier_width_m": 0.0,
+    "resegment_min_new_m2": 0.0,
+    "stop_confirmations": 1,
+    "goal_commitment": False,
+    "local_min_escape": False,
+    "stuck_recovery": False,
+    "potential_field": {
+        "lookahead_clearance_m": 0.0,
+        "map_guard_radius_m": 0.0,
+        "guard_steer_max_rad": 0.0,
+        "braking_guard": False,
+    },
+}
 
 #: The paper's method alone (``semantic-paper``): Algorithm 1 along the map's path and nothing
 #: of ours; ``configs/expert/paper_method.yaml`` names it (tests/policies/test_policy_config.py).

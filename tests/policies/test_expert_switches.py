@@ -70,3 +70,13 @@ def test_a_removed_switch_in_a_policy_config_is_an_error_too(tmp_path, capsys) -
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "error: config key 'grid_fallback' was removed" in err[0]
     assert "semantic-paper" in err[0]
+
+
+@pytest.mark.parametrize("spec", ["semantic", "semantic-v2", "semantic-paper", "frontier-value"])
+def test_an_expert_with_its_recipe_pickles(spec: str) -> None:
+    import pickle
+
+    pol = make_policy(spec)
+    back = pickle.loads(pickle.dumps(pol))
+    assert back.recipe == pol.recipe
+    assert [s.name for s in back.plan_sources] == [s.name for s in pol.plan_sources]
