@@ -31,14 +31,10 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.expert.params import (
-    SemanticExpertParams,
-    for_outside_choice,
-    outside_choice_params,
-)
+from semexplore_gym.policies.expert.params import SemanticExpertParams
 from semexplore_gym.policies.expert.plan import Plan, PlanKind
 from semexplore_gym.policies.expert.plan_context import PlanContext, PlanSource
-from semexplore_gym.policies.expert.plan_sources import DEFAULT_PLAN_SOURCES, insert_plan_source
+from semexplore_gym.policies.expert.recipes import OUTSIDE_CHOICE
 
 from semexplore_gym.core.features.frontier_option_features import (
     OPTION_FEATURE_NAMES,
@@ -92,8 +88,9 @@ class FrontierStudentParams:
 
     Attributes:
         expert: The semantic expert's parameters (navigation, memory, stop rule; its
-            frontier choice is not used while the student has options; ``grid_candidate`` and
-            ``semantic_grid_route`` are off, and setting either is an error).
+            frontier choice is not used while the student has options; the expert is made
+            from the outside-choice recipe, :data:`~semexplore_gym.policies.expert.recipes.
+            OUTSIDE_CHOICE`).
         model: The learned score.
         keep_goal: Keep the current goal while it is still one of the options (reached,
             mapped or unreachable goals end it); the choice is made only then. False: choose
@@ -102,7 +99,7 @@ class FrontierStudentParams:
             within this of the best.
     """
 
-    expert: SemanticExpertParams = field(default_factory=outside_choice_params)
+    expert: SemanticExpertParams = field(default_factory=SemanticExpertParams)
     model: FrontierStudentModel = field(default_factory=FrontierStudentModel)
     keep_goal: bool = True
     switch_margin: float = 0.5
@@ -184,11 +181,8 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         chooser: OptionChooser | None = None,
     ) -> None:
         self.student_params = params if params is not None else FrontierStudentParams()
-        expert = for_outside_choice(self.student_params.expert, self.name)
-        sources = insert_plan_source(
-            DEFAULT_PLAN_SOURCES, StudentFrontier(self._decide), before="semantic"
-        )
-        super().__init__(expert, segmenter=segmenter, plan_sources=sources)
+        recipe = OUTSIDE_CHOICE.with_source(StudentFrontier(self._decide), before="semantic")
+        super().__init__(self.student_params.expert, segmenter=segmenter, recipe=recipe)
         self.chooser = chooser
         self.decisions = 0
 

@@ -25,11 +25,8 @@ from typing import Any
 
 import numpy as np
 from semexplore_gym.policies.expert.expert import Segmenter, SemanticExpertPolicy
-from semexplore_gym.policies.expert.params import (
-    SemanticExpertParams,
-    for_outside_choice,
-    outside_choice_params,
-)
+from semexplore_gym.policies.expert.params import SemanticExpertParams
+from semexplore_gym.policies.expert.recipes import OUTSIDE_CHOICE
 
 from semexplore_gym.core.features.frontier_features import FEATURE_NAMES, frontier_value_features
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
@@ -79,12 +76,13 @@ class FrontierValueParams:
 
     Attributes:
         expert: The semantic expert's parameters (its cost weights and switch margin included;
-            ``grid_candidate`` and ``semantic_grid_route`` are off, and setting either is an
-            error: the learned ranking decides, driven as it was measured).
+            the expert is made from the outside-choice recipe, :data:`~semexplore_gym.policies.
+            expert.recipes.OUTSIDE_CHOICE`: the learned ranking decides, driven as it was
+            measured).
         value: The learned value's weights.
     """
 
-    expert: SemanticExpertParams = field(default_factory=outside_choice_params)
+    expert: SemanticExpertParams = field(default_factory=SemanticExpertParams)
     value: FrontierValueWeights = field(default_factory=FrontierValueWeights)
 
 
@@ -102,8 +100,7 @@ class FrontierValuePolicy(SemanticExpertPolicy):
     ) -> None:
         self.value_params = params if params is not None else FrontierValueParams()
         # The learned ranking chooses: the grid's nearest frontier must not overrule it.
-        expert = for_outside_choice(self.value_params.expert, self.name)
-        super().__init__(expert, segmenter=segmenter)
+        super().__init__(self.value_params.expert, segmenter=segmenter, recipe=OUTSIDE_CHOICE)
         self._obs: dict[str, np.ndarray] | None = None
 
     def act(self, obs: dict[str, np.ndarray], info: dict[str, Any]) -> np.ndarray:

@@ -35,51 +35,45 @@ Factory = Callable[[str, dict[str, Any]], Policy]
 
 
 def _expert_like(
-    name: str, arg: str, overrides: dict[str, Any], policy_cls: Any, *layers: Any
+    name: str,
+    arg: str,
+    overrides: dict[str, Any],
+    policy_cls: Any,
+    *layers: Any,
+    **kwargs: Any,
 ) -> Policy:
-    """A semantic-expert-family policy: ``policy_cls(params, segmenter=...)`` with its params
-    built from ``layers``, the caller's ``params`` and the overrides."""
+    """A semantic-expert-family policy: ``policy_cls(params, segmenter=..., **kwargs)`` with
+    its params built from ``layers``, the caller's ``params`` and the overrides."""
     segmenter = overrides.pop("segmenter", None)
     base = overrides.pop("params", None)
     if arg:
         raise ValueError(f"policy {name!r} takes no argument, got '{name}:{arg}'")
-    return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter)
+    return policy_cls(build_params(*layers, base, overrides), segmenter=segmenter, **kwargs)
 
 
-def _outside_choice_layer() -> dict[str, Any]:
-    """The layer below the user's for a policy whose goals an outside choice makes: its expert
-    runs with the :data:`~semexplore_gym.policies.expert.params.OUTSIDE_CHOICE_OFF`
-    switches off, and a user who sets one on gets an error naming it."""
-    from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
-
-    return {"expert": dict.fromkeys(OUTSIDE_CHOICE_OFF, False)}
-
-
-def _semantic_version(name: str) -> Factory:
-    """The factory of a named expert version (``semantic`` = the newest;
-    :mod:`semexplore_gym.policies.expert.versions`): its layer below the caller's params."""
+def _expert_recipe(name: str, recipe: Any) -> Factory:
+    """The factory of an expert made from ``recipe`` (:mod:`semexplore_gym.policies.expert.
+    recipes`): its parameter values below the caller's params. The argument may name a YAML
+    file of parameter values (``semantic:configs/expert/optuna_weights.yaml``), a layer
+    between the recipe's values and the caller's."""
 
     def factory(arg: str, overrides: dict[str, Any]) -> Policy:
         from semexplore_gym.policies.expert.expert import (
             SemanticExpertParams,
             SemanticExpertPolicy,
         )
-        from semexplore_gym.policies.expert.versions import version_layer
 
-        layer = version_layer(name)
-        layers = (SemanticExpertParams, layer) if layer else (SemanticExpertParams,)
-        return _expert_like(name, arg, overrides, SemanticExpertPolicy, *layers)
+        layers: list[Any] = [SemanticExpertParams, dict(recipe.params) or None]
+        if arg:
+            if not arg.endswith((".yaml", ".yml")):
+                raise ValueError(
+                    f"policy {name!r} takes no argument but a parameter file (.yaml), "
+                    f"got '{name}:{arg}'"
+                )
+            layers.append(arg)
+        return _expert_like(name, "", overrides, SemanticExpertPolicy, *layers, recipe=recipe)
 
     return factory
-
-
-def _semantic_paper(arg: str, overrides: dict[str, Any]) -> Policy:
-    """The paper's method alone: :data:`~semexplore_gym.policies.expert.params.PAPER_PURE`."""
-    from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
-    from semexplore_gym.policies.expert.params import PAPER_PURE
-
-    layers = (SemanticExpertParams, PAPER_PURE)
-    return _expert_like("semantic-paper", arg, overrides, SemanticExpertPolicy, *layers)
 
 
 def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
@@ -89,7 +83,7 @@ def _frontier_value(arg: str, overrides: dict[str, Any]) -> Policy:
         FrontierValuePolicy,
     )
 
-    layers = (FrontierValueParams, _outside_choice_layer())
+    layers = (FrontierValueParams,)
     return _expert_like("frontier-value", arg, overrides, FrontierValuePolicy, *layers)
 
 
@@ -109,7 +103,7 @@ def _frontier_student(arg: str, overrides: dict[str, Any]) -> Policy:
                 f"policy 'frontier-student:{arg}': give the model file or params, not both"
             )
         overrides["params"] = arg
-    layers = (FrontierStudentParams, _outside_choice_layer())
+    layers = (FrontierStudentParams,)
     return _expert_like("frontier-student", "", overrides, FrontierStudentPolicy, *layers)
 
 
@@ -286,12 +280,17 @@ def _python(arg: str, overrides: dict[str, Any]) -> Policy:
 
 def policy_factories() -> dict[str, Factory]:
     """The known policy names and their factories ``(argument, overrides) -> Policy``."""
-    from semexplore_gym.policies.expert.versions import EXPERT_VERSIONS, NEWEST_ALIAS
+    from semexplore_gym.policies.expert.recipes import PAPER_METHOD
+    from semexplore_gym.policies.expert.versions import (
+        EXPERT_VERSIONS,
+        NEWEST_ALIAS,
+        version_recipe,
+    )
 
     return {
-        NEWEST_ALIAS: _semantic_version(NEWEST_ALIAS),
-        **{name: _semantic_version(name) for name in EXPERT_VERSIONS},
-        "semantic-paper": _semantic_paper,
+        NEWEST_ALIAS: _expert_recipe(NEWEST_ALIAS, version_recipe(NEWEST_ALIAS)),
+        **{name: _expert_recipe(name, v.recipe) for name, v in EXPERT_VERSIONS.items()},
+        "semantic-paper": _expert_recipe("semantic-paper", PAPER_METHOD),
         "frontier-value": _frontier_value,
         "frontier-student": _frontier_student,
         "frontier": _frontier,

@@ -2,7 +2,9 @@
 
 * ``expert``: :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`, the replan
   schedule and its plug-in points.
-* ``params``: its parameters (``SemanticExpertParams``, the paper-pure preset).
+* ``params``: its parameters (``SemanticExpertParams``: numbers and the user's six switches).
+* ``recipes``: what an expert is made of (plan sources, goal rules, parameter values): today's,
+  ``semantic-v2``'s, the paper's method alone, the outside-choice experts'.
 * ``versions``: the named versions (``semantic-v2``, ``semantic-v3``; ``semantic`` = the newest).
 * ``plan``, ``plan_context``, ``plan_sources``, ``narrow_sources``: what a plan is, what a plan
   source reads, and the sources the expert asks in order.

@@ -25,9 +25,9 @@ class ExpertCounters:
         fallback_plans: Every other plan adopted (grid fallback, retry, look, commanded).
         entry_detours: Grid detours onto a semantic path whose first leg crossed a wall.
         semantic_grid_routes: Semantic plans driven over the grid's route to Algorithm 1's goal
-            instead of the map's path (``semantic_grid_route``).
+            instead of the map's path (the semantic source's ``grid_route``).
         grid_frontier_plans: Replans where the grid's nearest frontier cost less than
-            Algorithm 1's choice and was taken instead (``grid_candidate``).
+            Algorithm 1's choice and was taken instead (its ``grid_candidate``).
         escapes: Local-minimum escapes of the potential field.
         recoveries: Stuck recoveries (back-offs).
         blacklisted: Goals dropped.

@@ -39,7 +39,7 @@ from semexplore_gym.policies.expert.expert import (
     SemanticExpertParams,
     SemanticExpertPolicy,
 )
-from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
+from semexplore_gym.policies.expert.recipes import OUTSIDE_CHOICE, ExpertRecipe, for_outside_choice
 
 from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
@@ -50,11 +50,12 @@ class ExpertDriver(SemanticExpertPolicy):
     """The semantic expert driven by an outside goal choice or outside cost weights.
 
     Args:
-        params: Expert parameters (default: the robust expert's); ``grid_candidate`` is always
-            off (the outside choice, not the grid's nearest frontier, decides), and so is
-            ``semantic_grid_route`` (the learned agents were trained and measured driving the
-            map's paths).
+        params: Expert parameters (default: the robust expert's).
         segmenter: See :class:`~semexplore_gym.policies.expert.expert.SemanticExpertPolicy`.
+        recipe: Default :data:`~semexplore_gym.policies.expert.recipes.OUTSIDE_CHOICE`: the
+            outside choice, not the grid's nearest frontier, decides, and the learned agents
+            were trained and measured driving the map's paths. A recipe whose semantic source
+            has the grid candidate or the grid route is refused (a ValueError naming it).
 
     Attributes:
         goal_finished: The commanded goal is done (reached, vanished, blacklisted or gone);
@@ -64,15 +65,17 @@ class ExpertDriver(SemanticExpertPolicy):
     name = "semantic-driver"
     params: SemanticExpertParams
 
+    recipe = OUTSIDE_CHOICE
+
     def __init__(
-        self, params: SemanticExpertParams | None = None, segmenter: Segmenter | None = None
+        self,
+        params: SemanticExpertParams | None = None,
+        segmenter: Segmenter | None = None,
+        recipe: ExpertRecipe | None = None,
     ) -> None:
-        # The agent chooses the frontier: the grid's nearest frontier must not overrule it. The
-        # callers pass the plain expert's params (switches on by default), so they are turned
-        # off here rather than refused.
-        base = params if params is not None else SemanticExpertParams()
-        off = dict.fromkeys(OUTSIDE_CHOICE_OFF, False)
-        super().__init__(replace(base, **off), segmenter)
+        # The agent chooses the frontier: the grid's nearest frontier must not overrule it.
+        parts = for_outside_choice(recipe or OUTSIDE_CHOICE, "the expert driver")
+        super().__init__(params, segmenter, recipe=parts)
         self._goal: FrontierCandidate | None = None
         self.goal_finished = False
 

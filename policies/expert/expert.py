@@ -17,26 +17,23 @@ ground truth. What the paper leaves open, and the parameters for it:
 
 The parts
 ---------
-:class:`SemanticExpertPolicy` schedules replans and holds three parts, each with its own
-module and parameter group (a view of :class:`SemanticExpertParams`, whose flat YAML keys stay):
+:class:`SemanticExpertPolicy` schedules replans and holds three parts, built from its recipe
+(:mod:`~semexplore_gym.policies.expert.recipes`) and a parameter group each:
 
-* ``plan_sources``: an ordered tuple of :class:`~semexplore_gym.policies.expert.plan_sources.
-  PlanSource` objects (commanded goal, retry, view, semantic frontier, committed fallback,
-  nearest fallback, pocket escape, look; :mod:`~semexplore_gym.policies.expert.plan_sources`).
-  At each replan the first :class:`~semexplore_gym.policies.expert.plan.Plan` proposed is adopted;
-  when all pass, the expert waits, and stops after ``stop_confirmations`` such replans.
-* ``goal_memory``: a :class:`~semexplore_gym.policies.expert.goal_memory.GoalMemory` (drops,
-  reaches, retries, revivals, the trail, the commanded goal, the stop reason).
+* ``plan_sources``: the recipe's ordered :class:`PlanSource` objects
+  (:mod:`~semexplore_gym.policies.expert.plan_sources`); at each replan the first
+  :class:`Plan` proposed is adopted; when all pass, the expert waits, and stops after
+  ``stop_confirmations`` such replans.
+* ``goal_memory``: a :class:`~semexplore_gym.policies.expert.goal_memory.GoalMemory` with the
+  recipe's goal rules (drops, reaches, retries, revivals, the trail, the stop reason).
 * ``follower``: a :class:`~semexplore_gym.policies.expert.path_following.PathFollower`
-  (potential field, path progress, local-minimum escape, progress watch, back-off recovery).
+  (potential field, local-minimum escape, progress watch, back-off recovery).
 
-``counts`` (an :class:`~semexplore_gym.policies.expert.counters.ExpertCounters`) and
-``events`` record what fired; ``counters`` gives the counts as a ``{name: int}`` dict.
+``counts`` (an ``ExpertCounters``) and ``events`` record what fired.
 
 Plug-in points
 --------------
 For a learned frontier chooser, an oracle or a team coordinator; none needs a private member.
-
 *Replace the frontier ranking*: give a ``ranker`` (candidates, cheapest ``C`` first, in; the
 same candidates in the new order, ``cost`` rewritten if you like, out), or override
 :meth:`~SemanticExpertPolicy.rank_frontiers`; goal commitment then works on the new order.
@@ -45,8 +42,8 @@ Override :meth:`~SemanticExpertPolicy.choose_goal` to pick outright::
     expert = SemanticExpertPolicy(ranker=lambda cands: sorted(cands, key=lambda c: c.d_m))
 
 *Add a plan source*: a :class:`PlanSource` whose ``propose(ctx)`` returns a :class:`Plan` or
-None, put where it belongs in the order (the class attribute ``plan_sources``, or the
-argument of the same name; :func:`insert_plan_source` places one by name)::
+None, put where it belongs in the order of a recipe (the class attribute ``recipe``, or the
+argument ``plan_sources``; ``recipe.with_source`` places one by name)::
 
     class TeamGoal(PlanSource):  # a coordinator's assignment before the expert's own choice
         name = "team"
@@ -56,7 +53,7 @@ argument of the same name; :func:`insert_plan_source` places one by name)::
             return None if path is None else Plan(PlanKind.COMMANDED, goal, ctx.resampled(path))
 
     class TeamExpert(SemanticExpertPolicy):
-        plan_sources = insert_plan_source(DEFAULT_PLAN_SOURCES, TeamGoal(), before="semantic")
+        recipe = SEMANTIC_V3.with_source(TeamGoal(), before="semantic")
 
 *Drive to this goal*: :meth:`~SemanticExpertPolicy.drive_to` commands a point in world
 coordinates; the expert's navigation drives there over a clearance-aware grid route (with its
@@ -67,8 +64,7 @@ commanded_goal_xy_m` turns None once the goal is reached, failed or unreachable:
     while expert.commanded_goal_xy_m is not None:
         obs, *_ = env.step(expert.act(obs, info))
 
-Also: ``on_replan_due``, ``on_replanned``, ``request_replan`` (replans), ``frontier_candidates``
-(score any observation's frontiers); the expert's driver (``driver.py``) and ``learned_frontier_value`` use them.
+Also: ``on_replan_due``, ``on_replanned``, ``request_replan``, ``frontier_candidates``.
 """
 
 from __future__ import annotations
@@ -92,6 +88,7 @@ from semexplore_gym.policies.expert.plan_sources import (
     goal_open,
     insert_plan_source,
 )
+from semexplore_gym.policies.expert.recipes import SEMANTIC_V3, ExpertRecipe
 
 from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
@@ -137,8 +134,9 @@ class SemanticExpertPolicy(Policy):
             :class:`semexplore_gym.core.topometric.TopometricSegmenter` of its own.
         ranker: Re-ranks the scored frontiers before goal commitment (see the module
             docstring); default none (cheapest ``C`` first).
-        plan_sources: The plan sources in the order they are asked (default
-            :attr:`plan_sources`, the class's).
+        plan_sources: The plan sources in the order they are asked (default: the recipe's).
+        recipe: Its parts (default :attr:`recipe`, today's); ``make_policy`` layers its
+            parameter values below ``params``.
 
     Attributes (after ``reset``): ``tmap`` the last topometric map, ``candidates`` the scored
     frontiers of the last replan, ``mode`` an :class:`ExpertMode`, ``counts`` and ``events``
@@ -147,8 +145,9 @@ class SemanticExpertPolicy(Policy):
 
     name = "semantic"
     reads_map_in_step_only = True  # tested: missions identical with a copied or a shared map
-    #: The plan sources, in the order they are asked (see the module docstring).
-    plan_sources: tuple[PlanSource, ...] = DEFAULT_PLAN_SOURCES
+    #: What the expert is made of: its plan sources and goal rules (see the module docstring).
+    recipe: ExpertRecipe = SEMANTIC_V3
+    plan_sources: tuple[PlanSource, ...]
 
     def __init__(
         self,
@@ -156,6 +155,7 @@ class SemanticExpertPolicy(Policy):
         segmenter: Segmenter | None = None,
         ranker: FrontierRanker | None = None,
         plan_sources: Sequence[PlanSource] | None = None,
+        recipe: ExpertRecipe | None = None,
     ) -> None:
         super().__init__()
         prm = params if params is not None else SemanticExpertParams()
@@ -164,12 +164,14 @@ class SemanticExpertPolicy(Policy):
         self.counts = ExpertCounters()
         self.events: list[tuple[float, str, str]] = []
         self._time_s = 0.0
-        self.goal_memory = GoalMemory(prm.goal_memory, self.counts, self._log)
+        self.recipe = recipe if recipe is not None else type(self).recipe
+        rules = self.recipe.goal_rules
+        self.goal_memory = GoalMemory(prm.goal_memory, self.counts, self._log, rules)
         self.follower = PathFollower(prm.path_following, self.counts, self._log)
         self._segmenter = segmenter
         self.ranker = ranker
-        if plan_sources is not None:
-            self.plan_sources = tuple(plan_sources)
+        mine = plan_sources if plan_sources is not None else self.recipe.plan_sources
+        self.plan_sources = tuple(mine)
         self.tmap: TopometricMap | None = None
         self.candidates: list[FrontierCandidate] = []
         self.mode = ExpertMode.IDLE
@@ -291,8 +293,9 @@ class SemanticExpertPolicy(Policy):
         # commanded goal may lie in known space: it lasts until reached; a view's is its frontier.
         view = plan.kind == PlanKind.VIEW and plan.frontier_xy_m is not None
         watched = plan.frontier_xy_m if view and plan.frontier_xy_m else plan.goal_xy_m
+        radius_m, rules = self.params.goal_check_radius_m, self.goal_memory.rules
         if plan.kind != PlanKind.COMMANDED and not goal_open(
-            grid, self.geometry, watched, self.params
+            grid, self.geometry, watched, radius_m, on_frontier=rules.vanish_on_frontier
         ):
             return "goal_vanished"
         return ""
@@ -413,11 +416,8 @@ class SemanticExpertPolicy(Policy):
         return best
 
     def on_replan_due(self, reason: str) -> None:
-        """Called when a replan is due, just before it runs; does nothing by default.
-
-        Args:
-            reason: Why (one of :data:`REPLAN_REASONS`).
-        """
+        """Called when a replan is due (``reason``: one of :data:`REPLAN_REASONS`), just before
+        it runs; does nothing by default."""
 
     def on_replanned(self, source: PlanKind | None) -> None:
         """Called after every replan with :attr:`plan_source`; does nothing by default."""

@@ -6,7 +6,8 @@ goal fails (retry it another way, or drop it), when a goal is reached without cl
 frontier, when the map round a dropped goal changes, and why the mission stopped. Its
 parameters are :class:`~semexplore_gym.policies.expert.params.GoalMemoryParams` (the
 fields of the same names in :class:`SemanticExpertParams`, documented in
-:mod:`semexplore_gym.policies.expert.params`).
+:mod:`semexplore_gym.policies.expert.params`); which of its rules it follows is the
+:class:`GoalRules` of the expert's recipe (:mod:`semexplore_gym.policies.expert.recipes`).
 """
 
 from __future__ import annotations
@@ -29,12 +30,43 @@ from semexplore_gym.core.grid import GridGeometry
 if TYPE_CHECKING:
     from semexplore_gym.core.planning.graph_search import FrontierCandidate
 
-__all__ = ["TRAIL_CELL_M", "GoalMemory", "Reach", "Retry", "ViewRequest"]
+__all__ = ["TRAIL_CELL_M", "GoalMemory", "GoalRules", "Reach", "Retry", "ViewRequest"]
 
 _Scored = TypeVar("_Scored", bound="FrontierCandidate")
 
 #: Lattice of the robot's trail (metres per cell).
 TRAIL_CELL_M = 0.25
+
+
+@dataclass(frozen=True)
+class GoalRules:
+    """The rules a goal memory follows: a part of an expert's recipe, not a parameter.
+
+    The defaults are today's expert (``semantic-v3``); an older version's recipe lists the
+    rules of its time (:mod:`semexplore_gym.policies.expert.recipes`).
+
+    Attributes:
+        vanish_on_frontier: A goal is mapped once no frontier cell (UNKNOWN next to FREE) is
+            left near it; off (``semantic-v2``, the paper): once no UNKNOWN cell is, which
+            unknown space behind a mapped wall keeps from happening.
+        drop_each_point: A goal dropped beside an earlier drop keeps a point of its own, so the
+            frontier round it is ignored too (off: the grid fallback may find it again at once).
+        reach_blacklist: Drop a goal reached ``max_goal_reaches`` times without clearing.
+        oscillation_guard: Do not switch back to a goal abandoned ``oscillation_window_s`` ago.
+        shuttle_guard: Commit to a goal adopted again without the map growing.
+        view_unseen_frontiers: Look into a frontier reached without clearing from elsewhere
+            before dropping it (the recipe lists the ``view`` source).
+        grid_check: The stop rule is the grid check (the recipe lists the grid fallback); off:
+            the mission stops when Algorithm 1 has no frontier left (the paper).
+    """
+
+    vanish_on_frontier: bool = True
+    drop_each_point: bool = True
+    reach_blacklist: bool = True
+    oscillation_guard: bool = True
+    shuttle_guard: bool = True
+    view_unseen_frontiers: bool = True
+    grid_check: bool = True
 
 
 @dataclass(frozen=True)
@@ -80,6 +112,7 @@ class GoalMemory:
 
     Args:
         params: The goal memory's parameters.
+        rules: The rules it follows (default: today's expert's).
         counts: The expert's counters (``blacklisted``, ``retries``, ``revived``, ``looks``).
         log: Records an event ``(name, detail)`` in the expert's event log.
 
@@ -101,8 +134,10 @@ class GoalMemory:
         params: GoalMemoryParams,
         counts: ExpertCounters,
         log: Callable[[str, str], None],
+        rules: GoalRules | None = None,
     ) -> None:
         self.params = params
+        self.rules = rules if rules is not None else GoalRules()
         self.counts = counts
         self.log = log
         self.geometry: GridGeometry | None = None
@@ -121,7 +156,7 @@ class GoalMemory:
             prm.revive_min_changed_cells,
             prm.max_revivals,
             prm.max_goal_attempts,
-            drop_each_point=prm.drop_each_point,
+            drop_each_point=self.rules.drop_each_point,
         )
         self.blacklist = GoalBlacklist(prm.blacklist_radius_m)
         self.retry: Retry | None = None
@@ -155,7 +190,7 @@ class GoalMemory:
     def recently_abandoned(self, xy_m: tuple[float, float], now_s: float) -> bool:
         """With the oscillation guard on: whether the robot switched away from a goal near
         ``xy_m`` within ``oscillation_window_s``."""
-        return self.params.oscillation_guard and self.frontiers.recently_abandoned(
+        return self.rules.oscillation_guard and self.frontiers.recently_abandoned(
             xy_m, now_s, self.params.oscillation_window_s
         )
 
@@ -221,7 +256,7 @@ class GoalMemory:
         (and :attr:`shuttle_xy_m` set) when it is a goal adopted within the last
         ``shuttle_switches`` goals and the map gained less than ``shuttle_min_new_m2`` since."""
         prm = self.params
-        if not prm.shuttle_guard:
+        if not self.rules.shuttle_guard:
             return False
         assert self.geometry is not None
         min_new = prm.shuttle_min_new_m2 / self.geometry.resolution_m**2
@@ -316,7 +351,7 @@ class GoalMemory:
             # unless another place sees into it.
             self.counts.looks += 1
             self._give_up(grid, plan.frontier_xy_m, "looked", at)
-        elif self.params.reach_blacklist:
+        elif self.rules.reach_blacklist:
             self._register_reach(grid, plan.goal_xy_m, at)
 
     def _register_reach(
@@ -340,7 +375,7 @@ class GoalMemory:
         """Drop the frontier at ``xy_m`` as it is, or first look into it from elsewhere (once
         per place, with ``view_unseen_frontiers``)."""
         r = self.params.blacklist_radius_m
-        if not self.params.view_unseen_frontiers or any(
+        if not self.rules.view_unseen_frontiers or any(
             math.dist(xy_m, v) <= r for v in self.viewed
         ):
             self.drop(grid, xy_m, reason)
@@ -362,7 +397,7 @@ class GoalMemory:
 
     def stop_reason(self) -> str:
         """Which rule ended the mission, and what was left behind."""
-        if not self.params.grid_fallback:
+        if not self.rules.grid_check:
             n = self.frontiers.count()
             return "no semantic frontier left" + (f" ({n} frontier(s) dropped)" if n else "")
         parts = []

@@ -1,7 +1,7 @@
 """The semantic expert's narrow tier: plan sources through passages narrower than the planners'
-clearance (:class:`RoomBeyondGap`, ``room_beyond_gaps``; :class:`NarrowFallback`,
-``narrow_passages``). Their plans carry the map's clearance along their paths, and the path
-follower tracks the tight stretches slowly and exactly. Both are in
+clearance (:class:`RoomBeyondGap`, listed by today's expert's recipe; :class:`NarrowFallback`,
+the user's switch ``narrow_passages``). Their plans carry the map's clearance along their
+paths, and the path follower tracks the tight stretches slowly and exactly. Both are in
 :data:`~semexplore_gym.policies.expert.plan_sources.DEFAULT_PLAN_SOURCES`, after the pocket
 escape and before the stop rule's look.
 """
@@ -38,7 +38,7 @@ NARROW_SAME_GOAL_M = 1.0
 
 class RoomBeyondGap(PlanSource):
     """Nothing is reachable at the planners' clearance, but the map shows room beyond a gap
-    narrower than it (``room_beyond_gaps``: space with that clearance and a frontier, seen
+    narrower than it (space with that clearance and a frontier, seen
     through the gap; see :mod:`semexplore_gym.core.frontiers.beyond_gap`): through the gap at
     the narrow tier's clearance, tracked slowly and exactly, then on to that frontier."""
 
@@ -47,7 +47,7 @@ class RoomBeyondGap(PlanSource):
     def propose(self, ctx: PlanContext) -> Plan | None:
         prm = ctx.params
         thin_m = ctx.narrow_clearance_m()
-        if not (prm.grid_fallback and prm.room_beyond_gaps) or thin_m >= ctx.clearance_m:
+        if thin_m >= ctx.clearance_m:
             return None
         known = ctx.known_clearance_field()
         way = room_beyond_gap_path(
@@ -91,7 +91,7 @@ class NarrowFallback(PlanSource):
     def propose(self, ctx: PlanContext) -> Plan | None:
         prm = ctx.params
         thin_m = ctx.narrow_clearance_m()
-        if not (prm.grid_fallback and prm.narrow_passages) or thin_m >= ctx.clearance_m:
+        if not prm.narrow_passages or thin_m >= ctx.clearance_m:
             return None
         clearance = ctx.known_clearance_field()
         # The fallback's own frontier filter: a frontier as narrow as the passage is a crack as

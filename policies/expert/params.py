@@ -7,8 +7,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``goal_check_radius_m``, ``resegment_min_new_m2``): the map changes every step, but
   segmentation and search run only every ``replan_period_s``, and at once when the goal is
   reached, when it vanishes (no frontier cell, UNKNOWN next to FREE, is left within
-  ``goal_check_radius_m`` of it: its frontier has been mapped; ``vanish_on_frontier=false``:
-  no UNKNOWN cell at all, which unknown space behind a mapped wall keeps from happening), when
+  ``goal_check_radius_m`` of it: its frontier has been mapped; without the goal rule
+  ``vanish_on_frontier``, as in ``semantic-v2``: no UNKNOWN cell at all, which unknown space
+  behind a mapped wall keeps from happening), when
   the path is used up, or when a recovery ends. A scheduled
   replan skips the segmentation (map-change gating) when less than ``resegment_min_new_m2``
   became known since the last one, e.g. while the robot crosses explored space.
@@ -23,7 +24,8 @@ What the paper leaves open, and how the expert handles it (parameters in
 * **Path entry check**: when the straight first leg from the robot to the map's path crosses
   an occupied cell (the robot stands outside every area), a grid path with the robot's
   clearance leads to the path instead.
-* **Grid-frontier fallback** (``grid_fallback``, ``fallback_min_frontier_m``,
+* **Grid-frontier fallback** (sources ``committed_fallback``, ``nearest_fallback``;
+  ``fallback_min_frontier_m``,
   ``fallback_min_unknown_depth_m``, ``fallback_reach_m``): while the topometric map offers no
   frontier (no frontier pathway yet; frontiers the segmentation leaves out, such as unknown
   space seen only along a narrow laser fan or behind a gap), the robot drives to the nearest
@@ -64,29 +66,30 @@ What the paper leaves open, and how the expert handles it (parameters in
   ``revive_window_m`` of a dropped goal changed since it was dropped (the map around it grew or
   was corrected), it is considered again, at most ``max_revivals`` times. A goal dropped
   within ``blacklist_radius_m`` of an earlier drop is the same place for that count; with
-  ``drop_each_point`` (on) it keeps a point of its own too, so the frontier round it is ignored
-  as well (without, the grid fallback could find the same goal again at once, for ever).
+  the goal rule ``drop_each_point`` (not in ``semantic-v2``) it keeps a point of its own too,
+  so the frontier round it is ignored as well (without, the grid fallback could find the same
+  goal again at once, for ever).
 * **The stop rule**: the mission stops only when the grid fallback (a clearance-aware grid
   search, the final check) finds no frontier the robot's disc can reach, besides dropped goals;
   the stop reason names the rule and counts what was dropped and why.
-* **Pocket escape** (``pocket_escape``, ``pocket_max_share``, ``pocket_clearance_margin_m``):
+* **Pocket escape** (source ``pocket_escape``, ``pocket_max_share``, ``pocket_clearance_margin_m``):
   the potential field may park the robot closer to a wall than the planner's clearance, in a
   spot cut off from the rest of the usable map by a gap narrower than that clearance. The grid
   check then searches only that pocket and finds nothing. When the robot's region holds less
   than ``pocket_max_share`` of the usable cells, the robot leaves it over cells with the
   clearance of its radius plus ``pocket_clearance_margin_m`` (half the usual margin), and the
   check runs again, with the full clearance, from the nearest region that is not a pocket.
-* **A closer look at narrow frontiers** (``look_at_narrow_frontiers``, ``look_reach_m``,
+* **A closer look at narrow frontiers** (source ``look``, ``look_reach_m``,
   ``look_min_unknown_depth_m``): frontiers too narrow for the robot at first sight are not
   discarded: before stopping, the robot drives to a standable point within ``look_reach_m`` of
   one with unknown space behind it to look closer, once per place; if the gap widens it is
   explored, otherwise it is dropped as looked-at.
-* **Oscillation guard** (``oscillation_guard``, ``oscillation_window_s``): the robot does not
-  switch back to a goal it abandoned less than ``oscillation_window_s`` ago while its current
-  goal is still a candidate (two far frontiers whose costs trade places as the robot moves
+* **Oscillation guard** (goal rule ``oscillation_guard``, ``oscillation_window_s``): the robot
+  does not switch back to a goal it abandoned less than ``oscillation_window_s`` ago while its
+  current goal is still a candidate (two far frontiers whose costs trade places as the robot moves
   would otherwise keep it shuttling between them, as on open ground).
 
-* **Shuttle guard** (``shuttle_guard``, ``shuttle_switches``, ``shuttle_radius_m``,
+* **Shuttle guard** (goal rule ``shuttle_guard``, ``shuttle_switches``, ``shuttle_radius_m``,
   ``shuttle_min_new_m2``): the oscillation guard counts seconds, and a shuttle can be slower
   than its window (the robot circling round clutter on its way to one goal while Algorithm 1's
   costs trade places, a switch every couple of minutes, the map not growing). The shuttle
@@ -95,7 +98,7 @@ What the paper leaves open, and how the expert handles it (parameters in
   gained less than ``shuttle_min_new_m2`` since, it commits to that goal: no switching away
   until it is reached, its frontier is mapped or its approach fails (then the usual retries
   and drops, with the goal's time budget, take over).
-* **A reached frontier that stays unknown gets another view** (``view_unseen_frontiers``,
+* **A reached frontier that stays unknown gets another view** (source ``view``,
   ``view_rim_radius_m``, ``view_range_fraction``, ``view_min_range_margin_m``,
   ``view_clearance_margin_m``, ``view_min_unknown_m2``): a frontier reached ``max_goal_reaches`` times without clearing
   (or a narrow frontier looked at from close by without opening) is not dropped at once. The
@@ -131,7 +134,8 @@ What the paper leaves open, and how the expert handles it (parameters in
   that much since (from elsewhere). ``narrow_give_up_s`` > 0 gives up by time instead: no new
   narrow goal once the map has gained less than ``narrow_give_up_m2`` of room to move in the
   last ``narrow_give_up_s`` seconds (both measured in docs/results.md; off by default).
-* **Room beyond a gap** (``room_beyond_gaps``, ``narrow_min_room_m2``; on by default): when
+* **Room beyond a gap** (source ``room_beyond_gap``, ``narrow_min_room_m2``; in
+  ``semantic-v3``): when
   nothing is reachable at the planners' clearance, but the map shows room beyond a gap
   narrower than it (at least ``narrow_min_room_m2`` of space with the planners' clearance and a
   frontier next to it, seen through the gap:
@@ -141,8 +145,9 @@ What the paper leaves open, and how the expert handles it (parameters in
   the far side, never into a crack whose far side is rock, so it costs nothing where nothing
   lies beyond (``narrow_passages`` comes after it and probes the cracks too).
 
-Every addition to the paper can be switched off on its own (``configs/expert/paper_method.yaml``
-switches them all off: the paper's method alone).
+Which of these an expert holds is its recipe's (:mod:`semexplore_gym.policies.expert.recipes`:
+``semantic-v3``, ``semantic-v2``, ``semantic-paper``, the paper's method alone); the
+parameters here tune them. The on/off switches left are the user's choices.
 
 ``counters`` and ``events`` record how often each behaviour fired.
 """
@@ -150,7 +155,7 @@ switches them all off: the paper's method alone).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import Literal, TypeVar
+from typing import ClassVar, Literal, TypeVar
 
 from semexplore_gym.core.planning.graph_search import FrontierCostWeights
 from semexplore_gym.core.planning.potential_field import PotentialFieldParams
@@ -158,16 +163,36 @@ from semexplore_gym.core.topometric.params import SegmentationParams
 from semexplore_gym.core.validation import require_finite
 
 __all__ = [
-    "OUTSIDE_CHOICE_OFF",
-    "PAPER_PURE",
+    "REMOVED_SWITCHES",
     "GoalMemoryParams",
     "PathFollowingParams",
     "SemanticExpertParams",
-    "for_outside_choice",
-    "outside_choice_params",
 ]
 
 _Group = TypeVar("_Group")
+
+_V2 = "semantic-v3 has it; for the 0.2.0 expert without it use semantic-v2"
+_PAPER = "every version has it; for the paper's method without it use semantic-paper"
+
+#: The on/off switches that left the params: each behaviour is now a part an expert's recipe
+#: lists or not (:mod:`semexplore_gym.policies.expert.recipes`); setting one is an error that
+#: says which named version or preset gives the behaviour without it.
+REMOVED_SWITCHES: dict[str, str] = {
+    "vanish_on_frontier": f"'goal mapped when no frontier cell is near' is a goal rule; {_V2}",
+    "drop_each_point": f"'each dropped goal keeps its point' is a goal rule; {_V2}",
+    "shuttle_guard": f"the shuttle guard is a goal rule of the recipe; {_V2}",
+    "shuttle_guard_holds_grid": f"the shuttle guard holds against the grid candidate; {_V2}",
+    "view_unseen_frontiers": f"the 'view' plan source is part of the recipe; {_V2}",
+    "room_beyond_gaps": f"the 'room_beyond_gap' plan source is part of the recipe; {_V2}",
+    "grid_candidate": f"the semantic source's grid candidate is part of the recipe; {_V2}",
+    "semantic_grid_route": f"the semantic source's grid route is part of the recipe; {_V2}",
+    "grid_fallback": f"the grid fallback plan sources are part of the recipe; {_PAPER}",
+    "pocket_escape": f"the 'pocket_escape' plan source is part of the recipe; {_PAPER}",
+    "look_at_narrow_frontiers": f"the 'look' plan source is part of the recipe; {_PAPER}",
+    "oscillation_guard": f"the oscillation guard is a goal rule of the recipe; {_PAPER}",
+    "reach_blacklist": f"dropping goals reached but not cleared is a goal rule; {_PAPER}",
+    "entry_detour": f"the semantic source's entry detour is part of the recipe; {_PAPER}",
+}
 
 
 @dataclass(frozen=True)
@@ -214,16 +239,10 @@ class GoalMemoryParams:
     revive_window_m: float
     revive_min_changed_cells: int
     max_revivals: int
-    drop_each_point: bool
-    reach_blacklist: bool
-    oscillation_guard: bool
     oscillation_window_s: float
-    grid_fallback: bool
-    shuttle_guard: bool
     shuttle_switches: int
     shuttle_radius_m: float
     shuttle_min_new_m2: float
-    view_unseen_frontiers: bool
 
 
 def _group(cls: type[_Group], params: SemanticExpertParams) -> _Group:
@@ -234,6 +253,13 @@ def _group(cls: type[_Group], params: SemanticExpertParams) -> _Group:
 @dataclass(frozen=True)
 class SemanticExpertParams:
     """All parameters of the semantic expert (defaults: the paper's weights, then ours).
+
+    Four on/off switches are the user's choice here (``narrow_passages``,
+    ``goal_commitment``, ``local_min_escape``, ``stuck_recovery``), two more sit in the nested
+    groups (``potential_field.braking_guard``, ``segmentation.keep_debug``); which plan sources
+    and goal rules an expert holds is its recipe's (:mod:`semexplore_gym.policies.expert.
+    recipes`), and a removed switch (:data:`REMOVED_SWITCHES`) is an error naming the version
+    that gives the behaviour.
 
     Attributes:
         cost: Frontier cost weights ``w_v``, ``w_p``, ``w_I`` (defaults: the paper's, defined
@@ -250,15 +276,9 @@ class SemanticExpertParams:
         goal_reached_radius_m: The goal counts as reached within this distance.
         goal_check_radius_m: The goal has vanished (replan at once) when no UNKNOWN cell is
             left within this distance of it (with ``vanish_on_frontier``: no frontier cell).
-        vanish_on_frontier: The goal has vanished when no *frontier* cell (UNKNOWN next to
-            FREE) is left near it, rather than no UNKNOWN cell: unknown space behind a mapped
-            wall (a thick wall's inside, the far side of a thin one) is no frontier, and waiting
-            for it to be mapped drove the robot all the way to goals whose frontier was long
-            mapped. Also the committed fallback's test. Off in the paper-pure preset.
         commitment_radius_m: A frontier this close to the current goal is the same goal.
         switch_margin: Another frontier replaces the current one only if cheaper by this much.
         min_frontier_width_m: Narrower frontier openings are ignored.
-        grid_fallback: Use the grid BFS frontier while the topometric map offers none.
         fallback_min_frontier_m: Smallest frontier group the fallback considers (its cell count
             times the resolution, metres). Smaller groups are mostly leaks through gaps in
             rasterised walls, which no robot can clear.
@@ -283,17 +303,10 @@ class SemanticExpertParams:
         revive_window_m: Radius round a dropped goal watched for map changes.
         revive_min_changed_cells: Changed cells in that window that bring a dropped goal back.
         max_revivals: How often one place may come back.
-        drop_each_point: A goal dropped near an earlier drop keeps a point of its own (see
-            above).
-        pocket_escape: When the grid check finds nothing from a pocket of the usable map,
-            leave the pocket and check again from outside (see above; part of
-            ``grid_fallback``).
         pocket_max_share: The robot's region is a pocket when it holds less than this share
             of the usable cells.
         pocket_clearance_margin_m: The way out of a pocket keeps the robot radius plus this
             from walls.
-        look_at_narrow_frontiers: Drive close to frontiers too narrow to reach, to look again
-            (an extension of the grid fallback's final check: needs ``grid_fallback``).
         look_reach_m: The look point lies within this distance of the frontier.
         look_min_unknown_depth_m: Unknown depth behind a narrow frontier worth a look.
         look_min_frontier_m: Smallest narrow frontier worth a look (cells x resolution); one-
@@ -305,19 +318,11 @@ class SemanticExpertParams:
         max_look_drives: Drives to look points per mission. A gap seen narrow that opens up is
             rare; most candidates are the mixed cells along a wall's unseen far side, so the
             drives are capped (frontiers the trail already passed close to are dropped free).
-        oscillation_guard: Do not switch back to a recently abandoned goal.
         oscillation_window_s: How long an abandoned goal stays "recent".
-        shuttle_guard: Commit to a goal adopted again without the map growing (see above).
         shuttle_switches: How many of the last adopted goals a new goal is compared with.
         shuttle_radius_m: A goal this close to an earlier one is the same goal.
         shuttle_min_new_m2: Known area the map must gain between two adoptions of the same goal
             for the second not to count as a shuttle.
-        shuttle_guard_holds_grid: The goal the shuttle guard holds is kept against the grid's
-            nearest frontier too (``grid_candidate``), not only against Algorithm 1's other
-            frontiers: else the two sources can take turns for ever.
-        view_unseen_frontiers: Before dropping a frontier reached without clearing, drive to a
-            place that sees into it (see above; part of ``reach_blacklist`` and
-            ``look_at_narrow_frontiers``).
         view_rim_radius_m: The unknown cells to see lie within this distance of the frontier.
         view_range_fraction: A view place lies within this share of the LiDAR's maximum range
             of them (farther, beams are more than a cell apart).
@@ -340,8 +345,6 @@ class SemanticExpertParams:
         narrow_give_up_s: The narrow tier takes no new goal once this long (seconds) has passed
             since the map last gained ``narrow_give_up_m2`` of room to move, counted from its
             first goal (0, the default: never; 100 measured in docs/results.md).
-        room_beyond_gaps: Go through a gap narrower than the planners' clearance where the map
-            shows room with a frontier beyond it (see the module docstring).
         narrow_min_room_m2: Room beyond a gap is at least this much area the robot's centre
             may take at the planners' clearance.
         tight_speed_mps: Forward speed where a narrow plan's path is tight.
@@ -349,23 +352,16 @@ class SemanticExpertParams:
         tight_turn_in_place_rad: ... and turns on the spot above this heading error ...
         tight_centring_range_m: ... centred between walls the scan sees within this on both
             sides.
-        entry_detour: Reach the map's path over the grid when its first leg crosses a wall.
-        grid_candidate: The nearest frontier a grid search reaches competes with Algorithm 1's
-            choice, scored by the same ``C`` without semantic terms (``d / L_path + w_v * v``):
-            frontiers the topometric map has no pathway for (or reaches the long way) are
-            explored as the robot passes them, not left for the end.
-        semantic_grid_route: Drive to Algorithm 1's goal over the grid's clearance-aware route
-            instead of the topometric map's path through the skeleton (the goal and its cost
-            are Algorithm 1's); the map's path where the grid has no route.
         goal_commitment: Keep the current frontier unless another is clearly cheaper.
         local_min_escape: Lower the repulsion when the field holds the robot still.
         stuck_recovery: Watch progress; back off, retry or drop the goal when stuck.
-        reach_blacklist: Drop goals reached ``max_goal_reaches`` times without clearing.
         goal_time_factor: A goal not reached within this many times its path's length at full
             speed (at least ``min_goal_time_s``) counts as a failed approach (part of
             ``stuck_recovery``): the robot may be moving but not getting there.
         min_goal_time_s: See ``goal_time_factor``.
     """
+
+    removed_config_keys: ClassVar[dict[str, str]] = REMOVED_SWITCHES
 
     cost: FrontierCostWeights = field(default_factory=FrontierCostWeights)
     potential_field: PotentialFieldParams = field(default_factory=PotentialFieldParams)
@@ -376,11 +372,9 @@ class SemanticExpertParams:
     resegment_min_new_m2: float = 0.1
     goal_reached_radius_m: float = 0.35
     goal_check_radius_m: float = 0.5
-    vanish_on_frontier: bool = True
     commitment_radius_m: float = 1.0
     switch_margin: float = 0.5
     min_frontier_width_m: float = 0.25
-    grid_fallback: bool = True
     fallback_min_frontier_m: float = 0.35
     fallback_min_unknown_depth_m: float = 0.2
     fallback_reach_m: float = 0.1
@@ -400,25 +394,18 @@ class SemanticExpertParams:
     revive_window_m: float = 0.75
     revive_min_changed_cells: int = 40
     max_revivals: int = 2
-    drop_each_point: bool = True
-    pocket_escape: bool = True
     pocket_max_share: float = 0.1
     pocket_clearance_margin_m: float = 0.025
-    look_at_narrow_frontiers: bool = True
     look_reach_m: float = 1.0
     look_min_unknown_depth_m: float = 0.3
     look_min_frontier_m: float = 0.15
     look_seen_radius_m: float = 1.5
     look_clearance_fraction: float = 0.5
     max_look_drives: int = 2
-    oscillation_guard: bool = True
     oscillation_window_s: float = 120.0
-    shuttle_guard: bool = True
     shuttle_switches: int = 6
     shuttle_radius_m: float = 1.0
     shuttle_min_new_m2: float = 1.0
-    shuttle_guard_holds_grid: bool = True
-    view_unseen_frontiers: bool = True
     view_rim_radius_m: float = 0.5
     view_range_fraction: float = 0.7
     view_min_range_margin_m: float = 0.15
@@ -429,19 +416,14 @@ class SemanticExpertParams:
     narrow_give_up_goals: int = 0
     narrow_give_up_m2: float = 0.5
     narrow_give_up_s: float = 0.0
-    room_beyond_gaps: bool = True
     narrow_min_room_m2: float = 0.5
     tight_speed_mps: float = 0.08
     tight_track_lookahead_m: float = 0.06
     tight_turn_in_place_rad: float = 0.15
     tight_centring_range_m: float = 0.3
-    entry_detour: bool = True
-    grid_candidate: bool = True
-    semantic_grid_route: bool = True
     goal_commitment: bool = True
     local_min_escape: bool = True
     stuck_recovery: bool = True
-    reach_blacklist: bool = True
     goal_time_factor: float = 4.0
     min_goal_time_s: float = 90.0
 
@@ -538,59 +520,3 @@ class SemanticExpertParams:
     def goal_memory(self) -> GoalMemoryParams:
         """The goal memory's parameters (a view of this object's fields)."""
         return _group(GoalMemoryParams, self)
-
-
-#: The switches an expert whose goals an outside choice makes (teams, the learning agents'
-#: driver, the frontier student, the learned frontier value) runs with off, and why.
-OUTSIDE_CHOICE_OFF: dict[str, str] = {
-    "grid_candidate": "the grid's nearest frontier would overrule the outside choice",
-    "semantic_grid_route": "it was trained and measured driving the map's paths",
-}
-
-
-def outside_choice_params() -> SemanticExpertParams:
-    """The expert's defaults with the :data:`OUTSIDE_CHOICE_OFF` switches off."""
-    return SemanticExpertParams(grid_candidate=False, semantic_grid_route=False)
-
-
-def for_outside_choice(params: SemanticExpertParams, policy: str) -> SemanticExpertParams:
-    """``params`` for ``policy``, whose goals an outside choice makes; a ValueError naming the
-    key when one of the :data:`OUTSIDE_CHOICE_OFF` switches is on (it cannot be honoured)."""
-    for key, why in OUTSIDE_CHOICE_OFF.items():
-        if getattr(params, key):
-            raise ValueError(f"{policy} cannot honour expert.{key}=true: {why}; leave it out")
-    return params
-
-
-#: The paper's method alone: every addition of ours switched off, Algorithm 1 with area-level
-#: ``A_cost``, the paper's weights (the defaults). ``configs/expert/paper_method.yaml`` restates it
-#: (tests/policies/test_policy_config.py compares them); ``--policy semantic-paper`` uses it.
-PAPER_PURE: dict[str, object] = {
-    "prune_by": "area",
-    "min_frontier_width_m": 0.0,
-    "resegment_min_new_m2": 0.0,
-    "stop_confirmations": 1,
-    "grid_fallback": False,
-    "pocket_escape": False,
-    "look_at_narrow_frontiers": False,
-    "oscillation_guard": False,
-    "shuttle_guard": False,
-    "view_unseen_frontiers": False,
-    "entry_detour": False,
-    "grid_candidate": False,
-    "semantic_grid_route": False,
-    "vanish_on_frontier": False,
-    "shuttle_guard_holds_grid": False,
-    "room_beyond_gaps": False,
-    "drop_each_point": False,
-    "goal_commitment": False,
-    "local_min_escape": False,
-    "stuck_recovery": False,
-    "reach_blacklist": False,
-    "potential_field": {
-        "lookahead_clearance_m": 0.0,
-        "map_guard_radius_m": 0.0,
-        "guard_steer_max_rad": 0.0,
-        "braking_guard": False,
-    },
-}

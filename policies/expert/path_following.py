@@ -192,7 +192,7 @@ class PathFollower:
         return cmd.v_mps, cmd.omega_radps, escaping
 
     def tight(self, plan: Plan) -> bool:
-        """A narrow plan (``narrow_passages``, ``room_beyond_gaps``: one that carries its path's
+        """A narrow plan (``narrow_passages``, ``room_beyond_gap``: one that carries its path's
         clearance) whose next stretch has less than the planners' clearance on the map (the
         expert then holds its periodic replans: a plan from inside the passage would hand the
         robot back to the potential field)."""

@@ -84,12 +84,18 @@ def frontier_near(
 
 
 def goal_open(
-    grid: np.ndarray, geometry: GridGeometry, xy: tuple[float, float], params: SemanticExpertParams
+    grid: np.ndarray,
+    geometry: GridGeometry,
+    xy: tuple[float, float],
+    radius_m: float,
+    *,
+    on_frontier: bool,
 ) -> bool:
     """Whether the frontier a goal at ``xy`` serves is still there: a frontier cell (with
-    ``vanish_on_frontier``; else any UNKNOWN cell) within ``goal_check_radius_m`` of it."""
-    near = frontier_near if params.vanish_on_frontier else unknown_near
-    return near(grid, geometry, xy, params.goal_check_radius_m)
+    ``on_frontier``, the goal rule ``vanish_on_frontier``; else any UNKNOWN cell) within
+    ``radius_m`` (``goal_check_radius_m``) of it."""
+    near = frontier_near if on_frontier else unknown_near
+    return near(grid, geometry, xy, radius_m)
 
 
 @dataclass

@@ -19,7 +19,7 @@ source                  proposes
 ``nearest_fallback``    the nearest frontier a clearance-aware grid search reaches
 ``pocket_escape``       out of a pocket of the usable map, then to a frontier outside it
 ``room_beyond_gap``     through a gap narrower than the clearance into room the map shows
-                        beyond it, with a frontier (``room_beyond_gaps``; in
+                        beyond it, with a frontier (in
                         :mod:`~semexplore_gym.policies.expert.narrow_sources`)
 ``narrow_fallback``     the nearest frontier a grid search reaches with a thinner clearance
                         (``narrow_passages``), through passages followed slowly and exactly
@@ -27,8 +27,11 @@ source                  proposes
 ======================  ======================================================================
 
 Every source reads what it needs from a :class:`PlanContext` and keeps no state of its own (the
-goal memory and the counters are the expert's), so one instance serves every expert. A source
-switched off by the parameters passes.
+goal memory and the counters are the expert's), so one instance serves every expert. Which
+sources an expert asks, and which variant of each, is its recipe's
+(:mod:`~semexplore_gym.policies.expert.recipes`): the paper's method lists ``commanded``,
+``retry`` and ``semantic`` (the map's path) only; ``narrow_fallback`` passes unless the user
+switches ``narrow_passages`` on.
 """
 
 from __future__ import annotations
@@ -249,15 +252,35 @@ class ViewFrontier(PlanSource):
 class SemanticFrontier(PlanSource):
     """Algorithm 1's frontier (the expert's ``choose_goal``) along the topometric map's path.
 
-    With ``semantic_grid_route``, the robot drives to that goal over the grid's clearance-aware
-    route instead (the map's path runs through the skeleton, by the middle of every area and
-    intersection on the way; the route cuts those corners at the planners' clearance); the
-    map's path where the grid has none. With ``entry_detour``, when the straight first leg from
-    the robot to the map's path crosses a wall, a grid route leads onto the path instead (none:
-    pass).
+    A recipe picks the variant (all three on: today's expert; all off: the paper's method):
+
+    Args:
+        grid_candidate: The grid's nearest frontier competes with Algorithm 1's choice, scored
+            by the same ``C`` without semantic terms (``d / L_path + w_v * v``): frontiers the
+            topometric map has no pathway for (or reaches the long way) are explored as the
+            robot passes them. A goal the shuttle guard holds is seen through against it.
+        grid_route: The robot drives to Algorithm 1's goal over the grid's clearance-aware
+            route (the map's path runs through the skeleton, by the middle of every area and
+            intersection on the way; the route cuts those corners at the planners' clearance);
+            the map's path where the grid has none.
+        entry_detour: When the straight first leg from the robot to the map's path crosses a
+            wall, a grid route leads onto the path instead (none: pass).
     """
 
     name = "semantic"
+
+    def __init__(
+        self, *, grid_candidate: bool = True, grid_route: bool = True, entry_detour: bool = True
+    ) -> None:
+        self.grid_candidate = bool(grid_candidate)
+        self.grid_route = bool(grid_route)
+        self.entry_detour = bool(entry_detour)
+
+    def __repr__(self) -> str:
+        return (
+            f"SemanticFrontier(grid_candidate={self.grid_candidate}, "
+            f"grid_route={self.grid_route}, entry_detour={self.entry_detour})"
+        )
 
     def propose(self, ctx: PlanContext) -> Plan | None:
         if not ctx.candidates:
@@ -265,18 +288,17 @@ class SemanticFrontier(PlanSource):
         chosen = ctx.choose_goal(ctx.candidates)
         # A goal the shuttle guard holds is seen through: the grid's frontier must not take
         # turns with it (the two sources would shuttle between them as Algorithm 1's did).
-        held = ctx.params.shuttle_guard_holds_grid and ctx.memory.is_shuttle_goal(chosen.goal_xy_m)
-        if ctx.params.grid_candidate and not held:
+        if self.grid_candidate and not ctx.memory.is_shuttle_goal(chosen.goal_xy_m):
             nearer = _cheaper_grid_frontier(ctx, chosen)
             if nearer is not None:
                 return nearer
         path: np.ndarray | None = chosen.path_m
-        route = ctx.grid_route(chosen.goal_xy_m) if ctx.params.semantic_grid_route else None
+        route = ctx.grid_route(chosen.goal_xy_m) if self.grid_route else None
         if route is not None:
             path = route
             ctx.counts.semantic_grid_routes += 1
         elif (
-            ctx.params.entry_detour
+            self.entry_detour
             and len(chosen.path_m) >= 2
             and not segment_is_clear(ctx.grid, ctx.geometry, ctx.xy_m, tuple(chosen.path_m[1]))
         ):
@@ -321,13 +343,18 @@ class CommittedFallback(PlanSource):
         prm = ctx.params
         old = ctx.current
         if (
-            not prm.grid_fallback
-            or old is None
+            old is None
             or old.kind != PlanKind.FALLBACK
             or ctx.memory.is_blacklisted(old.goal_xy_m)
             or math.hypot(ctx.pose[0] - old.goal_xy_m[0], ctx.pose[1] - old.goal_xy_m[1])
             <= prm.goal_reached_radius_m
-            or not goal_open(ctx.grid, ctx.geometry, old.goal_xy_m, prm)
+            or not goal_open(
+                ctx.grid,
+                ctx.geometry,
+                old.goal_xy_m,
+                prm.goal_check_radius_m,
+                on_frontier=ctx.memory.rules.vanish_on_frontier,
+            )
         ):
             return None
         path = ctx.grid_route(old.goal_xy_m)
@@ -342,8 +369,6 @@ class NearestFallback(PlanSource):
     name = "nearest_fallback"
 
     def propose(self, ctx: PlanContext) -> Plan | None:
-        if not ctx.params.grid_fallback:
-            return None
         found = ctx.nearest_grid_frontier()
         if found is None:
             return None
@@ -367,8 +392,6 @@ class PocketEscape(PlanSource):
 
     def propose(self, ctx: PlanContext) -> Plan | None:
         prm = ctx.params
-        if not (prm.grid_fallback and prm.pocket_escape):
-            return None
         thin_m = ctx.robot_radius_m + prm.pocket_clearance_margin_m
         clearance = ctx.clearance_field()
         exit_path = pocket_exit_path(
@@ -412,8 +435,6 @@ class LookAtNarrowFrontier(PlanSource):
 
     def propose(self, ctx: PlanContext) -> Plan | None:
         prm = ctx.params
-        if not (prm.grid_fallback and prm.look_at_narrow_frontiers):
-            return None
         res_m = ctx.geometry.resolution_m
         if ctx.counts.look_drives >= prm.max_look_drives:
             return None
@@ -444,7 +465,8 @@ class LookAtNarrowFrontier(PlanSource):
         return None
 
 
-#: The expert's plan sources, in the order they are asked (see the module docstring).
+#: Today's expert's plan sources (``semantic-v3``), in the order they are asked (see the module
+#: docstring; the other recipes: :mod:`~semexplore_gym.policies.expert.recipes`).
 DEFAULT_PLAN_SOURCES: tuple[PlanSource, ...] = (
     CommandedGoal(),
     RetryFailedGoal(),

@@ -2,25 +2,27 @@
 
 As with Gymnasium's env ids (``CartPole-v0``, ``CartPole-v1``), a version name never changes
 meaning: a table measured with ``semantic-v2`` is measured again with ``semantic-v2`` in any
-later release, while ``semantic`` moves on to the newest version. A version is a layer of
-parameter values on the expert's defaults (:data:`EXPERT_VERSIONS`); ``make_policy`` builds it
-below the caller's own overrides, so ``semantic-v2[cost.w_v=2]`` is the 0.2.0 expert with
-another weight. Every run record (the mission JSON of ``semexplore explore``, ``runs.csv``'s
+later release, while ``semantic`` moves on to the newest version. A version is a recipe
+(:class:`~semexplore_gym.policies.expert.recipes.ExpertRecipe`: the plan sources it asks, the
+rules of its goal memory, its parameter values; :data:`EXPERT_VERSIONS`); ``make_policy``
+builds it with the caller's overrides on top, so ``semantic-v2[cost.w_v=2]`` is the 0.2.0
+expert with another weight. Every run record (the mission JSON of ``semexplore explore``, ``runs.csv``'s
 ``policy_version`` column and ``summary.md``) states the version a spec resolved to
 (:func:`expert_version`).
 
-A release that changes the expert's behaviour adds a version here with an empty layer (today's
-defaults), and each older version's layer keeps its missions as they were (today: the switches
-of what came later, off). ``tests/policies/test_expert_versions.py`` holds ``semantic-v2`` to
+A release that changes the expert's behaviour adds a version here with a new recipe, and each
+older version keeps its recipe, so its missions stay as they were: an old behaviour lives in the
+parts an old recipe lists, not in a switch of today's expert. ``tests/policies/test_expert_versions.py`` holds ``semantic-v2`` to
 the 0.2.0 release's own mission on a small office and ``semantic`` to ``semantic-v3``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import MappingProxyType
 
+from semexplore_gym.policies.expert.recipes import SEMANTIC_V2, SEMANTIC_V3, ExpertRecipe
 from semexplore_gym.policies.specs import parse_spec
 
 
@@ -31,27 +33,15 @@ class ExpertVersion:
     Attributes:
         name: The policy spec that runs it (``semantic-v2``); never reused for another behaviour.
         release: The package release it shipped in.
-        layer: Parameter values on top of today's defaults (flat dotted keys) that give it.
+        recipe: What it is made of (its plan sources, goal rules and parameter values).
         changes: What changed against the version before, in a few words.
     """
 
     name: str
     release: str
-    layer: Mapping[str, object] = field(default_factory=dict)
+    recipe: ExpertRecipe
     changes: str = ""
 
-
-#: The switches of behaviours added after 0.2.0: all off is the 0.2.0 expert, mission for mission.
-_AFTER_0_2_0: dict[str, object] = {
-    "shuttle_guard": False,
-    "view_unseen_frontiers": False,
-    "grid_candidate": False,
-    "vanish_on_frontier": False,
-    "shuttle_guard_holds_grid": False,
-    "room_beyond_gaps": False,
-    "drop_each_point": False,
-    "semantic_grid_route": False,
-}
 
 #: Every named version, oldest first.
 EXPERT_VERSIONS: Mapping[str, ExpertVersion] = MappingProxyType(
@@ -59,15 +49,12 @@ EXPERT_VERSIONS: Mapping[str, ExpertVersion] = MappingProxyType(
         v.name: v
         for v in (
             ExpertVersion(
-                "semantic-v2",
-                "0.2.0",
-                MappingProxyType(_AFTER_0_2_0),
-                "the robust expert of the 0.2.0 release",
+                "semantic-v2", "0.2.0", SEMANTIC_V2, "the robust expert of the 0.2.0 release"
             ),
             ExpertVersion(
                 "semantic-v3",
                 "0.3.0",
-                MappingProxyType({}),
+                SEMANTIC_V3,
                 "shuttle guard, views into frontiers reached but unseen, the grid's nearest "
                 "frontier as a candidate, goals mapped when their frontier is, room beyond "
                 "gaps, a point of its own per dropped goal, Algorithm 1's goal over the grid's "
@@ -90,12 +77,12 @@ def expert_version(spec: str) -> str:
     Raises:
         ValueError: a malformed spec (the message names it).
     """
-    base, _, _ = parse_spec(spec)
+    base = parse_spec(spec)[0].partition(":")[0]
     if base == NEWEST_ALIAS:
         return LATEST_EXPERT
     return base if base in EXPERT_VERSIONS else ""
 
 
-def version_layer(name: str) -> dict[str, object]:
-    """The parameter layer of version ``name`` (``semantic`` for the newest)."""
-    return dict(EXPERT_VERSIONS[LATEST_EXPERT if name == NEWEST_ALIAS else name].layer)
+def version_recipe(name: str) -> ExpertRecipe:
+    """The recipe of version ``name`` (``semantic`` for the newest)."""
+    return EXPERT_VERSIONS[LATEST_EXPERT if name == NEWEST_ALIAS else name].recipe

@@ -57,16 +57,13 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
     team: TeamPolicy
     try:
         if base in SEMANTIC_TEAM_POLICIES:
-            from semexplore_gym.policies.expert.params import OUTSIDE_CHOICE_OFF
             from semexplore_gym.policies.team.semantic_team import (
                 SemanticTeam,
                 SemanticTeamParams,
             )
 
-            # Below the user's layers: a switch the team cannot honour, set on, is an error.
-            off = {"expert": dict.fromkeys(OUTSIDE_CHOICE_OFF, False)}
             layer = SEMANTIC_TEAM_POLICIES[base]
-            params = build_params(SemanticTeamParams, off, layer, bracket)
+            params = build_params(SemanticTeamParams, layer, bracket)
             team = SemanticTeam(params, **overrides)
         elif base in TEAM_POLICIES:
             layer = TEAM_POLICIES[base]

@@ -39,11 +39,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
-from semexplore_gym.policies.expert.params import (
-    SemanticExpertParams,
-    for_outside_choice,
-    outside_choice_params,
-)
+from semexplore_gym.policies.expert.params import SemanticExpertParams
+from semexplore_gym.policies.expert.recipes import OUTSIDE_CHOICE
 from semexplore_gym.policies.team.base import TeamPolicy
 from semexplore_gym.policies.team.frontier_teams import yield_action
 
@@ -67,10 +64,10 @@ class SemanticTeamParams:
         idle_recheck_s: A stopped robot looks again this often while teammates work.
         yield_distance_m: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
         yield_cone_rad: See :class:`~semexplore_gym.policies.team.FrontierTeamParams`.
-        expert: Each robot's expert parameters (``grid_candidate`` is off, and setting it is
-            an error: the team's coordinated choice, not each robot's nearest frontier,
-            decides; so is ``semantic_grid_route``: the teams were measured driving the map's
-            paths).
+        expert: Each robot's expert parameters; each robot's expert is made from the
+            outside-choice recipe (:data:`~semexplore_gym.policies.expert.recipes.
+            OUTSIDE_CHOICE`: the team's coordinated choice, not each robot's nearest frontier,
+            decides, and the teams were measured driving the map's paths).
     """
 
     semantic: bool = True
@@ -82,14 +79,16 @@ class SemanticTeamParams:
     idle_recheck_s: float = 5.0
     yield_distance_m: float = 0.7
     yield_cone_rad: float = 1.2
-    expert: SemanticExpertParams = dataclasses.field(default_factory=outside_choice_params)
+    expert: SemanticExpertParams = dataclasses.field(default_factory=SemanticExpertParams)
 
 
 class _ExpertMember(SemanticExpertPolicy):
     """One robot's expert; its goal choice is the team's."""
 
+    recipe = OUTSIDE_CHOICE
+
     def __init__(self, team: SemanticTeam, index: int, params: SemanticExpertParams) -> None:
-        super().__init__(for_outside_choice(params, "the semantic team"))
+        super().__init__(params)
         self.team = team
         self.index = index
         self.goal_intersection_xy: tuple[float, float] | None = None
@@ -127,7 +126,6 @@ class SemanticTeam(TeamPolicy):
             p = dataclasses.replace(
                 p, expert=dataclasses.replace(p.expert, cost=_metric_only(p.expert))
             )
-        for_outside_choice(p.expert, "the semantic team")
         self.params = p
         self.name = "team_semantic" if p.semantic else "team_semantic_nosem"
         self.members: list[_ExpertMember] = []

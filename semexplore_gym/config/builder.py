@@ -126,6 +126,9 @@ def _coerce_scalar(value: Any, tp: Any, path: str) -> Any:
 def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -> T:
     """Build dataclass ``cls`` from a (nested) mapping; missing keys keep their defaults.
 
+    A dataclass may name keys it no longer has in a class attribute ``removed_config_keys``
+    (key -> what gives that behaviour now): such a key is an error that says so.
+
     Raises:
         ConfigError: on an unknown key (named by its dotted path) or a value of the wrong type.
     """
@@ -139,6 +142,9 @@ def from_dict(cls: type[T], data: Mapping[str, Any] | None, _prefix: str = "") -
     for key, value in data.items():
         path = f"{_prefix}.{key}" if _prefix else str(key)
         if key not in names:
+            gone = getattr(cls, "removed_config_keys", {}).get(key)
+            if gone is not None:
+                raise ConfigError(f"config key {short_repr(path)} was removed: {gone}")
             raise ConfigError(
                 f"unknown config key {short_repr(path)}; valid keys here: {', '.join(sorted(names))}"
             )

@@ -265,10 +265,10 @@ def train_frontier_value(
                 break
             batch = _draw_batch(cfg, rng)
             pop = np.vstack([mean, _sample(rng, mean, sigma, lo, hi, cfg.population - 1)])
-            # The reference: the expert the value re-ranks, Algorithm 1's choice (grid_candidate
-            # off, as in FrontierValuePolicy), so the mean at zero weights scores 0.
+            # The reference: the expert the value re-ranks (the value at zero weights, the
+            # outside-choice recipe's Algorithm 1 choice), so the mean at zero weights scores 0.
             jobs: list[tuple[str, int, str, dict[str, float]]] = [
-                (w, s, "semantic", {"grid_candidate": False}) for w, s in batch
+                (w, s, "frontier-value", {}) for w, s in batch
             ]
             for row in pop:
                 ov = {k: float(v) for k, v in zip(keys, row, strict=True)}

@@ -9,6 +9,8 @@ import math
 import numpy as np
 import pytest
 from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
+from semexplore_gym.policies.expert.goal_memory import GoalRules
+from semexplore_gym.policies.expert.recipes import SEMANTIC_V3, ExpertRecipe
 
 from semexplore_gym.core.frontiers.viewpoint import (
     ViewSearch,
@@ -72,7 +74,9 @@ def _two_frontier_tmap(grid: np.ndarray, *_: object, **__: object) -> Topometric
     return TopometricMap(GEOM, ids, {0: area}, openings, frontiers, edges, math.nan, 0.155)
 
 
-def _shuttle_mission(params: SemanticExpertParams, period_s: float, time_s: float) -> object:
+def _shuttle_mission(
+    params: SemanticExpertParams, period_s: float, time_s: float, recipe: ExpertRecipe
+) -> object:
     """The robot circles in the corridor's middle without mapping anything, while the two
     frontiers' costs trade places every ``period_s`` (a ranker stands in for Algorithm 1)."""
     pol: SemanticExpertPolicy
@@ -82,7 +86,9 @@ def _shuttle_mission(params: SemanticExpertParams, period_s: float, time_s: floa
         ranked = sorted(cands, key=lambda c: c.goal_xy_m[0] * (1 if left_first else -1))
         return [dataclasses.replace(c, cost=float(10 * i)) for i, c in enumerate(ranked)]
 
-    pol = SemanticExpertPolicy(params, segmenter=_two_frontier_tmap, ranker=trading_places)
+    pol = SemanticExpertPolicy(
+        params, segmenter=_two_frontier_tmap, ranker=trading_places, recipe=recipe
+    )
     grid = _corridor_open_at_both_ends()
     pol.reset(_obs(grid, 2.5, 1.5), INFO, seed=0)
     for k in range(int(time_s / 0.2)):
@@ -95,16 +101,17 @@ def test_a_goal_shuttle_slower_than_the_oscillation_window_is_caught_and_broken(
     # Costs trade places every 150 s, longer than the oscillation guard's 120 s window: the
     # guard alone lets the robot switch goals every 150 s for as long as the mission lasts.
     # The ranker stands in for Algorithm 1's costs: the grid's nearest frontier must not
-    # compete with it here (grid_candidate is measured on its own).
-    quiet = dict(
-        stuck_recovery=False, local_min_escape=False, resegment_min_new_m2=0.0, grid_candidate=False
+    # compete with it here (the grid candidate is measured on its own).
+    quiet = SemanticExpertParams(
+        stuck_recovery=False, local_min_escape=False, resegment_min_new_m2=0.0
     )
-    guard_only = _shuttle_mission(SemanticExpertParams(shuttle_guard=False, **quiet), 150, 1500)
+    recipe = SEMANTIC_V3.with_semantic(grid_candidate=False)
+    guard_only = _shuttle_mission(quiet, 150, 1500, recipe.with_rules(shuttle_guard=False))
     assert guard_only.counters["switches"] >= 8
     assert guard_only.counters["shuttles"] == 0
     # The shuttle guard counts goal switches, not seconds: the goal adopted again without the
     # map growing is kept.
-    pol = _shuttle_mission(SemanticExpertParams(**quiet), 150, 1500)
+    pol = _shuttle_mission(quiet, 150, 1500, recipe)
     assert pol.counters["shuttles"] == 1
     assert pol.counters["switches"] == 2
     assert any(e == "shuttle" for _t, e, _d in pol.events)
@@ -122,7 +129,7 @@ def test_goals_adopted_again_after_the_map_grew_are_no_shuttle() -> None:
     assert not mem.adopt((1.2, 1.0), 1000 + 400)  # 1 m² more known: progress
     assert mem.adopt((4.3, 1.0), 1450)  # back without 1 m² more: a shuttle
     assert mem.is_shuttle_goal((4.0, 1.1)) and not mem.is_shuttle_goal((1.0, 1.0))
-    off = GoalMemory(SemanticExpertParams(shuttle_guard=False).goal_memory, ExpertCounters(), print)
+    off = GoalMemory(prm.goal_memory, ExpertCounters(), print, GoalRules(shuttle_guard=False))
     off.reset(GEOM)
     assert not any(off.adopt(xy, 0) for xy in [(1.0, 1.0), (4.0, 1.0), (1.0, 1.0)])
 
@@ -165,10 +172,12 @@ def test_find_view_pose_sees_the_rim_from_a_reachable_place_away_from_the_tried_
         ViewSearch((1.0, 0.5))
 
 
-def _reach_the_gap(params: SemanticExpertParams) -> SemanticExpertPolicy:
+def _reach_the_gap(
+    params: SemanticExpertParams, recipe: ExpertRecipe = SEMANTIC_V3
+) -> SemanticExpertPolicy:
     """The robot reaches the frontier in the gap (the grid fallback's goal) while its unknown
     side stays unknown (the map is held fixed)."""
-    pol = SemanticExpertPolicy(params, segmenter=_empty_tmap)
+    pol = SemanticExpertPolicy(params, segmenter=_empty_tmap, recipe=recipe)
     grid = _room_and_nook()
     start = _obs(grid, 1.0, 1.5)
     pol.reset(start, INFO, seed=0)
@@ -204,7 +213,8 @@ def test_a_frontier_reached_but_not_cleared_is_seen_from_another_place() -> None
     assert not pol.done
     assert pol.plan_source == "fallback" and pol.goal_xy_m[0] > 2.6  # past the gap
     # Without the view, the same frontier is dropped and the mission ends.
-    off = _reach_the_gap(dataclasses.replace(prm, view_unseen_frontiers=False))
+    no_view = SEMANTIC_V3.with_rules(view_unseen_frontiers=False).without("view")
+    off = _reach_the_gap(prm, no_view)
     for _ in range(3):
         off.act(_obs(_room_and_nook(), 2.3, 1.5), INFO)
     assert off.done and "reached 1 times, not cleared" in off.stop_reason
@@ -273,7 +283,9 @@ def _long_corridor_tmap(grid: np.ndarray, *_: object, **__: object) -> Topometri
     return TopometricMap(LONG, ids, {0: area}, openings, frontiers, edges, math.nan, 0.155)
 
 
-def _sliver_mission(params: SemanticExpertParams, time_s: float) -> SemanticExpertPolicy:
+def _sliver_mission(
+    params: SemanticExpertParams, time_s: float, recipe: ExpertRecipe = SEMANTIC_V3
+) -> SemanticExpertPolicy:
     """Two slivers of unknown at the ends of a 60 m corridor, which no scan ever maps (the map
     is held fixed). The robot drives along its plan at full speed; Algorithm 1's costs (a
     ranker stands in) always favour the frontier farther away, as on the open forest where
@@ -290,7 +302,9 @@ def _sliver_mission(params: SemanticExpertParams, time_s: float) -> SemanticExpe
         ranked = sorted(cands, key=lambda c: -abs(c.goal_xy_m[0] - xy[0]))
         return [dataclasses.replace(c, cost=float(10 * i)) for i, c in enumerate(ranked)]
 
-    pol = SemanticExpertPolicy(params, segmenter=_long_corridor_tmap, ranker=farther_first)
+    pol = SemanticExpertPolicy(
+        params, segmenter=_long_corridor_tmap, ranker=farther_first, recipe=recipe
+    )
     pol.reset(_obs(g, *xy), info, seed=0)
     for _ in range(int(time_s / 0.2)):
         pol.act(_obs(g, *xy), info)
@@ -315,6 +329,8 @@ def test_a_mission_with_only_unseeable_slivers_left_stops_by_itself() -> None:
     assert "no frontier left" in pol.stop_reason
     # Without the shuttle guard the robot turns back before it reaches either sliver, and goes
     # on doing so: neither is ever dropped, the mission ends only by the time limit.
-    off = _sliver_mission(SemanticExpertParams(shuttle_guard=False), 3000.0)
+    off = _sliver_mission(
+        SemanticExpertParams(), 3000.0, SEMANTIC_V3.with_rules(shuttle_guard=False)
+    )
     assert not off.done and off.counters["switches"] >= 10
     assert off.counters["blacklisted"] == 0

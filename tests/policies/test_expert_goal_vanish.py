@@ -1,5 +1,5 @@
 """When a goal's frontier counts as mapped: any UNKNOWN cell near the goal (``unknown_near``),
-or, with ``vanish_on_frontier``, only a frontier cell (UNKNOWN next to FREE: ``frontier_near``).
+or, with the goal rule ``vanish_on_frontier`` (today's recipe's), only a frontier cell (UNKNOWN next to FREE: ``frontier_near``).
 Unknown space behind a mapped wall is no frontier: no drive can map it from this side."""
 
 from __future__ import annotations
@@ -36,17 +36,17 @@ def test_unknown_behind_a_wall_is_no_frontier() -> None:
     assert frontier_near(grid, geometry, (0.1, 0.5), 0.5)  # a box past the map's edge: unknown
 
 
-def _committed_fallback_keeps(grid: np.ndarray, geometry: GridGeometry, **params) -> bool:
+def _committed_fallback_keeps(grid: np.ndarray, geometry: GridGeometry, **rules) -> bool:
     from semexplore_gym.policies.expert.counters import ExpertCounters
-    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory, GoalRules
     from semexplore_gym.policies.expert.params import SemanticExpertParams
     from semexplore_gym.policies.expert.plan import Plan, PlanKind
     from semexplore_gym.policies.expert.plan_context import PlanContext
     from semexplore_gym.policies.expert.plan_sources import CommittedFallback
 
-    prm = SemanticExpertParams(**params)
+    prm = SemanticExpertParams()
     counts = ExpertCounters()
-    memory = GoalMemory(prm.goal_memory, counts, lambda *_: None)
+    memory = GoalMemory(prm.goal_memory, counts, lambda *_: None, GoalRules(**rules))
     memory.reset(geometry, prm.goal_memory)
     old = Plan(PlanKind.FALLBACK, GOAL_XY_M, np.array([(0.5, 0.5), GOAL_XY_M]))
     ctx = PlanContext(
@@ -91,13 +91,17 @@ def _thick_walled_rooms() -> np.ndarray:
 def test_by_thick_walls_goals_are_let_go_once_their_frontier_is_mapped(
     ros_map_file, short_mission
 ) -> None:
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
     world = ros_map_file(_thick_walled_rooms(), "thick_rooms")
     # the expert of that time (a later change off), so that this tests one change
-    new, p_new = short_mission(world, "semantic[semantic_grid_route=false]", 0, 300)
-    old, p_old = short_mission(
-        world, "semantic[vanish_on_frontier=false;semantic_grid_route=false]", 0, 300
-    )
-    assert p_new.params.vanish_on_frontier and not p_old.params.vanish_on_frontier
+    then = SEMANTIC_V3.with_semantic(grid_route=False)
+    new, p_new = short_mission(world, SemanticExpertPolicy(recipe=then), 0, 300)
+    before = then.with_rules(vanish_on_frontier=False)
+    old, p_old = short_mission(world, SemanticExpertPolicy(recipe=before), 0, 300)
+    assert p_new.goal_memory.rules.vanish_on_frontier
+    assert not p_old.goal_memory.rules.vanish_on_frontier
     # the unknown inside the walls kept a goal alive until the robot reached it
     assert p_new.counters["replan_goal_vanished"] > p_old.counters["replan_goal_vanished"]
     assert p_new.counters["replan_goal_reached"] < p_old.counters["replan_goal_reached"]

@@ -1,5 +1,5 @@
-"""The grid's nearest frontier competes with Algorithm 1's choice (``grid_candidate``): scored
-by the same ``C`` without semantic terms."""
+"""The grid's nearest frontier competes with Algorithm 1's choice (the semantic source's
+``grid_candidate`` variant, today's recipe's): scored by the same ``C`` without semantic terms."""
 
 from __future__ import annotations
 
@@ -39,10 +39,10 @@ def _context(plan_context, chosen_cost: float, goal_xy_m=(0.2, 1.5), **params):
     return plan_context(grid, geometry, prm, (*ROBOT_XY_M, 0.0), [chosen])
 
 
-def _propose(ctx):
+def _propose(ctx, **variant):
     from semexplore_gym.policies.expert.plan_sources import SemanticFrontier
 
-    return SemanticFrontier().propose(ctx)
+    return SemanticFrontier(**variant).propose(ctx)
 
 
 def test_a_cheaper_grid_frontier_replaces_algorithm_1s_choice(plan_context) -> None:
@@ -79,23 +79,28 @@ def test_a_grid_frontier_next_to_algorithm_1s_goal_is_the_same_goal(plan_context
     assert ctx.counts.grid_frontier_plans == 0
 
 
-def test_the_paper_pure_preset_and_the_switch_leave_algorithm_1_alone(plan_context) -> None:
-    from semexplore_gym.policies.expert.params import PAPER_PURE
+def test_the_paper_method_and_semantic_v2_leave_algorithm_1_alone(plan_context) -> None:
     from semexplore_gym.policies.expert.plan import PlanKind
+    from semexplore_gym.policies.expert.recipes import PAPER_METHOD, SEMANTIC_V2
 
-    assert PAPER_PURE["grid_candidate"] is False
-    ctx = _context(plan_context, chosen_cost=5.0, grid_candidate=False)
-    assert _propose(ctx).kind == PlanKind.SEMANTIC
+    for recipe in (PAPER_METHOD, SEMANTIC_V2):
+        assert recipe.semantic_source is not None and not recipe.semantic_source.grid_candidate
+    ctx = _context(plan_context, chosen_cost=5.0)
+    assert _propose(ctx, grid_candidate=False).kind == PlanKind.SEMANTIC
     assert ctx.counts.grid_frontier_plans == 0
 
 
 def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_mission) -> None:
-    """An 8 m maze (a tuning world of #33): the frontiers Algorithm 1 leaves behind are taken on the way."""
+    """An 8 m maze (a tuning world): the frontiers Algorithm 1 leaves behind are taken on the way."""
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
     world = "maze:seed=61001,size_m=8,braid=0.3"
-    # the expert of that time (two later changes off), so that this tests one change
-    then = "vanish_on_frontier=false;shuttle_guard_holds_grid=false"
-    new, p_new = short_mission(world, f"semantic[{then}]", 5000, 1200)
-    old, p_old = short_mission(world, f"semantic[grid_candidate=false;{then}]", 5000, 1200)
+    # the expert of that time (a later goal rule off), so that this tests one change
+    then = SEMANTIC_V3.with_rules(vanish_on_frontier=False)
+    without = then.with_semantic(grid_candidate=False)
+    new, p_new = short_mission(world, SemanticExpertPolicy(recipe=then), 5000, 1200)
+    old, p_old = short_mission(world, SemanticExpertPolicy(recipe=without), 5000, 1200)
     assert p_new.counters["grid_frontier_plans"] > 0
     assert p_old.counters["grid_frontier_plans"] == 0
     assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0
@@ -104,38 +109,35 @@ def test_in_a_maze_the_expert_explores_what_it_passes_and_drives_less(short_miss
 
 def test_policies_that_choose_the_frontier_themselves_run_without_it() -> None:
     """Teams, the learning agents' driver and the learned frontier value make the choice: the
-    grid's nearest frontier never overrules it. The driver turns it off whatever its caller's
-    params say; the others run without it by default and refuse it when asked
-    (tests/policies/test_outside_choice.py)."""
+    grid's nearest frontier never overrules it. They run the outside-choice recipe, and refuse
+    a recipe or key with it (tests/policies/test_outside_choice.py)."""
     from semexplore_gym.policies.expert.driver import ExpertDriver
-    from semexplore_gym.policies.expert.params import SemanticExpertParams
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
     from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
     from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
 
-    assert SemanticExpertParams().grid_candidate  # the robust expert's default
-    on = SemanticExpertParams(grid_candidate=True)
-    assert not ExpertDriver(on).params.grid_candidate
-    assert not ExpertDriver().params.grid_candidate
-    assert not FrontierValuePolicy().params.grid_candidate
+    def candidate(pol) -> bool:
+        return any(getattr(s, "grid_candidate", False) for s in pol.plan_sources)
+
+    assert candidate(SemanticExpertPolicy())  # the robust expert's default
+    assert not candidate(ExpertDriver())
+    assert not candidate(FrontierValuePolicy())
     team = SemanticTeam()
-    assert not _ExpertMember(team, 0, team.params.expert).params.grid_candidate
+    assert not candidate(_ExpertMember(team, 0, team.params.expert))
 
 
-@pytest.mark.parametrize("holds", [True, False])
 def test_the_goal_the_shuttle_guard_holds_is_kept_against_the_grid_frontier(
-    plan_context, holds: bool
+    plan_context,
 ) -> None:
     """A goal adopted again without progress is seen through: the grid's frontier does not
     take turns with it (else the two sources shuttle, as on a real SLAM map for 2,000 s)."""
     from semexplore_gym.policies.expert.plan import PlanKind
 
-    ctx = _context(
-        plan_context, chosen_cost=5.0, shuttle_guard_holds_grid=holds
-    )  # the grid's is cheaper
+    ctx = _context(plan_context, chosen_cost=5.0)  # the grid's is cheaper
     ctx.memory.shuttle_xy_m = (0.2, 1.5)  # the shuttle guard holds Algorithm 1's goal
     plan = _propose(ctx)
-    assert plan.kind == (PlanKind.SEMANTIC if holds else PlanKind.FALLBACK)
-    assert ctx.counts.grid_frontier_plans == (0 if holds else 1)
+    assert plan.kind == PlanKind.SEMANTIC
+    assert ctx.counts.grid_frontier_plans == 0
     ctx = _context(
         plan_context, chosen_cost=5.0
     )  # the guard holds another goal: the grid's frontier wins

@@ -35,13 +35,24 @@ def _room_with_slots(width_px: int = 5, n: int = 8) -> np.ndarray:
 def _slots_missions(ros_map_file, short_mission, give_up: str):
     """The narrow tier in the slotted room without and with the give-up ``give_up``: the
     missions ``(keeps_on, p_on), (gives_up, p_up)``."""
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.params import SemanticExpertParams
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
+    from semexplore_gym.config import build_params
+
     world = ros_map_file(_room_with_slots(), "slots", (0.013, 0.021))
-    # The expert of the time the give-up was made (vanish_on_frontier came later: with it, the
-    # unknown rock round a slot's end is no frontier and fewer slots become goals).
-    old_test = "vanish_on_frontier=false;shuttle_guard_holds_grid=false"
+    # The expert of the time the give-up was made (the goal rule vanish_on_frontier came later:
+    # with it, the unknown rock round a slot's end is no frontier and fewer slots become goals).
+    then = SEMANTIC_V3.with_rules(vanish_on_frontier=False)
+
+    def expert(*overrides: str) -> SemanticExpertPolicy:
+        prm = build_params(SemanticExpertParams, overrides=["narrow_passages=true", *overrides])
+        return SemanticExpertPolicy(prm, recipe=then)
+
     return (
-        short_mission(world, f"semantic[narrow_passages=true;{old_test}]", 2, 600),
-        short_mission(world, f"semantic[narrow_passages=true;{give_up};{old_test}]", 2, 600),
+        short_mission(world, expert(), 2, 600),
+        short_mission(world, expert(give_up), 2, 600),
     )
 
 

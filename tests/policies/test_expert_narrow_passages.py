@@ -1,4 +1,5 @@
-"""The expert's graded clearance (``room_beyond_gaps``, on by default; ``narrow_passages``):
+"""The expert's graded clearance (the ``room_beyond_gap`` source, in today's recipe; the
+user's switch ``narrow_passages``):
 passages narrower than the planners' clearance but wider than the robot are explored, slowly
 and without touching their walls."""
 
@@ -51,14 +52,18 @@ def test_room_seen_beyond_a_gap_just_wider_than_the_robot_is_explored_by_default
     ros_map_file, short_mission, width_px
 ):
     # 0.25 m and 0.30 m: narrower than the planners' clearance allows (gaps from 0.31 m), wider
-    # than the robot. The default expert goes through (room_beyond_gaps), slowly and exactly.
+    # than the robot. The default expert goes through (room_beyond_gap), slowly and exactly.
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
     world = ros_map_file(_rooms_with_a_gap(width_px), "gap", (0.013, 0.021))
     for seed in (1, 2):
         result, policy = short_mission(world, "semantic", seed, 300)
         assert result.self_stopped and result.coverage >= 0.97 and result.collisions == 0
         assert policy.counters["narrow_plans"] > 0 and policy.counters["tight_steps"] > 0
         assert any(e == "room" for _t, e, _d in policy.events)
-        off, _ = short_mission(world, "semantic[room_beyond_gaps=false]", seed, 300)
+        without = SemanticExpertPolicy(recipe=SEMANTIC_V3.without("room_beyond_gap"))
+        off, _ = short_mission(world, without, seed, 300)
         assert off.self_stopped and off.coverage < 0.8  # stops in its own room
 
 
@@ -78,7 +83,9 @@ def test_narrow_passages_is_off_by_default_and_its_parameters_are_checked():
     from semexplore_gym.policies.expert.params import SemanticExpertParams
 
     assert SemanticExpertParams().narrow_passages is False
-    assert SemanticExpertParams().room_beyond_gaps is True
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
+    assert "room_beyond_gap" in SEMANTIC_V3.source_names
     with pytest.raises(ValueError, match="narrow_min_room_m2"):
         SemanticExpertParams(narrow_min_room_m2=float("nan"))
     with pytest.raises(ValueError, match="narrow_clearance_margin_m"):

@@ -10,7 +10,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from semexplore_gym.policies.expert.expert import SemanticExpertParams, SemanticExpertPolicy
-from semexplore_gym.policies.expert.params import PAPER_PURE
+from semexplore_gym.policies.expert.recipes import PAPER_METHOD, PAPER_PARAMS, SEMANTIC_V3
 from semexplore_gym.policies.navigation.frontier_memory import FrontierMemory
 from semexplore_gym.policies.navigation.side_approach import side_approach
 from semexplore_gym.policies.registry import make_policy
@@ -131,9 +131,10 @@ def test_a_narrow_at_first_sight_opening_gets_a_closer_look_then_is_explored() -
     assert pol.plan_source == "fallback" and pol.goal_xy_m[0] > 2.3
     # Had it stayed narrow, reaching the look point drops it as looked-at and the mission ends
     # (with the view of unseen frontiers off; on, a place that sees through the gap comes first).
+    no_view = SEMANTIC_V3.with_rules(view_unseen_frontiers=False).without("view")
     for view in (False, True):
-        prm = SemanticExpertParams(view_unseen_frontiers=view)
-        pol2 = SemanticExpertPolicy(prm, segmenter=_empty_tmap)
+        recipe = SEMANTIC_V3 if view else no_view
+        pol2 = SemanticExpertPolicy(segmenter=_empty_tmap, recipe=recipe)
         pol2.reset(narrow, INFO, seed=0)
         pol2.act(narrow, INFO)
         at_goal = _obs(_two_rooms(0.2), *pol2.goal_xy_m)
@@ -191,15 +192,16 @@ def test_the_grid_check_leads_out_of_a_pocket_instead_of_stopping() -> None:
     assert any(e == "pocket" for _t, e, _d in pol.events)
     # Without the escape the room beyond the pocket's gap, which the map shows with its
     # frontier, still leads out (at the narrow tier's clearance) ...
-    room = SemanticExpertPolicy(SemanticExpertParams(pocket_escape=False), segmenter=_empty_tmap)
+    no_escape = SEMANTIC_V3.without("pocket_escape")
+    room = SemanticExpertPolicy(segmenter=_empty_tmap, recipe=no_escape)
     room.reset(in_pocket, INFO, seed=0)
     room.act(in_pocket, INFO)
     assert room.plan_source == "fallback" and room.goal_xy_m[0] > 3.3
     assert room.counters["pocket_escapes"] == 0 and room.counters["narrow_plans"] == 1
     assert any(e == "room" for _t, e, _d in room.events)
     # ... and without both the check sees only the pocket: no fallback goal (a look, a stop).
-    no_way = SemanticExpertParams(pocket_escape=False, room_beyond_gaps=False)
-    off = SemanticExpertPolicy(no_way, segmenter=_empty_tmap)
+    no_way = no_escape.without("room_beyond_gap")
+    off = SemanticExpertPolicy(segmenter=_empty_tmap, recipe=no_way)
     off.reset(in_pocket, INFO, seed=0)
     for _ in range(20):
         off.act(in_pocket, INFO)
@@ -294,19 +296,21 @@ def test_side_approach_comes_from_away_from_the_failure() -> None:
     assert math.dist(tuple(path[-1]), target) <= 0.15 + RES  # grid_path_to's goal radius
 
 
-def test_paper_pure_yaml_is_the_paper_pure_preset() -> None:
+def test_paper_method_yaml_names_the_paper_method_recipe() -> None:
     from semexplore_gym.policies.specs import load_policy_config
 
     cfg = load_policy_config(REPO / "configs" / "expert" / "paper_method.yaml")
-    from_yaml = build_params(SemanticExpertParams, cfg.params)
-    assert from_yaml == build_params(SemanticExpertParams, PAPER_PURE)
+    assert cfg.policy == "semantic-paper" and not cfg.params
     pol = make_policy("semantic-paper")
-    assert pol.params == from_yaml
+    assert pol.recipe is PAPER_METHOD
+    assert pol.params == build_params(SemanticExpertParams, dict(PAPER_PARAMS))
     assert pol.params.cost == SemanticExpertParams().cost  # the paper's weights
-    flags = (
-        "grid_fallback pocket_escape look_at_narrow_frontiers oscillation_guard entry_detour "
-        "goal_commitment local_min_escape stuck_recovery reach_blacklist"
-    ).split()
+    assert pol.recipe.source_names == ("commanded", "retry", "semantic")
+    semantic = pol.recipe.semantic_source
+    assert semantic is not None
+    assert not (semantic.grid_candidate or semantic.grid_route or semantic.entry_detour)
+    assert not any(vars(pol.goal_memory.rules).values())  # no goal rule of ours
+    flags = "goal_commitment local_min_escape stuck_recovery".split()
     assert not any(getattr(pol.params, f) for f in flags)
     assert all(getattr(SemanticExpertParams(), f) for f in flags)  # the robust default
     assert not pol.params.potential_field.braking_guard and pol.params.prune_by == "area"

@@ -1,4 +1,5 @@
-"""Algorithm 1's goal driven over the grid's route (``semantic_grid_route``): the goal and its
+"""Algorithm 1's goal driven over the grid's route (the semantic source's ``grid_route``
+variant, today's recipe's): the goal and its
 cost stay Algorithm 1's, the path is the grid's clearance-aware route instead of the map's."""
 
 from __future__ import annotations
@@ -25,10 +26,10 @@ def _room() -> tuple[np.ndarray, GridGeometry]:
     return grid, GridGeometry(RES_M, 0.0, 0.0, 60, 100)
 
 
-def _context(plan_context, grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M, **params):
+def _context(plan_context, grid: np.ndarray, geometry: GridGeometry, goal_xy_m=GOAL_XY_M):
     from semexplore_gym.policies.expert.params import SemanticExpertParams
 
-    prm = SemanticExpertParams(**{"grid_candidate": False, **params})
+    prm = SemanticExpertParams()
     path = MAP_PATH_M.copy()
     path[-1] = goal_xy_m
     chosen = SimpleNamespace(goal_xy_m=goal_xy_m, path_m=path, l_path_m=4.0, cost=0.5)
@@ -39,16 +40,16 @@ def _length_m(path: np.ndarray) -> float:
     return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
 
-def _propose(ctx):
+def _propose(ctx, grid_route: bool = True):
     from semexplore_gym.policies.expert.plan_sources import SemanticFrontier
 
-    return SemanticFrontier().propose(ctx)
+    return SemanticFrontier(grid_candidate=False, grid_route=grid_route).propose(ctx)
 
 
 def test_the_goal_is_driven_to_over_the_grids_route(plan_context) -> None:
     from semexplore_gym.policies.expert.plan import PlanKind
 
-    ctx = _context(plan_context, *_room(), semantic_grid_route=True)
+    ctx = _context(plan_context, *_room())
     plan = _propose(ctx)
     assert plan.kind == PlanKind.SEMANTIC and plan.goal_xy_m == GOAL_XY_M
     assert plan.candidate is ctx.candidates[0]  # Algorithm 1's choice, its cost untouched
@@ -59,9 +60,9 @@ def test_the_goal_is_driven_to_over_the_grids_route(plan_context) -> None:
     assert ctx.counts.semantic_grid_routes == 1
 
 
-def test_switched_off_the_maps_path_is_driven(plan_context) -> None:
-    ctx = _context(plan_context, *_room(), semantic_grid_route=False)
-    plan = _propose(ctx)
+def test_without_it_the_maps_path_is_driven(plan_context) -> None:
+    ctx = _context(plan_context, *_room())
+    plan = _propose(ctx, grid_route=False)
     assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
     assert plan.path_m[:, 1].max() > 2.6
     assert ctx.counts.semantic_grid_routes == 0
@@ -73,43 +74,50 @@ def test_where_the_grid_has_no_route_the_maps_path_stands(plan_context) -> None:
     grid, geometry = _room()
     grid[:, 70:72] = OCCUPIED  # at x = 3.5 m, past the map path's first leg
     grid[28:33, 70:72] = FREE  # a 0.25 m gap: under 2 x 0.155 m
-    ctx = _context(plan_context, grid, geometry, semantic_grid_route=True)
+    ctx = _context(plan_context, grid, geometry)
     plan = _propose(ctx)
     assert _length_m(plan.path_m) == pytest.approx(_length_m(MAP_PATH_M), abs=0.05)
     assert ctx.counts.semantic_grid_routes == 0
 
 
-def test_the_robust_expert_has_it_and_the_paper_pure_preset_does_not() -> None:
-    from semexplore_gym.policies.expert.params import PAPER_PURE, SemanticExpertParams
+def test_todays_recipe_has_it_and_the_older_ones_do_not() -> None:
+    from semexplore_gym.policies.expert.recipes import PAPER_METHOD, SEMANTIC_V2, SEMANTIC_V3
 
-    assert SemanticExpertParams().semantic_grid_route
-    assert PAPER_PURE["semantic_grid_route"] is False
+    routes = [r.semantic_source.grid_route for r in (SEMANTIC_V3, SEMANTIC_V2, PAPER_METHOD)]
+    assert routes == [True, False, False]
 
 
 def test_policies_measured_on_the_maps_paths_keep_them() -> None:
     """Teams, the learning agents' driver, the frontier student and the learned frontier value
-    were trained and measured driving the map's paths: they keep them (the driver whatever
-    its caller's params say; the others refuse the switch: tests/policies/test_outside_choice.py)."""
+    were trained and measured driving the map's paths: they keep them (the outside-choice
+    recipe; a recipe or key with the route is refused: tests/policies/test_outside_choice.py)."""
     from semexplore_gym.policies.expert.driver import ExpertDriver
-    from semexplore_gym.policies.expert.params import SemanticExpertParams
     from semexplore_gym.policies.frontier_student import FrontierStudentPolicy
     from semexplore_gym.policies.learned_frontier_value import FrontierValuePolicy
     from semexplore_gym.policies.team.semantic_team import SemanticTeam, _ExpertMember
 
-    on = SemanticExpertParams(semantic_grid_route=True)
-    assert not ExpertDriver(on).params.semantic_grid_route
-    assert not ExpertDriver().params.semantic_grid_route
-    assert not FrontierValuePolicy().params.semantic_grid_route
-    assert not FrontierStudentPolicy().params.semantic_grid_route
+    def route(pol) -> bool:
+        return any(getattr(s, "grid_route", False) for s in pol.plan_sources)
+
     team = SemanticTeam()
-    assert not _ExpertMember(team, 0, team.params.expert).params.semantic_grid_route
+    for pol in (
+        ExpertDriver(),
+        FrontierValuePolicy(),
+        FrontierStudentPolicy(),
+        _ExpertMember(team, 0, team.params.expert),
+    ):
+        assert not route(pol), type(pol).__name__
 
 
 def test_in_a_maze_the_expert_drives_less_over_the_grids_routes(short_mission) -> None:
     """An 8 m maze (a tuning world of the path decomposition): the same goals, shorter drives."""
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.recipes import SEMANTIC_V3
+
     world = "maze:seed=61001,size_m=8,braid=0.3"
     new, p_new = short_mission(world, "semantic", 5000, 1200)
-    old, p_old = short_mission(world, "semantic[semantic_grid_route=false]", 5000, 1200)
+    without = SemanticExpertPolicy(recipe=SEMANTIC_V3.with_semantic(grid_route=False))
+    old, p_old = short_mission(world, without, 5000, 1200)
     assert p_new.counters["semantic_grid_routes"] > 0
     assert p_old.counters["semantic_grid_routes"] == 0
     assert new.self_stopped and new.coverage >= 0.99 and new.collisions == 0

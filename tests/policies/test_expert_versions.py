@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -19,17 +19,6 @@ from semexplore_gym.policies.registry import make_policy
 
 from semexplore_gym.cli import main
 
-#: Every switch added after 0.2.0, off: the 0.2.0 expert as a spec of today's.
-LONG_SPEC = (
-    "semantic[shuttle_guard=false;view_unseen_frontiers=false;grid_candidate=false;"
-    "vanish_on_frontier=false;shuttle_guard_holds_grid=false;room_beyond_gaps=false;"
-    "drop_each_point=false;semantic_grid_route=false]"
-)
-#: The README's spec for the expert before (shuttle guard and views still on).
-SIX_SWITCH_SPEC = (
-    "semantic[grid_candidate=false;vanish_on_frontier=false;shuttle_guard_holds_grid=false;"
-    "room_beyond_gaps=false;drop_each_point=false;semantic_grid_route=false]"
-)
 #: A small world on which the 0.2.0 expert and today's differ.
 WORLD = "office:seed=0,size_m=8"
 #: The 0.2.0 release's own code on WORLD (semexplore explore --world WORLD --max-time-s 300
@@ -54,13 +43,20 @@ def test_semantic_is_the_newest_version_and_todays_defaults() -> None:
     assert make_policy("semantic-v3").params == newest == SemanticExpertParams()
 
 
-def test_semantic_v2_is_the_long_switch_spec_and_takes_overrides() -> None:
-    v2, today = make_policy("semantic-v2").params, SemanticExpertParams()
-    assert v2 == make_policy(LONG_SPEC).params != today
-    # Only on/off switches differ from today's defaults: the 0.2.0 expert's values are today's.
-    changed = {f.name for f in fields(v2) if getattr(v2, f.name) != getattr(today, f.name)}
-    assert changed == set(EXPERT_VERSIONS["semantic-v2"].layer)
-    assert all(getattr(today, k) is True for k in changed)
+def test_semantic_v2_is_its_recipe_on_todays_values_and_takes_overrides() -> None:
+    pol, today = make_policy("semantic-v2"), make_policy("semantic")
+    v2 = pol.params
+    # The 0.2.0 expert's parameter values are today's; its parts are its own.
+    assert v2 == today.params == SemanticExpertParams()
+    assert pol.recipe is EXPERT_VERSIONS["semantic-v2"].recipe
+    assert set(today.recipe.source_names) - set(pol.recipe.source_names) == {
+        "view",
+        "room_beyond_gap",
+    }
+    semantic = pol.recipe.semantic_source
+    assert semantic is not None and not semantic.grid_candidate and not semantic.grid_route
+    rules = pol.goal_memory.rules
+    assert not (rules.shuttle_guard or rules.drop_each_point or rules.vanish_on_frontier)
     tuned = make_policy("semantic-v2[cost.w_v=2]").params
     assert tuned == replace(v2, cost=replace(v2.cost, w_v=2.0))
 
@@ -85,26 +81,22 @@ def test_semantic_v2_runs_by_name_as_the_0_2_0_release_did(
     v2 = _explore("semantic-v2", capsys)
     assert v2["policy_version"] == "semantic-v2"
     assert {k: v2[k] for k in RELEASE_0_2_0} == RELEASE_0_2_0
-    long_spec = _explore(LONG_SPEC, capsys)
-    assert long_spec["policy_version"] == "semantic-v3"  # today's expert with switches set
-    assert {k: long_spec[k] for k in RELEASE_0_2_0} == RELEASE_0_2_0
 
 
 @pytest.mark.slow
-def test_the_shuttle_guard_and_the_views_came_after_0_2_0_too(
+def test_semantic_v2_runs_maze2_as_the_0_2_0_release_did(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """Six switches off (the spec the docs gave for "the expert before") is not the 0.2.0
-    expert: the shuttle guard and the views of unseen frontiers came after it as well. On maze2
-    the 0.2.0 release's code took 261.0 s over 54.885 m (the same command from its sources)."""
+    """On maze2 the 0.2.0 release's code took 261.0 s over 54.885 m (the same command from its
+    sources); ``semantic-v2`` by name does too, today's expert does not."""
     argv = ["explore", "--world", "maze2", "--max-time-s", "1200", "--json", "--no-progress"]
     runs = {}
-    for spec in ("semantic-v2", SIX_SWITCH_SPEC):
+    for spec in ("semantic-v2", "semantic"):
         assert main([*argv, "--policy", spec]) == 0
         runs[spec] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     release = {"mission_time_s": 261.0, "path_length_m": 54.885}
     assert {k: runs["semantic-v2"][k] for k in release} == release
-    assert {k: runs[SIX_SWITCH_SPEC][k] for k in release} != release
+    assert {k: runs["semantic"][k] for k in release} != release
 
 
 @pytest.mark.slow
@@ -147,3 +139,17 @@ def test_pretrained_details_name_the_expert_version(capsys: pytest.CaptureFixtur
         models
     )
     assert all(m.to_dict()["expert_version"] == "semantic-v2" for m in models)
+
+
+def test_a_version_takes_its_parameter_values_from_a_file(tmp_path: Path) -> None:
+    """``semantic:FILE.yaml`` is a short spec for many values (the docs' Optuna weights)."""
+    pol = make_policy("semantic:configs/expert/optuna_weights.yaml")
+    assert (pol.params.cost.w_v, pol.params.cost.w_p, pol.params.cost.w_i) == (0.62, 0.051, 0.004)
+    assert expert_version("semantic:configs/expert/optuna_weights.yaml") == "semantic-v3"
+    own = tmp_path / "w.yaml"
+    own.write_text("cost: {w_v: 2.0}\n")
+    v2 = make_policy(f"semantic-v2:{own}[cost.w_p=0.5]")
+    assert (v2.params.cost.w_v, v2.params.cost.w_p) == (2.0, 0.5)  # the bracket wins last
+    assert v2.recipe is EXPERT_VERSIONS["semantic-v2"].recipe
+    with pytest.raises(ValueError, match="takes no argument but a parameter file"):
+        make_policy("semantic:tuned")

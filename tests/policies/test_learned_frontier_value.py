@@ -16,10 +16,11 @@ from semexplore_gym.evaluation.rollout import make_mission_env, run_mission
 WORLD = "maze:seed=3,size_m=6"
 
 
-def _trajectory(spec: str, max_time_s: float, **overrides: float) -> np.ndarray:
+def _trajectory(spec: str | object, max_time_s: float, **overrides: float) -> np.ndarray:
     env = make_mission_env(WORLD, overrides=[f"episode.max_time_s={max_time_s}"])
+    policy = make_policy(spec, **overrides) if isinstance(spec, str) else spec
     try:
-        res = run_mission(env, make_policy(spec, **overrides), seed=1, max_time_s=max_time_s)
+        res = run_mission(env, policy, seed=1, max_time_s=max_time_s)
     finally:
         env.close()
     return np.asarray(res.trajectory)
@@ -28,7 +29,10 @@ def _trajectory(spec: str, max_time_s: float, **overrides: float) -> np.ndarray:
 def test_with_every_weight_at_zero_it_is_the_expert_step_for_step() -> None:
     # The expert it re-ranks: Algorithm 1's choice, without the grid candidate, along the map's
     # paths (as the learned value was measured).
-    expert = _trajectory("semantic[grid_candidate=false;semantic_grid_route=false]", 40.0)
+    from semexplore_gym.policies.expert.expert import SemanticExpertPolicy
+    from semexplore_gym.policies.expert.recipes import OUTSIDE_CHOICE
+
+    expert = _trajectory(SemanticExpertPolicy(recipe=OUTSIDE_CHOICE), 40.0)
     learned = _trajectory("frontier-value", 40.0)
     assert len(expert) > 10
     np.testing.assert_array_equal(learned, expert)

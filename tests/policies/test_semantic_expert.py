@@ -11,6 +11,7 @@ from semexplore_gym.policies.expert.expert import (
     SemanticExpertPolicy,
     area_type_raster,
 )
+from semexplore_gym.policies.expert.recipes import PAPER_METHOD, SEMANTIC_V3
 from semexplore_gym.policies.registry import make_policy
 
 from semexplore_gym.core.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
@@ -99,8 +100,8 @@ def obs_at(
 def test_semantic_plan_drives_towards_the_frontier_and_reports_stats():
     grid = corridor_grid()
     # along the map's path (the grid's route instead: test_expert_semantic_grid_route.py)
-    prm = SemanticExpertParams(semantic_grid_route=False)
-    pol = SemanticExpertPolicy(prm, segmenter=corridor_tmap)
+    recipe = SEMANTIC_V3.with_semantic(grid_route=False)
+    pol = SemanticExpertPolicy(segmenter=corridor_tmap, recipe=recipe)
     obs = obs_at(grid, 0.5, 1.0, 0.0)
     pol.reset(obs, INFO, seed=0)
     a = pol.act(obs, INFO)
@@ -151,14 +152,14 @@ def test_fallback_without_frontier_pathways_then_stop_when_nothing_is_left():
     assert np.all(pol.act(obs, INFO) == 0)
 
 
-def test_fallback_can_be_disabled():
+def test_without_the_fallback_sources_the_mission_stops_with_algorithm_1():
     pol = SemanticExpertPolicy(
-        SemanticExpertParams(grid_fallback=False, stop_confirmations=1), segmenter=empty_tmap
+        SemanticExpertParams(stop_confirmations=1), segmenter=empty_tmap, recipe=PAPER_METHOD
     )
     obs = obs_at(corridor_grid(), 0.5, 1.0, 0.0)
     pol.reset(obs, INFO, seed=0)
     pol.act(obs, INFO)
-    assert pol.done
+    assert pol.done and pol.stop_reason == "no semantic frontier left"
 
 
 def test_stuck_robot_backs_off_and_blacklists_its_goal():

@@ -31,10 +31,10 @@ def _fake_runner(calls: list) -> object:
         out = []
         for world, seed, spec, ov in jobs:
             assert "seed=*" in world and 0 <= seed <= 99
-            if spec == "semantic":
+            assert spec == "frontier-value"
+            if not ov:  # the reference: the value at zero weights, the expert it re-ranks
                 out.append((100.0, 0.99))
                 continue
-            assert spec == "frontier-value"
             err = (ov["value.w_path_m"] - 0.3) ** 2 + 0.1 * (ov["expert.switch_margin"] - 1.0) ** 2
             out.append((80.0 * math.exp(err), 0.99))
         return out
