@@ -221,11 +221,11 @@ class OptionChoice(gym.Wrapper):
     def _observation(self, decision: Any) -> dict[str, np.ndarray]:
         p = self.params
         n, k = p.max_options, len(OPTION_FEATURE_NAMES)
-        time_s = float(self._info.get("sim_time_s", 0.0))
         if decision is None:
             feats, grid = np.zeros((0, k)), np.zeros((1, 1), dtype=np.int8)
-        else:
-            feats, grid = decision.features, decision.grid
+            time_s = float(self._info.get("sim_time_s", 0.0))
+        else:  # the driver's own clock, as a policy that drives without this wrapper reads it
+            feats, grid, time_s = decision.features, decision.grid, float(decision.time_s)
         ob = option_observation(feats, grid, time_s, n, p.time_scale_s)
         self._slots, self._valid = ob.slots, ob.valid
         hits = np.flatnonzero(ob.slots == decision.choice) if decision is not None else []
