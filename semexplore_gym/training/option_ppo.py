@@ -48,6 +48,8 @@ class OptionPPOConfig:
         total_timesteps: PPO decisions (all envs together), BC's not counted.
         n_envs, n_steps, batch_size, n_epochs, learning_rate, gamma, ent_coef: MaskablePPO.
         torch_threads: ``torch.set_num_threads``.
+        wall_budget_s: PPO stops (and saves) once the run has taken this much wall time,
+            BC included (0: no limit; a resumed run counts from its restart).
     """
 
     seed: int = 0
@@ -69,6 +71,7 @@ class OptionPPOConfig:
     gamma: float = 0.98
     ent_coef: float = 0.003
     torch_threads: int = 1
+    wall_budget_s: float = 0.0
 
     def __post_init__(self) -> None:
         ints = ("hidden", "bc_epochs", "total_timesteps", "n_envs", "n_steps", "batch_size")
@@ -84,6 +87,9 @@ class OptionPPOConfig:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        w = self.wall_budget_s
+        if not (isinstance(w, (int, float)) and math.isfinite(w) and w >= 0):
+            raise ValueError(f"wall_budget_s must be a finite number >= 0, got {w!r}")
         if not 0 < self.gamma <= 1:
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         if not self.splits:
@@ -269,7 +275,7 @@ def _new_model(cfg: OptionPPOConfig, vec_env: Any, out: Path) -> Any:
     )  # fmt: skip
 
 
-def _callback(out: Path, log: EpisodeLog) -> Any:
+def _callback(out: Path, log: EpisodeLog, stop_at: float) -> Any:
     from stable_baselines3.common.callbacks import BaseCallback
 
     class Curve(BaseCallback):
@@ -278,7 +284,7 @@ def _callback(out: Path, log: EpisodeLog) -> Any:
                 if done:
                     ret = float(info.get("episode_total", float("nan")))
                     log.add(self.num_timesteps, "ppo", info.get("world", "?"), ret, info)
-            return True
+            return time.perf_counter() < stop_at
 
         def _on_rollout_end(self) -> None:
             (out / "checkpoints").mkdir(exist_ok=True)
@@ -352,13 +358,19 @@ def train_option_ppo(
             log(f"BC on {len(data['label'])} decisions: {metrics}")
         model.save(str(out / "bc_model.zip"))
     metrics["bc_s"] = time.perf_counter() - t0
+    metrics["resumed_at"] = int(model.num_timesteps)
     remaining = cfg.total_timesteps - model.num_timesteps
     if remaining > 0:
-        model.learn(remaining, callback=_callback(out, curve), progress_bar=progress,
+        stop_at = t0 + cfg.wall_budget_s if cfg.wall_budget_s > 0 else math.inf
+        model.learn(remaining, callback=_callback(out, curve, stop_at), progress_bar=progress,
                     reset_num_timesteps=False)  # fmt: skip
     model.save(str(out / "model.zip"))
     vec.close()
     plot_curve(out / "curve.csv", out / "curve.png")
-    metrics.update(timesteps=int(model.num_timesteps), episodes=curve.episodes)
+    metrics.update(
+        timesteps=int(model.num_timesteps),
+        episodes=curve.episodes,
+        wall_s=time.perf_counter() - t0,
+    )
     assert isinstance(model, MaskablePPO)
     return metrics
