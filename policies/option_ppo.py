@@ -45,12 +45,9 @@ G = len(GLOBAL_FEATURE_NAMES)
 P = len(PRIVILEGED_FEATURE_NAMES)
 
 
-@cache
-def option_network_classes() -> dict[str, type]:
-    """``{"OptionExtractor", "OptionNets", "OptionActorCriticPolicy"}`` (torch imported here)."""
+def _option_nets_class() -> type:
+    """The actor-critic module (torch imported here)."""
     import torch as th
-    from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
-    from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
     from torch import nn
 
     def mlp(sizes: list[int], last_act: bool = False) -> nn.Sequential:
@@ -60,20 +57,6 @@ def option_network_classes() -> dict[str, type]:
             if i < len(sizes) - 2 or last_act:
                 layers.append(nn.Tanh())
         return nn.Sequential(*layers)
-
-    class OptionExtractor(BaseFeaturesExtractor):
-        """Flattens ``options``, ``valid``, ``global`` (and ``privileged``) in that order."""
-
-        def __init__(self, observation_space: Any) -> None:
-            n = observation_space["valid"].shape[0]
-            self.n_options = n
-            self.privileged = "privileged" in observation_space.spaces
-            dim = n * K + n + G + ((n + 1) * P if self.privileged else 0)
-            super().__init__(observation_space, features_dim=dim)
-
-        def forward(self, obs: dict[str, Any]) -> Any:
-            keys = ["options", "valid", "global"] + (["privileged"] if self.privileged else [])
-            return th.cat([obs[k].reshape(obs[k].shape[0], -1) for k in keys], dim=1)
 
     class OptionNets(nn.Module):
         """The actor's per-option scorer and the privileged critic (see the module)."""
@@ -118,6 +101,33 @@ def option_network_classes() -> dict[str, type]:
         def forward(self, features: Any) -> tuple[Any, Any]:
             return self.forward_actor(features), self.forward_critic(features)
 
+    return OptionNets
+
+
+@cache
+def option_network_classes() -> dict[str, type]:
+    """``{"OptionExtractor", "OptionNets", "OptionActorCriticPolicy"}`` (torch imported here)."""
+    import torch as th
+    from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
+    from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+    from torch import nn
+
+    OptionNets = _option_nets_class()
+
+    class OptionExtractor(BaseFeaturesExtractor):
+        """Flattens ``options``, ``valid``, ``global`` (and ``privileged``) in that order."""
+
+        def __init__(self, observation_space: Any) -> None:
+            n = observation_space["valid"].shape[0]
+            self.n_options = n
+            self.privileged = "privileged" in observation_space.spaces
+            dim = n * K + n + G + ((n + 1) * P if self.privileged else 0)
+            super().__init__(observation_space, features_dim=dim)
+
+        def forward(self, obs: dict[str, Any]) -> Any:
+            keys = ["options", "valid", "global"] + (["privileged"] if self.privileged else [])
+            return th.cat([obs[k].reshape(obs[k].shape[0], -1) for k in keys], dim=1)
+
     class OptionActorCriticPolicy(MaskableActorCriticPolicy):
         """MaskablePPO's policy with :class:`OptionNets`; the action head is the identity."""
 
@@ -127,14 +137,16 @@ def option_network_classes() -> dict[str, type]:
             super().__init__(*args, **kwargs)
 
         def _build_mlp_extractor(self) -> None:
-            ext = self.features_extractor
-            self.mlp_extractor = OptionNets(ext.n_options, ext.privileged, self.hidden)
+            ext: Any = self.features_extractor
+            nets: Any = OptionNets(ext.n_options, ext.privileged, self.hidden)
+            self.mlp_extractor = nets
 
         def _build(self, lr_schedule: Any) -> None:
             self._build_mlp_extractor()
             self.action_net = nn.Identity()
             self.value_net = nn.Linear(self.mlp_extractor.latent_dim_vf, 1)
-            self.optimizer = self.optimizer_class(
+            make_optimizer: Any = self.optimizer_class
+            self.optimizer = make_optimizer(
                 self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
             )
 

@@ -22,6 +22,7 @@ import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -336,7 +337,7 @@ def train_option_ppo(
     log(f"{len(worlds)} training worlds")
     curve = EpisodeLog(out / "curve.csv")
     metrics: dict[str, Any] = {}
-    vec = DummyVecEnv([lambda i=i: make_world_env(cfg, worlds, i) for i in range(cfg.n_envs)])
+    vec = DummyVecEnv([partial(make_world_env, cfg, worlds, i) for i in range(cfg.n_envs)])
     last = out / "checkpoints" / "last.zip"
     t0 = time.perf_counter()
     if last.is_file():
@@ -352,7 +353,7 @@ def train_option_ppo(
                     data = {k: z[k] for k in z.files}
             else:
                 data = collect_bc(cfg, worlds, curve)
-                np.savez_compressed(data_path, **data)
+                np.savez_compressed(data_path, **data)  # type: ignore[arg-type]
             metrics.update(fit_bc(model.policy, data, cfg.bc_epochs, cfg.bc_lr, cfg.seed))
             metrics["bc_decisions"] = len(data["label"])
             log(f"BC on {len(data['label'])} decisions: {metrics}")

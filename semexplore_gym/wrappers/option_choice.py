@@ -128,7 +128,7 @@ class OptionChoice(gym.Wrapper):
         self.params = params or OptionParams()
         self.privileged = bool(privileged)
         n, k = self.params.max_options, len(OPTION_FEATURE_NAMES)
-        space = {
+        space: dict[str, spaces.Space[Any]] = {
             "options": spaces.Box(-CLIP, CLIP, (n, k), np.float32),
             "valid": spaces.Box(0.0, 1.0, (n,), np.float32),
             "global": spaces.Box(0.0, 1.0, (len(GLOBAL_FEATURE_NAMES),), np.float32),
@@ -228,7 +228,11 @@ class OptionChoice(gym.Wrapper):
             feats, grid, time_s = decision.features, decision.grid, float(decision.time_s)
         ob = option_observation(feats, grid, time_s, n, p.time_scale_s)
         self._slots, self._valid = ob.slots, ob.valid
-        hits = np.flatnonzero(ob.slots == decision.choice) if decision is not None else []
+        hits = (
+            np.flatnonzero(ob.slots == decision.choice)
+            if decision is not None
+            else np.zeros(0, dtype=np.int64)
+        )
         self.teacher_row = int(hits[0]) if len(hits) else -1
         out = {"options": ob.options, "valid": ob.valid, "global": ob.global_features}
         if self.privileged:

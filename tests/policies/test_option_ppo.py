@@ -92,7 +92,6 @@ def test_bc_warm_start_fits_a_tiny_dataset() -> None:
 
 def test_policy_saves_and_loads_by_reference(tmp_path: object) -> None:
     from sb3_contrib import MaskablePPO
-
     from semexplore_gym.policies.option_ppo import load_option_model
 
     env = _fake_env()

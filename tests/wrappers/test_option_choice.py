@@ -119,9 +119,9 @@ def test_the_agents_choice_is_driven_and_rewarded() -> None:
         env.close()
     assert info["chosen_row"] == row and info["decision_time_s"] > 0
     p = OptionParams()
-    expect = p.area_reward_per_m2 * info["area_gain_m2"] - p.time_penalty_per_s * info[
-        "decision_time_s"
-    ]
+    expect = (
+        p.area_reward_per_m2 * info["area_gain_m2"] - p.time_penalty_per_s * info["decision_time_s"]
+    )
     assert reward == pytest.approx(expect, abs=1e-6) or reward == pytest.approx(
         expect + p.goal_bonus
     )

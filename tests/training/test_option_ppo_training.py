@@ -50,7 +50,10 @@ def test_cli_reports_a_bad_key_in_one_line(tmp_path: Path, capsys: pytest.Captur
                "--out", str(tmp_path / "run"), "--train-set", "n_envs=0"])  # fmt: skip
     err = capsys.readouterr().err.strip()
     assert rc == 2
-    assert err.startswith("semexplore train: error:") and "n_envs must be an integer >= 1, got 0" in err
+    assert (
+        err.startswith("semexplore train: error:")
+        and "n_envs must be an integer >= 1, got 0" in err
+    )
     assert len(err.splitlines()) == 1
 
 
