@@ -186,7 +186,9 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
     from semexplore_gym.policies.pretrained import get_pretrained
 
     model = get_pretrained(arg)
-    if model.model_path.suffix == ".yaml":
+    if model.policy:  # a policy of its own reads the file (option-ppo)
+        policy = policy_factories()[model.policy](str(model.model_path), overrides)
+    elif model.model_path.suffix == ".yaml":
         # A learned frontier value or a frontier student: weights on top of the expert's
         # navigation (no torch needed); a student's file has a ``model`` section.
         from semexplore_gym.config.loading import load_yaml_file
@@ -198,6 +200,18 @@ def _pretrained(arg: str, overrides: dict[str, Any]) -> Policy:
         policy = _sb3(str(model.model_path), overrides)
     policy.name = model.spec
     return policy
+
+
+def _option_ppo(arg: str, overrides: dict[str, Any]) -> Policy:
+    """``option-ppo:MODEL.zip``: the frontier student choosing by the option actor
+    (:mod:`semexplore_gym.policies.option_ppo`; torch and sb3-contrib needed)."""
+    from semexplore_gym.policies.option_ppo import OptionPPOPolicy
+
+    if not arg or not os.path.isfile(arg):
+        raise ValueError(f"policy 'option-ppo:{arg}': no such model file")
+    if overrides:
+        raise ValueError(f"policy 'option-ppo:{arg}' takes no parameters, got {sorted(overrides)}")
+    return OptionPPOPolicy(arg)
 
 
 def _user_module(arg: str, source: str) -> ModuleType:
@@ -293,6 +307,7 @@ def policy_factories() -> dict[str, Factory]:
         "semantic-paper": _expert_recipe("semantic-paper", PAPER_METHOD),
         "frontier-value": _frontier_value,
         "frontier-student": _frontier_student,
+        "option-ppo": _option_ppo,
         "frontier": _frontier,
         "nearest": _nearest,
         "random": _random,

@@ -91,6 +91,7 @@ def register_envs() -> None:
         "SemanticExplore-v0": "semexplore_gym.envs.semantic_explore:SemanticExploreEnv",
         "SemanticExploreFrontier-v0": "semexplore_gym.expert_driven_envs:make_frontier_choice_env",
         "SemanticExploreWeights-v0": "semexplore_gym.expert_driven_envs:make_planner_weights_env",
+        "SemanticExploreOptions-v0": "semexplore_gym.expert_driven_envs:make_option_choice_env",
     }
     # gym.make_vec("SemanticExplore-v0", num_envs=n) builds the batched FastSyncVectorEnv
     # (vectorization_mode="sync" still gives gymnasium's SyncVectorEnv).

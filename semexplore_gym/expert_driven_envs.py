@@ -26,6 +26,7 @@ from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 from semexplore_gym.policies.expert.driver import ExpertDriver
 from semexplore_gym.policies.expert.expert import SemanticExpertParams
 from semexplore_gym.wrappers.frontier_choice import FrontierChoice, MacroParams, PlannerWeights
+from semexplore_gym.wrappers.option_choice import OptionChoice, OptionParams
 
 
 def _parts(
@@ -76,3 +77,41 @@ def make_planner_weights_env(
     """
     env, driver, params = _parts(world, config, overrides, render_mode, macro, expert)
     return PlannerWeights(env, driver, params)
+
+
+def make_option_choice_env(
+    world: str | os.PathLike | Any = "maze1",
+    config: Any = None,
+    overrides: list[str] | None = None,
+    option: OptionParams | Mapping[str, Any] | None = None,
+    student: str = "pretrained:oracle_student",
+    privileged: bool = False,
+) -> OptionChoice:
+    """``SemanticExploreOptions-v0``: :class:`OptionChoice` over ``SemanticExplore-v0``, the
+    frontier student ``student`` (a policy spec) driving; its own choices are the
+    ``teacher_row`` of each decision.
+
+    Args:
+        world, config, overrides: As for ``SemanticExplore-v0``.
+        option: :class:`OptionParams` or a mapping of its fields.
+        student: A frontier-student spec (``frontier-student``, ``pretrained:oracle_student``).
+        privileged: Training only: the env hands the true world to the wrapper (not the
+            driver), which adds the ``privileged`` observation key.
+
+    Raises:
+        ValueError: ``student`` is not a frontier student.
+    """
+    from semexplore_gym.policies.frontier_student import FrontierStudentPolicy
+    from semexplore_gym.policies.registry import make_policy
+
+    driver = make_policy(student)
+    if not isinstance(driver, FrontierStudentPolicy):
+        raise ValueError(f"student must be a frontier-student spec, got {student!r}")
+    env = SemanticExploreEnv(
+        world=world,
+        config=config,
+        overrides=overrides,
+        map_observation="shared",
+        privileged=privileged,
+    )
+    return OptionChoice(env, driver, build_params(OptionParams, option), privileged=privileged)

@@ -38,7 +38,7 @@ _FIELDS = (
     "results",
 )
 #: Fields an entry may leave out, with their default.
-_OPTIONAL_FIELDS = {"expert_version": "semantic-v2"}
+_OPTIONAL_FIELDS = {"expert_version": "semantic-v2", "policy": ""}
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,8 @@ class PretrainedModel:
         expert_version: The expert version its results were compared with: the expert of its
             time (``semantic-v2`` for the models measured before the 0.3.0 release, unless its
             entry says otherwise; :mod:`semexplore_gym.policies.expert.versions`).
+        policy: The policy name that runs its model file (``option-ppo``); empty: chosen by
+            the file (an SB3 zip, a frontier value or a frontier student).
     """
 
     name: str
@@ -69,6 +71,7 @@ class PretrainedModel:
     training_time: str
     results: str
     expert_version: str = "semantic-v2"
+    policy: str = ""
 
     @property
     def spec(self) -> str:

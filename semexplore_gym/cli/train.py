@@ -1,4 +1,4 @@
-"""``semexplore train --algo bc|dagger|ppo|maskable_ppo|frontier_value|oracle_student --train-config FILE --out DIR``: train an agent.
+"""``semexplore train --algo bc|dagger|ppo|maskable_ppo|frontier_value|oracle_student|option_ppo --train-config FILE --out DIR``: train an agent.
 
 ``bc`` records expert episodes and behaviour-clones an SB3 policy; ``dagger`` does the same and
 then runs DAgger rounds; ``ppo`` trains SB3 PPO on the egocentric env, optionally starting from
@@ -14,10 +14,13 @@ tensorboard is missing) and, for bc/dagger, the dataset ``dataset.npz`` and ``me
 ``oracle_student`` trains the frontier student on the oracle's labels by DAgger (no torch;
 :mod:`~semexplore_gym.training.oracle_student`) and writes ``model.yaml``, one model per round,
 the labels (``samples/``), ``episodes.jsonl``, ``rounds.jsonl`` and ``metrics.json``; rerun the
-same command to resume.
+same command to resume. ``option_ppo`` trains MaskablePPO choosing among every reachable
+frontier option, with a privileged critic, after behaviour cloning of the frontier student
+(:mod:`~semexplore_gym.training.option_ppo`); it writes ``model.zip``, ``bc_model.zip``,
+``curve.csv``, ``curve.png`` and ``checkpoints/last.zip``; rerun the same command to resume.
 
 The shipped configs (``configs/agents/*.yml``: bc_maze, dagger_maze, ppo_maze,
-frontier_choice_maze, planner_weights_maze, frontier_value, oracle_student) work from any
+frontier_choice_maze, planner_weights_maze, frontier_value, oracle_student, option_ppo) work from any
 directory.
 
 Example::
@@ -48,7 +51,15 @@ from semexplore_gym.config import ConfigError, to_dict
 from semexplore_gym.config.extras import require_extra
 from semexplore_gym.evaluation.errors import ParameterError
 
-ALGOS = ("bc", "dagger", "ppo", "maskable_ppo", "frontier_value", "oracle_student")
+ALGOS = (
+    "bc",
+    "dagger",
+    "ppo",
+    "maskable_ppo",
+    "frontier_value",
+    "oracle_student",
+    "option_ppo",
+)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -67,7 +78,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         choices=ALGOS,
         help="bc, dagger, ppo, maskable_ppo (macro-action envs), frontier_value (a learned "
         "frontier value for the expert, fitted by a cross-entropy method over missions) or "
-        "oracle_student (a frontier chooser trained by DAgger on the oracle's labels)",
+        "oracle_student (a frontier chooser trained by DAgger on the oracle's labels) or "
+        "option_ppo (MaskablePPO over every frontier option, a privileged critic)",
     )
     p.add_argument(
         "--train-config",
@@ -107,6 +119,8 @@ def run(args: argparse.Namespace) -> int:
         return _run_frontier_value(args)
     if args.algo == "oracle_student":
         return _run_oracle_student(args)
+    if args.algo == "option_ppo":
+        return _run_option_ppo(args)
     require_extra("rl", f"semexplore train --algo {args.algo}", "torch", "stable_baselines3")
     import torch
 
@@ -160,7 +174,21 @@ def _run_oracle_student(args: argparse.Namespace) -> int:
     return _run_without_torch(args, load_oracle_student_config, train_oracle_student)
 
 
-def _run_without_torch(args: argparse.Namespace, load: Any, train: Any) -> int:
+def _run_option_ppo(args: argparse.Namespace) -> int:
+    """``--algo option_ppo``: BC then MaskablePPO over frontier options
+    (:mod:`~semexplore_gym.training.option_ppo`)."""
+    require_extra("rl", "semexplore train --algo option_ppo", "torch", "sb3_contrib")
+    from functools import partial
+
+    from semexplore_gym.training.option_ppo import load_option_ppo_config, train_option_ppo
+
+    train = partial(train_option_ppo, progress=not args.no_progress)
+    return _run_without_torch(args, load_option_ppo_config, train, "model.zip")
+
+
+def _run_without_torch(
+    args: argparse.Namespace, load: Any, train: Any, model: str = "model.yaml"
+) -> int:
     """Load the config, write the run record, ``train(cfg, out, log=...)``, write
     ``metrics.json`` (its result, the wall time and ``model.yaml``'s path)."""
     try:
@@ -171,7 +199,7 @@ def _run_without_torch(args: argparse.Namespace, load: Any, train: Any) -> int:
     _write_run_record(out, cfg, args)
     t0 = time.perf_counter()
     final = train(cfg, out, log=lambda line: print(line, flush=True))
-    metrics = {"total_s": time.perf_counter() - t0, "model": str(out / "model.yaml"), **final}
+    metrics = {"total_s": time.perf_counter() - t0, "model": str(out / model), **final}
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print_result(args, metrics)
     return 0
