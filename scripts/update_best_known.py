@@ -8,7 +8,8 @@ is merged into the table (``--table``; default: the shipped
 ``configs/best_known/best_known.csv``): per (world, seed, start) the lowest T99 and the lowest
 distance to 99 % any policy reached, with the policy spec that reached it. ``--bounds`` then
 computes the certified lower bound (``semexplore_gym.core.coverage_tour.lower_bound``, privileged:
-it reads the true world) for every entry that lacks one, writing the table after each entry, so
+it reads the true world) for every entry that lacks one (an infinite bound is kept as ``inf``
+and not computed again), writing the table after each entry, so
 an interrupted run resumes where it stopped. Prints one line per run folder and a summary; with
 ``--json`` one JSON object instead.
 """
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -33,16 +35,15 @@ from semexplore_gym.evaluation.best_known import (
 
 def entry_bound(world: str, seed: int, start: str) -> tuple[float | None, float | None]:
     """``(lower_bound_s, lower_bound_m)`` of one (world, seed, start), from the start pose that
-    ``env.reset(seed=seed)`` draws with the benchmark's start setting (both None when no
-    explorer can reach the coverage goal at all)."""
-    import math
-
+    ``env.reset(seed=seed)`` draws with the benchmark's start setting (both ``inf`` when no
+    explorer can reach the coverage goal at all: the table keeps that, so the bound is not
+    computed again)."""
     from semexplore_gym.cli.oracle import certified_bound
 
     random_start = "true" if start == "random" else "false"
     bound = certified_bound(world, seed, env_overrides=[f"episode.random_start={random_start}"])
     if not math.isfinite(bound.distance_m):
-        return None, None
+        return math.inf, math.inf
     return round(bound.time_s, 3), round(bound.distance_m, 3)
 
 
