@@ -13,6 +13,7 @@ oracle's T99 is at most each other policy's; and the median T99 / bound per poli
     python scripts/check_lower_bound.py runs/paper
     python scripts/check_lower_bound.py runs/paper runs/mazes runs/offices --json
     python scripts/check_lower_bound.py runs/paper --fresh   # after a change to the bound
+    python scripts/check_lower_bound.py ../theirs/runs/x --bounds-dir runs/bounds   # read-only
     python scripts/check_lower_bound.py runs/paper --out runs/paper/lower_bounds.csv
 """
 
@@ -41,6 +42,13 @@ def main(argv: list[str] | None = None) -> int:
         default=None,
         help="bound CSV of a single folder (default: RUN_DIR/lower_bounds.csv)",
     )
+    ap.add_argument(
+        "--bounds-dir",
+        type=Path,
+        default=None,
+        help="keep each folder's bound CSV here (named after the folder's path) instead of in "
+        "the folder: for folders that are not yours to write in",
+    )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     ap.add_argument("--json", action="store_true", help="print the per-family report as JSON")
     ap.add_argument(
@@ -62,6 +70,10 @@ def main(argv: list[str] | None = None) -> int:
             runs = list(csv.DictReader(fh))
         settings = _benchmark_settings(run_dir)
         out = args.out or run_dir / "lower_bounds.csv"
+        if args.bounds_dir is not None:
+            args.bounds_dir.mkdir(parents=True, exist_ok=True)
+            name = "_".join(run_dir.resolve().parts[1:]) or "root"
+            out = args.bounds_dir / f"{name}.csv"
         if args.fresh:
             out.unlink(missing_ok=True)
         bounds = compute_bounds(runs, settings, out, not args.no_progress)
