@@ -8,7 +8,8 @@ is merged into the table (``--table``; default: the shipped
 ``configs/best_known/best_known.csv``): per (world, seed, start) the lowest T99 and the lowest
 distance to 99 % any policy reached, with the policy spec that reached it. ``--bounds`` then
 computes the certified lower bound (``semexplore_gym.core.coverage_tour.lower_bound``, privileged:
-it reads the true world) for every entry that lacks one (an infinite bound is kept as ``inf``
+it reads the true world) for every entry that lacks one and that no merged folder's
+``lower_bounds.csv`` (``scripts/check_lower_bound.py``) gives (an infinite bound is kept as ``inf``
 and not computed again), writing the table after each entry, so
 an interrupted run resumes where it stopped. Prints one line per run folder and a summary; with
 ``--json`` one JSON object instead.
@@ -64,8 +65,35 @@ def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int
         add_distance_to_99(folder, rows)
         table, beats = merge_runs(table, rows, start)
         n_beats += len(beats)
-        print(f"{folder}: {len(rows)} missions, {len(beats)} new best known", file=log)
+        n_read = read_folder_bounds(table, folder, start)
+        print(
+            f"{folder}: {len(rows)} missions, {len(beats)} new best known, "
+            f"{n_read} bounds read from its lower_bounds.csv",
+            file=log,
+        )
     return table, n_beats
+
+
+def read_folder_bounds(table: dict, folder: Path, start: str) -> int:
+    """Fill the missing bounds of ``table`` from ``folder/lower_bounds.csv`` (written by
+    ``scripts/check_lower_bound.py`` for the same starts); returns how many it filled."""
+    import csv
+
+    path = folder / "lower_bounds.csv"
+    if not path.is_file():
+        return 0
+    n = 0
+    with path.open(newline="") as fh:
+        for row in csv.DictReader(fh):
+            entry = table.get((row["world"], int(row["seed"]), start))
+            if entry is None or entry.get("lower_bound_s") is not None:
+                continue
+            bound_s, bound_m = float(row["lower_bound_s"]), float(row["lower_bound_m"])
+            finite = math.isfinite(bound_s) and math.isfinite(bound_m)
+            entry["lower_bound_s"] = round(bound_s, 3) if finite else math.inf
+            entry["lower_bound_m"] = round(bound_m, 3) if finite else math.inf
+            n += 1
+    return n
 
 
 def add_bounds(table: dict, path: Path, progress: bool) -> int:

@@ -95,3 +95,27 @@ def test_an_infinite_bound_is_kept_and_not_computed_again(tmp_path: Path, monkey
     assert calls == [(WORLD, 0, "random")]
     e = read_table(table)[(WORLD, 0, "random")]
     assert e["lower_bound_s"] == float("inf") and e["lower_bound_m"] == float("inf")
+
+
+def test_bounds_come_from_the_folder_s_check_before_any_is_computed(
+    run_folder: Path, tmp_path: Path, monkeypatch, capsys
+):
+    import shutil
+
+    mod = _script()
+    folder = tmp_path / "run"
+    shutil.copytree(run_folder, folder)
+    (folder / "lower_bounds.csv").write_text(
+        "world,seed,lower_bound_m,lower_bound_s,groups,bound_planning_s\n"
+        f'"{WORLD}",0,1.5,7.25,2,0.1\n"{WORLD}",1,inf,inf,0,0.1\n'
+    )
+    monkeypatch.setattr(mod, "entry_bound", lambda *a: pytest.fail(f"computed {a}"))
+    table = tmp_path / "t.csv"
+    assert mod.main([str(folder), "--table", str(table), "--bounds", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["bounds_computed"] == 0
+    entries = read_table(table)
+    assert (
+        entries[(WORLD, 0, "random")]["lower_bound_s"],
+        entries[(WORLD, 0, "random")]["lower_bound_m"],
+    ) == (7.25, 1.5)
+    assert entries[(WORLD, 1, "random")]["lower_bound_s"] == float("inf")
