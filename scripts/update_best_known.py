@@ -48,7 +48,9 @@ def entry_bound(world: str, seed: int, start: str) -> tuple[float | None, float 
     return round(bound.time_s, 3), round(bound.distance_m, 3)
 
 
-def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int]:
+def merge_folders(
+    table: dict, folders: list[Path], log: Any, bounds_dir: Path | None = None
+) -> tuple[dict, int]:
     """``table`` with every comparable run folder merged in; returns it and the new bests."""
     from semexplore_gym.evaluation.report import add_distance_to_99
     from semexplore_gym.evaluation.run_row import read_runs
@@ -65,7 +67,7 @@ def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int
         add_distance_to_99(folder, rows)
         table, beats = merge_runs(table, rows, start)
         n_beats += len(beats)
-        n_read = read_folder_bounds(table, folder, start)
+        n_read = read_folder_bounds(table, folder, start, bounds_dir)
         print(
             f"{folder}: {len(rows)} missions, {len(beats)} new best known, "
             f"{n_read} bounds read from its lower_bounds.csv",
@@ -74,12 +76,17 @@ def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int
     return table, n_beats
 
 
-def read_folder_bounds(table: dict, folder: Path, start: str) -> int:
-    """Fill the missing bounds of ``table`` from ``folder/lower_bounds.csv`` (written by
-    ``scripts/check_lower_bound.py`` for the same starts); returns how many it filled."""
+def read_folder_bounds(
+    table: dict, folder: Path, start: str, bounds_dir: Path | None = None
+) -> int:
+    """Fill the missing bounds of ``table`` from ``folder/lower_bounds.csv``, or from the
+    folder's CSV in ``bounds_dir`` (both written by ``scripts/check_lower_bound.py`` for the
+    same starts, the latter with ``--bounds-dir``); returns how many it filled."""
     import csv
 
     path = folder / "lower_bounds.csv"
+    if bounds_dir is not None:
+        path = bounds_dir / ("_".join(folder.resolve().parts[1:]) + ".csv")
     if not path.is_file():
         return 0
     n = 0
@@ -113,6 +120,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("runs", nargs="*", type=Path, help="benchmark output folders to merge")
     ap.add_argument("--table", type=Path, default=None, help="table to update (default: shipped)")
     ap.add_argument("--bounds", action="store_true", help="compute missing lower bounds")
+    ap.add_argument(
+        "--bounds-dir",
+        type=Path,
+        default=None,
+        help="read the folders' checked bounds from here (check_lower_bound.py --bounds-dir)",
+    )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     args = ap.parse_args(argv)
@@ -121,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     try:
         table = read_table(path)
-        table, n_beats = merge_folders(table, args.runs, log)
+        table, n_beats = merge_folders(table, args.runs, log, args.bounds_dir)
         write_table(path, table)
         n_bounds = add_bounds(table, path, not args.no_progress) if args.bounds else 0
     except ValueError as e:
