@@ -1,14 +1,19 @@
-"""Check the certified lower bound against every mission of a benchmark output folder.
+"""Check the certified lower bound against every mission of benchmark output folders.
 
-For each (world, start seed) of ``RUN_DIR/runs.csv`` it computes the bound from the same start
-the benchmark used (``benchmark.json``: random or fixed start, env config), writes one row per
-pair to a CSV as it goes (rerunning resumes), then reports how many missions reached 99 %
-coverage sooner than the bound's time, or after a shorter drive than its distance (the drive
-to 99 % read from the mission's trace and trajectory when the folder has them; ``seed=*``
-worlds take the mission's seed), which must be
-none, and the median T99 / bound per policy and world family.
+For each (world, start seed) of each ``RUN_DIR/runs.csv`` it computes the bound from the same
+start the benchmark used (``benchmark.json``: random or fixed start, env config), writes one row
+per pair to a CSV in that folder as it goes (rerunning resumes), then reports how many missions
+reached 99 % coverage sooner than the bound's time, or after a shorter drive than its distance
+(the drive to 99 % read from the mission's trace and trajectory when the folder has them;
+``seed=*`` worlds take the mission's seed), which must be none; per world family the starts,
+the missions, the median best known ÷ bound (the best T99 any policy of any folder reached from
+that start), the oracle's median T99 ÷ bound and the share of paired missions where the
+oracle's T99 is at most each other policy's; and the median T99 / bound per policy and family.
 
     python scripts/check_lower_bound.py runs/paper
+    python scripts/check_lower_bound.py runs/paper runs/mazes runs/offices --json
+    python scripts/check_lower_bound.py runs/paper --fresh   # after a change to the bound
+    python scripts/check_lower_bound.py ../theirs/runs/x --bounds-dir runs/bounds   # read-only
     python scripts/check_lower_bound.py runs/paper --out runs/paper/lower_bounds.csv
 """
 
@@ -17,6 +22,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -24,25 +30,58 @@ from pathlib import Path
 import numpy as np
 
 BOUND_COLUMNS = ("world", "seed", "lower_bound_m", "lower_bound_s", "groups", "bound_planning_s")
+ORACLE = "oracle"
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("run_dir", type=Path, help="a 'semexplore benchmark' output folder")
+    ap.add_argument("run_dirs", nargs="+", type=Path, help="'semexplore benchmark' output folders")
     ap.add_argument(
-        "--out", type=Path, default=None, help="bound CSV (default: RUN_DIR/lower_bounds.csv)"
+        "--out",
+        type=Path,
+        default=None,
+        help="bound CSV of a single folder (default: RUN_DIR/lower_bounds.csv)",
+    )
+    ap.add_argument(
+        "--bounds-dir",
+        type=Path,
+        default=None,
+        help="keep each folder's bound CSV here (named after the folder's path) instead of in "
+        "the folder: for folders that are not yours to write in",
     )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    ap.add_argument("--json", action="store_true", help="print the per-family report as JSON")
+    ap.add_argument(
+        "--fresh",
+        action="store_true",
+        help="recompute every bound (after a change to the bound) instead of reading the CSVs",
+    )
     args = ap.parse_args(argv)
-    runs_csv = args.run_dir / "runs.csv"
-    if not runs_csv.is_file():
-        print(f"error: no runs.csv in {args.run_dir}", file=sys.stderr)
+    if args.out is not None and len(args.run_dirs) > 1:
+        print("error: --out needs exactly one RUN_DIR", file=sys.stderr)
         return 2
-    with runs_csv.open(newline="") as fh:
-        runs = list(csv.DictReader(fh))
-    out = args.out or args.run_dir / "lower_bounds.csv"
-    bounds = compute_bounds(runs, _benchmark_settings(args.run_dir), out, not args.no_progress)
-    print(report(runs, bounds, args.run_dir))
+    missions: list[dict] = []
+    for run_dir in args.run_dirs:
+        runs_csv = run_dir / "runs.csv"
+        if not runs_csv.is_file():
+            print(f"error: no runs.csv in {run_dir}", file=sys.stderr)
+            return 2
+        with runs_csv.open(newline="") as fh:
+            runs = list(csv.DictReader(fh))
+        settings = _benchmark_settings(run_dir)
+        out = args.out or run_dir / "lower_bounds.csv"
+        if args.bounds_dir is not None:
+            args.bounds_dir.mkdir(parents=True, exist_ok=True)
+            name = "_".join(run_dir.resolve().parts[1:]) or "root"
+            out = args.bounds_dir / f"{name}.csv"
+        if args.fresh:
+            out.unlink(missing_ok=True)
+        bounds = compute_bounds(runs, settings, out, not args.no_progress)
+        missions += checked_missions(runs, bounds, run_dir, settings)
+    if args.json:
+        print(json.dumps(family_report(missions), indent=1))
+    else:
+        print(report(missions))
     return 0
 
 
@@ -124,39 +163,141 @@ def drive_to_99_m(run_dir: Path, world: str, policy: str, seed: int) -> float | 
     return float(np.hypot(steps[:, 0], steps[:, 1]).sum())
 
 
-def report(
-    runs: list[dict[str, str]], bounds: dict[tuple[str, int], dict[str, str]], run_dir: Path
-) -> str:
-    """Violations (must be none) and median T99 / bound per policy and family."""
+def checked_missions(
+    runs: list[dict[str, str]],
+    bounds: dict[tuple[str, int], dict[str, str]],
+    run_dir: Path,
+    settings: tuple[object, dict[str, bool], bool],
+) -> list[dict]:
+    """One record per mission: its start key, T99, drive to 99 % and the bound of its start."""
     from semexplore_gym.evaluation.suites import world_family
 
-    ratios: dict[tuple[str, str], list[float]] = defaultdict(list)
-    n_t99 = n_drive = bad_t = bad_d = 0
+    _, suite_random, fixed = settings
+    out = []
     for r in runs:
         seed = int(r["seed"])
         b = bounds[(r["world"], seed)]
-        bound_s, bound_m = float(b["lower_bound_s"]), float(b["lower_bound_m"])
-        if r["T99_s"] not in ("", "None"):
-            t99 = float(r["T99_s"])
-            n_t99 += 1
-            bad_t += t99 < bound_s
-            if bound_s > 0:
-                ratios[(r["policy"], world_family(r["world"]))].append(t99 / bound_s)
-        drive = drive_to_99_m(run_dir, r["world"], r["policy"], seed)
-        if drive is not None:
-            n_drive += 1
-            bad_d += drive < bound_m
+        random_start = suite_random.get(r["world"], True) and not fixed
+        t99 = float(r["T99_s"]) if r.get("T99_s") not in (None, "", "None") else None
+        out.append(
+            {
+                "folder": str(run_dir),
+                "start": (r["world"], seed, random_start),
+                "family": world_family(r["world"]),
+                "policy": r["policy"],
+                "T99_s": t99,
+                "drive_m": drive_to_99_m(run_dir, r["world"], r["policy"], seed),
+                "bound_s": float(b["lower_bound_s"]),
+                "bound_m": float(b["lower_bound_m"]),
+            }
+        )
+    return out
+
+
+def _median(xs: list[float]) -> float | None:
+    return round(float(np.median(xs)), 3) if xs else None
+
+
+def _oracle_wins(ms: list[dict]) -> tuple[int, int]:
+    """``(pairs where the oracle's T99 <= the other policy's, pairs)`` over every other policy
+    that ran the same start in the same folder (a policy that never reached 99 % loses to one
+    that did; pairs where neither did are left out)."""
+    by_start: dict[tuple, dict[str, float | None]] = defaultdict(dict)
+    for m in ms:
+        by_start[(m["folder"], m["start"])][m["policy"]] = m["T99_s"]
+    wins = pairs = 0
+    for times in by_start.values():
+        if ORACLE not in times:
+            continue
+        mine = times[ORACLE]
+        for policy, t in times.items():
+            if policy == ORACLE or (mine is None and t is None):
+                continue
+            pairs += 1
+            wins += mine is not None and (t is None or mine <= t)
+    return wins, pairs
+
+
+def family_report(missions: list[dict]) -> dict[str, dict]:
+    """Per world family (and ``all``): starts, missions, violations, the medians and the
+    oracle's wins (see the module docstring)."""
+    fams: dict[str, list[dict]] = defaultdict(list)
+    for m in missions:
+        fams[m["family"]].append(m)
+    fams["all"] = list(missions)
+    out = {}
+    for fam, ms in sorted(fams.items()):
+        best: dict[tuple, float] = {}
+        bound: dict[tuple, float] = {}
+        for m in ms:
+            bound[m["start"]] = m["bound_s"]
+            if m["T99_s"] is not None:
+                best[m["start"]] = min(best.get(m["start"], math.inf), m["T99_s"])
+        ok = [k for k in best if 0 < bound[k] < math.inf]
+        oracle = [
+            math.inf if m["T99_s"] is None else m["T99_s"] / m["bound_s"]
+            for m in ms
+            if m["policy"] == ORACLE and 0 < m["bound_s"] < math.inf
+        ]
+        wins, pairs = _oracle_wins(ms)
+        out[fam] = {
+            "starts": len(bound),
+            "missions": len(ms),
+            "with_T99": sum(m["T99_s"] is not None for m in ms),
+            "T99_below_bound": sum(
+                m["T99_s"] is not None and m["T99_s"] < m["bound_s"] for m in ms
+            ),
+            "with_drive": sum(m["drive_m"] is not None for m in ms),
+            "drive_below_bound": sum(
+                m["drive_m"] is not None and m["drive_m"] < m["bound_m"] for m in ms
+            ),
+            "median_best_known_over_bound": _median([best[k] / bound[k] for k in ok]),
+            "median_oracle_over_bound": _median(oracle),
+            "oracle_missions": len(oracle),
+            "oracle_wins": wins,
+            "oracle_pairs": pairs,
+        }
+    return out
+
+
+def report(missions: list[dict]) -> str:
+    """Violations (must be none), the per-family table and median T99 / bound per policy."""
+    fams = family_report(missions)
+    total = fams["all"]
     lines = [
-        f"missions: {len(runs)}; with T99: {n_t99}, T99 below the bound: {bad_t}",
-        f"with a drive to 99 % on file: {n_drive}, drive below the bound: {bad_d}",
-        "| policy | family | n | median T99 / bound | min |",
-        "|---|---|---|---|---|",
+        f"missions: {total['missions']}; with T99: {total['with_T99']}, "
+        f"T99 below the bound: {total['T99_below_bound']}",
+        f"with a drive to 99 % on file: {total['with_drive']}, "
+        f"drive below the bound: {total['drive_below_bound']}",
+        "",
+        "| family | starts | missions | below the bound | best known ÷ bound | "
+        "oracle ÷ bound (its missions) | oracle T99 <= other's |",
+        "|---|---|---|---|---|---|---|",
     ]
+    for fam, f in fams.items():
+        share = f"{f['oracle_wins']}/{f['oracle_pairs']}" if f["oracle_pairs"] else "-"
+        if f["oracle_pairs"]:
+            share += f" ({100.0 * f['oracle_wins'] / f['oracle_pairs']:.0f} %)"
+        lines.append(
+            f"| {fam} | {f['starts']} | {f['missions']} | "
+            f"{f['T99_below_bound'] + f['drive_below_bound']} | "
+            f"{_fmt(f['median_best_known_over_bound'])} | "
+            f"{_fmt(f['median_oracle_over_bound'])} ({f['oracle_missions']}) | {share} |"
+        )
+    ratios: dict[tuple[str, str], list[float]] = defaultdict(list)
+    for m in missions:
+        if m["T99_s"] is not None and 0 < m["bound_s"] < math.inf:
+            ratios[(m["policy"], m["family"])].append(m["T99_s"] / m["bound_s"])
+    lines += ["", "| policy | family | n | median T99 / bound | min |", "|---|---|---|---|---|"]
     for (policy, fam), xs in sorted(ratios.items()):
         lines.append(
             f"| {policy} | {fam} | {len(xs)} | {float(np.median(xs)):.2f} | {min(xs):.2f} |"
         )
     return "\n".join(lines)
+
+
+def _fmt(x: float | None) -> str:
+    return "-" if x is None else f"{x:.2f}"
 
 
 if __name__ == "__main__":

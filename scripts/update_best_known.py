@@ -8,7 +8,9 @@ is merged into the table (``--table``; default: the shipped
 ``configs/best_known/best_known.csv``): per (world, seed, start) the lowest T99 and the lowest
 distance to 99 % any policy reached, with the policy spec that reached it. ``--bounds`` then
 computes the certified lower bound (``semexplore_gym.core.coverage_tour.lower_bound``, privileged:
-it reads the true world) for every entry that lacks one, writing the table after each entry, so
+it reads the true world) for every entry that lacks one and that no merged folder's
+``lower_bounds.csv`` (``scripts/check_lower_bound.py``) gives (an infinite bound is kept as ``inf``
+and not computed again), writing the table after each entry, so
 an interrupted run resumes where it stopped. Prints one line per run folder and a summary; with
 ``--json`` one JSON object instead.
 """
@@ -17,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -33,20 +36,21 @@ from semexplore_gym.evaluation.best_known import (
 
 def entry_bound(world: str, seed: int, start: str) -> tuple[float | None, float | None]:
     """``(lower_bound_s, lower_bound_m)`` of one (world, seed, start), from the start pose that
-    ``env.reset(seed=seed)`` draws with the benchmark's start setting (both None when no
-    explorer can reach the coverage goal at all)."""
-    import math
-
+    ``env.reset(seed=seed)`` draws with the benchmark's start setting (both ``inf`` when no
+    explorer can reach the coverage goal at all: the table keeps that, so the bound is not
+    computed again)."""
     from semexplore_gym.cli.oracle import certified_bound
 
     random_start = "true" if start == "random" else "false"
     bound = certified_bound(world, seed, env_overrides=[f"episode.random_start={random_start}"])
     if not math.isfinite(bound.distance_m):
-        return None, None
+        return math.inf, math.inf
     return round(bound.time_s, 3), round(bound.distance_m, 3)
 
 
-def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int]:
+def merge_folders(
+    table: dict, folders: list[Path], log: Any, bounds_dir: Path | None = None
+) -> tuple[dict, int]:
     """``table`` with every comparable run folder merged in; returns it and the new bests."""
     from semexplore_gym.evaluation.report import add_distance_to_99
     from semexplore_gym.evaluation.run_row import read_runs
@@ -63,8 +67,40 @@ def merge_folders(table: dict, folders: list[Path], log: Any) -> tuple[dict, int
         add_distance_to_99(folder, rows)
         table, beats = merge_runs(table, rows, start)
         n_beats += len(beats)
-        print(f"{folder}: {len(rows)} missions, {len(beats)} new best known", file=log)
+        n_read = read_folder_bounds(table, folder, start, bounds_dir)
+        print(
+            f"{folder}: {len(rows)} missions, {len(beats)} new best known, "
+            f"{n_read} bounds read from its lower_bounds.csv",
+            file=log,
+        )
     return table, n_beats
+
+
+def read_folder_bounds(
+    table: dict, folder: Path, start: str, bounds_dir: Path | None = None
+) -> int:
+    """Fill the missing bounds of ``table`` from ``folder/lower_bounds.csv``, or from the
+    folder's CSV in ``bounds_dir`` (both written by ``scripts/check_lower_bound.py`` for the
+    same starts, the latter with ``--bounds-dir``); returns how many it filled."""
+    import csv
+
+    path = folder / "lower_bounds.csv"
+    if bounds_dir is not None:
+        path = bounds_dir / ("_".join(folder.resolve().parts[1:]) + ".csv")
+    if not path.is_file():
+        return 0
+    n = 0
+    with path.open(newline="") as fh:
+        for row in csv.DictReader(fh):
+            entry = table.get((row["world"], int(row["seed"]), start))
+            if entry is None or entry.get("lower_bound_s") is not None:
+                continue
+            bound_s, bound_m = float(row["lower_bound_s"]), float(row["lower_bound_m"])
+            finite = math.isfinite(bound_s) and math.isfinite(bound_m)
+            entry["lower_bound_s"] = round(bound_s, 3) if finite else math.inf
+            entry["lower_bound_m"] = round(bound_m, 3) if finite else math.inf
+            n += 1
+    return n
 
 
 def add_bounds(table: dict, path: Path, progress: bool) -> int:
@@ -84,6 +120,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("runs", nargs="*", type=Path, help="benchmark output folders to merge")
     ap.add_argument("--table", type=Path, default=None, help="table to update (default: shipped)")
     ap.add_argument("--bounds", action="store_true", help="compute missing lower bounds")
+    ap.add_argument(
+        "--bounds-dir",
+        type=Path,
+        default=None,
+        help="read the folders' checked bounds from here (check_lower_bound.py --bounds-dir)",
+    )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     args = ap.parse_args(argv)
@@ -92,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     try:
         table = read_table(path)
-        table, n_beats = merge_folders(table, args.runs, log)
+        table, n_beats = merge_folders(table, args.runs, log, args.bounds_dir)
         write_table(path, table)
         n_bounds = add_bounds(table, path, not args.no_progress) if args.bounds else 0
     except ValueError as e:

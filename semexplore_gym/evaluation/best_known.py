@@ -5,7 +5,8 @@ A table (``configs/best_known/best_known.csv``, shipped; one row per (world, see
 the shortest time to 99 % coverage (``T99_s``) any policy has reached from that start with the
 default env config, the policy spec that reached it, the shortest distance driven to 99 %
 (``D99_m``) and its policy, and the certified lower bounds on both (the bound of
-:mod:`semexplore_gym.core.coverage_tour`, when it was computed). ``seed`` is the benchmark's
+:mod:`semexplore_gym.core.coverage_tour`, when it was computed; ``inf`` when it was computed
+and no explorer can reach the goal, so a mission that did lies below it). ``seed`` is the benchmark's
 seed, which draws the start pose; ``start`` is ``random`` (a suite's start poses) or ``fixed``
 (``--fixed-start``).
 
@@ -49,6 +50,8 @@ BEAT_MARGIN = 0.005
 #: ``semexplore explore``'s time limit when ``--max-time-s`` is not given.
 EXPLORE_DEFAULT_LIMIT_S = 1200.0
 _FLOAT_COLUMNS = ("T99_s", "D99_m", "lower_bound_s", "lower_bound_m")
+#: Columns that may hold ``inf``: a bound computed as infinite (no explorer reaches the goal).
+_BOUND_COLUMNS = ("lower_bound_s", "lower_bound_m")
 _STARTS = ("random", "fixed")
 
 Key = tuple[str, int, str]
@@ -68,6 +71,8 @@ def _float_or_none(text: str, where: str, column: str) -> float | None:
         value = float(text)
     except ValueError:
         raise ValueError(f"{where}: {column} is not a number: {text!r}") from None
+    if column in _BOUND_COLUMNS and value == math.inf:
+        return value  # computed, and infinite: kept, so the bound is not computed again
     if not math.isfinite(value) or value < 0:
         raise ValueError(f"{where}: {column} must be a finite number >= 0, got {text!r}")
     return value
@@ -224,7 +229,7 @@ def mission_ratios(
         t99, d99 = _finite(r.get("T99_s")), _finite(r.get("D99_m"))
 
         def ratio(v: float | None, ref: float | None) -> float | None:
-            if ref is None or ref <= 0:
+            if ref is None or not 0 < ref < math.inf:
                 return None
             return math.inf if v is None else v / ref
 

@@ -57,6 +57,14 @@ def test_a_table_survives_writing_and_reading(tmp_path):
     assert read_table(tmp_path / "absent.csv") == {}
 
 
+def test_an_infinite_bound_survives_and_flags_a_mission_that_reached_the_goal(tmp_path):
+    table = {("cave:seed=2", 0, "random"): _entry("cave:seed=2", 0, 100.0, math.inf)}
+    table[("cave:seed=2", 0, "random")]["lower_bound_m"] = math.inf
+    assert read_table(write_table(tmp_path / "t.csv", table)) == table
+    ratios = mission_ratios([_row("cave:seed=2", "semantic", 0, 120.0, 30.0)], table, "random")
+    assert ratios[0]["below_bound"] and ratios[0]["bound_ratio"] is None
+
+
 @pytest.mark.parametrize(
     ("cell", "value", "message"),
     [
@@ -64,6 +72,7 @@ def test_a_table_survives_writing_and_reading(tmp_path):
         ("start", "left", "start must be random or fixed"),
         ("T99_s", "-3", "T99_s must be a finite number"),
         ("T99_s", "nan", "T99_s must be a finite"),
+        ("T99_s", "inf", "T99_s must be a finite"),
     ],
 )
 def test_a_malformed_table_names_its_line(tmp_path, cell, value, message):

@@ -1,5 +1,6 @@
 """The guard: on small worlds of every family the oracle reaches 99 % no later than the expert
-and nearest frontier, so an expert that gets faster cannot silently pass its yardstick."""
+and nearest frontier, so an expert that gets faster cannot silently pass its yardstick, and no
+policy reaches it sooner than the certified lower bound of its start allows."""
 
 from __future__ import annotations
 
@@ -50,10 +51,15 @@ def _rooms_and_corridors(path: Path) -> Path:
 
 
 def _check_the_oracle_is_first(world: str, seed: int, short_mission) -> None:
+    from semexplore_gym.cli.oracle import certified_bound
+
+    bound_s = certified_bound(world, seed, env_overrides=["episode.random_start=true"]).time_s
     oracle, _ = short_mission(world, "oracle", seed, 900)
     assert oracle.t99_s is not None and oracle.collisions == 0
+    assert oracle.t99_s >= bound_s, (world, "oracle", bound_s)
     for spec in ("semantic", "nearest"):
         other, _ = short_mission(world, spec, seed, 900)
+        assert other.t99_s is None or other.t99_s >= bound_s, (world, spec, bound_s)
         assert other.t99_s is None or oracle.t99_s <= other.t99_s, (world, spec)
 
 

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "check_lower_bound.py"
 
@@ -20,15 +22,19 @@ def _run(*args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
-def _fake_runs(folder: Path, t99_s: list[str]) -> None:
-    """A runs.csv of one world (seed=* resolved per seed) and a benchmark.json."""
+def _fake_runs(folder: Path, t99_s: list[str], policies: tuple[str, ...] = ("p",)) -> None:
+    """A runs.csv of one world (seed=* resolved per seed; each policy in turn) and a
+    benchmark.json."""
     folder.mkdir()
     (folder / "benchmark.json").write_text(json.dumps({"fixed_start": False, "suites": None}))
     with (folder / "runs.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=["world", "policy", "seed", "T99_s"])
         w.writeheader()
         for i, t in enumerate(t99_s):
-            w.writerow({"world": "maze:seed=*,size_m=5", "policy": "p", "seed": i % 2, "T99_s": t})
+            policy = policies[(i // 2) % len(policies)]
+            w.writerow(
+                {"world": "maze:seed=*,size_m=5", "policy": policy, "seed": i % 2, "T99_s": t}
+            )
 
 
 def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path) -> None:
@@ -48,3 +54,21 @@ def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path
 def test_a_folder_without_runs_is_one_clear_line(tmp_path) -> None:
     res = _run(str(tmp_path))
     assert res.returncode == 2 and res.stderr.strip().startswith("error: no runs.csv")
+
+
+def test_folders_are_checked_together_per_family_with_the_oracle_s_wins(tmp_path) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    # seed 0: oracle 1e6 s, p 2e6 s (a win); seed 1: the oracle never reached 99 % (a loss).
+    _fake_runs(a, ["1e6", "", "2e6", "1e6"], ("oracle", "p"))
+    _fake_runs(b, ["3e6", "3e6"], ("oracle",))
+    res = _run(str(a), str(b), "--no-progress", "--json")
+    assert res.returncode == 0, res.stderr
+    maze = json.loads(res.stdout)["maze"]
+    assert (maze["starts"], maze["missions"], maze["T99_below_bound"]) == (2, 6, 0)
+    assert (maze["oracle_wins"], maze["oracle_pairs"]) == (1, 2)
+    # The best known per start is the best of both folders: 1e6 s from either seed.
+    fresh = _run(str(a), str(b), "--no-progress", "--json", "--fresh")
+    assert json.loads(fresh.stdout)["maze"]["median_best_known_over_bound"] == pytest.approx(
+        maze["median_best_known_over_bound"]
+    )
+    assert _run(str(a), str(b), "--out", str(tmp_path / "x.csv")).returncode == 2

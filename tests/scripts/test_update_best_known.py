@@ -72,3 +72,50 @@ def test_a_folder_without_runs_is_one_error_line(tmp_path: Path, capsys: Any):
     assert _script().main([str(tmp_path), "--table", str(tmp_path / "t.csv")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no runs.csv" in err[0]
+
+
+def test_an_infinite_bound_is_kept_and_not_computed_again(tmp_path: Path, monkeypatch, capsys):
+    mod = _script()
+    table = tmp_path / "t.csv"
+    table.write_text(
+        "world,seed,start,T99_s,T99_policy,D99_m,D99_policy,lower_bound_s,lower_bound_m\n"
+        f'"{WORLD}",0,random,50.0,nearest,9.0,nearest,,\n'
+    )
+    calls: list[tuple[str, int, str]] = []
+
+    def no_reach(world: str, seed: int, start: str) -> tuple[float, float]:
+        calls.append((world, seed, start))
+        return mod.math.inf, mod.math.inf
+
+    monkeypatch.setattr(mod, "entry_bound", no_reach)
+    for _ in range(2):
+        assert mod.main(["--table", str(table), "--bounds", "--json", "--no-progress"]) == 0
+    reports = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["bounds_computed"] for r in reports] == [1, 0]
+    assert calls == [(WORLD, 0, "random")]
+    e = read_table(table)[(WORLD, 0, "random")]
+    assert e["lower_bound_s"] == float("inf") and e["lower_bound_m"] == float("inf")
+
+
+def test_bounds_come_from_the_folder_s_check_before_any_is_computed(
+    run_folder: Path, tmp_path: Path, monkeypatch, capsys
+):
+    import shutil
+
+    mod = _script()
+    folder = tmp_path / "run"
+    shutil.copytree(run_folder, folder)
+    (folder / "lower_bounds.csv").write_text(
+        "world,seed,lower_bound_m,lower_bound_s,groups,bound_planning_s\n"
+        f'"{WORLD}",0,1.5,7.25,2,0.1\n"{WORLD}",1,inf,inf,0,0.1\n'
+    )
+    monkeypatch.setattr(mod, "entry_bound", lambda *a: pytest.fail(f"computed {a}"))
+    table = tmp_path / "t.csv"
+    assert mod.main([str(folder), "--table", str(table), "--bounds", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["bounds_computed"] == 0
+    entries = read_table(table)
+    assert (
+        entries[(WORLD, 0, "random")]["lower_bound_s"],
+        entries[(WORLD, 0, "random")]["lower_bound_m"],
+    ) == (7.25, 1.5)
+    assert entries[(WORLD, 1, "random")]["lower_bound_s"] == float("inf")

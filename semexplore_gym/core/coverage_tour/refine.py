@@ -28,7 +28,7 @@ import numpy as np
 from scipy import sparse
 
 from semexplore_gym.core.coverage_tour.problem import SensorModel
-from semexplore_gym.core.coverage_tour.viewpoints import visible_sets
+from semexplore_gym.core.coverage_tour.viewpoints import row_counts, visible_sets
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.mapping.raycast import SegmentIndex
 from semexplore_gym.core.planning.grid_search import distance_field, shortest_path_cells
@@ -168,7 +168,7 @@ def refine_tour(
     legs: LegVisibility,
     candidates: tuple[np.ndarray, sparse.csr_matrix],
     solve_order: Callable[[np.ndarray], list[int]],
-    geo_cost: np.ndarray,
+    geo_cost: np.ndarray | GeodesicFields,
     max_rounds: int = 4,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Shorten the open tour ``nodes_rc`` (row 0: the start) keeping ``required`` columns seen.
@@ -180,7 +180,8 @@ def refine_tour(
         legs: The leg and viewpoint visibility.
         candidates: ``(N, 2)`` cells a viewpoint may move to, and ``(N, M)`` what each sees.
         solve_order: Open tour order (node 0 first) of a distance matrix (LKH).
-        geo_cost: ``(H, W)`` cost for the tour's distances (metres per cell on the standing mask).
+        geo_cost: ``(H, W)`` cost for the tour's distances (metres per cell on the standing
+            mask), or a :class:`GeodesicFields` over it whose kept fields are reused.
         max_rounds: Rounds of drop, move and re-solve at most.
 
     Returns:
@@ -199,7 +200,7 @@ def refine_tour(
         _fill(tour, count, required, legs, dist, (cand, candidates[1]))
         if count.covered() < required:
             return np.array(tour, dtype=np.int64), dist.matrix(tour).astype(np.float64)
-    moves = (cand, candidates[1].tocsc())
+    moves = (cand, candidates[1])
     for _ in range(max_rounds):
         before = dist.length(tour)
         _drop_pass(tour, count, required, legs, dist)
@@ -210,11 +211,43 @@ def refine_tour(
     return np.array(tour, dtype=np.int64), dist.matrix(tour).astype(np.float64)
 
 
-class _Distances:
-    """Geodesic distances between cells, one Dijkstra per source cell (cached)."""
+class GeodesicFields:
+    """Dijkstra distance fields (float64, metres) over one cell-cost grid, one per source cell,
+    kept while ``budget_bytes`` allows: the cover, the distance matrix and the refinement all
+    ask for the fields of the same viewpoints, and each costs a Dijkstra over the whole map.
 
-    def __init__(self, geo_cost: np.ndarray) -> None:
-        self.cost = geo_cost
+    Args:
+        cost: ``(H, W)`` cost of entering each cell (``inf`` off the standing mask).
+        budget_bytes: Memory for the kept fields (at least 8 are kept whatever their size).
+    """
+
+    def __init__(self, cost: np.ndarray, budget_bytes: float = 256e6) -> None:
+        self.cost = cost
+        self._fields: dict[tuple[int, int], np.ndarray] = {}
+        self._max = max(8, int(budget_bytes // max(1, cost.size * 8)))
+
+    def kept(self, a: tuple[int, int]) -> np.ndarray | None:
+        """The field from ``a`` if it was computed and kept, else None (computes nothing)."""
+        return self._fields.get(a)
+
+    def field(self, a: tuple[int, int]) -> np.ndarray:
+        """The field from ``a`` (read-only: shared), kept when the budget allows."""
+        got = self._fields.get(a)
+        if got is None:
+            got = distance_field(self.cost, a)[0]
+            got.flags.writeable = False
+            if len(self._fields) < self._max:
+                self._fields[a] = got
+        return got
+
+
+class _Distances:
+    """Geodesic distances between cells, one Dijkstra per source cell (cached as float32; the
+    fields ``shared`` already holds are reused)."""
+
+    def __init__(self, geo_cost: np.ndarray | GeodesicFields) -> None:
+        self._shared = geo_cost if isinstance(geo_cost, GeodesicFields) else None
+        self.cost = geo_cost.cost if isinstance(geo_cost, GeodesicFields) else geo_cost
         self._fields: dict[tuple[int, int], np.ndarray] = {}
 
     def field(self, a: tuple[int, int]) -> np.ndarray:
@@ -222,7 +255,9 @@ class _Distances:
         if got is None:
             if len(self._fields) >= _MAX_FIELDS:  # big maps: bounded memory
                 self._fields.clear()
-            got = distance_field(self.cost, a)[0].astype(np.float32)
+            known = self._shared.kept(a) if self._shared is not None else None
+            full = known if known is not None else distance_field(self.cost, a)[0]
+            got = full.astype(np.float32)
             self._fields[a] = got
         return got
 
@@ -309,7 +344,7 @@ def _move_pass(
     required: int,
     legs: LegVisibility,
     dist: _Distances,
-    candidates: tuple[np.ndarray, sparse.csc_matrix],
+    candidates: tuple[np.ndarray, sparse.csr_matrix],
     tries: int,
 ) -> None:
     """Move each viewpoint to the candidate of least detour that keeps the target seen.
@@ -317,7 +352,8 @@ def _move_pass(
     Only candidates that see enough of what the viewpoint alone sees (all but the tour's
     surplus over ``required``) are tried, least detour first, ``tries`` at most.
     """
-    cand, sets_csc = candidates
+    cand, sets = candidates
+    unique_flags = np.zeros(sets.shape[1], dtype=bool)
     for i in range(1, len(tour)):
         prev, cur = tour[i - 1], tour[i]
         nxt = tour[i + 1] if i + 1 < len(tour) else None
@@ -332,8 +368,10 @@ def _move_pass(
         unique = own[count.count[own] == 1]
         need = unique.size - (count.covered() - required)
         if need > 0:
-            hits = np.asarray(sets_csc[:, unique].sum(axis=1)).ravel()
-            better = better[hits[better] >= need]
+            unique_flags[unique] = True
+            hits = row_counts(unique_flags, sets.indptr, sets.indices, better)
+            unique_flags[unique] = False
+            better = better[hits >= need]
         for k in better[np.argsort(detour[better], kind="stable")][:tries]:
             new = (int(cand[k, 0]), int(cand[k, 1]))
             if new in tour:
@@ -359,7 +397,7 @@ def _fill(
     to_cand = [dist.field(n)[cand[:, 0], cand[:, 1]].astype(np.float64) for n in tour]
     tried = np.zeros(cand.shape[0], dtype=bool)
     while count.covered() < required:
-        gains = np.asarray(sets.dot((count.count == 0).astype(np.int32))).ravel()
+        gains = row_counts(count.count == 0, sets.indptr, sets.indices)
         ins, where = _insertion_costs(tour, to_cand, dist)
         score = np.where((gains > 0) & ~tried & np.isfinite(ins), gains / (ins + offset_m), -1.0)
         k = int(np.argmax(score))

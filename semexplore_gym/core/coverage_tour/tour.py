@@ -38,6 +38,7 @@ from scipy import sparse
 
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
 from semexplore_gym.core.coverage_tour.refine import (
+    GeodesicFields,
     LegVisibility,
     refine_tour,
     tour_visible,
@@ -45,6 +46,7 @@ from semexplore_gym.core.coverage_tour.refine import (
 from semexplore_gym.core.coverage_tour.viewpoints import (
     candidate_viewpoints,
     nearest_allowed_cell,
+    row_counts,
     standing_mask,
     visible_sets,
     wall_clearance_m,
@@ -219,13 +221,14 @@ def travel_aware_cover(
     required: int,
     covered: np.ndarray,
     cells_rc: np.ndarray,
-    standing: np.ndarray,
+    fields: GeodesicFields,
     start_rc: tuple[int, int],
-    resolution_m: float,
     detour_m: float,
 ) -> list[int]:
     """Greedy cover by cells per metre: each step takes the row with the most uncovered columns
     per ``detour_m`` + path length from the nearest point chosen so far (the start first).
+    Path lengths are ``fields``' (metres per cell on the standing mask); the fields of the
+    start and of every chosen cell stay there for the tour's distance matrix.
 
     Plain greedy (:func:`greedy_cover`) reaches deep into every dead end for the last cells; this
     grows the chosen set outward from the start, which keeps the tour through it short. Lazy:
@@ -237,8 +240,7 @@ def travel_aware_cover(
     n_cov = int(cov.sum())
     indptr, indices = visible.indptr, visible.indices
     gain_ub = row_counts(~cov, indptr, indices).astype(np.float64)
-    cost = np.where(standing, resolution_m, np.inf)
-    dist, _ = distance_field(cost, start_rc)
+    dist = fields.field((int(start_rc[0]), int(start_rc[1]))).copy()
     cells = np.asarray(cells_rc, dtype=np.int64)
     chosen: list[int] = []
     taken = np.zeros(n, dtype=bool)
@@ -262,30 +264,21 @@ def travel_aware_cover(
         taken[best] = True
         cov[indices[indptr[best] : indptr[best + 1]]] = True
         n_cov += best_gain
-        d_new, _ = distance_field(cost, (int(cells[best, 0]), int(cells[best, 1])))
-        np.minimum(dist, d_new, out=dist)
+        np.minimum(dist, fields.field((int(cells[best, 0]), int(cells[best, 1]))), out=dist)
     return chosen
 
 
-def row_counts(flags: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """Per CSR row, how many of its columns are set in ``flags`` (no sparse product, no copies
-    of the matrix)."""
-    n = indptr.size - 1
-    lengths = np.diff(indptr)
-    if indices.size == 0:
-        return np.zeros(n, dtype=np.int64)
-    starts = np.minimum(indptr[:-1], indices.size - 1)
-    sums = np.add.reduceat(flags[indices], starts, dtype=np.int64)
-    return np.where(lengths > 0, sums, 0)
-
-
 def geodesic_matrix(
-    standing: np.ndarray, geometry: GridGeometry, cells_rc: np.ndarray
+    standing: np.ndarray,
+    geometry: GridGeometry,
+    cells_rc: np.ndarray,
+    fields: GeodesicFields | None = None,
 ) -> np.ndarray:
     """8-connected path lengths in metres between ``cells_rc`` over ``standing``.
 
     Each cell is a source of one Dijkstra on the standing mask's bounding box (a source may lie
-    outside the mask: the start's own cell). Unreachable pairs are ``inf``.
+    outside the mask: the start's own cell), unless ``fields`` (over the same standing mask at
+    ``geometry``'s resolution) kept its field already. Unreachable pairs are ``inf``.
     """
     cells = np.asarray(cells_rc, dtype=np.int64).reshape(-1, 2)
     rows = np.flatnonzero(standing.any(axis=1))
@@ -299,6 +292,10 @@ def geodesic_matrix(
     k = cells.shape[0]
     out = np.full((k, k), np.inf)
     for i in range(k):
+        known = fields.kept((int(cells[i, 0]), int(cells[i, 1]))) if fields is not None else None
+        if known is not None:
+            out[i] = known[cells[:, 0], cells[:, 1]]
+            continue
         dist, _ = distance_field(cost, (int(local[i, 0]), int(local[i, 1])))
         out[i] = dist[local[:, 0], local[:, 1]]
     out = np.minimum(out, out.T)  # the start's cell may sit outside the mask: use the way in
@@ -393,9 +390,8 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
         index,
         prm.robust_cells,
     )
-    nodes, dist = _cover_then_order(
-        vis, required, covered0, candidates, standing, start_rc, geo, prm
-    )
+    fields = GeodesicFields(np.where(standing, res, np.inf))
+    nodes, dist = _cover_then_order(vis, required, covered0, candidates, fields, start_rc, geo, prm)
     if prm.refine_rounds > 0 and nodes.shape[0] > 1:
         nodes, dist = refine_tour(
             nodes,
@@ -404,7 +400,7 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
             legs,
             (candidates, vis),
             lambda d: open_tour_order(d, prm.lkh_runs),
-            np.where(standing, res, np.inf),
+            fields,
             prm.refine_rounds,
         )
     k = nodes.shape[0]
@@ -443,7 +439,7 @@ def _cover_then_order(
     required: int,
     covered0: np.ndarray,
     candidates: np.ndarray,
-    standing: np.ndarray,
+    fields: GeodesicFields,
     start_rc: tuple[int, int],
     geo: GridGeometry,
     prm: TourParams,
@@ -451,19 +447,12 @@ def _cover_then_order(
     """The plain tour: a (travel-aware) cover of the viewpoints alone, ordered by LKH."""
     if prm.detour_m > 0:
         chosen = travel_aware_cover(
-            vis,
-            required,
-            covered0,
-            candidates,
-            standing,
-            start_rc,
-            geo.resolution_m,
-            prm.detour_m,
+            vis, required, covered0, candidates, fields, start_rc, prm.detour_m
         )
     else:
         chosen = greedy_cover(vis, required, covered0)
     nodes = np.vstack([np.array([start_rc], dtype=np.int64), candidates[chosen]])
-    dist = geodesic_matrix(standing, geo, nodes)
+    dist = geodesic_matrix(np.isfinite(fields.cost), geo, nodes, fields)
     order = open_tour_order(dist, prm.lkh_runs)
     return nodes[order], dist[np.ix_(order, order)]
 

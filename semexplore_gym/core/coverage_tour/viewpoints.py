@@ -118,6 +118,29 @@ def candidate_viewpoints(
     return np.column_stack([br * s + kk // s, bc * s + kk % s]).astype(np.int64)
 
 
+def row_counts(
+    flags: np.ndarray, indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray | None = None
+) -> np.ndarray:
+    """Per CSR row (or per row of ``rows`` only), how many of its columns are set in ``flags``
+    (one pass over the rows' entries: no sparse product, no copies of the matrix)."""
+    picked = np.arange(indptr.size - 1) if rows is None else np.asarray(rows, dtype=np.int64)
+    return count_set_columns(np.asarray(flags, dtype=np.bool_), indptr, indices, picked)
+
+
+@njit(cache=True)
+def count_set_columns(flags, indptr, indices, rows):  # pragma: no cover - numba
+    """``out[j]``: how many columns of CSR row ``rows[j]`` are set in ``flags``."""
+    out = np.zeros(rows.size, dtype=np.int64)
+    for j in range(rows.size):
+        i = rows[j]
+        total = 0
+        for p in range(indptr[i], indptr[i + 1]):
+            if flags[indices[p]]:
+                total += 1
+        out[j] = total
+    return out
+
+
 def visible_sets(
     world: World,
     geometry: GridGeometry,

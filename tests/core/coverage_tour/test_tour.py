@@ -126,3 +126,36 @@ def test_scans_along_the_legs_count_and_refining_never_lengthens_the_tour(privil
 def test_bad_tour_params_name_the_bad_value(kwargs, words):
     with pytest.raises(ValueError, match=words):
         TourParams(**kwargs)
+
+
+def test_row_counts_counts_set_columns_of_all_rows_or_the_rows_asked():
+    from semexplore_gym.core.coverage_tour.viewpoints import row_counts
+
+    rng = np.random.default_rng(3)
+    dense = rng.random((40, 70)) < 0.2
+    dense[5] = False  # an empty row
+    m = sparse.csr_matrix(dense)
+    flags = rng.random(70) < 0.5
+    want = (dense & flags).sum(axis=1)
+    assert np.array_equal(row_counts(flags, m.indptr, m.indices), want)
+    rows = np.array([7, 5, 0, 7])
+    assert np.array_equal(row_counts(flags, m.indptr, m.indices, rows), want[rows])
+
+
+def test_shared_distance_fields_give_the_same_matrix():
+    from semexplore_gym.core.coverage_tour.refine import GeodesicFields
+    from semexplore_gym.core.coverage_tour.tour import geodesic_matrix
+    from semexplore_gym.core.planning.grid_search import distance_field
+
+    standing = np.ones((30, 40), dtype=bool)
+    standing[10, 5:38] = False  # a wall with a gap at each end
+    geo = GridGeometry(0.05, 0.0, 0.0, 30, 40)
+    cost = np.where(standing, 0.05, np.inf)
+    cells = np.array([[2, 3], [25, 30], [2, 35], [28, 1]])
+    fields = GeodesicFields(cost)
+    assert fields.kept((2, 3)) is None
+    assert np.array_equal(fields.field((2, 3)), distance_field(cost, (2, 3))[0])
+    assert fields.kept((2, 3)) is not None and fields.field((25, 30)) is not None
+    assert np.array_equal(
+        geodesic_matrix(standing, geo, cells, fields), geodesic_matrix(standing, geo, cells)
+    )
