@@ -1,0 +1,327 @@
+"""A team coverage tour: the one-robot tour's viewpoints split into k routes of least makespan.
+
+:func:`split_routes` solves a min-makespan vehicle routing problem on a distance matrix whose
+node 0 is the common start: k open routes (each ends where its last viewpoint is) that together
+visit every other node once, the longest as short as possible. It goes in two steps:
+
+1. **A split of the one-robot order** (:func:`split_order`): the open tour's viewpoints cut into
+   k consecutive chunks, each driven from the start, the cut points chosen exactly (a dynamic
+   programme over the cuts) for the least longest route. This is the initial solution, and the
+   answer when OR-Tools is missing or k = 1 (then it is the one-robot tour itself).
+2. **OR-Tools routing** from that split: arc costs the same geodesic distances the one-robot
+   tour uses (integer millimetres), a global span cost on the distance dimension (the makespan)
+   over the total as tie-break, guided local search (OR-Tools' routing search runs in one
+   thread), stopped after a fixed number of solutions (deterministic) or a wall-clock cap (a guard on big maps), whichever comes
+   first. The better of the two is kept, so the result is never worse than step 1.
+
+:func:`plan_team_tour` applies it to a :class:`~.tour.CoverageTour`. The routes see what the
+one-robot tour's viewpoints see; the scans along the new legs differ from the old legs' (the
+team oracle makes up any shortfall from its live map, as the one-robot oracle does).
+
+:func:`team_lower_bound` turns the one-robot bound into a bound on the team's makespan.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from semexplore_gym.core.coverage_tour.tour import CoverageTour
+from semexplore_gym.core.coverage_tour.viewpoints import nearest_allowed_cell
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.planning.grid_search import distance_field
+
+#: What to install when the routing solver is missing.
+ROUTING_HINT = (
+    "the team oracle's routing solver needs OR-Tools: pip install 'semexplore-gym[oracle]' "
+    "or pip install ortools"
+)
+
+
+@dataclass(frozen=True)
+class TeamTourParams:
+    """Settings of :func:`split_routes`.
+
+    Attributes:
+        solution_limit: OR-Tools stops after this many solutions (deterministic).
+        time_limit_s: ... or after this much wall time (a guard on big problems).
+        span_cost: Weight of the longest route against the total length (the total breaks
+            ties between splits of the same makespan).
+        use_solver: False keeps the split of the one-robot order (no OR-Tools).
+    """
+
+    solution_limit: int = 300
+    time_limit_s: float = 10.0
+    span_cost: int = 100
+    use_solver: bool = True
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.solution_limit, int) and self.solution_limit >= 1):
+            raise ValueError(
+                f"TeamTourParams.solution_limit must be an integer >= 1, got {self.solution_limit!r}"
+            )
+        if not (math.isfinite(self.time_limit_s) and self.time_limit_s > 0):
+            raise ValueError(
+                f"TeamTourParams.time_limit_s must be positive, got {self.time_limit_s!r}"
+            )
+        if not (isinstance(self.span_cost, int) and self.span_cost >= 1):
+            raise ValueError(
+                f"TeamTourParams.span_cost must be an integer >= 1, got {self.span_cost!r}"
+            )
+
+
+@dataclass(frozen=True)
+class TeamRoutes:
+    """k open routes from node 0 (see :func:`split_routes`).
+
+    Attributes:
+        routes: Per route, its nodes in visiting order (node 0, the start, left out; a route
+            may be empty).
+        lengths_m: Each route's length from the start.
+        makespan_m: The longest route.
+        total_m: All routes together.
+        solver: ``"split"`` (the cut one-robot order) or ``"ortools"`` (improved by routing).
+    """
+
+    routes: tuple[tuple[int, ...], ...]
+    lengths_m: tuple[float, ...]
+    makespan_m: float
+    total_m: float
+    solver: str
+
+
+def route_length_m(distances_m: np.ndarray, route: tuple[int, ...] | list[int]) -> float:
+    """Length of the open route from node 0 through ``route``."""
+    nodes = [0, *route]
+    return float(sum(distances_m[a, b] for a, b in zip(nodes[:-1], nodes[1:], strict=True)))
+
+
+def _check_problem(distances_m: np.ndarray, n_routes: int) -> np.ndarray:
+    d = np.asarray(distances_m, dtype=np.float64)
+    if d.ndim != 2 or d.shape[0] != d.shape[1] or d.shape[0] < 2:
+        raise ValueError(
+            f"a team tour needs a square distance matrix with the start and at least one "
+            f"viewpoint, got shape {d.shape}"
+        )
+    if not (isinstance(n_routes, (int, np.integer)) and n_routes >= 1):
+        raise ValueError(f"the number of robots must be an integer >= 1, got {n_routes!r}")
+    n_viewpoints = d.shape[0] - 1
+    if n_routes > n_viewpoints:
+        raise ValueError(
+            f"{n_routes} robots but only {n_viewpoints} viewpoint(s) to share: use at most "
+            f"{n_viewpoints} robots on this world"
+        )
+    if not np.isfinite(d[0, 1:]).all():
+        raise ValueError("a viewpoint cannot be reached from the start")
+    return d
+
+
+def split_order(distances_m: np.ndarray, order: list[int], n_routes: int) -> TeamRoutes:
+    """``order`` (nodes, the start left out) cut into ``n_routes`` consecutive chunks, each
+    driven from node 0, with the least longest chunk (exact over the cut points)."""
+    d = _check_problem(distances_m, n_routes)
+    n = len(order)
+    seq = np.asarray(order, dtype=np.int64)
+    # within[i, j]: the chunk seq[i..j-1] driven from the start (inf for i >= j: no empty chunk
+    # unless n < k, which _check_problem refuses).
+    steps = np.concatenate([[0.0], np.cumsum(d[seq[:-1], seq[1:]])]) if n else np.zeros(1)
+    best = np.full((n_routes + 1, n + 1), np.inf)
+    cut = np.zeros((n_routes + 1, n + 1), dtype=np.int64)
+    best[0, 0] = 0.0
+    for r in range(1, n_routes + 1):
+        for j in range(r, n + 1):
+            i = np.arange(r - 1, j)
+            chunk = d[0, seq[i]] + steps[j - 1] - steps[i]
+            val = np.maximum(best[r - 1, i], chunk)
+            m = int(np.argmin(val))
+            best[r, j], cut[r, j] = float(val[m]), int(i[m])
+    routes: list[tuple[int, ...]] = []
+    j = n
+    for r in range(n_routes, 0, -1):
+        i = int(cut[r, j])
+        routes.append(tuple(int(v) for v in seq[i:j]))
+        j = i
+    return _routes(d, routes[::-1], "split")
+
+
+def _routes(d: np.ndarray, routes: list[tuple[int, ...]], solver: str) -> TeamRoutes:
+    lengths = tuple(route_length_m(d, r) for r in routes)
+    return TeamRoutes(
+        routes=tuple(routes),
+        lengths_m=lengths,
+        makespan_m=max(lengths),
+        total_m=float(sum(lengths)),
+        solver=solver,
+    )
+
+
+def _ortools() -> tuple[object, object]:
+    try:
+        from ortools.constraint_solver import pywrapcp, routing_enums_pb2
+    except ImportError:
+        raise ImportError(ROUTING_HINT) from None
+    return pywrapcp, routing_enums_pb2
+
+
+def require_routing_solver() -> None:
+    """Raise ImportError (saying how to install it) when OR-Tools is missing."""
+    _ortools()
+
+
+def split_routes(
+    distances_m: np.ndarray,
+    n_routes: int,
+    order: list[int] | None = None,
+    params: TeamTourParams | None = None,
+) -> TeamRoutes:
+    """k open routes from node 0 through every other node of ``distances_m``, least makespan
+    (module docstring). ``order``: a one-robot visiting order (the start left out) to start
+    from; default ``1, 2, ...``. With ``n_routes == 1`` the answer is ``order`` itself.
+
+    Raises:
+        ValueError: ``n_routes`` < 1 or above the number of viewpoints, a bad matrix, a
+            viewpoint the start cannot reach.
+        ImportError: OR-Tools is missing (and ``params.use_solver``, ``n_routes`` > 1).
+    """
+    prm = params or TeamTourParams()
+    d = _check_problem(distances_m, n_routes)
+    seq = list(range(1, d.shape[0])) if order is None else [int(v) for v in order]
+    if sorted(seq) != list(range(1, d.shape[0])):
+        raise ValueError("order must list every node but the start (0) once")
+    first = split_order(d, seq, n_routes)
+    if n_routes == 1 or not prm.use_solver:
+        return first
+    found = _solve_routing(d, first, n_routes, prm)
+    if found is None:
+        return first
+    better = _routes(d, found, "ortools")
+    return better if better.makespan_m < first.makespan_m - 1e-9 else first
+
+
+def _solve_routing(
+    d: np.ndarray, initial: TeamRoutes, n_routes: int, prm: TeamTourParams
+) -> list[tuple[int, ...]] | None:
+    """OR-Tools' min-makespan routes from ``initial`` (None when it finds none)."""
+    pywrapcp, enums = _ortools()
+    n = d.shape[0]
+    # Node n is the routes' common end: free to reach from anywhere, so the routes are open.
+    mm = np.zeros((n + 1, n + 1), dtype=np.int64)
+    finite = np.where(np.isfinite(d), d, 10.0 * float(d[np.isfinite(d)].max() + 1.0) * n)
+    mm[:n, :n] = np.rint(finite * 1000.0).astype(np.int64)
+    manager = pywrapcp.RoutingIndexManager(n + 1, n_routes, [0] * n_routes, [n] * n_routes)  # type: ignore[attr-defined]
+    model = pywrapcp.RoutingModel(manager)  # type: ignore[attr-defined]
+    cb = model.RegisterTransitMatrix(mm.tolist())  # evaluated in C++, no Python callback
+    model.SetArcCostEvaluatorOfAllVehicles(cb)
+    model.AddDimension(cb, 0, int(mm.sum()) + 1, True, "distance")
+    model.GetDimensionOrDie("distance").SetGlobalSpanCostCoefficient(prm.span_cost)
+    search = pywrapcp.DefaultRoutingSearchParameters()  # type: ignore[attr-defined]
+    search.first_solution_strategy = enums.FirstSolutionStrategy.PATH_CHEAPEST_ARC  # type: ignore[attr-defined]
+    search.local_search_metaheuristic = enums.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH  # type: ignore[attr-defined]
+    search.solution_limit = prm.solution_limit
+    search.time_limit.FromMilliseconds(int(prm.time_limit_s * 1000))
+    model.CloseModelWithParameters(search)
+    start = model.ReadAssignmentFromRoutes([list(r) for r in initial.routes], True)
+    sol = (
+        model.SolveFromAssignmentWithParameters(start, search)
+        if start is not None
+        else model.SolveWithParameters(search)
+    )
+    if sol is None:
+        return None
+    routes: list[tuple[int, ...]] = []
+    for v in range(n_routes):
+        i = model.Start(v)
+        nodes: list[int] = []
+        i = sol.Value(model.NextVar(i))
+        while not model.IsEnd(i):
+            nodes.append(int(manager.IndexToNode(i)))
+            i = sol.Value(model.NextVar(i))
+        routes.append(tuple(nodes))
+    return routes
+
+
+@dataclass(frozen=True)
+class TeamTour:
+    """:func:`plan_team_tour`'s answer: per robot, viewpoint indices of the one-robot tour.
+
+    Attributes:
+        routes: Per robot, indices into ``tour.viewpoints_rc`` in visiting order.
+        lengths_m: Each route's geodesic length from the start.
+        makespan_m: The longest route.
+        solver: See :class:`TeamRoutes`.
+    """
+
+    routes: tuple[tuple[int, ...], ...]
+    lengths_m: tuple[float, ...]
+    makespan_m: float
+    solver: str
+
+
+def start_distances_m(
+    tour: CoverageTour, geometry: GridGeometry, start_xy_m: tuple[float, float]
+) -> np.ndarray:
+    """The ``(K + 1, K + 1)`` geodesic matrix of the start (node 0) and ``tour``'s viewpoints,
+    on the tour's standing mask (one Dijkstra from the start; the rest is the tour's own)."""
+    start_rc = nearest_allowed_cell(tour.standing, geometry, start_xy_m)
+    cost = np.where(tour.standing, geometry.resolution_m, np.inf)
+    field, _ = distance_field(cost, start_rc)
+    k = tour.n_viewpoints
+    out = np.zeros((k + 1, k + 1))
+    vp = tour.viewpoints_rc
+    out[0, 1:] = out[1:, 0] = field[vp[:, 0], vp[:, 1]]
+    out[1:, 1:] = tour.distances_m
+    return out
+
+
+def plan_team_tour(
+    tour: CoverageTour,
+    geometry: GridGeometry,
+    start_xy_m: tuple[float, float],
+    n_robots: int,
+    params: TeamTourParams | None = None,
+) -> TeamTour:
+    """The viewpoints of ``tour`` split into ``n_robots`` routes from ``start_xy_m`` (the tour's
+    own order is the initial split; one robot gets the tour itself).
+
+    Raises:
+        ValueError: ``n_robots`` < 1 or above the tour's viewpoints (the message says so).
+    """
+    if tour.n_viewpoints == 0:
+        raise ValueError("the coverage tour has no viewpoint: nothing to share among robots")
+    d = start_distances_m(tour, geometry, start_xy_m)
+    found = split_routes(d, n_robots, list(range(1, tour.n_viewpoints + 1)), params)
+    return TeamTour(
+        routes=tuple(tuple(v - 1 for v in r) for r in found.routes),
+        lengths_m=found.lengths_m,
+        makespan_m=found.makespan_m,
+        solver=found.solver,
+    )
+
+
+def team_lower_bound_m(
+    one_robot_m: float, farthest_m: float, n_robots: int, starts_gap_m: float = 0.0
+) -> float:
+    """A lower bound on the team's makespan (the longest drive of any robot) to the goal.
+
+    Args:
+        one_robot_m: A lower bound on one robot's drive from robot 0's start.
+        farthest_m: A lower bound on the drive from robot 0's start into some region the goal
+            forces an explorer to enter (the one-region bound).
+        n_robots: Team size k.
+        starts_gap_m: Length of a path from robot 0's start through every teammate's start
+            (0 when all start at one point).
+
+    Returns:
+        ``max(farthest_m - starts_gap_m, (one_robot_m - starts_gap_m) / (2 k - 1), 0)``.
+        Proof: some robot enters the forced region, from a start at most ``starts_gap_m`` from
+        robot 0's. And one robot can do the team's work alone: from robot 0's start along the
+        gap path, driving each robot's route out and (but the last) back: ``(2k - 1)`` times
+        the makespan plus the gap, at least ``one_robot_m``.
+    """
+    k = int(n_robots)
+    if k < 1:
+        raise ValueError(f"the number of robots must be >= 1, got {n_robots!r}")
+    gap = max(0.0, float(starts_gap_m))
+    return max(0.0, float(farthest_m) - gap, (float(one_robot_m) - gap) / (2 * k - 1))
