@@ -140,9 +140,9 @@ def split_order(distances_m: np.ndarray, order: list[int], n_routes: int) -> Tea
     routes: list[tuple[int, ...]] = []
     j = n
     for r in range(n_routes, 0, -1):
-        i = int(cut[r, j])
-        routes.append(tuple(int(v) for v in seq[i:j]))
-        j = i
+        lo = int(cut[r, j])
+        routes.append(tuple(int(v) for v in seq[lo:j]))
+        j = lo
     return _routes(d, routes[::-1], "split")
 
 
