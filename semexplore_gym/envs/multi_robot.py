@@ -326,11 +326,20 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.agents = list(self.possible_agents)
         zero = {"free_area_change": 0.0, "time": 0.0, "collision": 0.0, "team": 0.0}
         infos = {a: self._agent_info(i, dict(zero), True) for i, a in enumerate(self.agents)}
+        self._start_poses, self._reach = list(poses), reach
         if self.privileged:
             for i, a in enumerate(self.agents):
-                truth = SemanticExploreEnv._privileged_world(self, poses[i], reach)  # type: ignore[arg-type]
-                infos[a][PRIVILEGED_INFO_KEY] = truth
+                infos[a][PRIVILEGED_INFO_KEY] = self.ground_truth(i)
         return self._observations(), infos
+
+    def ground_truth(self, index: int) -> Any:
+        """The episode's :class:`~semexplore_gym.core.coverage_tour.PrivilegedWorld` seen from
+        robot ``index``'s start (what ``privileged=True`` hands that agent at ``reset``; the
+        benchmark reads it for the lower bound). For runners, never for policies."""
+        if not self._started:
+            raise RuntimeError("ground_truth() needs reset() first")
+        pose = self._start_poses[index]
+        return SemanticExploreEnv._privileged_world(self, pose, self._reach)  # type: ignore[arg-type]
 
     def step(
         self, actions: dict[str, Any]

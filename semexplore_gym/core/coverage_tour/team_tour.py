@@ -301,7 +301,11 @@ def plan_team_tour(
 
 
 def team_lower_bound_m(
-    one_robot_m: float, farthest_m: float, n_robots: int, starts_gap_m: float = 0.0
+    one_robot_m: float,
+    farthest_m: float,
+    n_robots: int,
+    starts_gap_m: float = 0.0,
+    start_spread_m: float | None = None,
 ) -> float:
     """A lower bound on the team's makespan (the longest drive of any robot) to the goal.
 
@@ -311,17 +315,45 @@ def team_lower_bound_m(
             forces an explorer to enter (the one-region bound).
         n_robots: Team size k.
         starts_gap_m: Length of a path from robot 0's start through every teammate's start
-            (0 when all start at one point).
+            in turn (0 when all start at one point).
+        start_spread_m: The longest path from robot 0's start to a teammate's (default
+            ``starts_gap_m``).
 
     Returns:
-        ``max(farthest_m - starts_gap_m, (one_robot_m - starts_gap_m) / (2 k - 1), 0)``.
-        Proof: some robot enters the forced region, from a start at most ``starts_gap_m`` from
-        robot 0's. And one robot can do the team's work alone: from robot 0's start along the
-        gap path, driving each robot's route out and (but the last) back: ``(2k - 1)`` times
-        the makespan plus the gap, at least ``one_robot_m``.
+        ``max(farthest_m - start_spread_m, (one_robot_m - starts_gap_m) / (2 k - 1), 0)``.
+        Proof: some robot enters the forced region, from a start at most ``start_spread_m``
+        from robot 0's. And one robot can do the team's work alone: from robot 0's start
+        along the gap path, driving each robot's route out and (but the last) back:
+        ``(2k - 1)`` times the makespan plus the gap, at least ``one_robot_m``.
     """
     k = int(n_robots)
     if k < 1:
         raise ValueError(f"the number of robots must be >= 1, got {n_robots!r}")
     gap = max(0.0, float(starts_gap_m))
-    return max(0.0, float(farthest_m) - gap, (float(one_robot_m) - gap) / (2 * k - 1))
+    spread = gap if start_spread_m is None else max(0.0, float(start_spread_m))
+    return max(0.0, float(farthest_m) - spread, (float(one_robot_m) - gap) / (2 * k - 1))
+
+
+def starts_gap_m(
+    allowed: np.ndarray, geometry: GridGeometry, starts_xy_m: list[tuple[float, float]]
+) -> tuple[float, float]:
+    """Paths in ``allowed`` cells (8-connected between cell centres, plus each start's way to
+    its cell's centre) for :func:`team_lower_bound_m`: from the first start through the others
+    in turn (``starts_gap_m``), and the longest from the first start to another
+    (``start_spread_m``); inf when a start's cell is not allowed."""
+    if len(starts_xy_m) < 2:
+        return 0.0, 0.0
+    res = geometry.resolution_m
+    cost = np.where(allowed, res, np.inf)
+    cells = [tuple(int(v) for v in geometry.world_to_grid(x, y)) for x, y in starts_xy_m]
+    h, w = allowed.shape
+    if not all(0 <= r < h and 0 <= c < w and allowed[r, c] for r, c in cells):
+        return math.inf, math.inf
+    ends = math.sqrt(2.0) * res  # half a diagonal at either end
+    from_first, _ = distance_field(cost, cells[0])
+    spread = max(float(from_first[b]) + ends for b in cells[1:])
+    total = float(from_first[cells[1]]) + ends
+    for a, b in zip(cells[1:-1], cells[2:], strict=True):
+        field, _ = distance_field(cost, a)
+        total += float(field[b]) + ends
+    return total, spread
