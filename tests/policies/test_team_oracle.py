@@ -56,3 +56,13 @@ def test_two_robots_split_the_tour_and_reach_the_goal_sooner_than_one():
     assert m2["oracle_makespan_m"] < m1["oracle_makespan_m"]
     assert min(two.path_per_robot_m) > 1.0  # both robots drove
     assert two.T99_s < one.T99_s
+
+
+def test_more_robots_than_viewpoints_is_one_clear_line(capsys: pytest.CaptureFixture[str]):
+    from semexplore_gym.cli import main
+
+    argv = ["explore", "--world", "maze:seed=3,size_m=2", "--robots", "8", "--policy", "oracle"]
+    assert main([*argv, "--max-time-s", "60"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("8 robots, but the coverage tour of this world has 1")
+    assert "Traceback" not in err and len(err.splitlines()) == 1
