@@ -122,12 +122,15 @@ class TeamOracle(TeamPolicy):
         seed: int | None = None,
     ) -> None:
         super().reset(observations, infos, seed=seed)
-        truths = [infos[a].get(PRIVILEGED_INFO_KEY) for a in self.agents]
-        if not all(isinstance(t, PrivilegedWorld) for t in truths):
-            raise PrivilegedPolicyError(_NOT_PRIVILEGED)
+        truths: list[PrivilegedWorld] = []
+        for a in self.agents:
+            truth = infos[a].get(PRIVILEGED_INFO_KEY)
+            if not isinstance(truth, PrivilegedWorld):
+                raise PrivilegedPolicyError(_NOT_PRIVILEGED)
+            truths.append(truth)
         require_routing_solver()
         prm = self.params
-        first: PrivilegedWorld = truths[0]  # type: ignore[assignment]
+        first = truths[0]
         tour_params = replace(
             prm.member.tour,
             leg_prefer_clearance_m=prm.member.path_prefer_clearance_m,
