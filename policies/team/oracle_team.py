@@ -47,7 +47,7 @@ from semexplore_gym.core.coverage_tour.team_tour import (
 _NOT_PRIVILEGED = (
     "the team oracle is a privileged policy: it needs the true world, which only "
     "SemanticExploreMulti-v0 made with privileged=True hands out (info['privileged_world'] at "
-    "reset); semexplore benchmark --team-sizes ... --oracle does that for it"
+    "reset); semexplore benchmark --robots ... --oracle does that for it"
 )
 
 
