@@ -8,12 +8,14 @@ yardstick for team policies, never a learner's teacher.
 At ``reset`` it plans the one-robot coverage tour from robot 0's start
 (:func:`~semexplore_gym.core.coverage_tour.plan_coverage_tour`, the one-robot oracle's settings)
 and splits its viewpoints into one route per robot with the least makespan
-(:func:`~semexplore_gym.core.coverage_tour.team_tour.plan_team_tour`: OR-Tools vehicle routing
-from the common start). Each robot then drives its route exactly as the one-robot oracle drives
+(:func:`~semexplore_gym.core.coverage_tour.team_tour.plan_team_tour`: OR-Tools vehicle routing,
+each route from its robot's own start: teammates start near robot 0, but sometimes on the far
+side of a wall). Each robot then drives its route exactly as the one-robot oracle drives
 its tour (:class:`~semexplore_gym.policies.oracle.OraclePolicy`, given the route instead of
 planning one: the same path following, stuck recovery, pruning against the live map, repairs,
-shortcuts and the fallback goals once the route is done). With the env's team map (the
-default) every robot prunes against what the whole team has seen. The team stops when team
+shortcuts and the fallback goals once the route is done: a robot whose route is done looks for
+what the team has not seen yet). With the env's team map (the default) every robot prunes
+against what the whole team has seen. The team stops when team
 coverage reaches ``coverage_goal`` or every robot has nothing left to do.
 """
 
@@ -143,8 +145,8 @@ class TeamOracle(TeamPolicy):
                 f"the team oracle needs a viewpoint per robot: {k} robots, but the coverage "
                 f"tour of this world has {tour.n_viewpoints}"
             )
-        start_xy = (first.start_pose[0], first.start_pose[1])
-        self.team_tour = split = plan_team_tour(tour, first.geometry, start_xy, k, prm.routing)
+        starts = [(t.start_pose[0], t.start_pose[1]) for t in truths]
+        self.team_tour = split = plan_team_tour(tour, first.geometry, starts, k, prm.routing)
         self.members = []
         for i, agent in enumerate(self.agents):
             route = split.routes[i]

@@ -146,8 +146,17 @@ def split_order(distances_m: np.ndarray, order: list[int], n_routes: int) -> Tea
     return _routes(d, routes[::-1], "split")
 
 
-def _routes(d: np.ndarray, routes: list[tuple[int, ...]], solver: str) -> TeamRoutes:
-    lengths = tuple(route_length_m(d, r) for r in routes)
+def _routes(
+    d: np.ndarray, routes: list[tuple[int, ...]], solver: str, own: np.ndarray | None = None
+) -> TeamRoutes:
+    """The routes with their lengths; ``own[i]``: robot ``i``'s start's distances to the nodes
+    (None: every robot starts at node 0)."""
+    lengths = tuple(
+        float(route_length_m(d, r))
+        if own is None or not r
+        else float(own[i, r[0]] + route_length_m(d, r) - d[0, r[0]])
+        for i, r in enumerate(routes)
+    )
     return TeamRoutes(
         routes=tuple(routes),
         lengths_m=lengths,
@@ -175,10 +184,15 @@ def split_routes(
     n_routes: int,
     order: list[int] | None = None,
     params: TeamTourParams | None = None,
+    own_starts_m: np.ndarray | None = None,
 ) -> TeamRoutes:
     """k open routes from node 0 through every other node of ``distances_m``, least makespan
     (module docstring). ``order``: a one-robot visiting order (the start left out) to start
     from; default ``1, 2, ...``. With ``n_routes == 1`` the answer is ``order`` itself.
+    ``own_starts_m``: ``(k, N)`` distances from each robot's own start to every node (column
+    0 unused): route ``i`` then runs from robot ``i``'s start (teammates that start apart, on
+    either side of a wall, say); the split of the order goes to the robots by
+    :func:`scipy.optimize.linear_sum_assignment` on the way to each piece's first node.
 
     Raises:
         ValueError: ``n_routes`` < 1 or above the number of viewpoints, a bad matrix, a
@@ -191,26 +205,58 @@ def split_routes(
     if sorted(seq) != list(range(1, d.shape[0])):
         raise ValueError("order must list every node but the start (0) once")
     first = split_order(d, seq, n_routes)
+    own = None
+    if own_starts_m is not None:
+        own = np.asarray(own_starts_m, dtype=np.float64)
+        if own.shape != (n_routes, d.shape[0]) or not np.isfinite(own[:, 1:]).all():
+            raise ValueError(
+                f"own_starts_m must be ({n_routes}, {d.shape[0]}) finite distances, got "
+                f"shape {own.shape}"
+            )
+        first = _assign_pieces(d, first, own)
     if n_routes == 1 or not prm.use_solver:
         return first
-    found = _solve_routing(d, first, n_routes, prm)
+    found = _solve_routing(d, first, n_routes, prm, own)
     if found is None:
         return first
-    better = _routes(d, found, "ortools")
+    better = _routes(d, found, "ortools", own)
     return better if better.makespan_m < first.makespan_m - 1e-9 else first
 
 
+def _assign_pieces(d: np.ndarray, split: TeamRoutes, own: np.ndarray) -> TeamRoutes:
+    """The pieces of ``split`` given to the robots whose starts are nearest their first nodes
+    (least total way in)."""
+    from scipy.optimize import linear_sum_assignment
+
+    routes = list(split.routes)
+    cost = np.array([[own[i, r[0]] if r else 0.0 for r in routes] for i in range(own.shape[0])])
+    rows, cols = linear_sum_assignment(cost)
+    given = [routes[c] for _, c in sorted(zip(rows, cols, strict=True))]
+    return _routes(d, given, split.solver, own)
+
+
 def _solve_routing(
-    d: np.ndarray, initial: TeamRoutes, n_routes: int, prm: TeamTourParams
+    d: np.ndarray,
+    initial: TeamRoutes,
+    n_routes: int,
+    prm: TeamTourParams,
+    own: np.ndarray | None = None,
 ) -> list[tuple[int, ...]] | None:
     """OR-Tools' min-makespan routes from ``initial`` (None when it finds none)."""
     pywrapcp, enums = _ortools()
-    n = d.shape[0]
-    # Node n is the routes' common end: free to reach from anywhere, so the routes are open.
-    mm = np.zeros((n + 1, n + 1), dtype=np.int64)
-    finite = np.where(np.isfinite(d), d, 10.0 * float(d[np.isfinite(d)].max() + 1.0) * n)
-    mm[:n, :n] = np.rint(finite * 1000.0).astype(np.int64)
-    manager = pywrapcp.RoutingIndexManager(n + 1, n_routes, [0] * n_routes, [n] * n_routes)  # type: ignore[attr-defined]
+    n, k = d.shape[0], n_routes
+    # Nodes: 0 .. n-1 as in d (0 unused), n .. n+k-1 the robots' starts, n+k the routes'
+    # common end: free to reach from anywhere, so the routes are open.
+    big = 10.0 * float(d[np.isfinite(d)].max() + 1.0) * n
+    full = np.zeros((n + k + 1, n + k + 1))
+    full[:n, :n] = np.where(np.isfinite(d), d, big)
+    starts = np.tile(d[0], (k, 1)) if own is None else own
+    full[n : n + k, :n] = np.where(np.isfinite(starts), starts, big)
+    full[:n, n : n + k] = big  # never into a start
+    mm = np.rint(full * 1000.0).astype(np.int64)
+    mm[:, n + k] = 0
+    depots = list(range(n, n + k))
+    manager = pywrapcp.RoutingIndexManager(n + k + 1, k, depots, [n + k] * k)  # type: ignore[attr-defined]
     model = pywrapcp.RoutingModel(manager)  # type: ignore[attr-defined]
     cb = model.RegisterTransitMatrix(mm.tolist())  # evaluated in C++, no Python callback
     model.SetArcCostEvaluatorOfAllVehicles(cb)
@@ -221,6 +267,7 @@ def _solve_routing(
     search.local_search_metaheuristic = enums.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH  # type: ignore[attr-defined]
     search.solution_limit = prm.solution_limit
     search.time_limit.FromMilliseconds(int(prm.time_limit_s * 1000))
+    model.AddDisjunction([manager.NodeToIndex(0)], 0)  # node 0 (the common start) is no stop
     model.CloseModelWithParameters(search)
     start = model.ReadAssignmentFromRoutes([list(r) for r in initial.routes], True)
     sol = (
@@ -264,34 +311,51 @@ def start_distances_m(
 ) -> np.ndarray:
     """The ``(K + 1, K + 1)`` geodesic matrix of the start (node 0) and ``tour``'s viewpoints,
     on the tour's standing mask (one Dijkstra from the start; the rest is the tour's own)."""
-    start_rc = nearest_allowed_cell(tour.standing, geometry, start_xy_m)
-    cost = np.where(tour.standing, geometry.resolution_m, np.inf)
-    field, _ = distance_field(cost, start_rc)
     k = tour.n_viewpoints
     out = np.zeros((k + 1, k + 1))
-    vp = tour.viewpoints_rc
-    out[0, 1:] = out[1:, 0] = field[vp[:, 0], vp[:, 1]]
+    out[0, 1:] = out[1:, 0] = _from_point(tour, geometry, start_xy_m)
     out[1:, 1:] = tour.distances_m
     return out
+
+
+def _from_point(
+    tour: CoverageTour, geometry: GridGeometry, xy_m: tuple[float, float]
+) -> np.ndarray:
+    """Geodesic distances from the standing cell nearest ``xy_m`` to the tour's viewpoints."""
+    rc = nearest_allowed_cell(tour.standing, geometry, xy_m)
+    cost = np.where(tour.standing, geometry.resolution_m, np.inf)
+    field, _ = distance_field(cost, rc)
+    vp = tour.viewpoints_rc
+    return np.asarray(field[vp[:, 0], vp[:, 1]], dtype=np.float64)
 
 
 def plan_team_tour(
     tour: CoverageTour,
     geometry: GridGeometry,
-    start_xy_m: tuple[float, float],
+    starts_xy_m: list[tuple[float, float]],
     n_robots: int,
     params: TeamTourParams | None = None,
 ) -> TeamTour:
-    """The viewpoints of ``tour`` split into ``n_robots`` routes from ``start_xy_m`` (the tour's
-    own order is the initial split; one robot gets the tour itself).
+    """The viewpoints of ``tour`` split into ``n_robots`` routes (the tour's own order is the
+    initial split; one robot gets the tour itself). ``starts_xy_m``: one common start (the
+    tour's), or one per robot (route ``i`` from start ``i``; the first is the tour's start).
 
     Raises:
-        ValueError: ``n_robots`` < 1 or above the tour's viewpoints (the message says so).
+        ValueError: ``n_robots`` < 1 or above the tour's viewpoints (the message says so), or
+            neither one start nor one per robot.
     """
     if tour.n_viewpoints == 0:
         raise ValueError("the coverage tour has no viewpoint: nothing to share among robots")
-    d = start_distances_m(tour, geometry, start_xy_m)
-    found = split_routes(d, n_robots, list(range(1, tour.n_viewpoints + 1)), params)
+    if len(starts_xy_m) not in (1, n_robots):
+        raise ValueError(f"give one start or one per robot ({n_robots}), got {len(starts_xy_m)}")
+    d = start_distances_m(tour, geometry, starts_xy_m[0])
+    own = None
+    if len(starts_xy_m) > 1:
+        own = np.zeros((n_robots, d.shape[0]))
+        for i, xy in enumerate(starts_xy_m):
+            own[i, 1:] = _from_point(tour, geometry, xy)
+    order = list(range(1, tour.n_viewpoints + 1))
+    found = split_routes(d, n_robots, order, params, own)
     return TeamTour(
         routes=tuple(tuple(v - 1 for v in r) for r in found.routes),
         lengths_m=found.lengths_m,

@@ -51,7 +51,7 @@ def _comb_matrix(n_teeth: int, depth: float) -> np.ndarray:
 def test_one_robot_gets_the_one_robot_tour(privileged_world):
     facts = _tree_facts(privileged_world)
     tour = plan_coverage_tour(facts)
-    team = plan_team_tour(tour, facts.geometry, facts.start_pose[:2], 1)
+    team = plan_team_tour(tour, facts.geometry, [facts.start_pose[:2]], 1)
     assert team.routes == (tuple(range(tour.n_viewpoints)),)
     assert team.makespan_m == pytest.approx(tour.length_m, abs=1e-6)
 
@@ -60,7 +60,8 @@ def test_a_tree_of_three_corridors_gives_each_of_three_robots_one_branch(privile
     facts = _tree_facts(privileged_world)
     tour = plan_coverage_tour(facts)
     spans = [
-        plan_team_tour(tour, facts.geometry, facts.start_pose[:2], k).makespan_m for k in (1, 2, 3)
+        plan_team_tour(tour, facts.geometry, [facts.start_pose[:2]], k).makespan_m
+        for k in (1, 2, 3)
     ]
     # k = 3: one branch each, the longest 4 - 1 m; k = 2: the short branch out and back and a
     # long one (2 x 1.5 + 3 m); the lattice and the cover's slack allow 0.6 m per branch driven.
@@ -123,3 +124,19 @@ def test_the_team_lower_bound_is_the_larger_of_its_two_parts():
     assert team_lower_bound_m(30.0, 12.0, 3, starts_gap_m=1.0) == 11.0
     with pytest.raises(ValueError, match="robots must be >= 1"):
         team_lower_bound_m(30.0, 4.0, 0)
+
+
+def test_robots_that_start_apart_take_the_routes_from_their_own_starts():
+    # Robot 0 at the spine's start, robot 1 at the far end of the spine (x = 9): the far teeth
+    # are robot 1's, whatever the common-start split would say.
+    d = _comb_matrix(8, 5.0)
+    own = np.zeros((2, 9))
+    own[0, 1:] = d[0, 1:]
+    own[1, 1:] = np.abs(9.0 - np.arange(1, 9)) + 5.0
+    got = split_routes(d, 2, own_starts_m=own)
+    assert set(got.routes[1]) >= {7, 8} and set(got.routes[0]) >= {1, 2}
+    assert got.makespan_m == pytest.approx(max(got.lengths_m))
+    assert got.makespan_m < split_routes(d, 2).makespan_m
+    # The lengths count each robot's own way in.
+    r1 = got.routes[1]
+    assert got.lengths_m[1] == pytest.approx(own[1, r1[0]] + route_length_m(d, r1) - d[0, r1[0]])
