@@ -14,6 +14,9 @@ visit every other node once, the longest as short as possible. It goes in two st
    thread), stopped after a fixed number of solutions (deterministic) or a wall-clock cap (a guard on big maps), whichever comes
    first. The better of the two is kept, so the result is never worse than step 1.
 
+With ``own_starts_m`` each route runs from its robot's own start instead (the split's pieces
+go to the robots nearest them, and OR-Tools gets one depot per robot).
+
 :func:`plan_team_tour` applies it to a :class:`~.tour.CoverageTour`. The routes see what the
 one-robot tour's viewpoints see; the scans along the new legs differ from the old legs' (the
 team oracle makes up any shortfall from its live map, as the one-robot oracle does).
