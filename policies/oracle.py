@@ -218,7 +218,7 @@ class OraclePolicy(Policy):
             leg_prefer_clearance_m=prm.path_prefer_clearance_m,
             leg_wall_cost=prm.path_wall_cost,
         )
-        self.tour = tour = plan_coverage_tour(facts, tour_params)
+        self.tour = tour = self.plan_tour(facts, tour_params)
         self.planning_s = time.perf_counter() - t0
         res = self.geometry.resolution_m
         clearance = wall_clearance_m(facts.world, self.geometry, prm.path_prefer_clearance_m)
@@ -265,6 +265,11 @@ class OraclePolicy(Policy):
         self._watch.reset(
             0.0, (float(obs["pose"][0]), float(obs["pose"][1])), known_cell_count(obs["map"])
         )
+
+    def plan_tour(self, facts: PrivilegedWorld, tour_params: TourParams) -> CoverageTour:
+        """The tour :meth:`reset` drives: the static coverage tour of ``facts`` (the team
+        oracle's members drive their share of the team's instead)."""
+        return plan_coverage_tour(facts, tour_params)
 
     def mission_metrics(self) -> dict[str, Any]:
         t = self.tour

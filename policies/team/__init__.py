@@ -5,7 +5,9 @@
 (Burgard-style utility discount and an assignment by ``linear_sum_assignment``, robots spread
 over branches), ``"coordinated_nobranch"`` (the same without the branch spreading),
 ``"semantic"`` (the coordinated semantic expert: the paper's expert per robot, goals divided
-through its ``choose_goal`` plug-in point) and ``"semantic_nosem"`` (its no-semantics ablation).
+through its ``choose_goal`` plug-in point), ``"semantic_nosem"`` (its no-semantics ablation) and
+``"oracle"`` (the privileged team oracle: the one-robot oracle's tour split into
+min-makespan routes; its env must be made with ``privileged=True``).
 
 A spec may end in a bracket of parameter overrides, as single-robot specs do:
 ``"semantic[discount_weight=6]"``, ``"semantic[expert.cost.w_v=0;branch_weight=0]"``,
@@ -36,9 +38,13 @@ SEMANTIC_TEAM_POLICIES: dict[str, dict[str, Any]] = {
 }
 
 
+#: The privileged team oracle's name (:mod:`.oracle_team`).
+TEAM_ORACLE = "oracle"
+
+
 def team_policy_names() -> list[str]:
     """Every name :func:`make_team_policy` knows."""
-    return sorted([*TEAM_POLICIES, *SEMANTIC_TEAM_POLICIES])
+    return sorted([*TEAM_POLICIES, *SEMANTIC_TEAM_POLICIES, TEAM_ORACLE])
 
 
 def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
@@ -65,6 +71,10 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
             layer = SEMANTIC_TEAM_POLICIES[base]
             params = build_params(SemanticTeamParams, layer, bracket)
             team = SemanticTeam(params, **overrides)
+        elif base == TEAM_ORACLE:
+            from semexplore_gym.policies.team.oracle_team import TeamOracle, TeamOracleParams
+
+            team = TeamOracle(build_params(TeamOracleParams, bracket), **overrides)
         elif base in TEAM_POLICIES:
             layer = TEAM_POLICIES[base]
             team = FrontierTeam(build_params(FrontierTeamParams, layer, bracket), **overrides)
@@ -80,6 +90,7 @@ def make_team_policy(spec: str, **overrides: Any) -> TeamPolicy:
 
 __all__ = [
     "SEMANTIC_TEAM_POLICIES",
+    "TEAM_ORACLE",
     "TEAM_POLICIES",
     "team_policy_names",
     "FrontierTeam",

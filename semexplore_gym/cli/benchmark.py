@@ -225,7 +225,8 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="also run the privileged oracle (full-knowledge tour) on every (world, seed) and "
         "write each mission's regret against it (regret.csv, summary.md, regret_ladder.png); "
-        "default: on with --suite or --split, off otherwise",
+        "default: on with --suite or --split, off otherwise; with --robots, the team oracle "
+        "(the tour split into routes of least makespan), off unless asked for",
     )
     p.add_argument(
         "--best-known",
@@ -360,9 +361,6 @@ def _run(args: argparse.Namespace) -> int:
 
         if getattr(args, "split", None):
             raise ValueError("--robots runs --worlds or --suite; --split is for single robots")
-        if args.oracle:
-            raise ValueError("--oracle is for single robots: the oracle has no team version")
-
         report = run_team_study(team_study_request(args))
         print_result(args, report, Path(report["summary"]).read_text())
         return 1 if report["failed"] else 0
@@ -454,9 +452,23 @@ def team_study_request(args: argparse.Namespace) -> Any:
         counts = tuple(int(v) for v in str(args.robots).split(",") if v.strip())
     except ValueError:
         raise ValueError(f"--robots must be team sizes in 1..8, got {args.robots!r}") from None
+    policies = _split_policies(str(args.policies))
+    if args.oracle:  # the team oracle, asked for by name (never on by default for teams)
+        from semexplore_gym.core.coverage_tour.team_tour import require_routing_solver
+        from semexplore_gym.core.coverage_tour.tour import require_solver
+
+        try:
+            require_solver()
+            require_routing_solver()
+        except ImportError as e:
+            raise ValueError(f"{e}; or leave the oracle out: --no-oracle") from None
+        if policies == ["semantic", "frontier", "nearest"]:
+            policies = ["semantic", "coordinated", "independent"]
+        if "oracle" not in policies:
+            policies.append("oracle")
     return TeamStudyRequest(
         robot_counts=counts,
-        policies=tuple(_split_policies(str(args.policies))),
+        policies=tuple(policies),
         worlds=tuple(split_worlds(args.worlds or "")),
         out=Path(args.out),
         seed0=args.seed0,

@@ -21,6 +21,7 @@ from gymnasium import spaces
 from gymnasium.utils import seeding
 
 from semexplore_gym.config.extras import MissingExtraError
+from semexplore_gym.core.coverage_tour.problem import PRIVILEGED_INFO_KEY
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.disc_cast import DiscObstacles
 from semexplore_gym.core.mapping.map_merge import merge_grids
@@ -120,7 +121,9 @@ class SemanticExploreMultiEnv(ParallelEnv):
     ``world``, ``config``, ``render_mode`` as ``SemanticExplore-v0``; ``overrides``: its
     ``section.key=value`` strings plus ``team.key=value`` for :class:`TeamParams`; ``team``:
     None, a mapping, a YAML path or :class:`TeamParams`; ``n_robots``: shortcut for
-    ``team.n_robots``.
+    ``team.n_robots``; ``privileged`` (False by default) as ``SemanticExplore-v0``'s: True puts
+    the ground truth in each agent's ``info`` of ``reset`` (``info["privileged_world"]``, that
+    agent's own start pose in it), for the team oracle only.
 
     ## Info (per agent)
     The single env's static entries (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), then
@@ -129,7 +132,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
     contacts of the team so far), ``reward_terms``.
 
     ## Version History
-    - v0: initial version.
+    - v0: initial version; later the ``privileged`` option (off by default; nothing changes
+      without it).
     """
 
     metadata: dict[str, Any] = {"name": ENV_ID, "render_modes": ["rgb_array"], "render_fps": 5}
@@ -142,7 +146,9 @@ class SemanticExploreMultiEnv(ParallelEnv):
         team: TeamParams | str | os.PathLike | dict | None = None,
         n_robots: int | None = None,
         render_mode: str | None = None,
+        privileged: bool = False,
     ) -> None:
+        self.privileged = bool(privileged)
         team_overrides, env_overrides = split_team_overrides(overrides)
         if n_robots is not None:
             team_overrides.append(f"n_robots={int(n_robots)}")
@@ -320,7 +326,20 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.agents = list(self.possible_agents)
         zero = {"free_area_change": 0.0, "time": 0.0, "collision": 0.0, "team": 0.0}
         infos = {a: self._agent_info(i, dict(zero), True) for i, a in enumerate(self.agents)}
+        self._start_poses, self._reach = list(poses), reach
+        if self.privileged:
+            for i, a in enumerate(self.agents):
+                infos[a][PRIVILEGED_INFO_KEY] = self.ground_truth(i)
         return self._observations(), infos
+
+    def ground_truth(self, index: int) -> Any:
+        """The episode's :class:`~semexplore_gym.core.coverage_tour.PrivilegedWorld` seen from
+        robot ``index``'s start (what ``privileged=True`` hands that agent at ``reset``; the
+        benchmark reads it for the lower bound). For runners, never for policies."""
+        if not self._started:
+            raise RuntimeError("ground_truth() needs reset() first")
+        pose = self._start_poses[index]
+        return SemanticExploreEnv._privileged_world(self, pose, self._reach)  # type: ignore[arg-type]
 
     def step(
         self, actions: dict[str, Any]

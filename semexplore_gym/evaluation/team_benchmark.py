@@ -22,7 +22,12 @@ path_total_m       distance driven by all robots; ``path_per_robot_m`` each, ``;
 overlap_ratio      Explore-Bench: area scanned by more than one robot / area explored
 robot_collisions   robot-robot contacts begun; ``contacts`` all contacts (walls included)
 wall_time_s        wall-clock time of the mission
+lower_bound_s      a certified lower bound on any team's T99 from these starts (this team
+                   size; :mod:`semexplore_gym.evaluation.team_bound`), empty where none
 ================== ==========================================================================
+
+The team oracle (policy ``oracle``, ``--oracle``) runs in a privileged env (the true world in
+its ``info`` at reset); every other team runs in a plain one.
 
 ``summary.md`` and ``team_speedup.png`` are written by
 :mod:`semexplore_gym.evaluation.team_report`.
@@ -61,6 +66,7 @@ COLUMNS = (
     "contacts",
     "steps",
     "wall_time_s",
+    "lower_bound_s",
 )
 
 
@@ -85,6 +91,7 @@ class TeamMissionResult:
     contacts: int
     steps: int
     wall_time_s: float
+    lower_bound_s: float | None = None
     coverage_trace: list[tuple[float, float]] = field(default_factory=list, repr=False)
 
     def row(self) -> dict[str, Any]:
@@ -95,6 +102,8 @@ class TeamMissionResult:
             d[k] = round(float(d[k]), 6)
         for k in ("mission_time_s", "path_total_m", "wall_time_s"):
             d[k] = round(float(d[k]), 3)
+        if d["lower_bound_s"] is not None:
+            d["lower_bound_s"] = round(float(d["lower_bound_s"]), 3)
         return d
 
 
@@ -225,6 +234,7 @@ class TeamTask:
     max_time_s: float | None
     env_config: Any
     overrides: tuple[str, ...]
+    lower_bound: bool = True
 
 
 #: Per process: the last env a team task made, reused while tasks share its world, size and
@@ -237,7 +247,9 @@ def run_team_task(task: TeamTask) -> dict[str, Any]:
     from semexplore_gym.envs.multi_robot import make_multi
     from semexplore_gym.policies.team import make_team_policy
 
-    key = (task.world, task.n_robots, repr(task.env_config), task.overrides)
+    team = make_team_policy(task.policy)
+    privileged = bool(getattr(team, "privileged", False))
+    key = (task.world, task.n_robots, repr(task.env_config), task.overrides, privileged)
     if _ENV_CACHE.get("key") != key:
         _ENV_CACHE.clear()
         _ENV_CACHE.update(
@@ -247,10 +259,16 @@ def run_team_task(task: TeamTask) -> dict[str, Any]:
                 config=task.env_config,
                 overrides=list(task.overrides),
                 n_robots=task.n_robots,
+                privileged=privileged,
             ),
         )
-    team = make_team_policy(task.policy)
-    row = run_team_mission(_ENV_CACHE["env"], team, task.seed, task.max_time_s).row()
+    env = _ENV_CACHE["env"]
+    result = run_team_mission(env, team, task.seed, task.max_time_s)
+    if task.lower_bound:
+        from semexplore_gym.evaluation.team_bound import team_lower_bound_s
+
+        result.lower_bound_s = team_lower_bound_s(env, (task.world, task.seed))
+    row = result.row()
     row["world"] = task.world  # the spelling, as resume reads it back
     return row
 
@@ -303,6 +321,7 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
     tasks = team_tasks(c)
     todo = [t for t in tasks if (t.world, names[t.policy], t.n_robots, t.seed) not in done]
     failed: list[tuple[tuple[str, str, int, int], str]] = []
+    _upgrade_header(csv_path)
     write_header = not csv_path.exists()
     bar = MissionsBar(c.progress, total=len(tasks), done=len(tasks) - len(todo))
     stream = mission_stream(todo, c.backend, c.workers, c.ray_address, run_team_task, run_team_task)
@@ -328,6 +347,22 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
         "failed": failed,
         "runs": str(csv_path),
     }
+
+
+def _upgrade_header(csv_path: Path) -> None:
+    """A ``runs.csv`` from before a column was added gets the column (empty) so resumed rows
+    line up with its header."""
+    if not csv_path.exists():
+        return
+    with csv_path.open(newline="") as f:
+        reader = csv.DictReader(f)
+        if reader.fieldnames is None or list(reader.fieldnames) == list(COLUMNS):
+            return
+        rows = list(reader)
+    with csv_path.open("w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS, restval="", extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(rows)
 
 
 @dataclass(frozen=True)

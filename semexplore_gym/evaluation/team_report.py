@@ -4,6 +4,10 @@
 coverage, the median of each seed's T99 ratio to one robot's (same policy, world and seed)
 and, per team size, a paired Wilcoxon test of each policy's T99 against ``independent``'s
 and of every other pair of policies.
+With the team oracle in the runs (``team_oracle``), each table adds per row the one-robot
+oracle's T99 over the row's (``T_oracle(1) / T99``: the oracle's own rows give its speed-up
+``T_oracle(1) / T_oracle(k)``), the regret (T99 over the team oracle's with as many robots,
+same world and start) and T99 over the team lower bound (``lower_bound_s``), medians over seeds.
 ``team_speedup.png`` draws that ratio against the team size, per family and policy (median
 and quartiles), with the perfect division 1/N for reference.
 """
@@ -18,6 +22,9 @@ import numpy as np
 
 #: The baseline every team policy is tested against.
 BASELINE = "team_independent"
+#: The team oracle's name in ``runs.csv``.
+ORACLE = "team_oracle"
+_ORACLE_HEADER = (" T_oracle(1) / T99 | regret | T99 / bound |", "---|---|---|")
 
 
 def _float(v: str) -> float:
@@ -60,6 +67,34 @@ def speedup_ratios(rows: list[dict[str, str]]) -> dict[tuple[str, str, int], lis
     return out
 
 
+def oracle_ratios(rows: list[dict[str, str]]) -> dict[tuple[str, str, int], list[list[float]]]:
+    """Per (family, policy, robots), per mission: the one-robot oracle's T99 over this T99,
+    this T99 over the team oracle's with as many robots (regret) and this T99 over the team
+    lower bound (NaN where a term is missing)."""
+    oracle = {
+        (r["world"], int(r["seed"]), int(r["n_robots"])): _float(r["T99_s"])
+        for r in rows
+        if r["policy"] == ORACLE
+    }
+    out: dict[tuple[str, str, int], list[list[float]]] = {}
+    for r in rows:
+        t99, n = _float(r["T99_s"]), int(r["n_robots"])
+        one = oracle.get((r["world"], int(r["seed"]), 1), math.nan)
+        same = oracle.get((r["world"], int(r["seed"]), n), math.nan)
+        bound = _float(r.get("lower_bound_s") or "")
+        cell = out.setdefault((family(r["world"]), r["policy"], n), [[], [], []])
+        cell[0].append(one / t99 if t99 > 0 else math.nan)
+        cell[1].append(t99 / same if same > 0 else math.nan)
+        cell[2].append(t99 / bound if bound > 0 else math.nan)
+    return out
+
+
+def _oracle_cells(values: list[list[float]] | None) -> str:
+    if values is None:
+        return " - | - | - |"
+    return "".join(f" {_fmt(_median(v), 2)} |" for v in values)
+
+
 def _table_row(rs: list[dict[str, str]], ratios: list[float], pol: str, n: int) -> str:
     per_robot_max = [max(float(v) for v in r["path_per_robot_m"].split(";")) for r in rs]
     coverage = [_float(r["coverage"]) for r in rs]
@@ -89,6 +124,9 @@ def team_summary_lines(rows: list[dict[str, str]]) -> list[str]:
     """The lines of the team benchmark's ``summary.md`` for the ``runs.csv`` rows ``rows``:
     per family a table per (policy, team size) and the paired T99 tests."""
     ratios = speedup_ratios(rows)
+    with_oracle = any(r["policy"] == ORACLE for r in rows)
+    against = oracle_ratios(rows) if with_oracle else {}
+    extra = _ORACLE_HEADER if with_oracle else ("", "")
     lines = ["# Team benchmark", ""]
     for fam in sorted({family(r["world"]) for r in rows}):
         fam_rows = [r for r in rows if family(r["world"]) == fam]
@@ -96,12 +134,15 @@ def team_summary_lines(rows: list[dict[str, str]]) -> list[str]:
             f"## {fam}",
             "",
             "| policy | robots | n | T90 s | T99 s | mission s | T99 / 1 robot | path total m "
-            "| path max m | overlap | robot coll. | coverage min | self-stopped |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "| path max m | overlap | robot coll. | coverage min | self-stopped |" + extra[0],
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|" + extra[1],
         ]
         for pol, n in sorted({(r["policy"], int(r["n_robots"])) for r in fam_rows}):
             rs = [r for r in fam_rows if r["policy"] == pol and int(r["n_robots"]) == n]
-            lines.append(_table_row(rs, ratios[(fam, pol, n)], pol, n))
+            line = _table_row(rs, ratios[(fam, pol, n)], pol, n)
+            if with_oracle:
+                line += _oracle_cells(against.get((fam, pol, n)))
+            lines.append(line)
         lines += ["", *paired_tests(fam_rows), ""]
     return lines
 

@@ -98,10 +98,101 @@ def test_team_summary_pairs_and_speedups(tmp_path: Path) -> None:
     assert p < 0.05  # semantic was faster on every one of the 7 seeds
 
 
-def test_benchmark_robots_refuses_the_oracle(capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ["benchmark", "--worlds", "maze1", "--robots", "2", "--oracle", "--out", "x"]
-    assert main(argv) != 0
-    assert "--oracle is for single robots" in capsys.readouterr().err
+@pytest.mark.slow
+def test_benchmark_robots_runs_the_team_oracle_and_its_bound_holds(tmp_path: Path) -> None:
+    pytest.importorskip("elkai")
+    pytest.importorskip("ortools")
+    out = tmp_path / "oracle"
+    argv = [
+        "benchmark",
+        "--worlds",
+        "maze:seed=*,size_m=5",
+        "--robots",
+        "1,2",
+        "--policies",
+        "independent",
+        "--oracle",
+        "--runs",
+        "2",
+        "--max-time-s",
+        "600",
+        "--out",
+        str(out),
+        "--no-progress",
+        "--no-plots",
+    ]
+    assert main(argv) == 0
+    with (out / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert {(r["policy"], r["n_robots"]) for r in rows} == {
+        (p, n) for p in ("team_independent", "team_oracle") for n in ("1", "2")
+    }
+    for r in rows:
+        assert r["T99_s"], r  # every team reaches 99 % on these small mazes
+        assert 0.0 <= float(r["lower_bound_s"]) <= float(r["T99_s"]), r
+    summary = (out / "summary.md").read_text()
+    assert "| T_oracle(1) / T99 | regret | T99 / bound |" in summary
+    oracle_two = next(line for line in summary.splitlines() if line.startswith("| team_oracle | 2"))
+    assert oracle_two.split("|")[-3].strip() == "1.00"  # the oracle's regret to itself
+
+
+def test_team_summary_gains_the_oracle_columns(tmp_path: Path) -> None:
+    from semexplore_gym.evaluation.team_report import oracle_ratios
+
+    rows = [
+        {
+            "world": "maze:seed=1",
+            "policy": pol,
+            "n_robots": str(n),
+            "seed": "1",
+            "T99_s": t99,
+            "lower_bound_s": bound,
+        }
+        for pol, n, t99, bound in (
+            ("team_oracle", 1, "100", "20"),
+            ("team_oracle", 2, "60", "10"),
+            ("team_semantic", 1, "150", "20"),
+            ("team_semantic", 2, "90", ""),
+        )
+    ]
+    got = oracle_ratios(rows)
+    assert got[("maze", "team_oracle", 2)] == [[pytest.approx(100 / 60)], [1.0], [6.0]]
+    speedup, regret, over_bound = got[("maze", "team_semantic", 2)]
+    assert speedup == [pytest.approx(100 / 90)] and regret == [1.5]
+    assert over_bound[0] != over_bound[0]  # no bound: NaN
+
+
+def test_resuming_an_older_runs_csv_adds_the_bound_column(tmp_path: Path) -> None:
+    from semexplore_gym.evaluation.team_benchmark import TeamBenchmarkConfig, run_team_benchmark
+
+    old = [c for c in COLUMNS if c != "lower_bound_s"]
+    (tmp_path / "runs.csv").write_text(
+        ",".join(old)
+        + "\n"
+        + ",".join(
+            {
+                "world": "maze:seed=3",
+                "policy": "team_independent",
+                "n_robots": "1",
+                "seed": "0",
+            }.get(c, "1")
+            for c in old
+        )
+        + "\n"
+    )
+    config = TeamBenchmarkConfig(
+        worlds=("maze:seed=3",),
+        policies=("independent",),
+        robot_counts=(1,),
+        seeds=(0,),
+        out=tmp_path,
+        progress=False,
+    )
+    assert run_team_benchmark(config)["skipped"] == 1
+    with (tmp_path / "runs.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert tuple(rows[0]) == COLUMNS and rows[0]["lower_bound_s"] == ""
+    assert rows[0]["policy"] == "team_independent"
 
 
 def test_team_mission_gif(tmp_path: Path) -> None:
