@@ -40,6 +40,7 @@ SPECS = {
     "oracle": "oracle",
     "sb3": f"sb3:{PRETRAINED / 'dagger_maze' / 'model.zip'}",
     "pretrained": "pretrained:frontier_choice_maze",
+    "option-ppo": f"option-ppo:{PRETRAINED / 'option_ppo' / 'model.zip'}",
     "py": "py:{own}:Spinner",
 }
 
@@ -57,7 +58,7 @@ def env():
 
 @pytest.mark.parametrize("name", sorted(SPECS))
 def test_act_before_reset_names_the_missing_call(name, env, tmp_path) -> None:
-    pytest.importorskip("torch") if name in ("sb3", "pretrained") else None
+    pytest.importorskip("torch") if name in ("sb3", "pretrained", "option-ppo") else None
     own = tmp_path / "own_policy.py"
     own.write_text(OWN_POLICY)
     policy = make_policy(SPECS[name].format(own=own))
