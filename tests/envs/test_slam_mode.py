@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -128,3 +129,40 @@ def test_the_team_env_refuses_the_slam_mode_in_one_line() -> None:
 
     with pytest.raises(ValueError, match=r"^slam\.enabled: the multi-robot env has no SLAM mode"):
         make_multi(world=WORLD, n_robots=2, config="slam")
+
+
+def test_the_odometry_ate_sits_beside_slams_and_is_zero_without_drift() -> None:
+    from semexplore_gym.evaluation.rollout import slam_metrics
+
+    drifting = gym.make("SemanticExplore-v0", world=WORLD, config="slam")
+    _drive(drifting, 150, 2)
+    figures = slam_metrics(drifting)
+    assert figures["odom_ate_m"] > 0.0 and figures["ate_m"] >= 0.0
+    alphas = ("rot_from_rot", "rot_from_trans", "trans_from_trans", "trans_from_rot")
+    exact = gym.make(
+        "SemanticExplore-v0",
+        world=WORLD,
+        config="slam",
+        overrides=[f"odometry.{a}=0" for a in alphas],
+    )
+    _drive(exact, 150, 2)
+    assert slam_metrics(exact)["odom_ate_m"] == 0.0
+
+
+def test_a_stop_short_on_a_map_that_closed_every_gap_is_a_false_stop() -> None:
+    from semexplore_gym.evaluation.rollout import slam_metrics
+
+    env = gym.make("SemanticExplore-v0", world=WORLD, config="slam")
+    _drive(env, 40, 1)
+    u: Any = env.unwrapped
+    assert u.grid.n_free_in_mask < u.grid.n_mask_cells  # short of the goal on the truth
+    honest = slam_metrics(env, self_stopped=True)
+    assert slam_metrics(env)["slam_false_stop"] is False  # not stopped: nothing to explain
+    # SLAM's map, with every cell it has not seen turned into wall: no frontier left.
+    closed = u.slam.grid.log_odds.copy()
+    closed[u.slam.grid.encoded == 128] = 5.0
+    u.slam.grid.load_log_odds(closed)
+    figures = slam_metrics(env, self_stopped=True)
+    assert figures["slam_false_stop"] is True
+    assert figures["slam_stop_artefact"] == "lost_frontier"
+    assert honest["slam_stop_artefact"] != "lost_frontier"
