@@ -22,6 +22,9 @@ path_total_m       distance driven by all robots; ``path_per_robot_m`` each, ``;
 overlap_ratio      Explore-Bench: area scanned by more than one robot / area explored
 robot_collisions   robot-robot contacts begun; ``contacts`` all contacts (walls included)
 wall_time_s        wall-clock time of the mission
+ate_m ...          with ``--env-config slam`` (each robot its own SLAM): the robots' mean ATE
+                   and odometry ATE, the merged SLAM map's error, all robots' loop closures
+                   and lost events (:data:`SLAM_COLUMNS`; empty without SLAM)
 ================== ==========================================================================
 
 ``summary.md`` and ``team_speedup.png`` are written by
@@ -62,6 +65,9 @@ COLUMNS = (
     "steps",
     "wall_time_s",
 )
+#: The SLAM columns (:meth:`~semexplore_gym.envs.team_slam.TeamSlam.metrics`), after
+#: :data:`COLUMNS`; a ``runs.csv`` written before them keeps its own header when resumed.
+SLAM_COLUMNS = ("ate_m", "odom_ate_m", "map_error", "loop_closures", "slam_lost_events")
 
 
 @dataclass
@@ -86,10 +92,13 @@ class TeamMissionResult:
     steps: int
     wall_time_s: float
     coverage_trace: list[tuple[float, float]] = field(default_factory=list, repr=False)
+    slam: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def row(self) -> dict[str, Any]:
         d = asdict(self)
         d.pop("coverage_trace")
+        d.update({k: self.slam.get(k) for k in SLAM_COLUMNS})
+        d.pop("slam")
         d["path_per_robot_m"] = ";".join(f"{v:.3f}" for v in self.path_per_robot_m)
         for k in ("coverage", "overlap_ratio"):
             d[k] = round(float(d[k]), 6)
@@ -172,6 +181,7 @@ def run_team_mission(
         steps=steps,
         wall_time_s=time.perf_counter() - wall0,
         coverage_trace=trace,
+        slam=env.slam.metrics(env.grid) if getattr(env, "slam", None) is not None else {},
     )
 
 
@@ -304,10 +314,14 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
     todo = [t for t in tasks if (t.world, names[t.policy], t.n_robots, t.seed) not in done]
     failed: list[tuple[tuple[str, str, int, int], str]] = []
     write_header = not csv_path.exists()
+    header = list((*COLUMNS, *SLAM_COLUMNS))
+    if not write_header:
+        with csv_path.open(newline="") as f:
+            header = next(csv.reader(f), header)
     bar = MissionsBar(c.progress, total=len(tasks), done=len(tasks) - len(todo))
     stream = mission_stream(todo, c.backend, c.workers, c.ray_address, run_team_task, run_team_task)
     with csv_path.open("a", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer = csv.DictWriter(f, fieldnames=header, extrasaction="ignore")
         if write_header:
             writer.writeheader()
         try:

@@ -123,14 +123,6 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(out)
 
 
-def test_the_team_env_refuses_the_slam_mode_in_one_line() -> None:
-    pytest.importorskip("pettingzoo")
-    from semexplore_gym.envs.multi_robot import make_multi
-
-    with pytest.raises(ValueError, match=r"^slam\.enabled: the multi-robot env has no SLAM mode"):
-        make_multi(world=WORLD, n_robots=2, config="slam")
-
-
 def test_the_odometry_ate_sits_beside_slams_and_is_zero_without_drift() -> None:
     from semexplore_gym.evaluation.rollout import slam_metrics
 

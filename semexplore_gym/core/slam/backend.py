@@ -203,7 +203,7 @@ class ScanSlam:
         if n_valid < 30:
             return False
         changed = np.count_nonzero(valid & (np.abs(now - before) > p.scan_jump_range_m))
-        return changed > p.scan_jump_share * n_valid
+        return bool(changed > p.scan_jump_share * n_valid)
 
     def _freeze_reference(self, floor: float, lost_now: bool = False) -> None:
         """Freeze the recent keyframes as the reference later ones must match at ``floor``;
