@@ -216,6 +216,46 @@ class SlamMode:
         }
 
 
+def draw_beside_truth(renderer: Any, snap: Any, truth_grid: OccupancyGrid, slam: SlamMode) -> Any:
+    """One frame of the SLAM mode for people: left the SLAM map the policy sees, with the
+    robot at SLAM's estimate and SLAM's keyframe trail; right the map the same scans build at
+    the true poses, with the true robot, scan and trail. The true walls (faint blue) lie under
+    both, so drift and doubled walls show as map off the walls.
+
+    Args:
+        renderer: A :class:`~semexplore_gym.rendering.renderer.Renderer` of the env's map frame.
+        snap: The env's :class:`~semexplore_gym.rendering.renderer.RenderSnapshot` (its map is
+            the SLAM map, its pose the true pose).
+        truth_grid: The map fused at the true poses.
+        slam: The env's SLAM mode.
+
+    Returns:
+        The ``(H, 2 W + gap, 3)`` uint8 frame.
+    """
+    from dataclasses import replace
+
+    keyframes = np.asarray(slam.backend.keyframe_poses, dtype=np.float64)[:, :2]
+    left = renderer.draw(
+        replace(
+            snap,
+            pose=slam.backend.estimate,
+            scan=None,
+            trajectory_m=keyframes,
+            text=f"SLAM map (the policy's)  ATE {slam.ate_m():.3f} m",
+        )
+    )
+    right = renderer.draw(
+        replace(
+            snap,
+            map=truth_grid.encoded.copy(),
+            overlay={},
+            text=f"{snap.text}  (truth: the same scans at the true poses)",
+        )
+    )
+    gap = np.full((left.shape[0], 6, 3), 255, dtype=np.uint8)
+    return np.concatenate([left, gap, right], axis=1)
+
+
 def _position_rmse_m(estimate: list[Pose], truth: list[Pose]) -> float:
     """RMSE of the positions of ``estimate`` against ``truth`` (same instants, no alignment)."""
     est = np.asarray(estimate, dtype=np.float64)[:, :2]

@@ -158,3 +158,16 @@ def test_a_stop_short_on_a_map_that_closed_every_gap_is_a_false_stop() -> None:
     assert figures["slam_false_stop"] is True
     assert figures["slam_stop_artefact"] == "lost_frontier"
     assert honest["slam_stop_artefact"] != "lost_frontier"
+
+
+def test_render_draws_the_slam_map_beside_the_truth() -> None:
+    slam = gym.make("SemanticExplore-v0", world=WORLD, config="slam", render_mode="rgb_array")
+    plain = gym.make("SemanticExplore-v0", world=WORLD, render_mode="rgb_array")
+    slam.reset(seed=0)
+    plain.reset(seed=0)
+    for _ in range(30):
+        slam.step(np.array([0.8, 0.2], dtype=np.float32))
+    frame, one = slam.render(), plain.render()
+    assert frame.shape == (one.shape[0], 2 * one.shape[1] + 6, 3) and frame.dtype == np.uint8
+    left, right = frame[:, : one.shape[1]], frame[:, one.shape[1] + 6 :]
+    assert not np.array_equal(left, right)  # two different maps
