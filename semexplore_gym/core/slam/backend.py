@@ -18,17 +18,16 @@ odometry's frame without telling the estimate, as a robot picked up and put down
 
 A kidnapped robot is noticed from two signs together. Its scan *jumps*: the odometry says it
 barely moved since the last scan, yet many beams changed by far more than that explains
-(``scan_jump_share``, ``scan_jump_range_m``). And its match *collapses*: the next keyframe's
-match scores low (below ``match_score_threshold``, or below ``score_collapse_ratio`` of the
-median of the recent well-matched keyframes: in a cluttered map the scan still fits somewhere
-near). Both together: the back end is lost at once. A collapse without a jump (a robot
-carried while the wheels turned, a scan unlike the map) freezes the local map from before
-(the *reference*): until a later keyframe matches the reference again, above the collapse
-floor (as well as the recent keyframes did, after a kidnap), every keyframe is also matched to
-it and counts as a low score when it fails there, however well it matched the keyframes taken
-since, at the wrong place; ``lost_after_keyframes`` such failures in a row and it is lost. A
-match that failed once (a fast turn into a new room) matches the reference at the next
-keyframe and clears it. These checks only judge: the estimate and the map are built as before.
+(``scan_jump_share``, ``scan_jump_range_m``). And the next keyframe's match *collapses*: it
+scores below ``match_score_threshold``, or below ``score_collapse_ratio`` of the median of the
+recent well-matched keyframes (in a cluttered map the scan still fits somewhere near). Both
+together: the back end is lost at once, and it freezes the local map from before the jump
+(the *reference*). Until a later keyframe matches the reference again as well as the
+keyframes before the jump matched, every keyframe is also matched to it and the back end stays
+lost, however well the keyframes taken since, at the wrong place, match each other. Either
+sign alone is no kidnap: a scan changes that much when a door or a teammate passes close, and
+a match collapses for a keyframe when the robot turns into a new room. These checks only
+judge: the estimate and the map are built as before.
 """
 
 from __future__ import annotations
@@ -218,28 +217,28 @@ class ScanSlam:
 
     def _agrees_with_reference(self, trusted: bool, prediction: Pose, points: np.ndarray) -> bool:
         """Whether the new keyframe counts as well matched (see the module docstring): its
-        match was trusted and did not collapse and, while a reference is frozen, its scan
-        also matches that as well as asked. A failure right after a scan jump is a kidnap:
-        lost at once."""
+        match was trusted and, after a kidnap, its scan also matches the frozen reference as
+        well as the keyframes before the kidnap matched. A scan jump followed by a collapsed
+        match here is a kidnap: lost at once."""
         p = self.params
         jumped, self._jump_pending = self._jump_pending, False
         if self._reference is None:
-            floor = p.score_collapse_ratio * self._good_median()
-            if trusted and self.last_score >= floor:
+            median = self._good_median()
+            if trusted and self.last_score >= p.score_collapse_ratio * median:
                 self._good_scores = [
                     *self._good_scores[-(p.submap_keyframes - 1) :],
                     self.last_score,
                 ]
                 return True
-            self._freeze_reference(self._good_median() if jumped else floor, lost_now=jumped)
-            return False
+            if jumped:
+                self._freeze_reference(median, lost_now=True)
+                return False
+            return trusted
         match = self._match(self._reference, points, prediction, p.search_xy_m)
         if len(points) >= 10 and match.score >= self._reference_floor:
             self._reference = None
             return True
-        if jumped:
-            self._freeze_reference(self._reference_floor, lost_now=True)
-        return False
+        return False  # still lost; a jump now changes nothing: the reference stays as it was
 
     def _good_median(self) -> float:
         """The median score of the recent well-matched keyframes (0 before three)."""

@@ -55,17 +55,17 @@ class SlamParams:
             direction (from the matcher's covariance) exceeds this is *degenerate*: the scan
             pins the pose only across that direction (a featureless corridor). It is counted,
             and along that direction the keyframe keeps the odometry prediction.
-        score_collapse_ratio: A match scoring below this share of the median score of the
-            recent well-matched keyframes has *collapsed* (a kidnapped robot's scan matched
-            somewhere it is not): it counts towards the lost judgement as a low score does,
-            and the keyframes after it must match the local map it collapsed against (see
-            :mod:`~semexplore_gym.core.slam.backend`). 0 turns the check off.
+        score_collapse_ratio: After a scan jump (``scan_jump_share``), a keyframe match
+            scoring below this share of the median score of the recent well-matched
+            keyframes has *collapsed* (a kidnapped robot's scan matched somewhere near that
+            it is not): the back end is lost (see :mod:`~semexplore_gym.core.slam.backend`).
+            0: only a match below ``match_score_threshold`` collapses.
         scan_jump_share: When the odometry says the robot barely moved since the last scan
             (under 0.2 m; any turn for a LiDAR that sees all around, else under 0.35 rad)
             but more than this share of the beams valid in both scans changed by more than
             ``scan_jump_range_m``, the scan *jumped*; a collapsed match at the next keyframe
             then means the robot was carried away (kidnapped): the back end reports itself
-            lost at once. 1 turns the check off.
+            lost at once. 1 turns the kidnap check off.
         scan_jump_range_m: A beam whose range changed by more than this has *changed*.
     """
 
