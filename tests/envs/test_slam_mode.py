@@ -114,6 +114,7 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(on)
     assert "ate_m" not in off
     assert on["ate_m"] < 0.1 and 0 <= on["map_error"] < 0.2
+    assert on["odom_ate_m"] > 3 * on["ate_m"]  # the goal: at least 3x below odometry alone
     assert 0 <= on["rpe_m"] < 0.1  # 400 s of the expert: far more than 1 m of travel
     assert on["collisions"] == 0
     # explore --json carries the SLAM figures when the env runs SLAM.
@@ -121,6 +122,8 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert main([*args, "--json", "--no-progress"]) == 0
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(out)
+    assert {"odom_ate_m", "slam_false_stop", "slam_stop_artefact"} <= set(out)
+    assert out["odom_ate_m"] > out["ate_m"]
 
 
 def test_the_odometry_ate_sits_beside_slams_and_is_zero_without_drift() -> None:
