@@ -31,6 +31,10 @@ FIGURES: dict[str, list[str]] = {
         "semexplore", "explore", "--world", "office:seed=304,size_m=8", "--robots", "3",
         "--gif", "{out}", "--gif-every-s", "1", "--max-time-s", "300", "--no-progress",
     ],
+    "slam_maze1.gif": [
+        "semexplore", "explore", "--world", "maze1", "--policy", "semantic", "--seed", "0",
+        "--env-config", "slam", "--gif", "{out}", "--gif-every-s", "8", "--no-progress",
+    ],
     "compute_scaling.png": [
         "python", "scripts/bench_compute_scaling.py", "--stat", "min",
         "--out", "{dir}/compute_scaling.csv", "--figure", "{out}",

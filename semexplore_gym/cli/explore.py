@@ -41,6 +41,9 @@ SLAM_JSON_KEYS: tuple[str, ...] = (
     "slam_lost",
     "slam_lost_events",
     "slam_degenerate_matches",
+    "odom_ate_m",
+    "slam_false_stop",
+    "slam_stop_artefact",
 )
 
 

@@ -40,6 +40,7 @@ from semexplore_gym.envs.multi_robot_config import (
 )
 from semexplore_gym.envs.semantic_explore import SemanticExploreEnv, is_unseeded_procedural
 from semexplore_gym.envs.static_info import static_info_of
+from semexplore_gym.envs.team_slam import TeamSlam
 from semexplore_gym.maps import make_world
 from semexplore_gym.sim.lidar import Lidar
 from semexplore_gym.sim.team import TeamSim, sense_with_teammates
@@ -129,7 +130,15 @@ class SemanticExploreMultiEnv(ParallelEnv):
     The single env's static entries (``map_geometry``, ``robot``, ``lidar``, ``dt_s``), then
     ``coverage`` (team), ``explored_area_m2`` (this agent's map), ``collisions`` (this robot's
     contacts), ``sim_time_s``, ``path_length_m`` (this robot's), ``robot_collisions`` (robot-robot
-    contacts of the team so far), ``reward_terms``.
+    contacts of the team so far), ``reward_terms``; with SLAM also this robot's ``slam_pose``,
+    ``slam_pose_error_m``, ``loop_closures``, ``slam_lost``, ``slam_lost_events`` and
+    ``slam_degenerate_matches``.
+
+    ## SLAM
+    With ``slam.enabled`` (``config="slam"``) each robot runs its own SLAM on its own drifting
+    odometry and scans, the observed ``map`` is the merge of the robots' SLAM maps and each
+    ``pose`` the robot's SLAM estimate; coverage and rewards stay on the map fused at the true
+    poses (:mod:`~semexplore_gym.envs.team_slam`; ``team.map_sharing: team`` only).
 
     ## Version History
     - v0: initial version; later the ``privileged`` option (off by default; nothing changes
@@ -154,10 +163,6 @@ class SemanticExploreMultiEnv(ParallelEnv):
             team_overrides.append(f"n_robots={int(n_robots)}")
         self.team: TeamParams = load_team_params(team, team_overrides)
         self.config: EnvConfig = load_env_config(config, env_overrides)
-        if self.config.slam.enabled:
-            raise ValueError(
-                "slam.enabled: the multi-robot env has no SLAM mode yet; use slam.enabled=false"
-            )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']}"
@@ -238,6 +243,10 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.grid = OccupancyGrid(self.map_geometry, cfg.mapping)
         self.odometry = [OdometryDrift(cfg.odometry) for _ in range(self.n_robots)]
         self._odometry_noisy = not cfg.odometry.is_perfect
+        self.slam = TeamSlam.create(
+            cfg, self.map_geometry, self.lidar.beam_angles_rad, self.n_robots, self.team.map_sharing
+        )
+        self._slam_ranges: list[np.ndarray] = [np.zeros(0, np.float32)] * self.n_robots
 
     def _choose_start(self, options: dict[str, Any] | None) -> tuple[float, float, float]:
         # Robot 0's start is the single-robot env's, by the same code.
@@ -323,6 +332,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
         self.scanned_count = np.zeros(self.map_geometry.shape, dtype=np.uint8)
         xy = np.array(poses, dtype=np.float64)[:, :2]
         self._scans = [self._sense(i, poses, xy) for i in range(n)]
+        if self.slam is not None:
+            self.slam.reset(list(poses), self._slam_ranges, reach)
         self.agents = list(self.possible_agents)
         zero = {"free_area_change": 0.0, "time": 0.0, "collision": 0.0, "team": 0.0}
         infos = {a: self._agent_info(i, dict(zero), True) for i, a in enumerate(self.agents)}
@@ -376,8 +387,14 @@ class SemanticExploreMultiEnv(ParallelEnv):
             own = self._map_of(i)
             own_before, team_before = own.n_free_cells, self.grid.n_free_cells
             self._scans[i] = self._sense(i, after, after_xy)
+            if self.slam is not None:
+                self._est_poses[i] = self.slam.update(
+                    i, self._est_poses[i], self._slam_ranges[i], a
+                )
             gains.append(own.n_free_cells - own_before)
             team_gains.append(self.grid.n_free_cells - team_before)
+        if self.slam is not None:
+            self.slam.merge()
         if self.own_grids:
             self._merge_in_range(after)
         res2 = cfg.mapping.resolution_m**2
@@ -417,7 +434,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
     ) -> np.ndarray:
         """Robot ``i``'s scan (``xy``: every robot's true position), fused into its map(s);
         with teammates, its cells are counted in ``scanned_count`` (bit ``i``: its
-        footprint, for the overlap ratio)."""
+        footprint, for the overlap ratio). With SLAM the map is fused at the true pose (for
+        coverage) and the ranges it fused are kept for the robot's SLAM."""
         teammates = footprint = None
         if self.n_robots > 1:
             teammates = DiscObstacles(
@@ -425,15 +443,18 @@ class SemanticExploreMultiEnv(ParallelEnv):
             )
             footprint = ScanFootprint(self.scanned_count, i)
         grids = [self.own_grids[i], self.grid] if self.own_grids else [self.grid]
-        return sense_with_teammates(
+        scan = sense_with_teammates(
             self.lidar,
             true_poses[i],
-            self._est_poses[i],
+            true_poses[i] if self.slam is not None else self._est_poses[i],
             grids,
             self.np_random,
             teammates,
             footprint,
         )
+        if self.slam is not None:
+            self._slam_ranges[i] = self.lidar.last_map_ranges.astype(np.float32)
+        return scan
 
     def _merge_in_range(self, true_poses: list[tuple[float, float, float]]) -> None:
         xy = np.array([p[:2] for p in true_poses])
@@ -452,16 +473,20 @@ class SemanticExploreMultiEnv(ParallelEnv):
         team_map = None
         if self.n_robots > 1 and not self.own_grids:
             # One snapshot of the team map per step, shared read-only by every agent.
-            team_map = self.grid.encoded_copy()
+            team_map = self._observed_grid(0).encoded_copy()
             team_map.flags.writeable = False
         for i, agent in enumerate(self.possible_agents):
             out[agent] = {
-                "map": team_map if team_map is not None else self._map_of(i).encoded_copy(),
+                "map": team_map if team_map is not None else self._observed_grid(i).encoded_copy(),
                 "pose": poses[i].copy(),
                 "scan": self._scans[i],
                 "teammates": poses[self._others[i]],
             }
         return out
+
+    def _observed_grid(self, i: int) -> OccupancyGrid:
+        """The map robot ``i`` observes: the merged SLAM map with SLAM, else its map."""
+        return self.slam.grid if self.slam is not None else self._map_of(i)
 
     def _agent_info(self, i: int, terms: dict[str, float], static: bool) -> dict[str, Any]:
         info = self._static_info.copy() if static else {}
@@ -472,6 +497,8 @@ class SemanticExploreMultiEnv(ParallelEnv):
         info["path_length_m"] = self.path_length_m[i]
         info["robot_collisions"] = self.sim.robot_collisions
         info["reward_terms"] = terms
+        if self.slam is not None:
+            info.update(self.slam.info(i, self.sim.poses[i]))
         return info
 
     # -------------------------------------------------------------- metrics

@@ -24,7 +24,7 @@ from semexplore_gym.envs.env_config import EnvConfig, load_env_config
 from semexplore_gym.envs.observation_options import MAP_OBSERVATIONS as MAP_OBSERVATIONS
 from semexplore_gym.envs.observation_options import STATIC_INFO_MODES as STATIC_INFO_MODES
 from semexplore_gym.envs.observation_options import ObservationOptions
-from semexplore_gym.envs.slam_mode import SlamMode, kidnap_start, slam_reset
+from semexplore_gym.envs.slam_mode import SlamMode, draw_beside_truth, kidnap_start, slam_reset
 from semexplore_gym.envs.static_info import FrozenInfo as FrozenInfo
 from semexplore_gym.envs.static_info import static_info_of
 from semexplore_gym.maps import make_world
@@ -141,7 +141,8 @@ class SemanticExploreEnv(gym.Env):
     area in the map), ``collisions`` (count so far), ``sim_time_s``, ``path_length_m``,
     ``reward_terms``; ``true_pose`` is *not* given (policies must not see ground truth). With
     ``slam.enabled`` (preset ``"slam"``) map and pose are SLAM's, ``info`` adds its figures and
-    ``reset(options={"kidnap_to": pose})`` kidnaps the robot (:mod:`~semexplore_gym.envs.slam_mode`).
+    ``reset(options={"kidnap_to": pose})`` kidnaps the robot (:mod:`~semexplore_gym.envs.slam_mode`);
+    ``render()`` then draws the SLAM map beside the map at the true poses.
 
     ## Notes
     Rendering overlays: ``env.unwrapped.set_overlay(dict)`` draws a policy's semantic areas,
@@ -529,7 +530,10 @@ class SemanticExploreEnv(gym.Env):
 
         if self._renderer is None:
             self._renderer = Renderer(self.map_geometry)
-        frame = self._renderer.draw(self.render_snapshot())
+        if self.slam is not None:  # the SLAM map beside the truth
+            frame = draw_beside_truth(self._renderer, self.render_snapshot(), self.grid, self.slam)
+        else:
+            frame = self._renderer.draw(self.render_snapshot())
         if self.render_mode == "rgb_array":
             return frame
         self._renderer.show(frame, fps=self.metadata["render_fps"])

@@ -26,6 +26,7 @@ import numpy as np
 from semexplore_gym.core.grid import UNKNOWN, GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import OccupancyGrid
 from semexplore_gym.core.slam.backend import ScanSlam
+from semexplore_gym.core.slam.false_stop import stop_artefact
 from semexplore_gym.core.slam.pose_graph import require_gtsam
 from semexplore_gym.core.slam.trajectory_error import relative_pose_error_m
 from semexplore_gym.envs.env_config import EnvConfig
@@ -109,6 +110,7 @@ class SlamMode:
             (lidar.mount_x_m, lidar.mount_y_m),
         )
         self._truth_at_keyframes: list[Pose] = []
+        self._odom_at_keyframes: list[Pose] = []
         self.started = False
 
     @classmethod
@@ -127,6 +129,7 @@ class SlamMode:
         """A new episode at the (shared) start ``pose``; returns the SLAM map."""
         self.backend.reset(pose, scan)
         self._truth_at_keyframes = [tuple(float(v) for v in pose)]  # type: ignore[list-item]
+        self._odom_at_keyframes = list(self._truth_at_keyframes)
         self.started = True
         return self.backend.grid
 
@@ -136,10 +139,14 @@ class SlamMode:
         self.backend.kidnap(pose)
 
     def update(self, odom_pose: Any, scan: np.ndarray, true_pose: Pose) -> Pose:
-        """One step on the odometry pose and the scan; returns the SLAM estimate."""
-        estimate = self.backend.update(tuple(float(v) for v in odom_pose), scan)  # type: ignore[arg-type]
+        """One step on the odometry pose and the scan; returns the SLAM estimate. At each new
+        keyframe the true and the odometry pose are kept beside it (:meth:`ate_m`,
+        :meth:`odom_ate_m`)."""
+        odom: Pose = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
+        estimate = self.backend.update(odom, scan)
         if len(self.backend.keyframe_poses) > len(self._truth_at_keyframes):
             self._truth_at_keyframes.append(true_pose)
+            self._odom_at_keyframes.append(odom)
         return estimate
 
     def info(self, true_pose: Pose) -> dict[str, Any]:
@@ -157,9 +164,12 @@ class SlamMode:
     def ate_m(self) -> float:
         """Absolute trajectory error: RMSE of the keyframe positions against the true poses
         there, without alignment (SLAM starts at the true start pose, a shared frame)."""
-        est = np.asarray(self.backend.keyframe_poses)[:, :2]
-        truth = np.asarray(self._truth_at_keyframes)[:, :2]
-        return float(np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1))))
+        return _position_rmse_m(self.backend.keyframe_poses, self._truth_at_keyframes)
+
+    def odom_ate_m(self) -> float:
+        """The same error for the raw odometry at the same keyframes: what the map would
+        have been built on without SLAM (the baseline :meth:`ate_m` is judged against)."""
+        return _position_rmse_m(self._odom_at_keyframes, self._truth_at_keyframes)
 
     def rpe_m(self) -> float | None:
         """Relative pose error over 1 m of true travel between keyframes (translation RMSE;
@@ -179,16 +189,75 @@ class SlamMode:
             return 0.0
         return float(np.count_nonzero(known & (slam != truth_grid.encoded)) / n_known)
 
-    def metrics(self, truth_grid: OccupancyGrid) -> dict[str, Any]:
-        """The mission's SLAM figures: ``ate_m``, ``rpe_m``, ``map_error``, ``loop_closures``,
-        ``slam_lost`` (at the end), ``slam_lost_events``, ``slam_degenerate_matches``."""
+    def metrics(self, truth_grid: OccupancyGrid, stopped_short: bool = False) -> dict[str, Any]:
+        """The mission's SLAM figures: ``ate_m``, ``odom_ate_m``, ``rpe_m``, ``map_error``,
+        ``loop_closures``, ``slam_lost`` (at the end), ``slam_lost_events``,
+        ``slam_degenerate_matches``, and for a policy that ``stopped_short`` (self-stop below
+        the coverage goal) whether a SLAM artefact explains it: ``slam_false_stop`` and
+        ``slam_stop_artefact`` (:func:`~semexplore_gym.core.slam.false_stop.stop_artefact`;
+        None when it did not stop short or the maps agree on the frontiers)."""
         rpe = self.rpe_m()
+        artefact = None
+        if stopped_short:
+            artefact = stop_artefact(
+                self.backend.grid.encoded, truth_grid.encoded, truth_grid.count_mask
+            )
         return {
             "ate_m": round(self.ate_m(), 5),
+            "odom_ate_m": round(self.odom_ate_m(), 5),
             "rpe_m": None if rpe is None else round(rpe, 5),
             "map_error": round(self.map_error(truth_grid), 5),
             "loop_closures": int(self.backend.loop_closures),
             "slam_lost": bool(self.backend.lost),
             "slam_lost_events": int(self.backend.lost_events),
             "slam_degenerate_matches": int(self.backend.degenerate_matches),
+            "slam_false_stop": artefact is not None,
+            "slam_stop_artefact": artefact,
         }
+
+
+def draw_beside_truth(renderer: Any, snap: Any, truth_grid: OccupancyGrid, slam: SlamMode) -> Any:
+    """One frame of the SLAM mode for people: left the SLAM map the policy sees, with the
+    robot at SLAM's estimate and SLAM's keyframe trail; right the map the same scans build at
+    the true poses, with the true robot, scan and trail. The true walls (faint blue) lie under
+    both, so drift and doubled walls show as map off the walls.
+
+    Args:
+        renderer: A :class:`~semexplore_gym.rendering.renderer.Renderer` of the env's map frame.
+        snap: The env's :class:`~semexplore_gym.rendering.renderer.RenderSnapshot` (its map is
+            the SLAM map, its pose the true pose).
+        truth_grid: The map fused at the true poses.
+        slam: The env's SLAM mode.
+
+    Returns:
+        The ``(H, 2 W + gap, 3)`` uint8 frame.
+    """
+    from dataclasses import replace
+
+    keyframes = np.asarray(slam.backend.keyframe_poses, dtype=np.float64)[:, :2]
+    left = renderer.draw(
+        replace(
+            snap,
+            pose=slam.backend.estimate,
+            scan=None,
+            trajectory_m=keyframes,
+            text=f"SLAM map (the policy's)  ATE {slam.ate_m():.3f} m",
+        )
+    )
+    right = renderer.draw(
+        replace(
+            snap,
+            map=truth_grid.encoded.copy(),
+            overlay={},
+            text=f"{snap.text}  (truth: the same scans at the true poses)",
+        )
+    )
+    gap = np.full((left.shape[0], 6, 3), 255, dtype=np.uint8)
+    return np.concatenate([left, gap, right], axis=1)
+
+
+def _position_rmse_m(estimate: list[Pose], truth: list[Pose]) -> float:
+    """RMSE of the positions of ``estimate`` against ``truth`` (same instants, no alignment)."""
+    est = np.asarray(estimate, dtype=np.float64)[:, :2]
+    true = np.asarray(truth, dtype=np.float64)[:, :2]
+    return float(np.sqrt(np.mean(np.sum((est - true) ** 2, axis=1))))

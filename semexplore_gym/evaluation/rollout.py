@@ -388,13 +388,20 @@ def run_mission(
     )
 
 
-def slam_metrics(env: Any) -> dict[str, Any]:
-    """The SLAM figures of the env's mission so far (``ate_m``, ``map_error``,
-    ``loop_closures``, ``slam_lost``; :meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`),
-    or ``{}`` when the env does not run SLAM."""
+def slam_metrics(env: Any, self_stopped: bool = False) -> dict[str, Any]:
+    """The SLAM figures of the env's mission so far (``ate_m``, ``odom_ate_m``,
+    ``map_error``, ``loop_closures``, ``slam_lost``, ``slam_false_stop``;
+    :meth:`~semexplore_gym.envs.slam_mode.SlamMode.metrics`), or ``{}`` when the env does not
+    run SLAM. ``self_stopped``: the policy ended the mission (a stop below the env's coverage
+    goal is then checked for a SLAM artefact)."""
     unwrapped = getattr(env, "unwrapped", env)
     slam = getattr(unwrapped, "slam", None)
-    return slam.metrics(unwrapped.grid) if slam is not None else {}
+    if slam is None:
+        return {}
+    grid = unwrapped.grid
+    coverage = grid.n_free_in_mask / max(1, grid.n_mask_cells)
+    short = self_stopped and coverage < unwrapped.config.episode.coverage_goal
+    return slam.metrics(grid, stopped_short=short)
 
 
 def _mission_result(
@@ -492,7 +499,7 @@ def _drive(
             break
     if gif is not None:
         gif.grab()
-    log.slam = slam_metrics(env)
+    log.slam = slam_metrics(env, self_stopped=bool(policy.done))
     return info, terminated, truncated
 
 

@@ -8,7 +8,8 @@ decomposition's columns (:mod:`.path_decomposition`: the path split into parts t
 ``path_length_m``, goals cleared and abandoned, the goals' detour ratio) come for every policy;
 ``policy_version`` names the semantic expert's version a spec ran (``semantic-v3`` for
 ``semantic``; empty for policies without versions). The SLAM columns (:data:`SLAM_COLUMNS`:
-trajectory errors, map error, loop closures and whether the back end ended lost) come only from
+trajectory errors of SLAM and of odometry alone, map error, loop closures, whether the back end
+ended lost, and whether the policy stopped short on a SLAM artefact) come only from
 missions in the env's SLAM mode (``--env-config slam``; empty otherwise). All of these were
 added after the first release, so older files may lack them.
 """
@@ -67,6 +68,9 @@ class RunRow:
     slam_lost: bool | None = None
     slam_lost_events: int | None = None
     slam_degenerate_matches: int | None = None
+    odom_ate_m: float | None = None
+    slam_false_stop: bool | None = None
+    slam_stop_artefact: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Column -> value, in column order."""
@@ -98,6 +102,9 @@ SLAM_COLUMNS: tuple[str, ...] = (
     "slam_lost",
     "slam_lost_events",
     "slam_degenerate_matches",
+    "odom_ate_m",
+    "slam_false_stop",
+    "slam_stop_artefact",
 )
 
 #: Columns added after the first release: rows of older ``runs.csv`` files lack them (None).
@@ -111,7 +118,7 @@ OPTIONAL_COLUMNS: frozenset[str] = frozenset(
     }
 )
 
-_TEXT_COLUMNS = ("world", "policy", "stop_reason", "policy_version")
+_TEXT_COLUMNS = ("world", "policy", "stop_reason", "policy_version", "slam_stop_artefact")
 _INT_COLUMNS = (
     "seed",
     "collisions",
@@ -123,7 +130,7 @@ _INT_COLUMNS = (
     "slam_lost_events",
     "slam_degenerate_matches",
 )
-_BOOL_COLUMNS = ("self_stopped", "slam_lost")
+_BOOL_COLUMNS = ("self_stopped", "slam_lost", "slam_false_stop")
 
 
 def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
@@ -133,7 +140,7 @@ def parse_cells(raw: dict[str, Any], where: str) -> dict[str, Any]:
     row: dict[str, Any] = {}
     for k, v in raw.items():
         if k in _TEXT_COLUMNS:
-            row[k] = v
+            row[k] = None if k in OPTIONAL_COLUMNS and k in SLAM_COLUMNS and v == "" else v
         elif k in _BOOL_COLUMNS and not (k in OPTIONAL_COLUMNS and v in ("", "None")):
             if v not in ("True", "False"):
                 raise ValueError(f"{where}: {k} must be True or False, got {short_repr(v)}")

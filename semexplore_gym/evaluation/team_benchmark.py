@@ -24,6 +24,9 @@ robot_collisions   robot-robot contacts begun; ``contacts`` all contacts (walls 
 wall_time_s        wall-clock time of the mission
 lower_bound_s      a certified lower bound on any team's T99 from these starts (this team
                    size; :mod:`semexplore_gym.evaluation.team_bound`), empty where none
+ate_m ...          with ``--env-config slam`` (each robot its own SLAM): the robots' mean ATE
+                   and odometry ATE, the merged SLAM map's error, all robots' loop closures
+                   and lost events (:data:`SLAM_COLUMNS`; empty without SLAM)
 ================== ==========================================================================
 
 The team oracle (policy ``oracle``, ``--oracle``) runs in a privileged env (the true world in
@@ -68,6 +71,9 @@ COLUMNS = (
     "wall_time_s",
     "lower_bound_s",
 )
+#: The SLAM columns (:meth:`~semexplore_gym.envs.team_slam.TeamSlam.metrics`), after
+#: :data:`COLUMNS`; a ``runs.csv`` written before them keeps its own header when resumed.
+SLAM_COLUMNS = ("ate_m", "odom_ate_m", "map_error", "loop_closures", "slam_lost_events")
 
 
 @dataclass
@@ -93,10 +99,13 @@ class TeamMissionResult:
     wall_time_s: float
     lower_bound_s: float | None = None
     coverage_trace: list[tuple[float, float]] = field(default_factory=list, repr=False)
+    slam: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def row(self) -> dict[str, Any]:
         d = asdict(self)
         d.pop("coverage_trace")
+        d.update({k: self.slam.get(k) for k in SLAM_COLUMNS})
+        d.pop("slam")
         d["path_per_robot_m"] = ";".join(f"{v:.3f}" for v in self.path_per_robot_m)
         for k in ("coverage", "overlap_ratio"):
             d[k] = round(float(d[k]), 6)
@@ -181,6 +190,7 @@ def run_team_mission(
         steps=steps,
         wall_time_s=time.perf_counter() - wall0,
         coverage_trace=trace,
+        slam=env.slam.metrics(env.grid) if getattr(env, "slam", None) is not None else {},
     )
 
 
@@ -323,10 +333,14 @@ def run_team_benchmark(config: TeamBenchmarkConfig) -> dict[str, Any]:
     failed: list[tuple[tuple[str, str, int, int], str]] = []
     _upgrade_header(csv_path)
     write_header = not csv_path.exists()
+    header = list((*COLUMNS, *SLAM_COLUMNS))
+    if not write_header:
+        with csv_path.open(newline="") as f:
+            header = next(csv.reader(f), header)
     bar = MissionsBar(c.progress, total=len(tasks), done=len(tasks) - len(todo))
     stream = mission_stream(todo, c.backend, c.workers, c.ray_address, run_team_task, run_team_task)
     with csv_path.open("a", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer = csv.DictWriter(f, fieldnames=header, extrasaction="ignore")
         if write_header:
             writer.writeheader()
         try:
@@ -356,11 +370,12 @@ def _upgrade_header(csv_path: Path) -> None:
         return
     with csv_path.open(newline="") as f:
         reader = csv.DictReader(f)
-        if reader.fieldnames is None or list(reader.fieldnames) == list(COLUMNS):
+        if reader.fieldnames is None or set(COLUMNS) <= set(reader.fieldnames):
             return
+        fieldnames = [*COLUMNS, *(c for c in SLAM_COLUMNS if c in reader.fieldnames)]
         rows = list(reader)
     with csv_path.open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS, restval="", extrasaction="ignore")
+        writer = csv.DictWriter(f, fieldnames=fieldnames, restval="", extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
 

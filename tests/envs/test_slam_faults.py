@@ -72,7 +72,7 @@ def test_a_featureless_corridor_is_reported_and_held_on_odometry_along_it() -> N
 WORLD = "maze:seed=3,size_m=5"
 
 
-def test_a_kidnapped_robot_leaves_slams_estimate_behind_and_the_error_shows() -> None:
+def test_a_kidnapped_robot_is_noticed_and_reported_lost() -> None:
     env = gym.make("SemanticExplore-v0", world=WORLD, config="slam")
     u: Any = env.unwrapped
     from semexplore_gym.policies.registry import make_policy
@@ -89,10 +89,17 @@ def test_a_kidnapped_robot_leaves_slams_estimate_behind_and_the_error_shows() ->
     assert len(u.slam.backend.keyframe_poses) > 1  # its map and keyframes are kept
     gap_m = math.hypot(target[0] - before[0], target[1] - before[1])
     assert info["slam_pose_error_m"] == pytest.approx(gap_m)
+    lost = []
     for _ in range(30):
         _, _, _, _, info = env.step(np.array([0.0, 1.0], dtype=np.float32))
+        lost.append(info["slam_lost"])
     assert info["slam_pose_error_m"] > 1.0
-    assert slam_metrics(env)["ate_m"] > 0.5  # the mission record shows it too
+    # The back end notices at its first keyframe there (the scan jumped while the wheels
+    # stood still, and its match collapsed) and stays lost: never silent.
+    assert lost[0] and all(lost) and info["slam_lost_events"] == 1
+    record = slam_metrics(env)
+    assert record["ate_m"] > 0.5  # the mission record shows it too
+    assert record["slam_lost"] is True and record["slam_lost_events"] == 1
 
 
 @pytest.mark.parametrize(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -113,6 +114,7 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(on)
     assert "ate_m" not in off
     assert on["ate_m"] < 0.1 and 0 <= on["map_error"] < 0.2
+    assert on["odom_ate_m"] > 3 * on["ate_m"]  # the goal: at least 3x below odometry alone
     assert 0 <= on["rpe_m"] < 0.1  # 400 s of the expert: far more than 1 m of travel
     assert on["collisions"] == 0
     # explore --json carries the SLAM figures when the env runs SLAM.
@@ -120,11 +122,55 @@ def test_slam_mission_ends_closer_to_the_truth_than_odometry_alone(capsys) -> No
     assert main([*args, "--json", "--no-progress"]) == 0
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert {"ate_m", "rpe_m", "map_error", "loop_closures", "slam_lost"} <= set(out)
+    assert {"odom_ate_m", "slam_false_stop", "slam_stop_artefact"} <= set(out)
+    assert out["odom_ate_m"] > out["ate_m"]
 
 
-def test_the_team_env_refuses_the_slam_mode_in_one_line() -> None:
-    pytest.importorskip("pettingzoo")
-    from semexplore_gym.envs.multi_robot import make_multi
+def test_the_odometry_ate_sits_beside_slams_and_is_zero_without_drift() -> None:
+    from semexplore_gym.evaluation.rollout import slam_metrics
 
-    with pytest.raises(ValueError, match=r"^slam\.enabled: the multi-robot env has no SLAM mode"):
-        make_multi(world=WORLD, n_robots=2, config="slam")
+    drifting = gym.make("SemanticExplore-v0", world=WORLD, config="slam")
+    _drive(drifting, 150, 2)
+    figures = slam_metrics(drifting)
+    assert figures["odom_ate_m"] > 0.0 and figures["ate_m"] >= 0.0
+    alphas = ("rot_from_rot", "rot_from_trans", "trans_from_trans", "trans_from_rot")
+    exact = gym.make(
+        "SemanticExplore-v0",
+        world=WORLD,
+        config="slam",
+        overrides=[f"odometry.{a}=0" for a in alphas],
+    )
+    _drive(exact, 150, 2)
+    assert slam_metrics(exact)["odom_ate_m"] == 0.0
+
+
+def test_a_stop_short_on_a_map_that_closed_every_gap_is_a_false_stop() -> None:
+    from semexplore_gym.evaluation.rollout import slam_metrics
+
+    env = gym.make("SemanticExplore-v0", world=WORLD, config="slam")
+    _drive(env, 40, 1)
+    u: Any = env.unwrapped
+    assert u.grid.n_free_in_mask < u.grid.n_mask_cells  # short of the goal on the truth
+    honest = slam_metrics(env, self_stopped=True)
+    assert slam_metrics(env)["slam_false_stop"] is False  # not stopped: nothing to explain
+    # SLAM's map, with every cell it has not seen turned into wall: no frontier left.
+    closed = u.slam.grid.log_odds.copy()
+    closed[u.slam.grid.encoded == 128] = 5.0
+    u.slam.grid.load_log_odds(closed)
+    figures = slam_metrics(env, self_stopped=True)
+    assert figures["slam_false_stop"] is True
+    assert figures["slam_stop_artefact"] == "lost_frontier"
+    assert honest["slam_stop_artefact"] != "lost_frontier"
+
+
+def test_render_draws_the_slam_map_beside_the_truth() -> None:
+    slam = gym.make("SemanticExplore-v0", world=WORLD, config="slam", render_mode="rgb_array")
+    plain = gym.make("SemanticExplore-v0", world=WORLD, render_mode="rgb_array")
+    slam.reset(seed=0)
+    plain.reset(seed=0)
+    for _ in range(30):
+        slam.step(np.array([0.8, 0.2], dtype=np.float32))
+    frame, one = slam.render(), plain.render()
+    assert frame.shape == (one.shape[0], 2 * one.shape[1] + 6, 3) and frame.dtype == np.uint8
+    left, right = frame[:, : one.shape[1]], frame[:, one.shape[1] + 6 :]
+    assert not np.array_equal(left, right)  # two different maps

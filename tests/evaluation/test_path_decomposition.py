@@ -242,7 +242,7 @@ def test_resuming_a_run_from_before_the_columns_adds_them(tmp_path) -> None:
     old = [c for c in CSV_COLUMNS if c not in DECOMPOSITION_COLUMNS]
     row = dict.fromkeys(old, "1")
     row.update(world="maze1", policy="nearest", self_stopped="True", stop_reason="done")
-    row.update({k: "False" for k in ("slam_lost",) if k in row})  # a bool column
+    row.update({k: "False" for k in ("slam_lost", "slam_false_stop") if k in row})  # bool columns
     with (tmp_path / "runs.csv").open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=old)
         w.writeheader()

@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("pettingzoo")
 
 from semexplore_gym.cli import main  # noqa: E402
-from semexplore_gym.evaluation.team_benchmark import COLUMNS  # noqa: E402
+from semexplore_gym.evaluation.team_benchmark import COLUMNS, SLAM_COLUMNS  # noqa: E402
 
 
 @pytest.mark.slow
@@ -35,7 +35,7 @@ def test_benchmark_robots_writes_team_columns(tmp_path: Path) -> None:
     assert main(argv) == 0
     with (out / "runs.csv").open(newline="") as f:
         rows = list(csv.DictReader(f))
-    assert tuple(rows[0]) == COLUMNS
+    assert tuple(rows[0]) == (*COLUMNS, *SLAM_COLUMNS)
     assert {(r["policy"], r["n_robots"]) for r in rows} == {
         ("team_coordinated", "1"),
         ("team_coordinated", "2"),

@@ -26,11 +26,22 @@ def merge_grids(grids: Sequence[OccupancyGrid]) -> None:
     """
     if len(grids) < 2:
         return
+    merged = merged_log_odds(grids)
+    for g in grids:
+        g.load_log_odds(merged)
+
+
+def merged_log_odds(grids: Sequence[OccupancyGrid]) -> np.ndarray:
+    """The merged log-odds of :func:`merge_grids` (a new array; the grids stay as they are).
+
+    Raises:
+        ValueError: no grids, or grids of different shapes.
+    """
+    if not grids:
+        raise ValueError("merged_log_odds needs at least one grid")
     shape = grids[0].geometry.shape
     if any(g.geometry.shape != shape for g in grids):
         raise ValueError("merge_grids needs grids of one shape")
     stack = np.stack([g.log_odds for g in grids])
     pick = np.argmax(np.abs(stack), axis=0)
-    merged = np.take_along_axis(stack, pick[None], axis=0)[0]
-    for g in grids:
-        g.load_log_odds(merged)
+    return np.take_along_axis(stack, pick[None], axis=0)[0]

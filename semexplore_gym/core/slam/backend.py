@@ -15,6 +15,19 @@ often it became so) when matches keep scoring too low (a kidnapped robot, a scan
 map), :attr:`ScanSlam.degenerate_matches` when a match pins the pose only across one direction
 (a featureless corridor; see ``SlamParams.degenerate_sd_m``). :meth:`ScanSlam.kidnap` moves the
 odometry's frame without telling the estimate, as a robot picked up and put down elsewhere.
+
+A kidnapped robot is noticed from two signs together. Its scan *jumps*: the odometry says it
+barely moved since the last scan, yet many beams changed by far more than that explains
+(``scan_jump_share``, ``scan_jump_range_m``). And the next keyframe's match *collapses*: it
+scores below ``match_score_threshold``, or below ``score_collapse_ratio`` of the median of the
+recent well-matched keyframes (in a cluttered map the scan still fits somewhere near). Both
+together: the back end is lost at once, and it freezes the local map from before the jump
+(the *reference*). Until a later keyframe matches the reference again as well as the
+keyframes before the jump matched, every keyframe is also matched to it and the back end stays
+lost, however well the keyframes taken since, at the wrong place, match each other. Either
+sign alone is no kidnap: a scan changes that much when a door or a teammate passes close, and
+a match collapses for a keyframe when the robot turns into a new room. These checks only
+judge: the estimate and the map are built as before.
 """
 
 from __future__ import annotations
@@ -93,7 +106,13 @@ class ScanSlam:
         self.degenerate_matches = 0
         self.last_score = 1.0
         self._cooldown = 0
+        self._reference: range | None = None
+        self._reference_floor = 0.0
+        self._good_scores: list[float] = []
+        self._jump_pending = False
         self._last_odom: Pose = tuple(float(v) for v in pose)  # type: ignore[assignment]
+        self._prev_odom = self._last_odom
+        self._prev_ranges = np.array(ranges_m, dtype=np.float32)
         self.estimate: Pose = self._last_odom
         self._add_keyframe(self._last_odom, ranges_m)
         self._fuse(0)
@@ -108,6 +127,7 @@ class ScanSlam:
         back end is told nothing else. Its estimate stays at the last keyframe, where it
         believes the robot is; only the odometry's jump is not taken as motion."""
         self._last_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
+        self._prev_odom = self._last_odom  # the wheels did not turn: odometry saw no motion
         self.estimate = self.keyframe_poses[-1]
 
     def _add_keyframe(self, pose: Pose, ranges_m: np.ndarray) -> None:
@@ -123,6 +143,10 @@ class ScanSlam:
     # ------------------------------------------------------------------- step
     def update(self, odom_pose: Pose, ranges_m: np.ndarray) -> Pose:
         """One step: the odometry pose and the scan taken there. Returns the new estimate."""
+        if self._scan_jumped(odom_pose, ranges_m):
+            self._jump_pending = True
+        self._prev_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
+        self._prev_ranges = np.array(ranges_m, dtype=np.float32)
         delta = relative(self._last_odom, tuple(float(v) for v in odom_pose))  # type: ignore[arg-type]
         prediction = compose(self.keyframe_poses[-1], delta)
         p = self.params
@@ -135,7 +159,7 @@ class ScanSlam:
         self._last_odom = tuple(float(v) for v in odom_pose)  # type: ignore[assignment]
         points = scan_points(np.asarray(ranges_m), self._beams, self._max_range_m, self._mount)
         pose, cov, trusted = self._track(prediction, points, delta)
-        self._judge(trusted)
+        self._judge(self._agrees_with_reference(trusted, prediction, points))
         n = len(self.keyframe_poses)
         self.edges.append(Edge(n - 1, n, relative(self.keyframe_poses[-1], pose), cov))
         self._add_keyframe(pose, ranges_m)
@@ -152,6 +176,75 @@ class ScanSlam:
         self.low_score_streak += 1
         if self.low_score_streak == self.params.lost_after_keyframes:
             self.lost_events += 1
+
+    def _scan_jumped(self, odom_pose: Pose, ranges_m: np.ndarray) -> bool:
+        """Whether the scan changed far more than the odometry's motion since the last scan
+        explains (see the module docstring)."""
+        p = self.params
+        d = relative(self._prev_odom, tuple(float(v) for v in odom_pose))  # type: ignore[arg-type]
+        n = len(self._beams)
+        step = float(self._beams[1] - self._beams[0]) if n > 1 else 0.0
+        full_circle = step > 0 and abs(n * step - 2 * math.pi) < 1e-3
+        if p.scan_jump_share >= 1.0 or math.hypot(d[0], d[1]) > 0.2 or step <= 0:
+            return False
+        if not full_circle and abs(d[2]) > 0.35:
+            return False
+        k = int(round(d[2] / step))
+        before = np.roll(self._prev_ranges, -k)  # beam i now looks where beam i + k looked
+        now = np.asarray(ranges_m, dtype=np.float32)
+        valid = (now > 0) & (before > 0)
+        if k != 0 and not full_circle:  # no wrap-around
+            if k > 0:
+                valid[n - k :] = False
+            else:
+                valid[:-k] = False
+        n_valid = int(np.count_nonzero(valid))
+        if n_valid < 30:
+            return False
+        changed = np.count_nonzero(valid & (np.abs(now - before) > p.scan_jump_range_m))
+        return bool(changed > p.scan_jump_share * n_valid)
+
+    def _freeze_reference(self, floor: float, lost_now: bool = False) -> None:
+        """Freeze the recent keyframes as the reference later ones must match at ``floor``;
+        ``lost_now``: the back end is lost at once (a jump), not after more failures."""
+        p = self.params
+        n = len(self.keyframe_poses)
+        self._reference = range(max(0, n - p.submap_keyframes), n)
+        self._reference_floor = max(floor, p.match_score_threshold)
+        if lost_now and not self.lost:
+            self.low_score_streak = p.lost_after_keyframes
+            self.lost_events += 1
+
+    def _agrees_with_reference(self, trusted: bool, prediction: Pose, points: np.ndarray) -> bool:
+        """Whether the new keyframe counts as well matched (see the module docstring): its
+        match was trusted and, after a kidnap, its scan also matches the frozen reference as
+        well as the keyframes before the kidnap matched. A scan jump followed by a collapsed
+        match here is a kidnap: lost at once."""
+        p = self.params
+        jumped, self._jump_pending = self._jump_pending, False
+        if self._reference is None:
+            median = self._good_median()
+            if trusted and self.last_score >= p.score_collapse_ratio * median:
+                self._good_scores = [
+                    *self._good_scores[-(p.submap_keyframes - 1) :],
+                    self.last_score,
+                ]
+                return True
+            if jumped:
+                self._freeze_reference(median, lost_now=True)
+                return False
+            return trusted
+        match = self._match(self._reference, points, prediction, p.search_xy_m)
+        if len(points) >= 10 and match.score >= self._reference_floor:
+            self._reference = None
+            return True
+        return False  # still lost; a jump now changes nothing: the reference stays as it was
+
+    def _good_median(self) -> float:
+        """The median score of the recent well-matched keyframes (0 before three)."""
+        if len(self._good_scores) < 3:
+            return 0.0
+        return float(np.median(self._good_scores))
 
     def _track(
         self, prediction: Pose, points: np.ndarray, delta: Pose

@@ -21,6 +21,9 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "loop_score_threshold": (0.0, 1.0),
     "lost_after_keyframes": (1, 100000),
     "degenerate_sd_m": (0.0, 10.0),
+    "score_collapse_ratio": (0.0, 1.0),
+    "scan_jump_share": (0.05, 1.0),
+    "scan_jump_range_m": (0.01, 10.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
 
@@ -52,6 +55,18 @@ class SlamParams:
             direction (from the matcher's covariance) exceeds this is *degenerate*: the scan
             pins the pose only across that direction (a featureless corridor). It is counted,
             and along that direction the keyframe keeps the odometry prediction.
+        score_collapse_ratio: After a scan jump (``scan_jump_share``), a keyframe match
+            scoring below this share of the median score of the recent well-matched
+            keyframes has *collapsed* (a kidnapped robot's scan matched somewhere near that
+            it is not): the back end is lost (see :mod:`~semexplore_gym.core.slam.backend`).
+            0: only a match below ``match_score_threshold`` collapses.
+        scan_jump_share: When the odometry says the robot barely moved since the last scan
+            (under 0.2 m; any turn for a LiDAR that sees all around, else under 0.35 rad)
+            but more than this share of the beams valid in both scans changed by more than
+            ``scan_jump_range_m``, the scan *jumped*; a collapsed match at the next keyframe
+            then means the robot was carried away (kidnapped): the back end reports itself
+            lost at once. 1 turns the kidnap check off.
+        scan_jump_range_m: A beam whose range changed by more than this has *changed*.
     """
 
     enabled: bool = False
@@ -69,6 +84,9 @@ class SlamParams:
     loop_score_threshold: float = 0.6
     lost_after_keyframes: int = 5
     degenerate_sd_m: float = 0.08
+    score_collapse_ratio: float = 0.75
+    scan_jump_share: float = 0.3
+    scan_jump_range_m: float = 0.5
 
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -125,3 +125,41 @@ def test_the_back_end_says_it_is_lost_when_matches_keep_failing() -> None:
     assert lost == [False, False, True, True, True]
     # Odometry alone carried the estimate meanwhile.
     assert slam.estimate == pytest.approx((1.5, 0.0, 0.0))
+
+
+def _kidnapped(params: SlamParams, to: tuple[float, float, float], steps: int = 8):
+    """The ring driven to its end, then the robot carried to ``to`` and turned in place
+    there; the back end is told only the odometry's new frame. Returns it, and whether it was
+    lost after each step there."""
+    slam, _, _ = _run(params, seed=3)
+    index = SegmentIndex(_ring_segments())
+    assert not slam.lost and slam.lost_events == 0
+    slam.kidnap(to)
+    lost = []
+    for k in range(1, steps + 1):
+        pose = (to[0], to[1], to[2] + 0.3 * k)
+        ranges = cast_scan(index, pose[0], pose[1], pose[2], BEAMS, MAX_RANGE_M)
+        slam.update(pose, np.minimum(ranges, MAX_RANGE_M))
+        lost.append(slam.lost)
+    return slam, lost
+
+
+def test_a_kidnapped_robot_is_noticed_and_stays_lost() -> None:
+    # Carried from the ring's bottom side to its top side, facing the other way.
+    slam, lost = _kidnapped(SlamParams(enabled=True), (3.0, 5.25, 0.5))
+    assert lost[0] and all(lost)
+    assert slam.lost_events == 1
+
+
+def test_without_the_jump_check_the_kidnap_goes_unnoticed() -> None:
+    # The keyframes after the kidnap match each other well: only the jump gives it away.
+    slam, lost = _kidnapped(SlamParams(enabled=True, scan_jump_share=1.0), (3.0, 5.25, 0.5))
+    assert not any(lost)
+    assert slam.lost_events == 0
+
+
+def test_a_collapse_without_a_jump_is_no_kidnap() -> None:
+    # Driven the ring with the collapse floor at its highest: many keyframes score below it
+    # on the way, none of them after a jump, and the back end never says it is lost.
+    slam, _, ate_m = _run(SlamParams(enabled=True, score_collapse_ratio=1.0), seed=3)
+    assert slam.lost_events == 0 and ate_m < 0.05
