@@ -66,6 +66,8 @@ class LowerBoundParams:
         group_scales: Group block sides to try, as multiples of the side whose square holds one
             more cell than the skip budget (the largest bound wins).
         max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
+        visibility_splits: Times a group's rectangle is quartered to find walls that block a
+            cell's view of each quarter (0: one wall for the whole group).
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
@@ -75,6 +77,7 @@ class LowerBoundParams:
     distance_cell_factor: int = 2
     group_scales: tuple[float, ...] = (1.0, 2.0)
     max_groups: int = 13
+    visibility_splits: int = 3
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
     coverage_share: float | None = None
@@ -84,6 +87,7 @@ class LowerBoundParams:
             ("hop_cells", 1, 64),
             ("distance_cell_factor", 1, 8),
             ("max_groups", 1, 18),
+            ("visibility_splits", 0, 8),
         ):
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
@@ -245,6 +249,7 @@ class _Problem:
     reach_m: float
     widen_m: float
     hop_cells: int
+    split_depth: int = 0
 
     def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
         """The coarse cell of each map cell (flat indices)."""
@@ -267,6 +272,7 @@ class _Problem:
             self.reach_m,
             self.widen_m,
             _VISIBILITY_TOL_M,
+            self.split_depth,
         )
         return self.to_coarse(fine)
 
@@ -340,6 +346,7 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         reach_m=facts.sensor.max_range_m + _VISIBILITY_TOL_M,
         widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
         hop_cells=p.hop_cells,
+        split_depth=p.visibility_splits,
     )
     from_start = prob.distances(prob.to_coarse(np.array([sr * geo.width + sc])))
     best: _Route | None = None

@@ -188,10 +188,80 @@ def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - n
 
 
 @njit(cache=True)
-def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  # pragma: no cover
+def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover
+    """Position in ``near[:m]`` of a wall that meets every segment between the two rectangles
+    (tried first: ``last``), or -1 for none."""
+    if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
+        return last
+    for p in range(m):
+        if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
+            return p
+    return -1
+
+
+@njit(cache=True)
+def _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pragma: no cover
+    """Whether every segment between ``rect`` and the square ``ux, uy`` (corners 0 and 2) no
+    longer than ``reach_m`` meets a wall: one wall blocks all of them, the two are farther
+    apart than ``reach_m``, or (up to ``depth`` times) each quarter of ``rect`` is blind in
+    turn (the segments from a rectangle are those from its quarters). Returns
+    ``(blind, last)``."""
+    ax = work[0]
+    ay = work[1]
+    fa = work[2]
+    fu = work[3]
+    stack = np.empty((4 * depth + 1, 5))
+    stack[0, 0] = rect[0]
+    stack[0, 1] = rect[1]
+    stack[0, 2] = rect[2]
+    stack[0, 3] = rect[3]
+    stack[0, 4] = 0.0
+    n = 1
+    while n > 0:
+        n -= 1
+        x0 = stack[n, 0]
+        y0 = stack[n, 1]
+        x1 = stack[n, 2]
+        y1 = stack[n, 3]
+        d = int(stack[n, 4])
+        gap_x = max(0.0, max(x0 - ux[2], ux[0] - x1))
+        gap_y = max(0.0, max(y0 - uy[2], uy[0] - y1))
+        if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
+            continue
+        ax[0] = x0
+        ax[1] = x1
+        ax[2] = x1
+        ax[3] = x0
+        ay[0] = y0
+        ay[1] = y0
+        ay[2] = y1
+        ay[3] = y1
+        p = _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu)
+        if p >= 0:
+            last = p
+            continue
+        if d >= depth:
+            return False, last
+        xm = 0.5 * (x0 + x1)
+        ym = 0.5 * (y0 + y1)
+        for q in range(4):
+            stack[n, 0] = x0 if q % 2 == 0 else xm
+            stack[n, 2] = xm if q % 2 == 0 else x1
+            stack[n, 1] = y0 if q < 2 else ym
+            stack[n, 3] = ym if q < 2 else y1
+            stack[n, 4] = d + 1
+            n += 1
+    return True, last
+
+
+@njit(cache=True)
+def group_region(
+    allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol, depth
+):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
-    rectangle and no single wall of ``walls`` meets every segment between the two."""
+    rectangle and the walls do not meet every segment between the two (:func:`_blind`, quarters
+    down to ``depth`` levels)."""
     h, w = allowed.shape
     c_lo = max(0, int(math.floor((rect[0] - reach_m - widen_m - gx0) / res)) - 1)
     c_hi = min(w - 1, int(math.floor((rect[2] + reach_m + widen_m - gx0) / res)) + 1)
@@ -211,12 +281,9 @@ def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  #
         if wx1 >= bx0 and wx0 <= bx1 and wy1 >= by0 and wy0 <= by1:
             near[m] = q
             m += 1
-    ax = np.array([rect[0], rect[2], rect[2], rect[0]])
-    ay = np.array([rect[1], rect[1], rect[3], rect[3]])
     ux = np.empty(4)
     uy = np.empty(4)
-    fa = np.empty(4)
-    fu = np.empty(4)
+    work = np.empty((4, 4))
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
     last = 0
@@ -240,15 +307,7 @@ def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  #
             uy[1] = y0
             uy[2] = y1
             uy[3] = y1
-            blind = False
-            if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
-                blind = True
-            else:
-                for p in range(m):
-                    if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
-                        blind = True
-                        last = p
-                        break
+            blind, last = _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work)
             if not blind:
                 out[count] = r * w + c
                 count += 1
