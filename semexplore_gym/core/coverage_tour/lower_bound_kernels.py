@@ -57,7 +57,9 @@ def _heap_pop(keys, vals, n):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no cover - numba
+def khop_distances(
+    moves, sources, k, res, target_of, n_targets, limit=np.inf
+):  # pragma: no cover - numba
     """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
     ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
@@ -68,7 +70,9 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
     the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
 
     With ``n_targets`` > 0 it stops once each target set (``target_of[cell]``, -1 for none)
-    holds its final least distance: every later value is at least the popped one.
+    holds its final least distance: every later value is at least the popped one. It also stops
+    once the popped value reaches ``limit`` and returns ``limit`` wherever its value is larger
+    (every value not yet final is at least the popped one): a lower bound still.
 
     Returns:
         ``moves.shape`` float64 distances (inf where unreached, or not needed for the targets).
@@ -106,6 +110,8 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
         if settled[a] or d > chain[a]:
             continue
         if n_targets > 0 and d >= tbest.max():
+            break
+        if d >= limit:
             break
         settled[a] = True
         ar = a // w
@@ -150,6 +156,10 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
                     stamp[nl] = sid
                     queue[tail] = nl
                     tail += 1
+    if limit < np.inf:
+        for i in range(h * w):
+            if best[i] > limit:
+                best[i] = limit
     return best.reshape(h, w)
 
 
@@ -255,13 +265,21 @@ def _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pr
 
 
 @njit(cache=True)
-def group_region(
-    allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol, depth
-):  # pragma: no cover - numba
+def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
     rectangle and the walls do not meet every segment between the two (:func:`_blind`, quarters
-    down to ``depth`` levels)."""
+    down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
+    stride``; a ``stride`` above 1 tests only every stride-th row and column (a sample, for
+    ranking groups, never for the bound)."""
+    gx0 = frame[0]
+    gy0 = frame[1]
+    res = frame[2]
+    reach_m = frame[3]
+    widen_m = frame[4]
+    tol = frame[5]
+    depth = int(frame[6])
+    stride = int(frame[7])
     h, w = allowed.shape
     c_lo = max(0, int(math.floor((rect[0] - reach_m - widen_m - gx0) / res)) - 1)
     c_hi = min(w - 1, int(math.floor((rect[2] + reach_m + widen_m - gx0) / res)) + 1)
@@ -287,11 +305,11 @@ def group_region(
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
     last = 0
-    for r in range(r_lo, r_hi + 1):
+    for r in range(r_lo, r_hi + 1, stride):
         y0 = gy0 + r * res - widen_m
         y1 = gy0 + (r + 1) * res + widen_m
         gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
-        for c in range(c_lo, c_hi + 1):
+        for c in range(c_lo, c_hi + 1, stride):
             if not allowed[r, c]:
                 continue
             x0 = gx0 + c * res - widen_m
@@ -370,3 +388,67 @@ def held_karp_route(first, legs, cells, budget):  # pragma: no cover - numba
         s = s ^ (1 << e)
         e = p
     return best, order[:n][::-1].copy()
+
+
+@njit(cache=True)
+def held_karp_entries(first, legs, group_of, cells, budget):  # pragma: no cover - numba
+    """:func:`held_karp_route` over entry pieces: node ``v`` is where the route first enters
+    the region of group ``group_of[v]``; ``first[v]``: start to node v; ``legs[v, w]``: node v to
+    node w. A route visits one node of each group of a subset S, and S leaves at most ``budget``
+    cells unvisited. Returns ``(length, group order)`` (inf and an empty order if none)."""
+    m = cells.shape[0]
+    nn = first.shape[0]
+    full = 1 << m
+    dp = np.full((full, max(nn, 1)), np.inf)
+    parent = np.full((full, max(nn, 1)), -1, dtype=np.int64)
+    held = np.zeros(full, dtype=np.int64)
+    total = 0
+    for i in range(m):
+        total += cells[i]
+    for v in range(nn):
+        s = 1 << group_of[v]
+        if first[v] < dp[s, v]:
+            dp[s, v] = first[v]
+    best = np.inf
+    best_set = -1
+    best_end = -1
+    if total <= budget:
+        best = 0.0
+        best_set = 0
+    for s in range(1, full):
+        low = s & (-s)
+        b = 0
+        while (1 << b) != low:
+            b += 1
+        held[s] = held[s ^ low] + cells[b]
+        ok = total - held[s] <= budget
+        for v in range(nn):
+            val = dp[s, v]
+            if not ((s >> group_of[v]) & 1) or val == np.inf:
+                continue
+            if ok and val < best:
+                best = val
+                best_set = s
+                best_end = v
+            if val >= best:
+                continue
+            for u in range(nn):
+                if (s >> group_of[u]) & 1:
+                    continue
+                t = s | (1 << group_of[u])
+                nv = val + legs[v, u]
+                if nv < dp[t, u]:
+                    dp[t, u] = nv
+                    parent[t, u] = v
+    order = np.empty(m, dtype=np.int64)
+    n = 0
+    s = best_set
+    e = best_end
+    while e >= 0:
+        order[n] = group_of[e]
+        n += 1
+        p = parent[s, e]
+        s = s ^ (1 << group_of[e])
+        e = p
+    return best, order[:n][::-1].copy()
+
