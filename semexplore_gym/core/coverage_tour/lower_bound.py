@@ -67,6 +67,8 @@ class LowerBoundParams:
             more cell than the skip budget (the largest bound wins).
         max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
         pool_groups: Groups (farthest first) the route's groups are chosen from.
+        leg_limit_share: Legs are searched only up to this share of the farthest entry
+            piece's distance from the start (longer ones count as that much; 1: no limit).
         keep_share: Share of the well-filled groups, those seen from the fewest cells (on a
             sample every ``sample_stride`` cells), the pool is drawn from.
         entry_tile_m: Side of the tiles that split where a route can first enter a region
@@ -81,10 +83,11 @@ class LowerBoundParams:
 
     hop_cells: int = 8
     distance_cell_factor: int = 2
-    group_scales: tuple[float, ...] = (1.0, 2.0)
+    group_scales: tuple[float, ...] = (1.0, 1.4)
     max_groups: int = 13
     pool_groups: int = 14
     keep_share: float = 0.5
+    leg_limit_share: float = 0.6
     sample_stride: int = 4
     visibility_splits: int = 3
     entry_tile_m: float = 1.0
@@ -116,8 +119,10 @@ class LowerBoundParams:
                 raise ValueError(f"{name} must be in [0, 0.5] m, got {v!r}")
         if not (math.isfinite(self.entry_tile_m) and 0.1 <= self.entry_tile_m <= 100):
             raise ValueError(f"entry_tile_m must be in [0.1, 100] m, got {self.entry_tile_m!r}")
-        if not (math.isfinite(self.keep_share) and 0 < self.keep_share <= 1):
-            raise ValueError(f"keep_share must be in (0, 1], got {self.keep_share!r}")
+        for name in ("keep_share", "leg_limit_share"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and 0 < v <= 1):
+                raise ValueError(f"{name} must be in (0, 1], got {v!r}")
         share = self.coverage_share
         if share is not None and not (0 < share <= 1):
             raise ValueError(f"coverage_share must be in (0, 1], got {share!r}")
@@ -487,7 +492,7 @@ def _bound_for_blocks(
     pieces = [prob.entry_pieces(r, start_cell, tile, p.max_entries) for r in regions]
     node_group = np.array([i for i, ps in enumerate(pieces) for _ in ps], dtype=np.int64)
     nodes = [q for ps in pieces for q in ps]
-    first, legs = _entry_legs(prob, nodes, node_group, from_start)
+    first, legs = _entry_legs(prob, nodes, node_group, from_start, p.leg_limit_share)
     pick = _choose_groups(first, legs, node_group, cells[chosen].astype(np.int64), budget, p)
     length, order = _route(first, legs, node_group, cells[chosen].astype(np.int64), budget, pick)
     idx = np.array(chosen, dtype=np.int64)[pick]
@@ -553,14 +558,20 @@ def _choose_groups(
 
 
 def _entry_legs(
-    prob: _Problem, nodes: list[np.ndarray], node_group: np.ndarray, from_start: np.ndarray
+    prob: _Problem,
+    nodes: list[np.ndarray],
+    node_group: np.ndarray,
+    from_start: np.ndarray,
+    share: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The start-to-node and node-to-node K-hop distances (the least over each piece's cells;
     either direction of a leg bounds it, so the larger of the two)."""
     n = len(nodes)
     first = np.array([_least(from_start, q) for q in nodes], dtype=np.float64)
-    # Legs longer than the farthest node from the start are lowered to it (still a bound).
-    limit = float(first[np.isfinite(first)].max()) if np.isfinite(first).any() else math.inf
+    # Legs longer than a share of the farthest node's distance from the start are lowered to
+    # it (still a bound; it saves searching the far side of the map from every node).
+    ok = np.isfinite(first)
+    limit = share * float(first[ok].max()) if ok.any() and share < 1 else math.inf
     legs = np.zeros((n, n), dtype=np.float64)
     for v in range(n):
         others = [nodes[u] for u in range(n) if node_group[u] != node_group[v]]
