@@ -15,18 +15,26 @@ optimum, so the result is below the path length of every explorer with this robo
    The Dijkstra distance over such hops (the last hop may end inside a ball) is <= the length.
 3. **Where a group can be seen from (a superset).** A scan marks a cell FREE only along a beam
    from the sensor that reaches a point of the cell's square within the LiDAR's range and
-   crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when its
-   square (widened by the LiDAR's mount offset) is farther than the range from A, or one wall
-   (collinear touching walls merged) meets every segment from U to A: its line separates them
+   crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when
+   every segment from U's square (widened by the LiDAR's mount offset) to A is longer than the
+   range or meets a wall. That holds when the two are farther apart than the range; when one
+   wall (collinear touching walls merged) meets every segment: its line separates them
    strictly and the 16 corner-pair segments cross it inside the wall (the segments from U to A
-   fill the convex hull of both, whose crossing with the line is spanned by the corner pairs).
+   fill the convex hull of both, whose crossing with the line is spanned by the corner pairs);
+   or when it holds for each quarter of A in turn, down to ``visibility_splits`` levels (the
+   segments to A are those to its quarters, so walls meeting at a corner block it together).
 4. **Route through must-see groups.** Groups are the coverage-mask cells of the blocks of a
    lattice. If the explorer never entered a group's region, none of its cells is FREE; the goal
    leaves at most ``budget`` mask cells unseen, so the explorer enters the regions of a set S
-   of the chosen groups whose others hold at most ``budget`` cells, in order of first entry,
-   each leg at least the K-hop distance between the regions. The bound is the least such route
-   over every feasible S (Held-Karp, exact), with any choice of groups (disjoint regions only
-   make it tighter); cells no allowed cell can see at all are taken off the budget first.
+   of the chosen groups whose others hold at most ``budget`` cells, in order of first entry.
+   It first enters a region at the start (if the start is in it) or by a move from a cell
+   outside it, so at one of its entry cells (cells of the region with a move to a cell
+   outside); those are split into a few entry pieces. Between first entering one region (at a
+   cell of one piece) and first entering the next (at a cell of one of its pieces) it drives at
+   least the K-hop distance between the two pieces (either direction: a path reversed is a
+   path; a value the search stopped short of counts as the limit it stopped at, below it).
+   The bound is the least such route over every feasible S, every order and every choice of
+   entry pieces (Held-Karp over subsets and last piece, exact), for any choice of groups.
 
 Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
 LiDAR fused at the true pose (the env's default: no range noise, no odometry drift).
@@ -301,9 +309,7 @@ class _Problem:
         )
         return self.to_coarse(group_region(self.allowed, rect, self.walls, frame))
 
-    def entry_pieces(
-        self, region: np.ndarray, start: int, tile: int, cap: int
-    ) -> list[np.ndarray]:
+    def entry_pieces(self, region: np.ndarray, start: int, tile: int, cap: int) -> list[np.ndarray]:
         """Where a route can first enter ``region`` (coarse cells): its cells with a move to a
         cell outside it, and the start's cell if inside; split into 8-connected pieces cut by
         ``tile``-cell tiles, at most ``cap`` of them (the rest merged into the nearest)."""
@@ -521,8 +527,11 @@ def _route(
     renumber[pick] = np.arange(len(pick))
     keep = renumber[node_group] >= 0
     return held_karp_entries(
-        first[keep], legs[np.ix_(keep, keep)].copy(), renumber[node_group[keep]],
-        cells[pick].copy(), int(budget)
+        first[keep],
+        legs[np.ix_(keep, keep)].copy(),
+        renumber[node_group[keep]],
+        cells[pick].copy(),
+        int(budget),
     )
 
 

@@ -451,4 +451,3 @@ def held_karp_entries(first, legs, group_of, cells, budget):  # pragma: no cover
         s = s ^ (1 << group_of[e])
         e = p
     return best, order[:n][::-1].copy()
-
