@@ -15,18 +15,26 @@ optimum, so the result is below the path length of every explorer with this robo
    The Dijkstra distance over such hops (the last hop may end inside a ball) is <= the length.
 3. **Where a group can be seen from (a superset).** A scan marks a cell FREE only along a beam
    from the sensor that reaches a point of the cell's square within the LiDAR's range and
-   crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when its
-   square (widened by the LiDAR's mount offset) is farther than the range from A, or one wall
-   (collinear touching walls merged) meets every segment from U to A: its line separates them
+   crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when
+   every segment from U's square (widened by the LiDAR's mount offset) to A is longer than the
+   range or meets a wall. That holds when the two are farther apart than the range; when one
+   wall (collinear touching walls merged) meets every segment: its line separates them
    strictly and the 16 corner-pair segments cross it inside the wall (the segments from U to A
-   fill the convex hull of both, whose crossing with the line is spanned by the corner pairs).
+   fill the convex hull of both, whose crossing with the line is spanned by the corner pairs);
+   or when it holds for each quarter of A in turn, down to ``visibility_splits`` levels (the
+   segments to A are those to its quarters, so walls meeting at a corner block it together).
 4. **Route through must-see groups.** Groups are the coverage-mask cells of the blocks of a
    lattice. If the explorer never entered a group's region, none of its cells is FREE; the goal
    leaves at most ``budget`` mask cells unseen, so the explorer enters the regions of a set S
-   of the chosen groups whose others hold at most ``budget`` cells, in order of first entry,
-   each leg at least the K-hop distance between the regions. The bound is the least such route
-   over every feasible S (Held-Karp, exact), with any choice of groups (disjoint regions only
-   make it tighter); cells no allowed cell can see at all are taken off the budget first.
+   of the chosen groups whose others hold at most ``budget`` cells, in order of first entry.
+   It first enters a region at the start (if the start is in it) or by a move from a cell
+   outside it, so at one of its entry cells (cells of the region with a move to a cell
+   outside); those are split into a few entry pieces. Between first entering one region (at a
+   cell of one piece) and first entering the next (at a cell of one of its pieces) it drives at
+   least the K-hop distance between the two pieces (either direction: a path reversed is a
+   path; a value the search stopped short of counts as the limit it stopped at, below it).
+   The bound is the least such route over every feasible S, every order and every choice of
+   entry pieces (Held-Karp over subsets and last piece, exact), for any choice of groups.
 
 Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
 LiDAR fused at the true pose (the env's default: no range noise, no odometry drift).
@@ -43,7 +51,7 @@ from scipy import ndimage
 
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
-    held_karp_route,
+    held_karp_entries,
     khop_distances,
 )
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
@@ -66,6 +74,16 @@ class LowerBoundParams:
         group_scales: Group block sides to try, as multiples of the side whose square holds one
             more cell than the skip budget (the largest bound wins).
         max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
+        pool_groups: Groups (farthest first) the route's groups are chosen from.
+        leg_limit_share: Legs are searched only up to this share of the farthest entry
+            piece's distance from the start (longer ones count as that much; 1: no limit).
+        keep_share: Share of the well-filled groups, those seen from the fewest cells (on a
+            sample every ``sample_stride`` cells), the pool is drawn from.
+        entry_tile_m: Side of the tiles that split where a route can first enter a region
+            into entry pieces (each piece a node of the route).
+        max_entries: Most entry pieces per group (more are merged into the nearest).
+        visibility_splits: Times a group's rectangle is quartered to find walls that block a
+            cell's view of each quarter (0: one wall for the whole group).
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
@@ -73,8 +91,15 @@ class LowerBoundParams:
 
     hop_cells: int = 8
     distance_cell_factor: int = 2
-    group_scales: tuple[float, ...] = (1.0, 2.0)
+    group_scales: tuple[float, ...] = (1.0, 1.4)
     max_groups: int = 13
+    pool_groups: int = 14
+    keep_share: float = 0.5
+    leg_limit_share: float = 0.6
+    sample_stride: int = 4
+    visibility_splits: int = 3
+    entry_tile_m: float = 1.0
+    max_entries: int = 3
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
     coverage_share: float | None = None
@@ -84,6 +109,10 @@ class LowerBoundParams:
             ("hop_cells", 1, 64),
             ("distance_cell_factor", 1, 8),
             ("max_groups", 1, 18),
+            ("pool_groups", 1, 64),
+            ("sample_stride", 1, 16),
+            ("visibility_splits", 0, 8),
+            ("max_entries", 1, 16),
         ):
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
@@ -96,6 +125,12 @@ class LowerBoundParams:
             v = getattr(self, name)
             if not (math.isfinite(v) and 0 <= v <= 0.5):
                 raise ValueError(f"{name} must be in [0, 0.5] m, got {v!r}")
+        if not (math.isfinite(self.entry_tile_m) and 0.1 <= self.entry_tile_m <= 100):
+            raise ValueError(f"entry_tile_m must be in [0.1, 100] m, got {self.entry_tile_m!r}")
+        for name in ("keep_share", "leg_limit_share"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and 0 < v <= 1):
+                raise ValueError(f"{name} must be in (0, 1], got {v!r}")
         share = self.coverage_share
         if share is not None and not (0 < share <= 1):
             raise ValueError(f"coverage_share must be in (0, 1], got {share!r}")
@@ -245,6 +280,7 @@ class _Problem:
     reach_m: float
     widen_m: float
     hop_cells: int
+    split_depth: int = 0
 
     def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
         """The coarse cell of each map cell (flat indices)."""
@@ -254,27 +290,71 @@ class _Problem:
     def to_coarse(self, flat: np.ndarray) -> np.ndarray:
         return np.unique(self.to_coarse_each(flat))
 
-    def region(self, rect: np.ndarray) -> np.ndarray:
-        """Coarse cells of the region of the group in ``rect``."""
+    def region(self, rect: np.ndarray, stride: int = 1) -> np.ndarray:
+        """Coarse cells of the region of the group in ``rect`` (with ``stride`` > 1 a sample
+        of it, only to rank groups)."""
         g = self.geometry
-        fine = group_region(
-            self.allowed,
-            rect,
-            self.walls,
-            g.origin_x_m,
-            g.origin_y_m,
-            g.resolution_m,
-            self.reach_m,
-            self.widen_m,
-            _VISIBILITY_TOL_M,
+        frame = np.array(
+            [
+                g.origin_x_m,
+                g.origin_y_m,
+                g.resolution_m,
+                self.reach_m,
+                self.widen_m,
+                _VISIBILITY_TOL_M,
+                self.split_depth,
+                stride,
+            ],
+            dtype=np.float64,
         )
-        return self.to_coarse(fine)
+        return self.to_coarse(group_region(self.allowed, rect, self.walls, frame))
+
+    def entry_pieces(self, region: np.ndarray, start: int, tile: int, cap: int) -> list[np.ndarray]:
+        """Where a route can first enter ``region`` (coarse cells): its cells with a move to a
+        cell outside it, and the start's cell if inside; split into 8-connected pieces cut by
+        ``tile``-cell tiles, at most ``cap`` of them (the rest merged into the nearest)."""
+        hc, wc = self.coarse.shape
+        if np.any(region == start):  # entered at the start, before any move
+            return [np.array([start], dtype=np.int64)]
+        inside = np.zeros(hc * wc, dtype=bool)
+        inside[region] = True
+        bits = self.coarse.reshape(-1)[region]
+        r, c = np.divmod(region, wc)
+        edge = np.zeros(region.size, dtype=bool)
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                if dr == 0 and dc == 0:
+                    continue
+                has = ((bits >> (3 * (dr + 1) + dc + 1)) & 1).astype(bool)
+                r2 = np.clip(r + dr, 0, hc - 1)
+                c2 = np.clip(c + dc, 0, wc - 1)
+                edge |= has & ~inside[r2 * wc + c2]
+        cells = region[edge]
+        if cells.size == 0:
+            return []
+        image = np.zeros(hc * wc, dtype=bool)
+        image[cells] = True
+        labels, _ = ndimage.label(image.reshape(hc, wc), structure=_EIGHT)
+        er, ec = np.divmod(cells, wc)
+        key = labels.reshape(-1)[cells] * (hc * wc) + (er // tile) * wc + ec // tile
+        _, piece = np.unique(key, return_inverse=True)
+        sizes = np.bincount(piece)
+        if sizes.size > cap:
+            big = np.argsort(-sizes, kind="stable")[:cap]
+            cy = np.bincount(piece, er) / sizes
+            cx = np.bincount(piece, ec) / sizes
+            near = big[np.argmin(np.hypot(cy[:, None] - cy[big], cx[:, None] - cx[big]), axis=1)]
+            piece = near[piece]
+        return [cells[piece == q] for q in np.unique(piece)]
 
     def distances(
-        self, coarse_sources: np.ndarray, targets: list[np.ndarray] | None = None
+        self,
+        coarse_sources: np.ndarray,
+        targets: list[np.ndarray] | None = None,
+        limit_m: float = math.inf,
     ) -> np.ndarray:
         """K-hop distances from the sources; with ``targets`` (coarse cell sets), exact only
-        as far as each set's least value needs."""
+        as far as each set's least value needs; values above ``limit_m`` lowered to it."""
         src = np.asarray(coarse_sources, dtype=np.int64)
         res = self.geometry.resolution_m * self.factor
         target_of = np.full(self.coarse.shape, -1, dtype=np.int64)
@@ -282,7 +362,9 @@ class _Problem:
         sets = [t for t in (targets or []) if t.size]
         for j, t in enumerate(sets):
             flat[t] = j
-        d = khop_distances(self.coarse, src, self.hop_cells, res, target_of, len(sets))
+        d = khop_distances(
+            self.coarse, src, self.hop_cells, res, target_of, len(sets), float(limit_m)
+        )
         return d.reshape(-1)
 
 
@@ -340,12 +422,14 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         reach_m=facts.sensor.max_range_m + _VISIBILITY_TOL_M,
         widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
         hop_cells=p.hop_cells,
+        split_depth=p.visibility_splits,
     )
-    from_start = prob.distances(prob.to_coarse(np.array([sr * geo.width + sc])))
+    start = prob.to_coarse(np.array([sr * geo.width + sc]))
+    from_start = prob.distances(start)
     best: _Route | None = None
     for scale in p.group_scales:
         block = max(1, int(math.ceil(scale * math.sqrt(budget + 1))))
-        found = _bound_for_blocks(prob, mask, block, from_start, budget, p.max_groups)
+        found = _bound_for_blocks(prob, mask, block, (int(start[0]), from_start), budget, p)
         if best is None or found.length_m > best.length_m:
             best = found
     assert best is not None
@@ -374,11 +458,17 @@ class _Route:
 
 
 def _bound_for_blocks(
-    prob: _Problem, mask: np.ndarray, block: int, from_start: np.ndarray, budget: int, cap: int
+    prob: _Problem,
+    mask: np.ndarray,
+    block: int,
+    start: tuple[int, np.ndarray],
+    budget: int,
+    p: LowerBoundParams,
 ) -> _Route:
     """Groups of ``block``-cell lattice blocks, chosen farthest first (from the start and the
     groups chosen so far, by distance to the group's own cells: a choice, not a proof step),
-    then the exact route over them."""
+    then the exact route over their entry pieces. ``start``: its coarse cell and distances."""
+    start_cell, from_start = start
     rects, cells, _ = mask_groups(mask, prob.geometry, block)
     rows, cols = np.nonzero(mask)
     bw = -(-mask.shape[1] // block)
@@ -386,48 +476,119 @@ def _bound_for_blocks(
     coarse_of = prob.to_coarse_each(rows * mask.shape[1] + cols)
     score = np.full(rects.shape[0], np.inf)
     np.minimum.at(score, group_of, from_start[coarse_of])
-    # Well-filled groups only (a scrap of a block is cheap to leave unseen).
+    # Well-filled groups only (a scrap of a block is cheap to leave unseen), and of those the
+    # share seen from the fewest cells (a sample of each region).
     score[cells < 0.5 * block * block] = 0.0
+    live = np.flatnonzero(score > 0)
+    if p.keep_share < 1 and live.size > p.pool_groups:
+        sample = np.array([prob.region(rects[g], p.sample_stride).size for g in live])
+        cut = np.quantile(sample, p.keep_share)
+        score[live[sample > cut]] = 0.0
     centres = 0.5 * (rects[:, :2] + rects[:, 2:])
     chosen: list[int] = []
     regions: list[np.ndarray] = []
-    while len(chosen) < min(cap, rects.shape[0]):
+    while len(chosen) < min(p.pool_groups, rects.shape[0]):
         g = int(np.argmax(score))
         if not score[g] > 0:
             break
         chosen.append(g)
         regions.append(prob.region(rects[g]))
         np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
-    m = len(chosen)
-    first = np.array([_least(from_start, r) for r in regions], dtype=np.float64)
-    legs = np.zeros((m, m), dtype=np.float64)
-    for i in range(m):
-        others = [regions[j] for j in range(m) if j != i]
-        field = prob.distances(regions[i], others) if regions[i].size else None
-        for j in range(m):
-            legs[i, j] = 0.0 if i == j else math.inf if field is None else _least(field, regions[j])
-    # A path from region i to j, reversed, runs from j to i: either direction bounds it.
-    legs = np.maximum(legs, legs.T)
-    idx = np.array(chosen, dtype=np.int64)
-    # A group's region is a set: a route may enter it at one cell and leave from another, so a
-    # group can shorten the route; each prefix of the choice is a valid problem: keep the best.
-    length, order, m_best = 0.0, np.zeros(0, dtype=np.int64), 0
-    for k in range(1, m + 1):
-        got, got_order = held_karp_route(
-            first[:k], legs[:k, :k].copy(), cells[idx[:k]].astype(np.int64), int(budget)
-        )
-        if got > length:
-            length, order, m_best = float(got), got_order, k
-    idx = idx[:m_best]
-    regions = regions[:m_best]
+    tile = max(1, int(round(p.entry_tile_m / (prob.geometry.resolution_m * prob.factor))))
+    pieces = [prob.entry_pieces(r, start_cell, tile, p.max_entries) for r in regions]
+    node_group = np.array([i for i, ps in enumerate(pieces) for _ in ps], dtype=np.int64)
+    nodes = [q for ps in pieces for q in ps]
+    first, legs = _entry_legs(prob, nodes, node_group, from_start, p.leg_limit_share)
+    pick = _choose_groups(first, legs, node_group, cells[chosen].astype(np.int64), budget, p)
+    length, order = _route(first, legs, node_group, cells[chosen].astype(np.int64), budget, pick)
+    idx = np.array(chosen, dtype=np.int64)[pick]
     return _Route(
         length_m=float(length),
         cells=tuple(int(c) for c in cells[idx]),
         centres_m=tuple((float(x), float(y)) for x, y in centres[idx]),
-        region_cells=tuple(int(r.size) for r in regions),
+        region_cells=tuple(int(regions[i].size) for i in pick),
         route=tuple(int(i) for i in order),
         block_cells=block,
     )
+
+
+def _route(
+    first: np.ndarray,
+    legs: np.ndarray,
+    node_group: np.ndarray,
+    cells: np.ndarray,
+    budget: int,
+    pick: list[int],
+) -> tuple[float, np.ndarray]:
+    """The exact route over the groups ``pick`` (indices into ``cells``), in their numbering."""
+    if not pick:
+        return 0.0, np.zeros(0, dtype=np.int64)
+    renumber = np.full(cells.size, -1, dtype=np.int64)
+    renumber[pick] = np.arange(len(pick))
+    keep = renumber[node_group] >= 0
+    return held_karp_entries(
+        first[keep],
+        legs[np.ix_(keep, keep)].copy(),
+        renumber[node_group[keep]],
+        cells[pick].copy(),
+        int(budget),
+    )
+
+
+def _choose_groups(
+    first: np.ndarray,
+    legs: np.ndarray,
+    node_group: np.ndarray,
+    cells: np.ndarray,
+    budget: int,
+    p: LowerBoundParams,
+) -> list[int]:
+    """Groups added one at a time, each the one whose route is longest (ties: the farther from
+    the start), up to ``max_groups``; the prefix with the longest route is kept (a choice, not
+    a proof step: any subset of groups gives a valid bound). A group the budget lets the route
+    skip adds nothing alone, so the search goes on past steps that do not lengthen the route."""
+    far = np.full(cells.size, 0.0)
+    ok = np.isfinite(first)
+    np.maximum.at(far, node_group[ok], first[ok])
+    pick: list[int] = []
+    best, best_k = 0.0, 0
+    while len(pick) < min(p.max_groups, cells.size):
+        trial = [
+            (_route(first, legs, node_group, cells, budget, pick + [g])[0], far[g], g)
+            for g in range(cells.size)
+            if g not in pick
+        ]
+        value, _, g = max(trial)
+        pick.append(g)
+        if value > best:
+            best, best_k = value, len(pick)
+    pick = pick[:best_k]
+    return pick
+
+
+def _entry_legs(
+    prob: _Problem,
+    nodes: list[np.ndarray],
+    node_group: np.ndarray,
+    from_start: np.ndarray,
+    share: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The start-to-node and node-to-node K-hop distances (the least over each piece's cells;
+    either direction of a leg bounds it, so the larger of the two)."""
+    n = len(nodes)
+    first = np.array([_least(from_start, q) for q in nodes], dtype=np.float64)
+    # Legs longer than a share of the farthest node's distance from the start are lowered to
+    # it (still a bound; it saves searching the far side of the map from every node).
+    ok = np.isfinite(first)
+    limit = share * float(first[ok].max()) if ok.any() and share < 1 else math.inf
+    legs = np.zeros((n, n), dtype=np.float64)
+    for v in range(n):
+        others = [nodes[u] for u in range(n) if node_group[u] != node_group[v]]
+        field = prob.distances(nodes[v], others, limit_m=limit)
+        for u in range(n):
+            if node_group[u] != node_group[v]:
+                legs[v, u] = _least(field, nodes[u])
+    return first, np.maximum(legs, legs.T)
 
 
 def _least(field: np.ndarray, cells: np.ndarray) -> float:

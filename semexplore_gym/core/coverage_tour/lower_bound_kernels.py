@@ -57,7 +57,9 @@ def _heap_pop(keys, vals, n):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no cover - numba
+def khop_distances(
+    moves, sources, k, res, target_of, n_targets, limit=np.inf
+):  # pragma: no cover - numba
     """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
     ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
@@ -68,7 +70,9 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
     the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
 
     With ``n_targets`` > 0 it stops once each target set (``target_of[cell]``, -1 for none)
-    holds its final least distance: every later value is at least the popped one.
+    holds its final least distance: every later value is at least the popped one. It also stops
+    once the popped value reaches ``limit`` and returns ``limit`` wherever its value is larger
+    (every value not yet final is at least the popped one): a lower bound still.
 
     Returns:
         ``moves.shape`` float64 distances (inf where unreached, or not needed for the targets).
@@ -106,6 +110,8 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
         if settled[a] or d > chain[a]:
             continue
         if n_targets > 0 and d >= tbest.max():
+            break
+        if d >= limit:
             break
         settled[a] = True
         ar = a // w
@@ -150,6 +156,10 @@ def khop_distances(moves, sources, k, res, target_of, n_targets):  # pragma: no 
                     stamp[nl] = sid
                     queue[tail] = nl
                     tail += 1
+    if limit < np.inf:
+        for i in range(h * w):
+            if best[i] > limit:
+                best[i] = limit
     return best.reshape(h, w)
 
 
@@ -188,10 +198,88 @@ def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - n
 
 
 @njit(cache=True)
-def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  # pragma: no cover
+def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover
+    """Position in ``near[:m]`` of a wall that meets every segment between the two rectangles
+    (tried first: ``last``), or -1 for none."""
+    if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
+        return last
+    for p in range(m):
+        if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
+            return p
+    return -1
+
+
+@njit(cache=True)
+def _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pragma: no cover
+    """Whether every segment between ``rect`` and the square ``ux, uy`` (corners 0 and 2) no
+    longer than ``reach_m`` meets a wall: one wall blocks all of them, the two are farther
+    apart than ``reach_m``, or (up to ``depth`` times) each quarter of ``rect`` is blind in
+    turn (the segments from a rectangle are those from its quarters). Returns
+    ``(blind, last)``."""
+    ax = work[0]
+    ay = work[1]
+    fa = work[2]
+    fu = work[3]
+    stack = np.empty((4 * depth + 1, 5))
+    stack[0, 0] = rect[0]
+    stack[0, 1] = rect[1]
+    stack[0, 2] = rect[2]
+    stack[0, 3] = rect[3]
+    stack[0, 4] = 0.0
+    n = 1
+    while n > 0:
+        n -= 1
+        x0 = stack[n, 0]
+        y0 = stack[n, 1]
+        x1 = stack[n, 2]
+        y1 = stack[n, 3]
+        d = int(stack[n, 4])
+        gap_x = max(0.0, max(x0 - ux[2], ux[0] - x1))
+        gap_y = max(0.0, max(y0 - uy[2], uy[0] - y1))
+        if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
+            continue
+        ax[0] = x0
+        ax[1] = x1
+        ax[2] = x1
+        ax[3] = x0
+        ay[0] = y0
+        ay[1] = y0
+        ay[2] = y1
+        ay[3] = y1
+        p = _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu)
+        if p >= 0:
+            last = p
+            continue
+        if d >= depth:
+            return False, last
+        xm = 0.5 * (x0 + x1)
+        ym = 0.5 * (y0 + y1)
+        for q in range(4):
+            stack[n, 0] = x0 if q % 2 == 0 else xm
+            stack[n, 2] = xm if q % 2 == 0 else x1
+            stack[n, 1] = y0 if q < 2 else ym
+            stack[n, 3] = ym if q < 2 else y1
+            stack[n, 4] = d + 1
+            n += 1
+    return True, last
+
+
+@njit(cache=True)
+def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
-    rectangle and no single wall of ``walls`` meets every segment between the two."""
+    rectangle and the walls do not meet every segment between the two (:func:`_blind`, quarters
+    down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
+    stride``; a ``stride`` above 1 tests only every stride-th row and column (a sample, for
+    ranking groups, never for the bound)."""
+    gx0 = frame[0]
+    gy0 = frame[1]
+    res = frame[2]
+    reach_m = frame[3]
+    widen_m = frame[4]
+    tol = frame[5]
+    depth = int(frame[6])
+    stride = int(frame[7])
     h, w = allowed.shape
     c_lo = max(0, int(math.floor((rect[0] - reach_m - widen_m - gx0) / res)) - 1)
     c_hi = min(w - 1, int(math.floor((rect[2] + reach_m + widen_m - gx0) / res)) + 1)
@@ -211,20 +299,17 @@ def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  #
         if wx1 >= bx0 and wx0 <= bx1 and wy1 >= by0 and wy0 <= by1:
             near[m] = q
             m += 1
-    ax = np.array([rect[0], rect[2], rect[2], rect[0]])
-    ay = np.array([rect[1], rect[1], rect[3], rect[3]])
     ux = np.empty(4)
     uy = np.empty(4)
-    fa = np.empty(4)
-    fu = np.empty(4)
+    work = np.empty((4, 4))
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
     last = 0
-    for r in range(r_lo, r_hi + 1):
+    for r in range(r_lo, r_hi + 1, stride):
         y0 = gy0 + r * res - widen_m
         y1 = gy0 + (r + 1) * res + widen_m
         gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
-        for c in range(c_lo, c_hi + 1):
+        for c in range(c_lo, c_hi + 1, stride):
             if not allowed[r, c]:
                 continue
             x0 = gx0 + c * res - widen_m
@@ -240,15 +325,7 @@ def group_region(allowed, rect, walls, gx0, gy0, res, reach_m, widen_m, tol):  #
             uy[1] = y0
             uy[2] = y1
             uy[3] = y1
-            blind = False
-            if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
-                blind = True
-            else:
-                for p in range(m):
-                    if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
-                        blind = True
-                        last = p
-                        break
+            blind, last = _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work)
             if not blind:
                 out[count] = r * w + c
                 count += 1
@@ -309,5 +386,68 @@ def held_karp_route(first, legs, cells, budget):  # pragma: no cover - numba
         n += 1
         p = parent[s, e]
         s = s ^ (1 << e)
+        e = p
+    return best, order[:n][::-1].copy()
+
+
+@njit(cache=True)
+def held_karp_entries(first, legs, group_of, cells, budget):  # pragma: no cover - numba
+    """:func:`held_karp_route` over entry pieces: node ``v`` is where the route first enters
+    the region of group ``group_of[v]``; ``first[v]``: start to node v; ``legs[v, w]``: node v to
+    node w. A route visits one node of each group of a subset S, and S leaves at most ``budget``
+    cells unvisited. Returns ``(length, group order)`` (inf and an empty order if none)."""
+    m = cells.shape[0]
+    nn = first.shape[0]
+    full = 1 << m
+    dp = np.full((full, max(nn, 1)), np.inf)
+    parent = np.full((full, max(nn, 1)), -1, dtype=np.int64)
+    held = np.zeros(full, dtype=np.int64)
+    total = 0
+    for i in range(m):
+        total += cells[i]
+    for v in range(nn):
+        s = 1 << group_of[v]
+        if first[v] < dp[s, v]:
+            dp[s, v] = first[v]
+    best = np.inf
+    best_set = -1
+    best_end = -1
+    if total <= budget:
+        best = 0.0
+        best_set = 0
+    for s in range(1, full):
+        low = s & (-s)
+        b = 0
+        while (1 << b) != low:
+            b += 1
+        held[s] = held[s ^ low] + cells[b]
+        ok = total - held[s] <= budget
+        for v in range(nn):
+            val = dp[s, v]
+            if not ((s >> group_of[v]) & 1) or val == np.inf:
+                continue
+            if ok and val < best:
+                best = val
+                best_set = s
+                best_end = v
+            if val >= best:
+                continue
+            for u in range(nn):
+                if (s >> group_of[u]) & 1:
+                    continue
+                t = s | (1 << group_of[u])
+                nv = val + legs[v, u]
+                if nv < dp[t, u]:
+                    dp[t, u] = nv
+                    parent[t, u] = v
+    order = np.empty(m, dtype=np.int64)
+    n = 0
+    s = best_set
+    e = best_end
+    while e >= 0:
+        order[n] = group_of[e]
+        n += 1
+        p = parent[s, e]
+        s = s ^ (1 << group_of[e])
         e = p
     return best, order[:n][::-1].copy()
