@@ -210,7 +210,7 @@ def test_every_reader_of_a_config_finds_the_shipped_one_from_elsewhere(
     assert {"paper", "mazes", "real"} <= set(list_suites())
     assert load_suite("paper").name == "paper"
     assert load_suite("configs/suites/mazes.yaml").name == "mazes"
-    assert load_policy_config("configs/expert/paper_method.yaml").params
+    assert load_policy_config("configs/expert/paper_method.yaml").policy == "semantic-paper"
     assert load_env_config("configs/paper.yaml").robot.max_linear_speed_mps == 0.15
     assert load_train_config("configs/agents/bc_maze.yml", []).bc.epochs > 0
 

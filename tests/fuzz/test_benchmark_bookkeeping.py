@@ -28,7 +28,7 @@ def fake_task(task):
 
     row = dict.fromkeys(CSV_COLUMNS, 1.0)
     row.update(world=task.world, policy=task.policy, seed=task.seed, self_stopped=True)
-    row.update(slam_lost=False)  # booleans, as self_stopped
+    row.update(slam_lost=False, slam_false_stop=False, slam_stop_artefact="")  # as self_stopped
     row.update(stop_reason="done", collisions=0, steps=3, T90_s=None, scored_replans=2)
     row["mission_time_s"] = task.max_time_s or 5.0
     return {"row": row, "trace": np.zeros((2, 3)), "trajectory": np.zeros((2, 3))}

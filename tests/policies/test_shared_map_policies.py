@@ -19,7 +19,7 @@ import semexplore_gym  # noqa: F401
 from semexplore_gym.evaluation.rollout import map_observation_for, run_mission
 
 #: Registered names that need an argument (a model file, a module) are not built here.
-_ARGUMENT_POLICIES = {"py", "sb3", "pretrained"}
+_ARGUMENT_POLICIES = {"py", "sb3", "pretrained", "option-ppo"}
 FLAGGED = sorted(
     name
     for name in policy_factories()
