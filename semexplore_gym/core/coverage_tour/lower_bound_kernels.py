@@ -332,62 +332,13 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     return out[:count].copy()
 
 
-@njit(cache=True)
-def held_karp_route(first, legs, cells, budget):  # pragma: no cover - numba
+def held_karp_route(first, legs, cells, budget):
     """Shortest route from the start through a subset S of the groups, over every S whose
     unvisited groups hold at most ``budget`` cells. ``first[i]``: start to group i; ``legs[i, j]``:
     group i to group j. Returns ``(length, order)`` (inf and an empty order if none is finite)."""
-    m = first.shape[0]
-    full = 1 << m
-    dp = np.full((full, max(m, 1)), np.inf)
-    parent = np.full((full, max(m, 1)), -1, dtype=np.int64)
-    held = np.zeros(full, dtype=np.int64)
-    total = 0
-    for i in range(m):
-        total += cells[i]
-        dp[1 << i, i] = first[i]
-    best = np.inf
-    best_set = -1
-    best_end = -1
-    if total <= budget:
-        best = 0.0
-        best_set = 0
-    for s in range(1, full):
-        low = s & (-s)
-        b = 0
-        while (1 << b) != low:
-            b += 1
-        held[s] = held[s ^ low] + cells[b]
-        ok = total - held[s] <= budget
-        for i in range(m):
-            v = dp[s, i]
-            if not ((s >> i) & 1) or v == np.inf:
-                continue
-            if ok and v < best:
-                best = v
-                best_set = s
-                best_end = i
-            if v >= best:
-                continue
-            for j in range(m):
-                if (s >> j) & 1:
-                    continue
-                t = s | (1 << j)
-                nv = v + legs[i, j]
-                if nv < dp[t, j]:
-                    dp[t, j] = nv
-                    parent[t, j] = i
-    order = np.empty(m, dtype=np.int64)
-    n = 0
-    s = best_set
-    e = best_end
-    while e >= 0:
-        order[n] = e
-        n += 1
-        p = parent[s, e]
-        s = s ^ (1 << e)
-        e = p
-    return best, order[:n][::-1].copy()
+    return held_karp_entries(
+        first, legs, np.arange(len(first)), cells, budget
+    )  # each group entered at one place: its own node
 
 
 @njit(cache=True)
