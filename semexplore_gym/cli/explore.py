@@ -17,6 +17,7 @@ from typing import Any
 
 from semexplore_gym.cli._flags import add_renamed_flag, check_output_flag
 from semexplore_gym.cli._output import print_json
+from semexplore_gym.evaluation.run_row import SLAM_COLUMNS
 from semexplore_gym.evaluation.warmup import COMPILE_ESTIMATE
 
 #: Keys of the ``--json`` object, in order.
@@ -32,19 +33,9 @@ JSON_KEYS: tuple[str, ...] = (
     "wall_time_s",
     "policy_version",
 )
-#: Added to the ``--json`` object when the env runs SLAM (``--env-config slam``).
-SLAM_JSON_KEYS: tuple[str, ...] = (
-    "ate_m",
-    "rpe_m",
-    "map_error",
-    "loop_closures",
-    "slam_lost",
-    "slam_lost_events",
-    "slam_degenerate_matches",
-    "odom_ate_m",
-    "slam_false_stop",
-    "slam_stop_artefact",
-)
+#: Added to the ``--json`` object when the env runs SLAM (``--env-config slam``): the same
+#: figures as ``runs.csv``'s SLAM columns.
+SLAM_JSON_KEYS: tuple[str, ...] = SLAM_COLUMNS
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
