@@ -15,6 +15,10 @@ oracle's T99 is at most each other policy's; and the median T99 / bound per poli
     python scripts/check_lower_bound.py runs/paper --fresh   # after a change to the bound
     python scripts/check_lower_bound.py ../theirs/runs/x --bounds-dir runs/bounds   # read-only
     python scripts/check_lower_bound.py runs/paper --out runs/paper/lower_bounds.csv
+    python scripts/check_lower_bound.py runs/a runs/b --missions-out checked.csv
+    semexplore report checked.csv   # the same tables again, from the checked missions
+
+The per-family figures are :mod:`semexplore_gym.evaluation.bound_check`'s.
 """
 
 from __future__ import annotations
@@ -22,15 +26,14 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
 import sys
-from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
+from semexplore_gym.evaluation.bound_check import family_report, report_lines, write_missions
+
 BOUND_COLUMNS = ("world", "seed", "lower_bound_m", "lower_bound_s", "groups", "bound_planning_s")
-ORACLE = "oracle"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -48,6 +51,13 @@ def main(argv: list[str] | None = None) -> int:
         default=None,
         help="keep each folder's bound CSV here (named after the folder's path) instead of in "
         "the folder: for folders that are not yours to write in",
+    )
+    ap.add_argument(
+        "--missions-out",
+        type=Path,
+        default=None,
+        help="write every checked mission (its T99, drive to 99 %% and its start's bound) to "
+        "this CSV, which 'semexplore report FILE' reads",
     )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     ap.add_argument("--json", action="store_true", help="print the per-family report as JSON")
@@ -78,10 +88,12 @@ def main(argv: list[str] | None = None) -> int:
             out.unlink(missing_ok=True)
         bounds = compute_bounds(runs, settings, out, not args.no_progress)
         missions += checked_missions(runs, bounds, run_dir, settings)
+    if args.missions_out is not None:
+        write_missions(args.missions_out, missions)
     if args.json:
         print(json.dumps(family_report(missions), indent=1))
     else:
-        print(report(missions))
+        print("\n".join(report_lines(missions)))
     return 0
 
 
@@ -192,112 +204,6 @@ def checked_missions(
             }
         )
     return out
-
-
-def _median(xs: list[float]) -> float | None:
-    return round(float(np.median(xs)), 3) if xs else None
-
-
-def _oracle_wins(ms: list[dict]) -> tuple[int, int]:
-    """``(pairs where the oracle's T99 <= the other policy's, pairs)`` over every other policy
-    that ran the same start in the same folder (a policy that never reached 99 % loses to one
-    that did; pairs where neither did are left out)."""
-    by_start: dict[tuple, dict[str, float | None]] = defaultdict(dict)
-    for m in ms:
-        by_start[(m["folder"], m["start"])][m["policy"]] = m["T99_s"]
-    wins = pairs = 0
-    for times in by_start.values():
-        if ORACLE not in times:
-            continue
-        mine = times[ORACLE]
-        for policy, t in times.items():
-            if policy == ORACLE or (mine is None and t is None):
-                continue
-            pairs += 1
-            wins += mine is not None and (t is None or mine <= t)
-    return wins, pairs
-
-
-def family_report(missions: list[dict]) -> dict[str, dict]:
-    """Per world family (and ``all``): starts, missions, violations, the medians and the
-    oracle's wins (see the module docstring)."""
-    fams: dict[str, list[dict]] = defaultdict(list)
-    for m in missions:
-        fams[m["family"]].append(m)
-    fams["all"] = list(missions)
-    out = {}
-    for fam, ms in sorted(fams.items()):
-        best: dict[tuple, float] = {}
-        bound: dict[tuple, float] = {}
-        for m in ms:
-            bound[m["start"]] = m["bound_s"]
-            if m["T99_s"] is not None:
-                best[m["start"]] = min(best.get(m["start"], math.inf), m["T99_s"])
-        ok = [k for k in best if 0 < bound[k] < math.inf]
-        oracle = [
-            math.inf if m["T99_s"] is None else m["T99_s"] / m["bound_s"]
-            for m in ms
-            if m["policy"] == ORACLE and 0 < m["bound_s"] < math.inf
-        ]
-        wins, pairs = _oracle_wins(ms)
-        out[fam] = {
-            "starts": len(bound),
-            "missions": len(ms),
-            "with_T99": sum(m["T99_s"] is not None for m in ms),
-            "T99_below_bound": sum(
-                m["T99_s"] is not None and m["T99_s"] < m["bound_s"] for m in ms
-            ),
-            "with_drive": sum(m["drive_m"] is not None for m in ms),
-            "drive_below_bound": sum(
-                m["drive_m"] is not None and m["drive_m"] < m["bound_m"] for m in ms
-            ),
-            "median_best_known_over_bound": _median([best[k] / bound[k] for k in ok]),
-            "median_oracle_over_bound": _median(oracle),
-            "oracle_missions": len(oracle),
-            "oracle_wins": wins,
-            "oracle_pairs": pairs,
-        }
-    return out
-
-
-def report(missions: list[dict]) -> str:
-    """Violations (must be none), the per-family table and median T99 / bound per policy."""
-    fams = family_report(missions)
-    total = fams["all"]
-    lines = [
-        f"missions: {total['missions']}; with T99: {total['with_T99']}, "
-        f"T99 below the bound: {total['T99_below_bound']}",
-        f"with a drive to 99 % on file: {total['with_drive']}, "
-        f"drive below the bound: {total['drive_below_bound']}",
-        "",
-        "| family | starts | missions | below the bound | best known ÷ bound | "
-        "oracle ÷ bound (its missions) | oracle T99 <= other's |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    for fam, f in fams.items():
-        share = f"{f['oracle_wins']}/{f['oracle_pairs']}" if f["oracle_pairs"] else "-"
-        if f["oracle_pairs"]:
-            share += f" ({100.0 * f['oracle_wins'] / f['oracle_pairs']:.0f} %)"
-        lines.append(
-            f"| {fam} | {f['starts']} | {f['missions']} | "
-            f"{f['T99_below_bound'] + f['drive_below_bound']} | "
-            f"{_fmt(f['median_best_known_over_bound'])} | "
-            f"{_fmt(f['median_oracle_over_bound'])} ({f['oracle_missions']}) | {share} |"
-        )
-    ratios: dict[tuple[str, str], list[float]] = defaultdict(list)
-    for m in missions:
-        if m["T99_s"] is not None and 0 < m["bound_s"] < math.inf:
-            ratios[(m["policy"], m["family"])].append(m["T99_s"] / m["bound_s"])
-    lines += ["", "| policy | family | n | median T99 / bound | min |", "|---|---|---|---|---|"]
-    for (policy, fam), xs in sorted(ratios.items()):
-        lines.append(
-            f"| {policy} | {fam} | {len(xs)} | {float(np.median(xs)):.2f} | {min(xs):.2f} |"
-        )
-    return "\n".join(lines)
-
-
-def _fmt(x: float | None) -> str:
-    return "-" if x is None else f"{x:.2f}"
 
 
 if __name__ == "__main__":

@@ -74,3 +74,20 @@ def test_the_docs_tables_are_what_semexplore_report_prints(tmp_path: Path, capsy
         assert main(["report", str(DOCS / source), *(["--table", table] if table else [])]) == 0
         printed = capsys.readouterr().out
         assert written[name].read_text(encoding="utf-8").startswith(printed), name
+
+
+def test_the_oracle_tables_have_each_family_of_their_runs(tmp_path: Path) -> None:
+    ext = _extension()
+    written = ext.write_tables(DOCS, tmp_path)
+    with (DOCS / ext.TABLES["oracle_regret"][0]).open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    regret = written["oracle_regret"].read_text(encoding="utf-8")
+    for family in {world_family(r["world"]) for r in runs}:
+        assert f"### {family}\n" in regret, family
+    with (DOCS / ext.TABLES["lower_bound_check"][0]).open(newline="") as f:
+        missions = list(csv.DictReader(f))
+    check = written["lower_bound_check"].read_text(encoding="utf-8")
+    for family in {world_family(r["world"]) for r in missions}:
+        n = sum(1 for r in missions if world_family(r["world"]) == family)
+        assert re.search(rf"^\| {family} \| \d+ \| {n} \| 0 \|", check, re.M), family
+    assert f"missions: {len(missions)};" in check

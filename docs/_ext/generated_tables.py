@@ -17,6 +17,8 @@ from typing import Any
 TABLES: dict[str, tuple[str, str | None]] = {
     "suites_overview": ("results/suites/runs.csv", "overview"),
     "best_known": ("../configs/best_known/best_known.csv", None),
+    "oracle_regret": ("results/oracle/runs.csv", "regret"),
+    "lower_bound_check": ("results/oracle/missions.csv", None),
 }
 GENERATED_DIR = "_generated"
 

@@ -1,5 +1,5 @@
-"""Markdown tables from result files: a benchmark's or a team benchmark's ``runs.csv``, or a
-best-known table.
+"""Markdown tables from result files: a benchmark's or a team benchmark's ``runs.csv``, a
+best-known table, or the lower bound's checked missions.
 
 One function, :func:`report_tables`, serves ``semexplore report`` and the docs build, which
 renders the user guide's result tables from the small result files under ``docs/results/`` (a
@@ -45,9 +45,9 @@ NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
 class TableReport:
     """What :func:`report_tables` read and the Markdown it made."""
 
-    kind: str  # "benchmark", "team" or "best_known"
+    kind: str  # "benchmark", "team", "best_known" or "bound_check"
     source: Path  # the CSV file read
-    table: str  # a name of RUN_TABLES, "team" or "best_known"
+    table: str  # a name of RUN_TABLES, "team", "best_known" or "bound_check"
     rows: int  # rows read (missions, or best-known entries)
     markdown: str
 
@@ -70,8 +70,10 @@ def report_tables(
 
     Args:
         path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (a team
-            benchmark's is told by its ``n_robots`` column), or a best-known table
-            (``configs/best_known/best_known.csv``, told by its columns).
+            benchmark's is told by its ``n_robots`` column), a best-known table
+            (``configs/best_known/best_known.csv``, told by its columns), or the checked
+            missions of ``scripts/check_lower_bound.py --missions-out`` (the bound's check per
+            family, :mod:`.bound_check`).
         table: for a benchmark's ``runs.csv``, one of :data:`RUN_TABLES` (default
             ``overview``); a team benchmark's summary and a best-known table are one table
             each and take None.
@@ -81,7 +83,7 @@ def report_tables(
         ValueError: one line naming the problem: no such file, no ``runs.csv`` in the folder,
             an unknown table, a column the table needs that the file lacks, no rows.
     """
-    from semexplore_gym.evaluation import best_known
+    from semexplore_gym.evaluation import best_known, bound_check
 
     source = _csv_of(Path(path))
     header = _header(source)
@@ -97,6 +99,14 @@ def report_tables(
         return TableReport("best_known", source, "best_known", len(entries), md)
     if "n_robots" in header:
         return _team_report(source, header, table)
+    if set(bound_check.MISSION_COLUMNS) <= set(header):
+        if table is not None:
+            raise ValueError(
+                f"{source} holds checked missions, which have one table (got --table {table})"
+            )
+        missions = bound_check.read_missions(source)
+        md = "\n".join(bound_check.report_lines(missions)) + "\n"
+        return TableReport("bound_check", source, "bound_check", len(missions), md)
     name = table or "overview"
     if name not in RUN_TABLES:
         raise ValueError(f"unknown table {name!r}: choose one of {', '.join(RUN_TABLES)}")

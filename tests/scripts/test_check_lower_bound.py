@@ -37,7 +37,7 @@ def _fake_runs(folder: Path, t99_s: list[str], policies: tuple[str, ...] = ("p",
             )
 
 
-def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path) -> None:
+def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path, capsys) -> None:
     run_dir = tmp_path / "bench"
     _fake_runs(run_dir, ["0.5", "1e6", "", "1e6"])
     first = _run(str(run_dir), "--no-progress")
@@ -46,9 +46,16 @@ def test_a_mission_faster_than_the_bound_is_counted_and_the_csv_resumes(tmp_path
     rows = list(csv.DictReader((run_dir / "lower_bounds.csv").open()))
     assert sorted(int(r["seed"]) for r in rows) == [0, 1]
     assert all(float(r["lower_bound_s"]) > 0.5 for r in rows)
-    again = _run(str(run_dir), "--no-progress")  # resumed: nothing recomputed
+    missions = tmp_path / "checked.csv"
+    again = _run(str(run_dir), "--no-progress", "--missions-out", str(missions))  # resumed
     assert again.returncode == 0 and again.stdout == first.stdout
     assert len(list(csv.DictReader((run_dir / "lower_bounds.csv").open()))) == 2
+    # The checked missions give `semexplore report` the script's own tables, bounds and all.
+    assert len(list(csv.DictReader(missions.open()))) == 4
+    from semexplore_gym.cli import main
+
+    assert main(["report", str(missions)]) == 0
+    assert capsys.readouterr().out.strip() == first.stdout.strip()
 
 
 def test_a_folder_without_runs_is_one_clear_line(tmp_path) -> None:
