@@ -150,11 +150,12 @@ def _several_runs_report(
         raise ValueError(f"unknown table {name!r}: choose one of {', '.join(RUN_TABLES)}")
     if name == "summary":
         raise ValueError(f"the summary table reads one run folder (got {len(sources)})")
-    rows: list[dict[str, Any]] = []
     for source in sources:
         header = _header(source)
         if "n_robots" in header or set(best_known.COLUMNS) <= set(header):
             raise ValueError(f"{source} is not a benchmark's runs.csv: report reads it alone")
+    rows: list[dict[str, Any]] = []
+    for source in sources:
         rows += read_trimmed_runs(source, NEEDED_COLUMNS[name], name, allow_empty=True)
     if not rows:
         raise ValueError(f"no finished missions in {', '.join(map(str, sources))}")
