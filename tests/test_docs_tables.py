@@ -37,7 +37,7 @@ def _included() -> dict[str, list[str]]:
 def test_the_build_step_writes_every_included_table(tmp_path: Path) -> None:
     written = _extension().write_tables(DOCS, tmp_path)
     included = _included()
-    assert {"suites_overview", "best_known"} <= set(included)
+    assert {"suites_overview", "best_known", "slam_vs_perfect"} <= set(included)
     assert set(included) == set(written), "a page includes a table no step makes, or vice versa"
     for name, path in written.items():
         text = path.read_text(encoding="utf-8")
@@ -65,6 +65,21 @@ def test_the_best_known_table_has_each_family_of_the_shipped_table(tmp_path: Pat
     for family in {world_family(r["world"]) for r in rows}:
         n = sum(1 for r in rows if world_family(r["world"]) == family and r["start"] == "random")
         assert f"| {family} | random | {n} | " in text, family
+
+
+def test_the_slam_table_pairs_each_family_and_policy_of_its_runs(tmp_path: Path) -> None:
+    """The shipped file holds the pairs only: each (family, policy) row counts half its rows."""
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["slam_vs_perfect"].read_text(encoding="utf-8")
+    with (DOCS / ext.TABLES["slam_vs_perfect"][0]).open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    slam = [r for r in runs if r["ate_m"]]
+    assert 2 * len(slam) == len(runs)
+    for family in {world_family(r["world"]) for r in runs}:
+        for policy in {r["policy"] for r in runs if world_family(r["world"]) == family}:
+            n = sum(1 for r in slam if world_family(r["world"]) == family and r["policy"] == policy)
+            assert f"| {family} | {policy} | {n} | " in text, (family, policy)
+    assert "| paper mazes | SLAM | " in text  # the expert against the baselines
 
 
 def test_the_docs_tables_are_what_semexplore_report_prints(tmp_path: Path, capsys) -> None:

@@ -19,6 +19,7 @@ TABLES: dict[str, tuple[str, str | None]] = {
     "best_known": ("../configs/best_known/best_known.csv", None),
     "oracle_regret": ("results/oracle/runs.csv", "regret"),
     "lower_bound_check": ("results/oracle/missions.csv", None),
+    "slam_vs_perfect": ("results/slam/runs.csv", "slam-vs-perfect"),
 }
 GENERATED_DIR = "_generated"
 

@@ -2,18 +2,21 @@
 
 RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to
 the columns a table reads is enough), a team benchmark's run folder (``--robots``: its
-summary), or a best-known table such as ``configs/best_known/best_known.csv``. For a
-benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one row per family
-and policy, the default), ``policies`` (one row per policy over all worlds), ``regret`` (each
-policy against the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run with
-``--env-config slam``) or ``summary`` (the whole summary but its best-known and learning
-sections, which read other files). The docs build renders the user guide's result tables with
-the same function.
+summary), or a best-known table such as ``configs/best_known/best_known.csv``. Several
+benchmark run folders or ``runs.csv`` files are read as one (their rows concatenated). For a
+benchmark, ``--table`` picks the table: ``overview`` (one row per family and policy, the
+default), ``policies`` (one row per policy over all worlds), ``regret`` (each policy against
+the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run with ``--env-config
+slam``), ``slam-vs-perfect`` (a run on the perfect map and the same run with ``--env-config
+slam``, missions paired by world, policy and seed) or ``summary`` (the whole ``summary.md``
+but its best-known and learning sections, which read other files; one run folder). The docs
+build renders the user guide's result tables with the same function.
 
 Example::
 
     semexplore report runs/bench10
     semexplore report runs/bench10 --table policies --out runs/bench10/policies.md
+    semexplore report runs/perfect runs/slam --table slam-vs-perfect
     semexplore report configs/best_known/best_known.csv --json
 """
 
@@ -38,7 +41,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "run_dir",
         metavar="RUN_DIR",
-        help="a benchmark or team benchmark run folder, a runs.csv, or a best-known CSV",
+        nargs="+",
+        help="a benchmark or team benchmark run folder, a runs.csv, or a best-known CSV; "
+        "several benchmark run folders or runs.csv files are read as one",
     )
     p.add_argument(
         "--table",
@@ -73,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(args, {**result.to_dict(), "out": args.out}, ensure_ascii=False)
     elif args.out is not None:
-        print(f"wrote {args.out} ({result.rows} rows of {result.source})", file=sys.stderr)
+        read = ", ".join(map(str, result.sources or (result.source,)))
+        print(f"wrote {args.out} ({result.rows} rows of {read})", file=sys.stderr)
     else:
         sys.stdout.write(result.markdown)
     return 0

@@ -47,6 +47,15 @@ def _false_stops(rows: list[dict[str, Any]]) -> str:
     return f"{len(kinds)}/{len(rows)} ({counts})"
 
 
+def _lost(rows: list[dict[str, Any]]) -> str:
+    """``k/n`` missions whose back end reported itself lost (``–``: no row says, as in a
+    ``runs.csv`` trimmed without the lost columns)."""
+    if all(r.get("slam_lost") is None and r.get("slam_lost_events") is None for r in rows):
+        return "–"
+    lost = sum(1 for r in rows if r.get("slam_lost") or (r.get("slam_lost_events") or 0) > 0)
+    return f"{lost}/{len(rows)}"
+
+
 def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str]:
     """``summary.md`` lines: per family and policy, median [IQR] of the trajectory errors (of
     SLAM, of odometry alone and their ratio), the map error, the loop closures and the
@@ -89,11 +98,10 @@ def slam_table(families: dict[str, dict[str, list[dict[str, Any]]]]) -> list[str
         if not rs:
             continue
         cells = [_median_iqr(rs, key, fmt) for key, _, fmt in _MEDIAN_COLUMNS]
-        lost = sum(1 for r in rs if r.get("slam_lost") or (r.get("slam_lost_events") or 0) > 0)
         lines.append(
             f"| {fam} | {policy} | {len(rs)} | "
             + " | ".join(cells)
-            + f" | {lost}/{len(rs)} | {_false_stops(rs)} |"
+            + f" | {_lost(rs)} | {_false_stops(rs)} |"
         )
     lines.append("")
     return lines

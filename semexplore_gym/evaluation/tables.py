@@ -5,22 +5,33 @@ One function, :func:`report_tables`, serves ``semexplore report`` and the docs b
 renders the user guide's result tables from the small result files under ``docs/results/`` (a
 table in the guide is computed from its data, never pasted). A benchmark's tables are those of
 its ``summary.md`` (:mod:`.report`); a ``runs.csv`` trimmed to the columns a table needs is
-enough for that table.
+enough for that table. Several ``runs.csv`` files are read as one: their rows concatenated
+(the perfect-map and the SLAM run of ``--table slam-vs-perfect``).
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 #: The tables of a benchmark's ``runs.csv``: the summary's overview (one row per family and
 #: policy), its per-policy table over all worlds, its regret against the oracle (a run with
-#: ``--oracle``), its SLAM table (missions with SLAM), or the whole summary as far as
-#: ``runs.csv`` holds it (the best-known and learning sections read other files).
-RUN_TABLES: tuple[str, ...] = ("overview", "policies", "regret", "slam", "summary")
+#: ``--oracle``), its SLAM table (missions with SLAM), the same missions on the perfect map and
+#: with SLAM paired (:mod:`.slam_comparison`), or the whole summary as far as ``runs.csv`` holds
+#: it (the best-known and learning sections read other files).
+RUN_TABLES: tuple[str, ...] = (
+    "overview",
+    "policies",
+    "regret",
+    "slam",
+    "slam-vs-perfect",
+    "summary",
+)
 _KEYS = ("world", "policy", "seed", "self_stopped")
 #: The ``runs.csv`` columns each table reads (the others may be absent).
 NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
@@ -28,6 +39,18 @@ NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
     "policies": (*_KEYS, "coverage", "mission_time_s"),
     "regret": (*_KEYS, "coverage", "mission_time_s", "path_length_m", "T90_s", "T99_s"),
     "slam": (*_KEYS, "ate_m"),
+    "slam-vs-perfect": (
+        *_KEYS,
+        "coverage",
+        "collisions",
+        "mission_time_s",
+        "wall_time_s",
+        "ate_m",
+        "odom_ate_m",
+        "map_error",
+        "loop_closures",
+        "slam_false_stop",
+    ),
     "summary": (
         *_KEYS,
         "coverage",
@@ -46,16 +69,18 @@ class TableReport:
     """What :func:`report_tables` read and the Markdown it made."""
 
     kind: str  # "benchmark", "team", "best_known" or "bound_check"
-    source: Path  # the CSV file read
+    source: Path  # the CSV file read (the first of several)
     table: str  # a name of RUN_TABLES, "team", "best_known" or "bound_check"
     rows: int  # rows read (missions, or best-known entries)
     markdown: str
+    sources: tuple[Path, ...] = ()  # every CSV file read (empty: just ``source``)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the fields, and each Markdown table as ``{"columns", "rows"}``."""
         return {
             "kind": self.kind,
             "source": str(self.source),
+            "sources": [str(p) for p in self.sources or (self.source,)],
             "table": self.table,
             "rows": self.rows,
             "tables": markdown_tables(self.markdown),
@@ -64,16 +89,19 @@ class TableReport:
 
 
 def report_tables(
-    path: str | Path, table: str | None = None, reference: str | None = None
+    path: str | os.PathLike | Sequence[str | os.PathLike],
+    table: str | None = None,
+    reference: str | None = None,
 ) -> TableReport:
     """The Markdown tables of a result file.
 
     Args:
         path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (a team
             benchmark's is told by its ``n_robots`` column), a best-known table
-            (``configs/best_known/best_known.csv``, told by its columns), or the checked
+            (``configs/best_known/best_known.csv``, told by its columns), the checked
             missions of ``scripts/check_lower_bound.py --missions-out`` (the bound's check per
-            family, :mod:`.bound_check`).
+            family, :mod:`.bound_check`); or several benchmark run folders or ``runs.csv``
+            files, whose rows are read as one.
         table: for a benchmark's ``runs.csv``, one of :data:`RUN_TABLES` (default
             ``overview``); a team benchmark's summary and a best-known table are one table
             each and take None.
@@ -85,7 +113,13 @@ def report_tables(
     """
     from semexplore_gym.evaluation import best_known, bound_check
 
-    source = _csv_of(Path(path))
+    paths = [path] if isinstance(path, str | os.PathLike) else list(path)
+    if not paths:
+        raise ValueError("no result file given")
+    sources = [_csv_of(Path(p)) for p in paths]
+    if len(sources) > 1:
+        return _several_runs_report(sources, table, reference)
+    source = sources[0]
     header = _header(source)
     if set(best_known.COLUMNS) <= set(header):
         if table is not None:
@@ -113,6 +147,31 @@ def report_tables(
     rows = read_trimmed_runs(source, NEEDED_COLUMNS[name], name)
     md = "\n".join(_run_table_lines(source, rows, name, reference)).strip() + "\n"
     return TableReport("benchmark", source, name, len(rows), md)
+
+
+def _several_runs_report(
+    sources: list[Path], table: str | None, reference: str | None
+) -> TableReport:
+    """The table of several benchmarks' ``runs.csv`` files read as one."""
+    from semexplore_gym.evaluation import best_known, bound_check
+
+    name = table or "overview"
+    if name not in RUN_TABLES:
+        raise ValueError(f"unknown table {name!r}: choose one of {', '.join(RUN_TABLES)}")
+    if name == "summary":
+        raise ValueError(f"the summary table reads one run folder (got {len(sources)})")
+    for source in sources:
+        header = _header(source)
+        single = (best_known.COLUMNS, bound_check.MISSION_COLUMNS)
+        if "n_robots" in header or any(set(c) <= set(header) for c in single):
+            raise ValueError(f"{source} is not a benchmark's runs.csv: report reads it alone")
+    rows: list[dict[str, Any]] = []
+    for source in sources:
+        rows += read_trimmed_runs(source, NEEDED_COLUMNS[name], name, allow_empty=True)
+    if not rows:
+        raise ValueError(f"no finished missions in {', '.join(map(str, sources))}")
+    md = "\n".join(_run_table_lines(sources[0], rows, name, reference)).strip() + "\n"
+    return TableReport("benchmark", sources[0], name, len(rows), md, tuple(sources))
 
 
 #: The columns of a team benchmark's ``runs.csv`` that its summary reads.
@@ -172,9 +231,12 @@ def _header(source: Path) -> list[str]:
     return next(csv.reader([first]), []) if first.strip() else []
 
 
-def read_trimmed_runs(source: Path, needed: tuple[str, ...], table: str) -> list[dict[str, Any]]:
+def read_trimmed_runs(
+    source: Path, needed: tuple[str, ...], table: str, allow_empty: bool = False
+) -> list[dict[str, Any]]:
     """The rows of a ``runs.csv`` that may lack columns other than ``needed`` (absent cells
-    read as empty), numbers parsed as :func:`~.run_row.read_runs` parses them."""
+    read as empty), numbers parsed as :func:`~.run_row.read_runs` parses them; a file without
+    rows is an error unless ``allow_empty``."""
     from semexplore_gym.evaluation.run_row import CSV_COLUMNS, complete_csv_bytes, parse_cells
 
     text = source.read_bytes()[: complete_csv_bytes(source)].decode("utf-8", errors="replace")
@@ -191,7 +253,7 @@ def read_trimmed_runs(source: Path, needed: tuple[str, ...], table: str) -> list
     rows = [
         parse_cells({**blank, **raw}, f"{source} line {i}") for i, raw in enumerate(reader, start=2)
     ]
-    if not rows:
+    if not rows and not allow_empty:
         raise ValueError(f"no finished missions in {source}")
     return rows
 
@@ -214,6 +276,10 @@ def _run_table_lines(
         return lines[lines.index("") + 1 :]  # without the section's heading
     if table == "policies":
         return report.policy_table(report.policies_of(rows))
+    if table == "slam-vs-perfect":
+        from semexplore_gym.evaluation.slam_comparison import slam_vs_perfect_lines
+
+        return slam_vs_perfect_lines(rows, ref)
     if table == "slam":
         lines = slam_table(report.group_by_family(rows))
         if not lines:

@@ -181,3 +181,67 @@ def test_report_regret_compares_each_policy_with_the_oracle(tmp_path: Path, caps
     (run / "runs.csv").write_text("\n".join(ln for ln in text if ",oracle," not in ln) + "\n")
     assert main(["report", str(run), "--table", "regret"]) == 2
     assert "has no oracle missions (run with --oracle)" in capsys.readouterr().err
+
+
+def _write_slam_pair(path: Path, slam: bool, seeds: range = range(3)) -> Path:
+    """A runs.csv of semantic and nearest on maze1, on the perfect map or with SLAM."""
+    path.mkdir(parents=True, exist_ok=True)
+    cols = ["world", "policy", "seed", "self_stopped", "coverage", "collisions"]
+    cols += ["mission_time_s", "wall_time_s", "ate_m", "odom_ate_m", "map_error"]
+    cols += ["loop_closures", "slam_false_stop"]
+    with (path / "runs.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for policy, t in (("semantic", 100.0), ("nearest", 200.0)):
+            for seed in seeds:
+                figures = [0.02, 0.4, 0.05, 3, False] if slam else [""] * 5
+                w.writerow(["maze1", policy, seed, True, 0.99, 0, t * (1.1 if slam else 1) + seed,
+                            1.0 + slam, *figures])  # fmt: skip
+    return path
+
+
+def test_report_reads_several_runs_as_one_for_the_slam_pairs(tmp_path: Path, capsys) -> None:
+    perfect = _write_slam_pair(tmp_path / "perfect", slam=False)
+    slam = _write_slam_pair(tmp_path / "slam", slam=True, seeds=range(2))
+    assert main(["report", str(perfect), str(slam / "runs.csv"), "--table", "slam-vs-perfect"]) == 0
+    out = capsys.readouterr().out
+    assert "| paper mazes | semantic | 2 | 2/2 / 2/2 | 0 / 0 | 1.10 (p = " in out
+    assert "| paper mazes | nearest | 2 | 2/2 / 2/2 | 0 / 0 | 1.10 (p = " in out
+    assert "| family | map | semantic ÷ nearest |" in out
+    assert "| paper mazes | SLAM | 0.50 (p = " in out
+    # Several runs read as one for any benchmark table, and --json names every file read.
+    assert main(["report", str(perfect), str(slam), "--table", "policies", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["rows"] == 10
+    assert result["sources"] == [str(perfect / "runs.csv"), str(slam / "runs.csv")]
+    assert [r[:2] for r in result["tables"][0]["rows"]] == [["semantic", "5"], ["nearest", "5"]]
+
+
+@pytest.mark.parametrize(
+    ("second", "argv_tail", "says"),
+    [
+        ("perfect", ["--table", "slam-vs-perfect"], "two perfect-map missions of world maze1"),
+        ("none", ["--table", "slam-vs-perfect"], "no perfect-map mission has a SLAM twin"),
+        ("plain", ["--table", "slam-vs-perfect"], "has no columns collisions, wall_time_s"),
+        ("slam", ["--table", "summary"], "the summary table reads one run folder (got 2)"),
+        ("best_known", [], "is not a benchmark's runs.csv: report reads it alone"),
+    ],
+)
+def test_bad_slam_pairs_are_one_error_line(
+    tmp_path: Path, capsys, second: str, argv_tail: list[str], says: str
+) -> None:
+    perfect = _write_slam_pair(tmp_path / "perfect", slam=False)
+    other = {
+        "perfect": perfect,
+        "none": _write_slam_pair(tmp_path / "none", slam=False, seeds=range(5, 7)),
+        "plain": _write_runs(tmp_path / "plain"),
+        "slam": _write_slam_pair(tmp_path / "slam", slam=True),
+        "best_known": tmp_path / "best_known.csv",
+    }[second]
+    if second == "best_known":
+        other.write_text(",".join(BEST_KNOWN_COLUMNS) + "\n")
+    assert main(["report", str(perfect), str(other), *argv_tail]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert captured.out == "" and len(lines) == 1, captured.err
+    assert lines[0].startswith("semexplore report: error:") and says in lines[0]

@@ -43,3 +43,15 @@ def test_a_table_without_false_stops_says_none_of_n() -> None:
     lines = slam_table({"office": {"nearest": [_row(0.02, 0.1, False)]}})
     (body,) = [line for line in lines if line.startswith("| office |")]
     assert body.endswith("| 0/1 | 0/1 |")
+
+
+def test_lost_is_a_dash_when_no_row_says() -> None:
+    """A runs.csv trimmed without the lost columns shows no count, rather than 0 lost."""
+    rows = [_row(0.02, 0.40, False), _row(0.04, 0.20, False)]
+    for r in rows:
+        r["slam_lost"] = r["slam_lost_events"] = None
+    (body,) = [ln for ln in slam_table({"maze": {"semantic": rows}}) if ln.startswith("| maze |")]
+    assert body.endswith("| – | 0/2 |")
+    rows[1]["slam_lost_events"] = 2
+    (body,) = [ln for ln in slam_table({"maze": {"semantic": rows}}) if ln.startswith("| maze |")]
+    assert body.endswith("| 1/2 | 0/2 |")
