@@ -2,7 +2,9 @@
 
 RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to
 the columns a table reads is enough), a team benchmark's run folder (``--robots``: its
-summary), or a best-known table such as ``configs/best_known/best_known.csv``. Several
+summary), a best-known table such as ``configs/best_known/best_known.csv``, or the checked
+missions ``scripts/check_lower_bound.py --missions-out FILE`` writes (the certified bound
+against every mission, per family). Several
 benchmark run folders or ``runs.csv`` files are read as one (their rows concatenated). For a
 benchmark, ``--table`` picks the table: ``overview`` (one row per family and policy, the
 default), ``policies`` (one row per policy over all worlds), ``regret`` (each policy against
@@ -18,6 +20,7 @@ Example::
     semexplore report runs/bench10 --table policies --out runs/bench10/policies.md
     semexplore report runs/perfect runs/slam --table slam-vs-perfect
     semexplore report configs/best_known/best_known.csv --json
+    semexplore report docs/results/oracle/missions.csv
 """
 
 from __future__ import annotations
@@ -42,7 +45,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "run_dir",
         metavar="RUN_DIR",
         nargs="+",
-        help="a benchmark or team benchmark run folder, a runs.csv, or a best-known CSV; "
+        help="a benchmark or team benchmark run folder, a runs.csv, a best-known CSV or "
+        "checked missions; "
         "several benchmark run folders or runs.csv files are read as one",
     )
     p.add_argument(
