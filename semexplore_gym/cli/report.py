@@ -7,13 +7,15 @@ benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one 
 and policy, the default), ``policies`` (one row per policy over all worlds), ``regret`` (each
 policy against the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run with
 ``--env-config slam``) or ``summary`` (the whole summary but its best-known and learning
-sections, which read other files). The docs build renders the user guide's result tables with
+sections, which read other files) or ``paired`` (per family, each policy's T99 paired with the
+``--reference`` policy's by world and start, with self-stops and collisions). The docs build renders the user guide's result tables with
 the same function.
 
 Example::
 
     semexplore report runs/bench10
     semexplore report runs/bench10 --table policies --out runs/bench10/policies.md
+    semexplore report runs/learners --table paired --reference semantic
     semexplore report configs/best_known/best_known.csv --json
 """
 
