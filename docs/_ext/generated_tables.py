@@ -17,6 +17,7 @@ from typing import Any
 TABLES: dict[str, tuple[str, str | None]] = {
     "suites_overview": ("results/suites/runs.csv", "overview"),
     "best_known": ("../configs/best_known/best_known.csv", None),
+    "learners_vs_expert": ("results/learning/runs.csv", "paired"),
 }
 GENERATED_DIR = "_generated"
 

@@ -6,10 +6,10 @@ summary), or a best-known table such as ``configs/best_known/best_known.csv``. F
 benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one row per family
 and policy, the default), ``policies`` (one row per policy over all worlds), ``regret`` (each
 policy against the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run with
-``--env-config slam``) or ``summary`` (the whole summary but its best-known and learning
-sections, which read other files) or ``paired`` (per family, each policy's T99 paired with the
-``--reference`` policy's by world and start, with self-stops and collisions). The docs build renders the user guide's result tables with
-the same function.
+``--env-config slam``), ``summary`` (the whole summary but its best-known and learning
+sections, which read other files), or ``paired`` (per family, each policy's T99 paired with
+the ``--reference`` policy's by world and start, with self-stops and collisions). The docs
+build renders the user guide's result tables with the same function.
 
 Example::
 
