@@ -37,7 +37,9 @@ def _included() -> dict[str, list[str]]:
 def test_the_build_step_writes_every_included_table(tmp_path: Path) -> None:
     written = _extension().write_tables(DOCS, tmp_path)
     included = _included()
-    assert {"suites_overview", "best_known", "slam_vs_perfect"} <= set(included)
+    assert {"suites_overview", "best_known", "slam_vs_perfect", "learners_vs_expert"} <= set(
+        included
+    )
     assert set(included) == set(written), "a page includes a table no step makes, or vice versa"
     for name, path in written.items():
         text = path.read_text(encoding="utf-8")
@@ -55,6 +57,19 @@ def test_the_benchmark_table_has_each_family_and_policy_of_its_runs(tmp_path: Pa
         for policy in {r["policy"] for r in runs}:
             n = sum(1 for r in runs if world_family(r["world"]) == family and r["policy"] == policy)
             assert f"| {family} | {policy} | {n} | " in text, (family, policy)
+
+
+def test_the_learners_table_pairs_each_policy_of_its_runs_with_the_expert(tmp_path: Path) -> None:
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["learners_vs_expert"].read_text(encoding="utf-8")
+    with (DOCS / ext.TABLES["learners_vs_expert"][0]).open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    assert {r["policy_version"] for r in runs if r["policy"] == "semantic"} == {"semantic-v3"}
+    for family in {world_family(r["world"]) for r in runs}:
+        for policy in {r["policy"] for r in runs}:
+            n = sum(1 for r in runs if world_family(r["world"]) == family and r["policy"] == policy)
+            assert f"| {family} | {policy} | {n} | " in text, (family, policy)
+    assert "T99 ÷ semantic" in text
 
 
 def test_the_best_known_table_has_each_family_of_the_shipped_table(tmp_path: Path) -> None:

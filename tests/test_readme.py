@@ -44,6 +44,7 @@ SITE_ORDER = (
     "slam",
     "results",
     "learning",
+    "learning-first-designs",
     "learned_frontier_value",
     "performance",
     "security",

@@ -20,6 +20,7 @@ TABLES: dict[str, tuple[str, str | None]] = {
     "oracle_regret": ("results/oracle/runs.csv", "regret"),
     "lower_bound_check": ("results/oracle/missions.csv", None),
     "slam_vs_perfect": ("results/slam/runs.csv", "slam-vs-perfect"),
+    "learners_vs_expert": ("results/learning/runs.csv", "paired"),
 }
 GENERATED_DIR = "_generated"
 

@@ -18,6 +18,10 @@ A second table, "Against the best baseline", pairs every other policy with the f
 baseline: nearest or FE, whichever is faster on that family (the bar of the learning issue's
 goal): the shorter median T99, then the shorter median mission time (a baseline that stops
 early below 99 % is not the faster one), with the same ratios and tests.
+
+:func:`paired_table_lines` is the learners' short table (``semexplore report --table paired``,
+the user guide's comparison with today's expert): per family, each policy's T99 paired with a
+reference policy's, with the self-stops and collisions the learning goals count.
 """
 
 from __future__ import annotations
@@ -202,4 +206,89 @@ def write_learning_table(out_dir: Any) -> list[str]:
         nxt = rest.find("\n## ")
         text = head.rstrip() + "\n" + (rest[nxt:] if nxt >= 0 else "")
     summary.write_text(text.rstrip() + "\n\n" + "\n".join(lines) + "\n")
+    return lines
+
+
+#: A mission counts as a self-stop at the coverage goal when it ended itself at or above this.
+SELF_STOP_COVERAGE = 0.97
+
+
+def _log_ratio_text(log: float) -> str:
+    if math.isnan(log):
+        return "–"
+    return "∞" if log == math.inf else f"{math.exp(log):.2f}"
+
+
+def _quantile(sorted_logs: list[float], q: float) -> float:
+    """The ``q`` quantile, interpolated linearly between neighbours as numpy does; one that
+    lies between a finite log ratio and a one-sided infinity is that infinity."""
+    pos = q * (len(sorted_logs) - 1)
+    lo, frac = int(pos), pos - int(pos)
+    if frac == 0.0:
+        return sorted_logs[lo]
+    a, b = sorted_logs[lo], sorted_logs[lo + 1]
+    if math.isinf(a) or math.isinf(b):
+        return a + b  # the infinity (nan between -inf and +inf: no ratio)
+    return a + frac * (b - a)
+
+
+def _ratio_iqr_cell(logs: np.ndarray) -> str:
+    """``median [q1–q3]`` of the ratios whose logs are given (the quantiles of the logs; a
+    one-sided pair counts as an infinite log ratio, not as the test's stand-in)."""
+    if logs.size == 0:
+        return "–"
+    exact = sorted(math.copysign(math.inf, x) if abs(x) >= _BIG_LOG else float(x) for x in logs)
+    q1, med, q3 = (_log_ratio_text(_quantile(exact, q)) for q in (0.25, 0.5, 0.75))
+    return f"{med} [{q1}–{q3}]"
+
+
+def _t99_cell(rows: list[dict[str, Any]]) -> str:
+    """The median T99 (the mean of the middle two of an even count; ∞ for no 99 %)."""
+    med = float(np.median([_value(r, "T99_s") for r in rows]))
+    return "∞" if math.isinf(med) else f"{med:.1f}"
+
+
+def _collisions_cell(rows: list[dict[str, Any]]) -> str:
+    counts = [int(r["collisions"]) for r in rows if r.get("collisions") is not None]
+    return str(sum(counts)) if counts else "–"
+
+
+def paired_table_lines(rows: list[dict[str, Any]], reference: str = EXPERT) -> list[str]:
+    """Each policy's T99 against ``reference``'s on the same (world, seed), per family.
+
+    One row per (family, policy), the reference first: missions, median T99, the median [IQR]
+    over pairs of the policy's T99 over the reference's (a mission that never reached 99 %
+    counts as ∞, as in the learning table), the Wilcoxon p of the pairs' log ratios, the pairs
+    where the policy was faster, the missions it ended itself at coverage ≥
+    :data:`SELF_STOP_COVERAGE`, and its collisions. ``rows`` need the columns ``world``,
+    ``policy``, ``seed``, ``self_stopped``, ``coverage``, ``T99_s`` and ``collisions``.
+    """
+    from semexplore_gym.evaluation.report import group_by_family
+
+    lines = [
+        f"Per family, each policy paired with `{reference}` by (world, seed). T99 ÷ "
+        f"{reference} = median [IQR] over the pairs of the policy's T99 over {reference}'s "
+        "(< 1: faster; a mission that never reached 99 % counts as ∞); p W = two-sided "
+        "Wilcoxon signed-rank test on the pairs' log ratios; faster = pairs where the policy "
+        f"reached 99 % sooner; self-stops = missions it ended itself at coverage ≥ "
+        f"{SELF_STOP_COVERAGE}.",
+        "",
+        f"| family | policy | n | T99 (s) | T99 ÷ {reference} [IQR] | p W | faster | "
+        "self-stops | collisions |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for family, by_policy in group_by_family(rows).items():
+        ref = {(r["world"], int(r["seed"])): r for r in by_policy.get(reference, [])}
+        order = [reference] if reference in by_policy else []
+        for policy in order + [p for p in by_policy if p != reference]:
+            rs = by_policy[policy]
+            logs = _paired(rs, ref, "T99_s") if policy != reference else np.zeros(0)
+            faster = f"{int(np.sum(logs < 0))}/{logs.size}" if logs.size else "–"
+            stops = sum(
+                1 for r in rs if r["self_stopped"] and (r["coverage"] or 0.0) >= SELF_STOP_COVERAGE
+            )
+            cells = [str(len(rs)), _t99_cell(rs), _ratio_iqr_cell(logs)]
+            cells += [_p_cell(logs), faster, f"{stops}/{len(rs)}", _collisions_cell(rs)]
+            lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
+    lines.append("")
     return lines

@@ -22,7 +22,8 @@ from typing import Any
 #: The tables of a benchmark's ``runs.csv``: the summary's overview (one row per family and
 #: policy), its per-policy table over all worlds, its regret against the oracle (a run with
 #: ``--oracle``), its SLAM table (missions with SLAM), the same missions on the perfect map and
-#: with SLAM paired (:mod:`.slam_comparison`), or the whole summary as far as ``runs.csv`` holds
+#: with SLAM paired (:mod:`.slam_comparison`), each policy's T99 paired with the reference's per
+#: family (``paired``: the learners' table), or the whole summary as far as ``runs.csv`` holds
 #: it (the best-known and learning sections read other files).
 RUN_TABLES: tuple[str, ...] = (
     "overview",
@@ -30,6 +31,7 @@ RUN_TABLES: tuple[str, ...] = (
     "regret",
     "slam",
     "slam-vs-perfect",
+    "paired",
     "summary",
 )
 _KEYS = ("world", "policy", "seed", "self_stopped")
@@ -61,6 +63,7 @@ NEEDED_COLUMNS: dict[str, tuple[str, ...]] = {
         "mean_map_generation_ms",
         "mean_global_planning_ms",
     ),
+    "paired": (*_KEYS, "coverage", "T99_s", "collisions"),
 }
 
 
@@ -265,6 +268,8 @@ def _run_table_lines(
     from semexplore_gym.evaluation.slam_report import slam_table
 
     ref = reference or report.REFERENCE_POLICY
+    if table == "paired":
+        return _paired_lines(source, rows, ref)
     has_oracle = any(r["policy"] == regret.ORACLE_SPEC for r in rows)
     if table == "summary":
         lines = report.summary_lines(source.parent, rows, ref)
@@ -287,6 +292,18 @@ def _run_table_lines(
         return lines[lines.index("") + 1 :]  # without the section's heading
     lines = report.overview_table(report.group_by_family(rows), ref)
     return lines[lines.index("") + 1 :]  # without the section's heading
+
+
+def _paired_lines(source: Path, rows: list[dict[str, Any]], reference: str) -> list[str]:
+    from semexplore_gym.evaluation.learning_table import paired_table_lines
+
+    policies = list(dict.fromkeys(r["policy"] for r in rows))
+    if reference not in policies:
+        raise ValueError(
+            f"{source} has no {reference} missions to pair with (its policies: "
+            f"{', '.join(policies)}; pick one with --reference)"
+        )
+    return paired_table_lines(rows, reference)
 
 
 def markdown_tables(markdown: str) -> list[dict[str, Any]]:

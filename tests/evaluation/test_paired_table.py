@@ -1,0 +1,105 @@
+"""``semexplore report --table paired``: each policy's T99 against the reference's on the same
+(world, seed), per family (the learners' table of the user guide)."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from semexplore_gym.cli import main
+
+COLUMNS = ("world", "policy", "seed", "self_stopped", "coverage", "T99_s", "collisions")
+#: (world, seed) -> the expert's T99; the learner takes these factors of it.
+EXPERT_T99 = {("maze1", 0): 100.0, ("maze1", 1): 200.0, ("maze2", 0): 400.0, ("maze2", 1): 50.0}
+LEARNER_FACTOR = {("maze1", 0): 0.5, ("maze1", 1): 0.8, ("maze2", 0): 1.5, ("maze2", 1): 0.9}
+
+
+def _write(path: Path, rows: list[tuple]) -> Path:
+    path.mkdir(parents=True, exist_ok=True)
+    with (path / "runs.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(COLUMNS)
+        w.writerows(rows)
+    return path
+
+
+def _missions() -> list[tuple]:
+    rows = [(w, "semantic", s, True, 0.999, t, 0) for (w, s), t in EXPERT_T99.items()]
+    for (w, s), t in EXPERT_T99.items():
+        # maze2 seed 1: the learner stopped early at 0.95 and never reached 99 %.
+        stopped_short = (w, s) == ("maze2", 1)
+        t99 = "" if stopped_short else t * LEARNER_FACTOR[(w, s)]
+        rows.append((w, "learner", s, True, 0.95 if stopped_short else 0.998, t99, s))
+    rows.append(("office:seed=1,size_m=12", "learner", 0, False, 0.9, "", ""))
+    return rows
+
+
+def _table_rows(out: str) -> list[str]:
+    return [ln for ln in out.splitlines() if ln.startswith("| ") and "family" not in ln]
+
+
+def test_each_policy_is_paired_with_the_reference_per_family(tmp_path: Path, capsys) -> None:
+    run = _write(tmp_path / "run", _missions())
+    assert main(["report", str(run), "--table", "paired"]) == 0
+    # Learner T99s 50, 160, 600, ∞ (never reached 99 %): median 380. Ratios to the expert 0.5,
+    # 0.8, 1.5, ∞: the median of the logs is between 0.8 and 1.5 (sqrt(0.8 · 1.5) = 1.10), the
+    # upper quartile between 1.5 and ∞ is ∞; faster on 2 of 4; 3 self-stops at ≥ 0.97;
+    # collisions 0 + 1 + 0 + 1. The office has no expert missions: nothing to pair with.
+    assert _table_rows(capsys.readouterr().out) == [
+        "| paper mazes | semantic | 4 | 150.0 | – | – | – | 4/4 | 0 |",
+        "| paper mazes | learner | 4 | 380.0 | 1.10 [0.71–∞] | 0.88 | 2/4 | 3/4 | 2 |",
+        "| office | learner | 1 | ∞ | – | – | – | 0/1 | – |",
+    ]
+
+
+def test_the_reference_is_the_one_asked_for(tmp_path: Path, capsys) -> None:
+    run = _write(tmp_path / "run", _missions()[:8])
+    assert main(["report", str(run), "--table", "paired", "--reference", "learner"]) == 0
+    rows = _table_rows(capsys.readouterr().out)
+    assert [r.split(" | ")[1] for r in rows] == ["learner", "semantic"]
+    # Expert / learner: 2.0, 1.25, 0.67 and 0 (the learner never reached 99 %): faster on 2.
+    assert rows[1].split(" | ")[4:7] == ["0.91 [0.00–1.41]", "0.88", "2/4"]
+
+
+def test_identical_pairs_have_no_test(tmp_path: Path, capsys) -> None:
+    same = [
+        (w, p, s, True, 1.0, t, 0) for (w, s), t in EXPERT_T99.items() for p in ("semantic", "copy")
+    ]
+    assert main(["report", str(_write(tmp_path / "run", same)), "--table", "paired"]) == 0
+    assert "| paper mazes | copy | 4 | 150.0 | 1.00 [1.00–1.00] | – | 0/4 | 4/4 | 0 |" in (
+        capsys.readouterr().out
+    )
+
+
+@pytest.mark.parametrize(
+    ("rows", "argv_tail", "says"),
+    [
+        (
+            [("maze1", "learner", 0, True, 1.0, 80.0, 0)],
+            [],
+            "has no semantic missions to pair with",
+        ),
+        ([("maze1", "semantic", 0, True, 1.0, 80.0, 0)], ["--reference", "nearest"], "no nearest"),
+        ([("maze1", "semantic", 0, True, 1.0, "fast", 0)], [], "T99_s is not a number: 'fast'"),
+    ],
+    ids=["no reference", "unknown reference", "bad cell"],
+)
+def test_bad_input_is_one_error_line(
+    tmp_path: Path, capsys, rows: list[tuple], argv_tail: list[str], says: str
+) -> None:
+    run = _write(tmp_path / "run", rows)
+    assert main(["report", str(run), "--table", "paired", *argv_tail]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert captured.out == "" and len(lines) == 1, captured
+    assert lines[0].startswith("semexplore report: error:") and says in lines[0], lines[0]
+
+
+def test_a_runs_csv_without_collisions_names_the_column(tmp_path: Path, capsys) -> None:
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "runs.csv").write_text("world,policy,seed,self_stopped,coverage,T99_s\n")
+    assert main(["report", str(run), "--table", "paired"]) == 2
+    assert "has no column collisions (the paired table reads" in capsys.readouterr().err
