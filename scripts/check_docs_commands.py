@@ -61,7 +61,7 @@ def long_blocks(markdown: str) -> list[tuple[int, str, str]]:
 
 def _logical_lines(body: str, first_line: int) -> Iterator[tuple[int, str]]:
     """Continuation lines joined, each with the page line it starts on."""
-    start, parts = first_line, []
+    start, parts = first_line, list[str]()
     for i, line in enumerate(body.splitlines(), first_line):
         if not parts:
             start = i
@@ -193,10 +193,11 @@ def check_policies(text: str) -> None:
     """Every spec of a comma-separated policy list resolves: the benchmark's own check (names,
     versions, overrides, files), except that a ``pretrained:NAME`` is looked up without loading
     its model and a model zip under ``runs/`` is one the reader trains first."""
-    from semexplore_gym.cli.benchmark import check_policies as check_specs
-    from semexplore_gym.cli.world_lists import refuse_repeats
     from semexplore_gym.policies.pretrained import get_pretrained
     from semexplore_gym.policies.specs import parse_spec, split_specs
+
+    from semexplore_gym.cli.benchmark import check_policies as check_specs
+    from semexplore_gym.cli.world_lists import refuse_repeats
 
     specs = split_specs(text)
     if not specs:
@@ -271,10 +272,11 @@ def check_train(args: argparse.Namespace) -> None:
 
 def check_names(args: argparse.Namespace, module: dict[str, Any] | None = None) -> None:
     """Resolve every value of ``args`` that names something, by the attribute it lands in."""
+    from semexplore_gym.policies.specs import load_policy_config
+
     from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.splits import split_suite
     from semexplore_gym.evaluation.suites import load_suite
-    from semexplore_gym.policies.specs import load_policy_config
 
     ns = vars(args)
     if ns.get("policies") and not ns.get("robots"):
@@ -292,7 +294,9 @@ def check_names(args: argparse.Namespace, module: dict[str, Any] | None = None) 
         if part.strip():
             _check_config("--split", lambda p, _o: split_suite(p), part.strip(), None)
     if ns.get("env_config") is not None or ns.get("env_overrides"):
-        _check_config("--env-config", load_env_config, ns.get("env_config"), ns.get("env_overrides"))
+        _check_config(
+            "--env-config", load_env_config, ns.get("env_config"), ns.get("env_overrides")
+        )
     if ns.get("policy_config") is not None:
         _check_config(
             "--policy-config", lambda p, _o: load_policy_config(p), ns["policy_config"], None
@@ -362,9 +366,7 @@ def check_page(path: Path) -> tuple[int, list[str]]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument(
-        "pages", nargs="*", help="Markdown pages (default: README.md and docs/*.md)"
-    )
+    ap.add_argument("pages", nargs="*", help="Markdown pages (default: README.md and docs/*.md)")
     args = ap.parse_args(argv)
     pages = [Path(p) for p in args.pages] or [
         REPO / "README.md",
