@@ -286,7 +286,10 @@ def check_names(args: argparse.Namespace, module: dict[str, Any] | None = None) 
     extra = tuple((module or {}).get("REAL_MAPS", {}))  # a script's own short names for maps
     for key in ("world", "worlds"):
         for world in _worlds(ns[key]) if ns.get(key) else []:
-            check_world(world.replace("seed=*", "seed=0"), extra)
+            try:
+                check_world(world.replace("seed=*", "seed=0"), extra)
+            except (ValueError, FileNotFoundError) as e:  # the flag as this command spells it
+                raise CommandError(re.sub(r"^--worlds\b", f"--{key}", str(e))) from None
     for suite in str(ns.get("suite") or "").split(","):
         if suite.strip():
             _check_config("--suite", lambda p, _o: load_suite(p), suite.strip(), None)
