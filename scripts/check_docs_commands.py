@@ -249,6 +249,16 @@ def _check_config(flag: str, load: Callable[..., Any], path: Any, overrides: Any
         raise CommandError(f"{flag} {path!r}: {e}") from None
 
 
+def check_team(args: argparse.Namespace) -> None:
+    """``semexplore benchmark --robots``: the team sizes parse and every team policy builds."""
+    from semexplore_gym.policies.team import make_team_policy
+
+    from semexplore_gym.cli.benchmark import team_study_request
+
+    for spec in team_study_request(args).policies:
+        make_team_policy(spec)
+
+
 def check_train(args: argparse.Namespace) -> None:
     """``semexplore train``: the train config and its ``--train-set`` overrides load for
     ``--algo`` (the loader the command itself uses)."""
@@ -332,6 +342,8 @@ def check_command(argv: list[str]) -> None:
 
             with contextlib.redirect_stderr(io.StringIO()):  # "writing to runs/..." notice
                 validate_args(args)
+            if args.robots:
+                check_team(args)
         if args.command == "train":
             check_train(args)
         check_names(args)

@@ -202,12 +202,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = parse_args(argv)
-    families = args.families
-    policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    from semexplore_gym.policies.specs import split_specs
 
     from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
+
+    args = parse_args(argv)
+    families = args.families
+    policies = split_specs(args.policies)  # a comma inside [...] stays with its spec
 
     worlds = sweep_worlds(families, args.per_family, args.seed0)
     limit_s = args.max_time_s or DEFAULT_MAX_TIME_S

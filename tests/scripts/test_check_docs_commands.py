@@ -47,8 +47,10 @@ def test_a_good_block_passes(checker, tmp_path: Path) -> None:
         "semexplore benchmark --split dungeon:test --policies "
         "'semantic,pretrained:oracle_student,sb3:runs/student/model.zip' --out runs/t",
         "semexplore explore --world map:tb3-world --policy semantic --json",
+        "semexplore benchmark --worlds 'office:seed=*,size_m=20' --robots 1,2,3,4 "
+        "--policies semantic,independent,greedy --runs 20 --out runs/team_study",
     )
-    assert checker.check_page(page) == (5, [])
+    assert checker.check_page(page) == (6, [])
 
 
 def test_a_python_c_list_feeds_a_later_command(checker, tmp_path: Path) -> None:
@@ -82,6 +84,11 @@ def test_a_python_c_list_feeds_a_later_command(checker, tmp_path: Path) -> None:
             "--train-config",
         ),
         ("python scripts/robustness_sweep.py --families noisecaves --out runs/x", "noisecaves"),
+        (
+            "semexplore benchmark --worlds office:seed=*,size_m=8 --robots 1,2 "
+            "--policies semantic,greedyy --out runs/x",
+            "unknown team policy 'greedyy'",
+        ),
         ("python scripts/no_such_script.py --out runs/x", "no such script"),
         ("bash run_everything.sh", "not the project's command"),
     ],
