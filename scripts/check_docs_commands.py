@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import os
 import re
 import runpy
 import shlex
@@ -83,8 +84,12 @@ def _expand(line: str, variables: dict[str, str]) -> str:
 
 def _evaluate(code: str) -> str:
     """The output of one ``python -c`` line of a block (a list the command reads)."""
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
+    }
     proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60
+        [sys.executable, "-c", code], cwd=REPO, env=env, capture_output=True, text=True, timeout=60
     )
     if proc.returncode != 0:
         raise CommandError(f"python -c failed: {proc.stderr.strip().splitlines()[-1:]}")
