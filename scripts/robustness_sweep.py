@@ -150,7 +150,8 @@ def _gif_failures(out: Path, rows: list[dict[str, Any]], policy: str, ok_coverag
         print(f"failure animation -> {path}", file=sys.stderr)
 
 
-def main(argv: list[str] | None = None) -> int:
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    """The command line, checked (families, counts) before anything is loaded or run."""
     ap = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
@@ -196,10 +197,19 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--per-family must be in [1, 10000], got {args.per_family}")
     if not 0.0 < args.ok_coverage <= 1.0:
         ap.error(f"--ok-coverage must be in (0, 1], got {args.ok_coverage}")
-    policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    args.families = families
+    return args
+
+
+def main(argv: list[str] | None = None) -> int:
+    from semexplore_gym.policies.specs import split_specs
 
     from semexplore_gym.envs.env_config import load_env_config
     from semexplore_gym.evaluation.harness import Task, read_runs, run_benchmark
+
+    args = parse_args(argv)
+    families = args.families
+    policies = split_specs(args.policies)  # a comma inside [...] stays with its spec
 
     worlds = sweep_worlds(families, args.per_family, args.seed0)
     limit_s = args.max_time_s or DEFAULT_MAX_TIME_S

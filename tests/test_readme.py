@@ -7,6 +7,11 @@ a reason when that folder is absent (or ``SEMEXPLORE_TEST_HIDE_SHARED=1`` hides 
 
 A block that only illustrates (output, a sketch) is marked: a `` ```{code-block} LANG``
 directive, or a ``<!-- not-run -->`` line right above its fence. Keep them few.
+
+A ``bash`` block with a ``<!-- long -->`` line right above its fence holds long reproduce
+commands (a published table's benchmark, hours on two cores): they are not run, but each must
+parse with its command's own parser and name policies, worlds, suites and configs that resolve
+(``scripts/check_docs_commands.py``, well under a second per command).
 """
 
 from __future__ import annotations
@@ -55,6 +60,8 @@ SITE_ORDER = (
 CI_COMMANDS = ("pip", "pytest")
 #: At most this many illustrative (not-run) blocks over README and site together.
 MAX_NOT_RUN = 4
+#: Pages whose commands a newcomer runs first: no long block there.
+FIRST_PAGES = ("README.md", "docs/index.md", "docs/getting-started.md")
 
 
 def shared_maps_present() -> bool:
@@ -177,12 +184,13 @@ def test_no_issue_numbers_or_commit_hashes(doc: str) -> None:
 class Block:
     page: str
     line: int
-    lang: str  # "bash", "python", "not-run" or a directive name such as "{toctree}"
+    lang: str  # "bash", "python", "not-run", "long" or a directive name such as "{toctree}"
     body: str
 
 
 FENCE = re.compile(
-    r"^(?P<mark><!-- not-run -->\n)?```(?P<info>[^\n]*)\n(?P<body>.*?)^```[ \t]*$", re.S | re.M
+    r"^(?P<mark><!-- (?:not-run|long) -->\n)?```(?P<info>[^\n]*)\n(?P<body>.*?)^```[ \t]*$",
+    re.S | re.M,
 )
 
 
@@ -192,7 +200,9 @@ def code_blocks(markdown: str, page: str = "") -> list[Block]:
     for m in FENCE.finditer(markdown):
         info = m.group("info").strip()
         line = markdown.count("\n", 0, m.start("info")) + 1
-        if m.group("mark") or info.startswith("{code-block}"):
+        if m.group("mark") and "long" in m.group("mark"):
+            lang = "long"
+        elif m.group("mark") or info.startswith("{code-block}"):
             lang = "not-run"
         elif info.startswith("{"):
             lang = info.split()[0]
@@ -255,10 +265,11 @@ def test_code_blocks_are_found() -> None:
     md = (
         "```bash\nsemexplore explore --world maze1 \\\n    --json  # c\nPYTHONPATH=$PWD python "
         "scripts/x.py && pip install -e .\n```\n<!-- not-run -->\n```python\nraise SystemExit\n"
-        "```\n```{code-block} text\nout\n```\n```{toctree}\nindex\n```\n"
+        "```\n```{code-block} text\nout\n```\n```{toctree}\nindex\n```\n<!-- long -->\n```bash\n"
+        "semexplore benchmark --suite caves --out runs/x\n```\n"
     )
     blocks = code_blocks(md)
-    assert [b.lang for b in blocks] == ["bash", "not-run", "not-run", "{toctree}"]
+    assert [b.lang for b in blocks] == ["bash", "not-run", "not-run", "{toctree}", "long"]
     assert bash_commands(blocks[0].body) == [
         ["semexplore", "explore", "--world", "maze1", "--json"],
         ["python", "scripts/x.py"],
@@ -283,10 +294,37 @@ def test_every_code_block_is_run_or_marked() -> None:
                 for argv in bash_commands(b.body):
                     if not is_runnable(argv) and argv[0] not in CI_COMMANDS:
                         problems.append(f"{where}: cannot run {shlex.join(argv)!r}")
-            elif b.lang not in ("python", "{toctree}", "{eval-rst}", "{include}"):
+            elif b.lang == "long" and _rel(page) in FIRST_PAGES:
+                problems.append(f"{where}: a long block on a page newcomers run first")
+            elif b.lang not in ("python", "long", "{toctree}", "{eval-rst}", "{include}"):
                 problems.append(f"{where}: a ```{b.lang} block: use bash/python or mark it")
     assert not problems, "\n".join(problems)
     assert len(not_run) <= MAX_NOT_RUN, f"too many illustrative blocks: {not_run}"
+
+
+def _docs_commands_checker():
+    """``scripts/check_docs_commands.py`` as a module."""
+    spec = importlib.util.spec_from_file_location(
+        "check_docs_commands", REPO / "scripts" / "check_docs_commands.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_long_blocks_parse_and_resolve() -> None:
+    """Every long reproduce command parses with its command's parser and names policies,
+    worlds, suites, splits and configs that resolve (nothing is run)."""
+    checker = _docs_commands_checker()
+    long = [b for b in all_blocks() if b.lang == "long"]
+    assert long, "no <!-- long --> block found"
+    checked, problems = 0, []
+    for page in doc_pages():
+        n, found = checker.check_page(page)
+        checked, problems = checked + n, problems + found
+    assert checked >= len(long)
+    assert not problems, "long reproduce commands that would not start:\n" + "\n".join(problems)
 
 
 def test_commands_are_found() -> None:
@@ -478,7 +516,7 @@ def test_no_documented_command_writes_into_docs() -> None:
     assert not _writes_into_docs(["semexplore", "explore", "--gif", "runs/x.gif"])
     found = []
     for b in all_blocks():
-        if b.lang == "bash":
+        if b.lang in ("bash", "long"):
             for argv in bash_commands(b.body):
                 if is_runnable(argv) and _writes_into_docs(argv):
                     found.append(f"{b.page}:{b.line}: {shlex.join(argv)}")

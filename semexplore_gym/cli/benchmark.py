@@ -41,7 +41,7 @@ def _split_policies(text: str) -> list[str]:
     return split_specs(text)
 
 
-def _check_policies(policies: list[str]) -> None:
+def check_policies(policies: list[str]) -> None:
     """Build every spec with a bracket or a file once, so a typo fails before any mission.
 
     Raises:
@@ -369,7 +369,7 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError("--policies is empty")
     refuse_repeats("--policies", policies)
     with_oracle = _add_oracle(args, policies)
-    _check_policies(policies)
+    check_policies(policies)
     suites: list[dict[str, Any]] = []
     if args.suite is not None or getattr(args, "split", None) is not None:
         tasks, suites, worlds = _suite_tasks(
