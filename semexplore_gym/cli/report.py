@@ -2,8 +2,9 @@
 
 RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to
 the columns a table reads is enough), a team benchmark's run folder (``--robots``: its
-summary), or a best-known table such as ``configs/best_known/best_known.csv``. For a
-benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one row per family
+summary's tables and paired tests, with the team oracle's columns when it ran, a bold line per
+world family instead of a heading), or a best-known table such as
+``configs/best_known/best_known.csv``. For a benchmark, ``--table`` picks the table of its ``summary.md``: ``overview`` (one row per family
 and policy, the default), ``policies`` (one row per policy over all worlds), ``regret`` (each
 policy against the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run with
 ``--env-config slam``) or ``summary`` (the whole summary but its best-known and learning
