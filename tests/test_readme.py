@@ -41,6 +41,7 @@ SITE_ORDER = (
     "benchmarks",
     "oracle",
     "teams",
+    "team-study",
     "slam",
     "results",
     "learning",

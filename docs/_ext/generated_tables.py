@@ -17,6 +17,7 @@ from typing import Any
 TABLES: dict[str, tuple[str, str | None]] = {
     "suites_overview": ("results/suites/runs.csv", "overview"),
     "best_known": ("../configs/best_known/best_known.csv", None),
+    "teams_mazes": ("results/teams/runs.csv", None),
 }
 GENERATED_DIR = "_generated"
 
