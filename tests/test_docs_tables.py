@@ -37,9 +37,13 @@ def _included() -> dict[str, list[str]]:
 def test_the_build_step_writes_every_included_table(tmp_path: Path) -> None:
     written = _extension().write_tables(DOCS, tmp_path)
     included = _included()
-    assert {"suites_overview", "best_known", "slam_vs_perfect", "learners_vs_expert"} <= set(
-        included
-    )
+    assert {
+        "suites_overview",
+        "best_known",
+        "slam_vs_perfect",
+        "learners_vs_expert",
+        "teams_mazes",
+    } <= set(included)
     assert set(included) == set(written), "a page includes a table no step makes, or vice versa"
     for name, path in written.items():
         text = path.read_text(encoding="utf-8")
@@ -95,6 +99,29 @@ def test_the_slam_table_pairs_each_family_and_policy_of_its_runs(tmp_path: Path)
             n = sum(1 for r in slam if world_family(r["world"]) == family and r["policy"] == policy)
             assert f"| {family} | {policy} | {n} | " in text, (family, policy)
     assert "| paper mazes | SLAM | " in text  # the expert against the baselines
+
+
+def test_the_team_table_has_each_policy_and_team_size_of_its_runs(tmp_path: Path) -> None:
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["teams_mazes"].read_text(encoding="utf-8")
+    with (DOCS / ext.TABLES["teams_mazes"][0]).open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    assert {r["policy"] for r in runs} == {"team_independent", "team_oracle"}
+    assert "| T_oracle(1) / T99 | regret | T99 / bound |" in text  # the team oracle's columns
+    for policy, robots in {(r["policy"], r["n_robots"]) for r in runs}:
+        n = sum(1 for r in runs if r["policy"] == policy and r["n_robots"] == robots)
+        assert f"| {policy} | {robots} | {n} | " in text, (policy, robots)
+    oracle_rows = [ln for ln in text.splitlines() if ln.startswith("| team_oracle |")]
+    assert oracle_rows and all(ln.split(" | ")[-2] == "1.00" for ln in oracle_rows)  # regret
+
+
+def test_the_shipped_team_missions_never_beat_their_lower_bound() -> None:
+    """teams.md says the team bound held on every shipped mission with a T99."""
+    with (DOCS / "results/teams/runs.csv").open(newline="") as f:
+        runs = [r for r in csv.DictReader(f) if r["T99_s"]]
+    assert len(runs) >= 100
+    for r in runs:
+        assert 0 <= float(r["lower_bound_s"]) <= float(r["T99_s"]), r
 
 
 def test_the_docs_tables_are_what_semexplore_report_prints(tmp_path: Path, capsys) -> None:

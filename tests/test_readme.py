@@ -46,6 +46,7 @@ SITE_ORDER = (
     "benchmarks",
     "oracle",
     "teams",
+    "team-study",
     "slam",
     "results",
     "learning",

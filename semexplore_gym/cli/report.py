@@ -1,19 +1,20 @@
 """``semexplore report``: a result file's tables as Markdown, computed from its data.
 
 RUN_DIR is a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (one trimmed to the
-columns a table reads is enough), a team benchmark's run folder (``--robots``: its summary), a
-best-known table such as ``configs/best_known/best_known.csv``, or the checked missions
-``scripts/check_lower_bound.py --missions-out FILE`` writes (the certified bound against every
-mission, per family). Several benchmark run folders or ``runs.csv`` files are read as one (their
-rows concatenated). For a benchmark, ``--table`` picks the table: ``overview`` (one row per
-family and policy, the default), ``policies`` (one row per policy over all worlds), ``regret``
-(each policy against the oracle, a run with ``--oracle``), ``slam`` (the SLAM table of a run
-with ``--env-config slam``), ``slam-vs-perfect`` (a run on the perfect map and the same run with
-``--env-config slam``, missions paired by world, policy and seed), ``paired`` (per family, each
-policy's T99 paired with the ``--reference`` policy's by world and start, with self-stops and
-collisions) or ``summary`` (the whole ``summary.md`` but its best-known and learning sections,
-which read other files; one run folder). The docs build renders the user guide's result tables
-with the same function.
+columns a table reads is enough), a team benchmark's run folder (``--robots``: its summary's
+tables and paired tests, with the team oracle's columns when it ran, a bold line per world
+family instead of a heading), a best-known table such as ``configs/best_known/best_known.csv``,
+or the checked missions ``scripts/check_lower_bound.py --missions-out FILE`` writes (the
+certified bound against every mission, per family). Several benchmark run folders or
+``runs.csv`` files are read as one (their rows concatenated). For a benchmark, ``--table`` picks
+the table: ``overview`` (one row per family and policy, the default), ``policies`` (one row per
+policy over all worlds), ``regret`` (each policy against the oracle, a run with ``--oracle``),
+``slam`` (the SLAM table of a run with ``--env-config slam``), ``slam-vs-perfect`` (a run on the
+perfect map and the same run with ``--env-config slam``, missions paired by world, policy and
+seed), ``paired`` (per family, each policy's T99 paired with the ``--reference`` policy's by
+world and start, with self-stops and collisions) or ``summary`` (the whole ``summary.md`` but
+its best-known and learning sections, which read other files; one run folder). The docs build
+renders the user guide's result tables with the same function.
 
 Example::
 

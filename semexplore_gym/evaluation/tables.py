@@ -100,7 +100,8 @@ def report_tables(
 
     Args:
         path: a benchmark run folder (its ``runs.csv`` is read), a ``runs.csv`` (a team
-            benchmark's is told by its ``n_robots`` column), a best-known table
+            benchmark's is told by its ``n_robots`` column: its summary, with the team
+            oracle's columns when the oracle ran, without headings), a best-known table
             (``configs/best_known/best_known.csv``, told by its columns), the checked
             missions of ``scripts/check_lower_bound.py --missions-out`` (the bound's check per
             family, :mod:`.bound_check`); or several benchmark run folders or ``runs.csv``
@@ -195,7 +196,29 @@ TEAM_COLUMNS: tuple[str, ...] = (
 )
 
 
+#: The team columns that hold numbers (the others: world and policy, free text;
+#: ``self_stopped``, True or False; ``path_per_robot_m``, numbers joined by ``;``), and
+#: those of them that may be empty (a team that never reached 90 % or 99 %, no bound).
+_TEAM_NUMBERS = (
+    "n_robots",
+    "seed",
+    "coverage",
+    "mission_time_s",
+    "T90_s",
+    "T99_s",
+    "path_total_m",
+    "overlap_ratio",
+    "robot_collisions",
+    "lower_bound_s",
+)
+_TEAM_MAY_BE_EMPTY = ("T90_s", "T99_s", "lower_bound_s")
+_TEAM_WHOLE = ("n_robots", "seed", "robot_collisions")
+
+
 def _team_report(source: Path, header: list[str], table: str | None) -> TableReport:
+    """A team benchmark's ``summary.md`` as one block of tables: per world family a bold line
+    naming it, its table (with the oracle's three columns when the team oracle ran) and the
+    paired tests; without the file's headings, so that a page can include it under its own."""
     from semexplore_gym.evaluation.team_report import team_summary_lines
 
     if table is not None:
@@ -209,11 +232,45 @@ def _team_report(source: Path, header: list[str], table: str | None) -> TableRep
         rows = list(csv.DictReader(f))
     if not rows:
         raise ValueError(f"no finished missions in {source}")
-    try:
-        md = "\n".join(team_summary_lines(rows)).strip() + "\n"
-    except (TypeError, IndexError) as e:
-        raise ValueError(f"{source}: a malformed row ({e})") from None
+    for line, row in enumerate(rows, start=2):
+        _check_team_row(row, f"{source} line {line}")
+    lines = []
+    for text in team_summary_lines(rows):
+        if text.startswith("## "):
+            lines.append(f"**{text[3:]}**")
+        elif not text.startswith("# "):
+            lines.append(text)
+    md = "\n".join(lines).strip() + "\n"
     return TableReport("team", source, "team", len(rows), md)
+
+
+def _check_team_row(row: dict[str, str | None], where: str) -> None:
+    """Raise one line naming the cell when a team ``runs.csv`` row cannot be read."""
+    for column in ("world", "policy"):
+        if not row.get(column):
+            raise ValueError(f"{where}: no {column}")
+    for column in _TEAM_NUMBERS:
+        value = row.get(column)
+        if value is None and column != "lower_bound_s":
+            raise ValueError(f"{where}: a short row (no {column} cell)")
+        if value in (None, "", "None") and column in _TEAM_MAY_BE_EMPTY:
+            continue
+        try:
+            number = int(value or "") if column in _TEAM_WHOLE else float(value or "")
+        except ValueError:
+            kind = "a whole number" if column in _TEAM_WHOLE else "a number"
+            raise ValueError(f"{where}: {column} is {value!r}, not {kind}") from None
+        if column == "n_robots" and number < 1:
+            raise ValueError(f"{where}: n_robots is {value!r}; a team has at least one robot")
+    if row.get("self_stopped") not in ("True", "False"):
+        raise ValueError(f"{where}: self_stopped is {row.get('self_stopped')!r}, not True or False")
+    per_robot = row.get("path_per_robot_m") or ""
+    try:
+        [float(v) for v in per_robot.split(";")]
+    except ValueError:
+        raise ValueError(
+            f"{where}: path_per_robot_m is {per_robot!r}, not numbers joined by ';'"
+        ) from None
 
 
 def _csv_of(p: Path) -> Path:

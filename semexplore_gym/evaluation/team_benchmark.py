@@ -71,6 +71,9 @@ COLUMNS = (
     "wall_time_s",
     "lower_bound_s",
 )
+#: The env overrides of every team benchmark mission (before its start setting, time limit and
+#: ``--env-set``): only the team's own stop or the time limit ends a mission.
+MISSION_OVERRIDES = ("episode.coverage_goal=1.0", "team.end_on_coverage=false")
 #: The SLAM columns (:meth:`~semexplore_gym.envs.team_slam.TeamSlam.metrics`), after
 #: :data:`COLUMNS`; a ``runs.csv`` written before them keeps its own header when resumed.
 SLAM_COLUMNS = ("ate_m", "odom_ate_m", "map_error", "loop_closures", "slam_lost_events")
@@ -286,7 +289,7 @@ def run_team_task(task: TeamTask) -> dict[str, Any]:
 def team_tasks(config: TeamBenchmarkConfig) -> list[TeamTask]:
     """Every mission of ``config``, world-major, then team size, policy and seed."""
     c = config
-    overrides = ["episode.coverage_goal=1.0", "team.end_on_coverage=false"]
+    overrides = list(MISSION_OVERRIDES)
     overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
     if c.max_time_s is not None:
         overrides.append(f"episode.max_time_s={c.max_time_s!r}")

@@ -245,3 +245,90 @@ def test_bad_slam_pairs_are_one_error_line(
     lines = captured.err.strip().splitlines()
     assert captured.out == "" and len(lines) == 1, captured.err
     assert lines[0].startswith("semexplore report: error:") and says in lines[0]
+
+
+#: The team runs.csv's columns, the oracle's bound last.
+TEAM_COLUMNS = ["world", "policy", "n_robots", "seed", "coverage", "mission_time_s"]
+TEAM_COLUMNS += ["self_stopped", "T90_s", "T99_s", "path_total_m", "path_per_robot_m"]
+TEAM_COLUMNS += ["overlap_ratio", "robot_collisions", "lower_bound_s"]
+
+
+def _write_team_runs(path: Path, edit: dict[str, str] | None = None) -> Path:
+    """A team runs.csv: one maze, two starts, the team oracle (T99 100 s alone, 60 s with two
+    robots) and independent robots (150 s, 90 s); the bound 20 s alone, 10 s with two; the
+    first row's cells replaced by ``edit``."""
+    path.mkdir(parents=True, exist_ok=True)
+    missions = [("team_oracle", 1, 100.0, 20.0), ("team_oracle", 2, 60.0, 10.0)]
+    missions += [("team_independent", 1, 150.0, 20.0), ("team_independent", 2, 90.0, 10.0)]
+    with (path / "runs.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=TEAM_COLUMNS)
+        w.writeheader()
+        for i, (seed, (policy, n, t99, bound)) in enumerate(
+            (s, m) for s in range(2) for m in missions
+        ):
+            per_robot = ";".join([str(40.0 / n)] * n)
+            cells = [
+                "maze:seed=3,size_m=6", policy, n, seed, 0.995, t99 + 5, True, t99 * 0.8, t99,
+                40.0, per_robot, 0.1 * (n - 1), 0, bound,
+            ]  # fmt: skip
+            row = dict(zip(TEAM_COLUMNS, map(str, cells), strict=True))
+            w.writerow({**row, **(edit or {})} if i == 0 else row)
+    return path
+
+
+def test_report_of_a_team_run_with_the_oracle_computes_its_columns(tmp_path: Path, capsys) -> None:
+    run = _write_team_runs(tmp_path / "team")
+    assert main(["report", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[:2] == ["**maze**", ""]  # no headings: a page includes it
+    assert not [ln for ln in out.splitlines() if ln.startswith("#")]
+    header = next(ln for ln in out.splitlines() if ln.startswith("| policy"))
+    assert header.endswith("| T_oracle(1) / T99 | regret | T99 / bound |")
+    rows = [ln for ln in out.splitlines() if ln.startswith("| team_")]
+    # T_oracle(1) / T99: 100 / T99; regret: T99 over the team oracle's with as many robots;
+    # T99 / bound: T99 over the row's lower_bound_s.
+    assert [r.split(" | ")[-3:] for r in rows] == [
+        ["0.67", "1.50", "7.50 |"],  # independent alone: 100/150, 150/100, 150/20
+        ["1.11", "1.50", "9.00 |"],  # independent, two: 100/90, 90/60, 90/10
+        ["1.00", "1.00", "5.00 |"],  # the oracle alone
+        ["1.67", "1.00", "6.00 |"],  # the oracle with two: its speed-up 100/60
+    ]
+    assert rows[0].startswith("| team_independent | 1 | 2 | 120.0 | 150.0 | 155.0 | 1.00 |")
+    assert main(["report", str(run), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["kind"] == "team"
+    assert result["tables"][0]["rows"][3][-3:] == ["1.67", "1.00", "6.00"]
+
+
+def test_report_of_a_team_run_without_a_bound_shows_a_dash(tmp_path: Path, capsys) -> None:
+    run = _write_team_runs(tmp_path / "team")
+    lines = (run / "runs.csv").read_text().splitlines()
+    (run / "runs.csv").write_text("\n".join(ln.rsplit(",", 1)[0] for ln in lines) + "\n")
+    assert main(["report", str(run)]) == 0
+    rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("| team_")]
+    assert rows[1].endswith("| 1.11 | 1.50 | - |")
+
+
+@pytest.mark.parametrize(
+    ("edit", "says"),
+    [
+        ({"T99_s": "fast"}, "line 2: T99_s is 'fast', not a number"),
+        ({"n_robots": "two"}, "line 2: n_robots is 'two', not a whole number"),
+        ({"n_robots": "0"}, "line 2: n_robots is '0'; a team has at least one robot"),
+        ({"seed": "1.5"}, "line 2: seed is '1.5', not a whole number"),
+        ({"self_stopped": "yes"}, "line 2: self_stopped is 'yes', not True or False"),
+        ({"path_per_robot_m": "20,20"}, "path_per_robot_m is '20,20', not numbers joined by ';'"),
+        ({"world": ""}, "line 2: no world"),
+    ],
+    ids=["T99", "robots", "no robot", "seed", "self-stopped", "per robot", "world"],
+)
+def test_a_bad_team_cell_is_one_error_line_naming_it(
+    tmp_path: Path, capsys, edit: dict[str, str], says: str
+) -> None:
+    run = _write_team_runs(tmp_path / "team", edit)
+    assert main(["report", str(run)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("semexplore report: error:"), lines
+    assert str(run / "runs.csv") in lines[0] and says in lines[0]
