@@ -342,6 +342,17 @@ def test_commands_are_found() -> None:
     assert any(b.lang == "python" and "record_expert_dataset" in b.body for b in blocks)
 
 
+def test_the_shrunk_benchmark_skips_the_oracle_only_beyond_the_paper_suite() -> None:
+    def run(*flags: str) -> list[str]:
+        return shrink(["semexplore", "benchmark", *flags, "--out", "runs/x"], [])
+
+    assert "--no-oracle" in run("--suite", "paper,mazes")
+    assert "--no-oracle" not in run("--suite", "paper")
+    assert "--no-oracle" not in run("--worlds", "maze1")
+    assert "--no-oracle" not in run("--suite", "mazes", "--oracle")  # asked for: kept
+    assert run("--suite", "mazes", "--no-oracle").count("--no-oracle") == 1
+
+
 # ------------------------------------------------------------------------- running commands
 def _replace_or_add(argv: list[str], flag: str, value: str) -> list[str]:
     if flag in argv:
@@ -405,6 +416,17 @@ def _cpu_s() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
+def _suites_beyond_paper(argv: list[str]) -> bool:
+    """Whether a benchmark runs a suite other than ``paper``: there the oracle (on by default
+    with ``--suite``) plans its tour and bound on worlds of up to 40 m, minutes of CPU that no
+    mission budget shrinks, so the docs test runs it with ``--no-oracle`` (the oracle inside a
+    benchmark is tested on small worlds: tests/evaluation/test_regret.py; the paper suite keeps
+    it here)."""
+    if "--suite" not in argv:
+        return False
+    return any(s != "paper" for s in argv[argv.index("--suite") + 1].split(","))
+
+
 def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
     """The same command with a test-sized budget (flags substituted or appended)."""
     if argv[0] == "python":
@@ -429,6 +451,8 @@ def shrink(argv: list[str], tiny_macro: list[str]) -> list[str]:
             worlds = ",".join(w for w in argv[i + 1].split(",") if not w.startswith("path/to/"))
             argv = [*argv[: i + 1], worlds, *argv[i + 2 :]]
         argv = _replace_or_add(_replace_or_add(argv, "--runs", "1"), "--max-time-s", "5")
+        if _suites_beyond_paper(argv) and "--oracle" not in argv and "--no-oracle" not in argv:
+            argv = [*argv, "--no-oracle"]
         return [*_replace_or_add(argv, "--workers", "1"), "--no-progress", *NO_PLOTS]
     if command == "compare-weights":
         for flag, value in (("--trials", "1"), ("--train-runs", "1"), ("--runs", "1")):
