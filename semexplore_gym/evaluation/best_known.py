@@ -138,8 +138,11 @@ def run_start(out_dir: str | os.PathLike) -> str | None:
         meta = json.loads(p.read_text())
     except (OSError, ValueError):
         return None
-    if meta.get("config") or meta.get("robots") or meta.get("env_overrides", [None]):
-        return None  # another env config, unknown overrides (older runs), or a team
+    # ``--env-config default`` names the default config itself (the ``default`` preset).
+    if meta.get("config") not in (None, "default") or meta.get("robots"):
+        return None  # another env config, or a team
+    if meta.get("env_overrides", [None]):
+        return None  # overrides, or unknown ones (an older manifest)
     return "fixed" if meta.get("fixed_start") else "random"
 
 

@@ -166,6 +166,7 @@ def test_only_runs_with_the_default_env_are_compared(tmp_path):
     assert run_start(tmp_path) is None  # no manifest
     assert manifest() == "random" and manifest(fixed_start=True) == "fixed"
     assert manifest(config="slam") is None
+    assert manifest(config="default") == "random"  # the default preset, named
     assert manifest(env_overrides=["lidar.max_range_m=5"]) is None
     (tmp_path / "benchmark.json").write_text(json.dumps({"fixed_start": False, "config": None}))
     assert run_start(tmp_path) is None  # an older manifest: overrides unknown
