@@ -225,7 +225,7 @@ def test_help_says_the_default_budget_is_a_demo_and_gives_the_documented_one(cap
     budget = "--trials 16 --runs 10 --max-time-s 600"
     assert budget in text
     # The budget is the one the documented table was measured with.
-    docs = Path(__file__).resolve().parents[2] / "docs" / "learning.md"
+    docs = Path(__file__).resolve().parents[2] / "docs" / "learning-first-designs.md"
     learning = " ".join(docs.read_text(encoding="utf-8").split())
     measured = learning.split("## Hand-tuned vs learned weights", 1)[1].split("|", 1)[0]
     assert budget in measured and "is a demo" in measured
