@@ -9,6 +9,8 @@ reached 99 % coverage sooner than the bound's time, or after a shorter drive tha
 the missions, the median best known ÷ bound (the best T99 any policy of any folder reached from
 that start), the oracle's median T99 ÷ bound and the share of paired missions where the
 oracle's T99 is at most each other policy's; and the median T99 / bound per policy and family.
+A mission that repeats an earlier folder's (same world, start and policy: the same
+deterministic mission) counts once.
 
     python scripts/check_lower_bound.py runs/paper
     python scripts/check_lower_bound.py runs/paper runs/mazes runs/offices --json
@@ -31,7 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
-from semexplore_gym.evaluation.bound_check import family_report, report_lines, write_missions
+from semexplore_gym.evaluation.bound_check import (
+    family_report,
+    report_lines,
+    unique_missions,
+    write_missions,
+)
 
 BOUND_COLUMNS = ("world", "seed", "lower_bound_m", "lower_bound_s", "groups", "bound_planning_s")
 
@@ -88,6 +95,12 @@ def main(argv: list[str] | None = None) -> int:
             out.unlink(missing_ok=True)
         bounds = compute_bounds(runs, settings, out, not args.no_progress)
         missions += checked_missions(runs, bounds, run_dir, settings)
+    missions, repeats = unique_missions(missions)
+    if repeats:
+        print(
+            f"{repeats} missions repeat a (world, start, policy) of an earlier folder: counted once",
+            file=sys.stderr,
+        )
     if args.missions_out is not None:
         write_missions(args.missions_out, missions)
     if args.json:

@@ -108,6 +108,19 @@ def read_missions(path: Path) -> list[dict[str, Any]]:
     return out
 
 
+def unique_missions(missions: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], int]:
+    """The missions with each (start, policy) once, the first folder's kept, and how many
+    repeats were dropped: two folders that ran the same policy from the same start ran the same
+    (deterministic) mission, which is one check of the bound, not two."""
+    first: dict[tuple[Any, ...], str] = {}  # (start, policy) -> the folder that ran it first
+    kept = []
+    for m in missions:
+        folder = first.setdefault((m["start"], m["policy"]), m["folder"])
+        if folder == m["folder"]:
+            kept.append(m)
+    return kept, len(missions) - len(kept)
+
+
 def _median(xs: list[float]) -> float | None:
     return round(float(np.median(xs)), 3) if xs else None
 

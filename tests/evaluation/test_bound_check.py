@@ -92,3 +92,23 @@ def test_bad_checked_missions_are_one_line(tmp_path: Path, capsys) -> None:
         assert "error: " in err and message in err and "\n" not in err, err
     assert main(["report", str(_missions(tmp_path)), "--table", "regret"]) == 2
     assert "one table" in capsys.readouterr().err
+
+
+def test_a_mission_two_folders_ran_counts_once(tmp_path: Path) -> None:
+    from semexplore_gym.evaluation.bound_check import unique_missions
+
+    maze = "maze:seed=1,size_m=6"
+    missions = read_missions(
+        _write(
+            tmp_path / "twice.csv",
+            [
+                _row("a", maze, 0, "semantic", "40"),
+                _row("b", maze, 0, "semantic", "40"),  # the same mission again
+                _row("b", maze, 0, "nearest", "50"),
+                _row("b", maze, 1, "semantic", "45"),  # another start
+            ],
+        )
+    )
+    kept, repeats = unique_missions(missions)
+    assert repeats == 1 and [m["folder"] for m in kept] == ["a", "b", "b"]
+    assert family_report(kept)["maze"]["missions"] == 3

@@ -67,12 +67,18 @@ def test_folders_are_checked_together_per_family_with_the_oracle_s_wins(tmp_path
     a, b = tmp_path / "a", tmp_path / "b"
     # seed 0: oracle 1e6 s, p 2e6 s (a win); seed 1: the oracle never reached 99 % (a loss).
     _fake_runs(a, ["1e6", "", "2e6", "1e6"], ("oracle", "p"))
-    _fake_runs(b, ["3e6", "3e6"], ("oracle",))
+    _fake_runs(b, ["3e6", "3e6"], ("q",))
     res = _run(str(a), str(b), "--no-progress", "--json")
     assert res.returncode == 0, res.stderr
     maze = json.loads(res.stdout)["maze"]
     assert (maze["starts"], maze["missions"], maze["T99_below_bound"]) == (2, 6, 0)
     assert (maze["oracle_wins"], maze["oracle_pairs"]) == (1, 2)
+    # A folder that ran the same policies from the same starts adds no mission.
+    c = tmp_path / "c"
+    _fake_runs(c, ["1e6", "", "2e6", "1e6"], ("oracle", "p"))
+    again = _run(str(a), str(b), str(c), "--no-progress", "--json")
+    assert json.loads(again.stdout)["maze"]["missions"] == 6
+    assert "4 missions repeat a (world, start, policy) of an earlier folder" in again.stderr
     # The best known per start is the best of both folders: 1e6 s from either seed.
     fresh = _run(str(a), str(b), "--no-progress", "--json", "--fresh")
     assert json.loads(fresh.stdout)["maze"]["median_best_known_over_bound"] == pytest.approx(
