@@ -113,6 +113,7 @@ def main(argv: list[str] | None = None) -> int:
 def _benchmark_settings(run_dir: Path) -> tuple[object, dict[str, bool], bool]:
     """The env config the benchmark made its starts with, the suites' random-start setting of
     each of their worlds, and whether every start was the world's own (``--fixed-start``)."""
+    from semexplore_gym.evaluation.splits import PARTS, split_suite
     from semexplore_gym.evaluation.suites import load_suite
 
     meta_path = run_dir / "benchmark.json"
@@ -121,7 +122,10 @@ def _benchmark_settings(run_dir: Path) -> tuple[object, dict[str, bool], bool]:
     env_config = config if isinstance(config, str) else None
     random_start: dict[str, bool] = {}
     for entry in meta.get("suites") or []:
-        suite = load_suite(entry["source"])
+        source = str(entry["source"])
+        # A split's part (`--split caves:test`) is recorded as its YAML path and ":test".
+        is_split = source.rpartition(":")[2] in PARTS and source.rpartition(":")[0]
+        suite = split_suite(source) if is_split else load_suite(source)
         for w in suite.worlds:
             random_start[w.world] = suite.random_start
     return env_config, random_start, bool(meta.get("fixed_start", False))

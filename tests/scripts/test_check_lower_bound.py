@@ -85,3 +85,23 @@ def test_folders_are_checked_together_per_family_with_the_oracle_s_wins(tmp_path
         maze["median_best_known_over_bound"]
     )
     assert _run(str(a), str(b), "--out", str(tmp_path / "x.csv")).returncode == 2
+
+
+def test_a_split_part_benchmark_is_checked_with_the_splits_starts(tmp_path) -> None:
+    """`benchmark --split caves:test` records its suite as the split's YAML path and ":test"."""
+    folder = tmp_path / "split"
+    folder.mkdir()
+    source = f"{REPO / 'configs' / 'splits' / 'caves.yaml'}:test"
+    meta = {
+        "fixed_start": False,
+        "suites": [{"name": "caves-test", "version": 1, "source": source}],
+    }
+    (folder / "benchmark.json").write_text(json.dumps(meta))
+    with (folder / "runs.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["world", "policy", "seed", "T99_s"])
+        w.writeheader()
+        w.writerow({"world": "cave:seed=63800,size_m=8,min_passage_m=0.5", "policy": "p",
+                    "seed": 0, "T99_s": "1e6"})  # fmt: skip
+    res = _run(str(folder), "--no-progress", "--json")
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout)["cave"]["missions"] == 1
