@@ -117,6 +117,19 @@ def _fast_tier_budget(request: pytest.FixtureRequest, _simulated_clock: _Simulat
 
 
 @pytest.fixture(scope="session")
+def docs_commands_checker():
+    """``scripts/check_docs_commands.py`` as a module (the docs' long-block checker)."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "check_docs_commands.py"
+    spec = importlib.util.spec_from_file_location("check_docs_commands", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
 def tiny_macro_train_args() -> Callable[[float], list[str]]:
     """``semexplore train`` overrides for a few-step macro-env training on a 4 m maze.
 

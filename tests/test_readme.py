@@ -303,21 +303,10 @@ def test_every_code_block_is_run_or_marked() -> None:
     assert len(not_run) <= MAX_NOT_RUN, f"too many illustrative blocks: {not_run}"
 
 
-def _docs_commands_checker():
-    """``scripts/check_docs_commands.py`` as a module."""
-    spec = importlib.util.spec_from_file_location(
-        "check_docs_commands", REPO / "scripts" / "check_docs_commands.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_long_blocks_parse_and_resolve() -> None:
+def test_long_blocks_parse_and_resolve(docs_commands_checker) -> None:
     """Every long reproduce command parses with its command's parser and names policies,
     worlds, suites, splits and configs that resolve (nothing is run)."""
-    checker = _docs_commands_checker()
+    checker = docs_commands_checker
     long = [b for b in all_blocks() if b.lang == "long"]
     assert long, "no <!-- long --> block found"
     checked, problems = 0, []
