@@ -17,9 +17,12 @@ legs are the paths it drives, so the tour's path cost is the oracle's own). Whil
 
 * every ``check_period_s`` it counts, for each viewpoint left, the cells of its visible set the
   live map (``obs["map"]``) has not mapped FREE yet. When some viewpoint is no longer needed,
-  it reruns the greedy cover over the viewpoints left on what is still unseen and reorders the
-  survivors by LKH from where the robot is (distances: the stored geodesic matrix plus one
-  Dijkstra from the robot);
+  it reruns the greedy cover over the viewpoints left on what is still unseen, and drives the
+  rest of the tour that the sensor model predicts to see what the tour's target still needs
+  after the shortest drive (:func:`~semexplore_gym.core.coverage_tour.refine.predicted_drive_m`,
+  the scans along the legs counted): the survivors in the tour's order, the survivors reordered
+  by LKH from where the robot is (distances: the stored geodesic matrix plus one Dijkstra from
+  the robot), or the tour as it was;
 * it drives to each viewpoint along a shortest path on the true standing mask that keeps off
   the walls, followed by the semantic expert's modified potential field
   (:func:`~semexplore_gym.core.planning.potential_field.potential_field_command`, the expert's
@@ -55,6 +58,7 @@ from semexplore_gym.core.coverage_tour import (
     open_tour_order,
     plan_coverage_tour,
 )
+from semexplore_gym.core.coverage_tour.refine import predicted_drive_m
 from semexplore_gym.core.coverage_tour.tour import row_counts
 from semexplore_gym.core.coverage_tour.viewpoints import (
     nearest_allowed_cell,
@@ -152,7 +156,7 @@ class OracleParams:
     goal_reached_radius_m: float = 0.1
     check_period_s: float = 0.4
     min_gain_cells: int = 1
-    path_prefer_clearance_m: float = 0.35
+    path_prefer_clearance_m: float = 0.2
     path_wall_cost: float = 4.0
     goal_time_factor: float = 3.0
     min_goal_time_s: float = 20.0
@@ -235,6 +239,7 @@ class OraclePolicy(Policy):
         self._geo_cost = np.where(tour.standing, res, np.inf)
         self._left: list[int] = list(range(tour.n_viewpoints))
         self._tried: set[tuple[int, int]] = set()
+        self._kept_useless: frozenset[int] = frozenset()
         self._goal_xy: tuple[float, float] | None = None
         self._goal_rc: tuple[int, int] | None = None
         self._goal_kind = ""
@@ -372,8 +377,9 @@ class OraclePolicy(Policy):
         unseen = self._unseen(grid)
         sub = tour.visible[self._left]
         gains = row_counts(unseen, sub.indptr, sub.indices)
-        if (gains >= self.params.min_gain_cells).all():
-            return
+        useless = frozenset(np.asarray(self._left)[gains < self.params.min_gain_cells].tolist())
+        if not useless or useless == self._kept_useless:
+            return  # none to drop, or the same ones the last check chose to keep
         seen = ~unseen
         # Drop only what the others make redundant: the live map lags the static prediction
         # (the robot passes near a viewpoint, not on it), so no margin is given away here.
@@ -381,8 +387,14 @@ class OraclePolicy(Policy):
         coverable[sub.indices] = True
         keep = sorted(greedy_cover(sub, int(coverable.sum()), seen))
         kept = [self._left[i] for i in keep]
-        self.counters["skipped"] += len(self._left) - len(kept)
-        self._left = self._order_from(pose, kept)
+        here = self._robot_cell(pose)
+        dist, _ = distance_field(self._geo_cost, here)
+        chosen = self._best_route(
+            here, dist, [kept, self._order_from(here, dist, kept), self._left], unseen
+        )
+        self.counters["skipped"] += len(self._left) - len(chosen)
+        self._left = chosen
+        self._kept_useless = useless & frozenset(chosen)
         self.counters["reorders"] += 1
         if self._goal_kind == "tour" and (
             not self._left or self._goal_rc != self._rc(self._left[0])
@@ -432,13 +444,44 @@ class OraclePolicy(Policy):
         r, c = self.tour.viewpoints_rc[vp]
         return int(r), int(c)
 
-    def _order_from(self, pose: tuple[float, float, float], vps: list[int]) -> list[int]:
-        """``vps`` as an open LKH tour from the robot's position."""
+    def _best_route(
+        self,
+        here: tuple[int, int],
+        dist: np.ndarray,
+        routes: list[list[int]],
+        unseen: np.ndarray,
+    ) -> list[int]:
+        """Of the candidate rests of the tour, the one the sensor model predicts to see what the
+        tour's target still needs after the shortest drive (the first on a tie; when none sees
+        it, the one that sees most). The tour's order was chosen with the scans along its legs
+        counted: an order re-solved on distances alone can lose what those legs saw."""
+        tour = self.tour
+        assert tour is not None and tour.legs is not None
+        need = math.ceil(self.params.tour.coverage_target * self._n_mask) - int((~unseen).sum())
+        best: tuple[Any, ...] | None = None
+        chosen = routes[0]
+        for route in routes:
+            cells = tour.viewpoints_rc[route].reshape(-1, 2)
+            lengths = np.concatenate(
+                [
+                    dist[cells[:1, 0], cells[:1, 1]],
+                    tour.distances_m[route[:-1], route[1:]],
+                ]
+            )
+            reached, drive_m, seen = predicted_drive_m(
+                tour.legs, np.vstack([np.array([here]), cells]), lengths, unseen, need
+            )
+            key = (0, drive_m, 0) if reached else (1, -seen, drive_m)
+            if best is None or key < best:
+                best, chosen = key, route
+        return list(chosen)
+
+    def _order_from(self, here: tuple[int, int], dist: np.ndarray, vps: list[int]) -> list[int]:
+        """``vps`` as an open LKH tour from the robot's cell ``here`` (``dist``: its geodesic
+        distance field)."""
         assert self.tour is not None
         if len(vps) <= 1:
             return list(vps)
-        here = self._robot_cell(pose)
-        dist, _ = distance_field(self._geo_cost, here)
         cells = self.tour.viewpoints_rc[vps]
         d0 = dist[cells[:, 0], cells[:, 1]]
         k = len(vps)

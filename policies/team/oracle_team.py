@@ -102,6 +102,13 @@ class _RouteOracle(OraclePolicy):
     def plan_tour(self, facts: PrivilegedWorld, tour_params: TourParams) -> CoverageTour:
         return self._route
 
+    def _best_route(
+        self, here: tuple[int, int], dist: np.ndarray, routes: list[list[int]], unseen: np.ndarray
+    ) -> list[int]:
+        # A route sees only its share of what the team needs: no prediction of the whole
+        # goal to judge it by; the survivors are re-solved from where the robot is.
+        return routes[1]
+
 
 class TeamOracle(TeamPolicy):
     """PRIVILEGED team explorer (module docstring): the oracle's tour split among the robots."""

@@ -470,3 +470,45 @@ def tour_visible(legs: LegVisibility, tour_rc: np.ndarray, n_cols: int) -> spars
     return sparse.csr_matrix(
         (np.ones(indices.size, dtype=bool), indices, indptr), shape=(len(parts), n_cols)
     )
+
+
+def predicted_drive_m(
+    legs: LegVisibility,
+    route_rc: np.ndarray,
+    leg_lengths_m: np.ndarray,
+    unseen: np.ndarray,
+    need: int,
+) -> tuple[bool, float, int]:
+    """How far a route must be driven until its scans see ``need`` of the ``unseen`` columns.
+
+    The route is driven leg by leg from ``route_rc[0]`` (where the robot is); what a leg's
+    scans and the scan at its end see counts once the leg is driven, so the distance is that of
+    the whole leg that completes the count (the same rounding for every route compared).
+
+    Args:
+        legs: The tour's leg and viewpoint visibility.
+        route_rc: ``(K + 1, 2)`` the robot's cell, then the viewpoints in the order driven.
+        leg_lengths_m: ``(K,)`` length of each leg.
+        unseen: ``(M,)`` bool: the columns not seen yet.
+        need: Columns still to see.
+
+    Returns:
+        ``(reached, distance_m, seen)``: whether the route sees ``need`` columns, the distance
+        driven when it does (else its whole length) and how many it sees by then.
+    """
+    route = [(int(r), int(c)) for r, c in np.asarray(route_rc, dtype=np.int64).reshape(-1, 2)]
+    todo = np.asarray(unseen, dtype=bool).copy()
+    seen = 0
+    driven = 0.0
+    if need <= 0:
+        return True, 0.0, 0
+    ends = legs.cells(np.array(route[1:], dtype=np.int64).reshape(-1, 2)) if len(route) > 1 else []
+    for i, (a, b) in enumerate(zip(route[:-1], route[1:], strict=True)):
+        driven += float(leg_lengths_m[i])
+        for cols in (legs.leg(a, b), ends[i]):
+            new = cols[todo[cols]]
+            todo[new] = False
+            seen += int(new.size)
+        if seen >= need:
+            return True, driven, seen
+    return False, driven, seen

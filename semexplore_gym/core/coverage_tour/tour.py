@@ -93,7 +93,7 @@ class TourParams:
     max_candidates: int = 6000
     refine_rounds: int = 4
     leg_sample_m: float = 0.25
-    leg_prefer_clearance_m: float = 0.35
+    leg_prefer_clearance_m: float = 0.2
     leg_wall_cost: float = 4.0
     robust_cells: int = 2
 
@@ -153,6 +153,8 @@ class CoverageTour:
         candidates_rc: ``(N, 2)`` all candidate viewpoints (for replanning).
         seen: ``(M,)`` bool: the columns the start scan, the viewpoints and the legs see.
         candidate_visible: ``(N, M)`` what one scan from each candidate sees (for shortcuts).
+        legs: What the scans along a driven leg see (cached; for judging a replanned rest of
+            the tour, :func:`~.refine.predicted_drive_m`).
     """
 
     viewpoints_rc: np.ndarray
@@ -171,6 +173,7 @@ class CoverageTour:
     )
     seen: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0, dtype=bool))
     candidate_visible: sparse.csr_matrix | None = field(repr=False, default=None)
+    legs: LegVisibility | None = field(repr=False, default=None)
 
     @property
     def n_viewpoints(self) -> int:
@@ -423,6 +426,7 @@ def plan_coverage_tour(facts: PrivilegedWorld, params: TourParams | None = None)
         candidates_rc=candidates,
         seen=covered,
         candidate_visible=vis,
+        legs=legs,
     )
 
 

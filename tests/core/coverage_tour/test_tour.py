@@ -159,3 +159,45 @@ def test_shared_distance_fields_give_the_same_matrix():
     assert np.array_equal(
         geodesic_matrix(standing, geo, cells, fields), geodesic_matrix(standing, geo, cells)
     )
+
+
+def test_the_predicted_drive_counts_leg_scans_and_stops_at_the_leg_that_completes_the_need(
+    privileged_world,
+):
+    # The comb again: driving the spine to its far end sees into every tooth on the way.
+    from semexplore_gym.core.coverage_tour.refine import predicted_drive_m
+
+    rects = [(0.0, 0.0, 6.0, 0.6)] + [(x, 0.6, x + 0.6, 1.8) for x in (0.9, 2.1, 3.3, 4.5)]
+    facts = _facts(privileged_world, rects, (6.0, 1.8), (0.3, 0.3, 0.0))
+    tour = plan_coverage_tour(facts, TourParams(robust_cells=0))
+    assert tour.legs is not None
+    geo = facts.geometry
+    start = np.array([geo.world_to_grid(0.3, 0.3)], dtype=np.int64).reshape(1, 2)
+    route = np.vstack([start, tour.viewpoints_rc])
+    legs_m = tour.leg_lengths_m
+    unseen = np.ones(tour.mask_flat.size, dtype=bool)
+    total = int(tour.seen.sum())
+    # Nothing needed: no drive. The whole route's count is what the tour counts as seen
+    # (less the start scan, which is not in the route's scans here).
+    assert predicted_drive_m(tour.legs, route, legs_m, unseen, 0) == (True, 0.0, 0)
+    reached, drive_m, seen = predicted_drive_m(tour.legs, route, legs_m, unseen, total + 1)
+    assert not reached and drive_m == pytest.approx(legs_m.sum()) and seen <= total
+    # More needed never means a shorter drive; what is counted is whole legs.
+    drives = []
+    for share in (0.2, 0.5, 0.8, 0.95):
+        reached, drive_m, seen = predicted_drive_m(
+            tour.legs, route, legs_m, unseen, int(share * seen)
+        )
+        assert reached
+        drives.append(drive_m)
+        assert any(drive_m == pytest.approx(c) for c in np.cumsum(legs_m))
+    assert drives == sorted(drives)
+    # Cells already seen do not count: with what the first leg and its viewpoint see marked
+    # seen, one more cell takes a longer drive than the first leg.
+    a, b = (int(route[0, 0]), int(route[0, 1])), (int(route[1, 0]), int(route[1, 1]))
+    first = np.union1d(tour.legs.leg(a, b), tour.legs.cells(route[1:2])[0])
+    later = unseen.copy()
+    later[first] = False
+    assert len(route) > 2 and later.sum() > 0
+    r1, d1, s1 = predicted_drive_m(tour.legs, route, legs_m, later, 1)
+    assert r1 and s1 >= 1 and d1 > legs_m[0]
