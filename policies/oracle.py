@@ -16,13 +16,10 @@ mask; an open LKH tour from the start, viewpoints dropped and moved while the to
 legs are the paths it drives, so the tour's path cost is the oracle's own). While it drives:
 
 * every ``check_period_s`` it counts, for each viewpoint left, the cells of its visible set the
-  live map (``obs["map"]``) has not mapped FREE yet. When some viewpoint is no longer needed,
-  it reruns the greedy cover over the viewpoints left on what is still unseen, and drives the
-  rest of the tour that the sensor model predicts to see what the tour's target still needs
-  after the shortest drive (:func:`~semexplore_gym.core.coverage_tour.refine.predicted_drive_m`,
-  the scans along the legs counted): the survivors in the tour's order, the survivors reordered
-  by LKH from where the robot is (distances: the stored geodesic matrix plus one Dijkstra from
-  the robot), or the tour as it was;
+  live map (``obs["map"]``) has not mapped FREE yet. When some viewpoint is no longer needed, it
+  reruns the greedy cover on what is still unseen and drives the rest of the tour the sensor
+  model predicts to see what the tour's target needs soonest, the scans along its legs counted
+  (:func:`~semexplore_gym.policies.oracle_goals.best_rest_of_tour`);
 * it drives to each viewpoint along a shortest path on the true standing mask that keeps off
   the walls, followed by the semantic expert's modified potential field
   (:func:`~semexplore_gym.core.planning.potential_field.potential_field_command`, the expert's
@@ -47,7 +44,13 @@ from typing import Any
 import numpy as np
 from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
 from semexplore_gym.policies.navigation import BackoffRecovery, ProgressWatch
-from semexplore_gym.policies.oracle_goals import fallback_cell, repair_cell, shortcut_cell
+from semexplore_gym.policies.oracle_goals import (
+    best_rest_of_tour,
+    fallback_cell,
+    open_order_from,
+    repair_cell,
+    shortcut_cell,
+)
 
 from semexplore_gym.core.coverage_tour import (
     PRIVILEGED_INFO_KEY,
@@ -55,10 +58,8 @@ from semexplore_gym.core.coverage_tour import (
     PrivilegedWorld,
     TourParams,
     greedy_cover,
-    open_tour_order,
     plan_coverage_tour,
 )
-from semexplore_gym.core.coverage_tour.refine import predicted_drive_m
 from semexplore_gym.core.coverage_tour.tour import row_counts
 from semexplore_gym.core.coverage_tour.viewpoints import (
     nearest_allowed_cell,
@@ -380,25 +381,20 @@ class OraclePolicy(Policy):
         useless = frozenset(np.asarray(self._left)[gains < self.params.min_gain_cells].tolist())
         if not useless or useless == self._kept_useless:
             return  # none to drop, or the same ones the last check chose to keep
-        seen = ~unseen
         # Drop only what the others make redundant: the live map lags the static prediction
         # (the robot passes near a viewpoint, not on it), so no margin is given away here.
-        coverable = seen.copy()
+        coverable = ~unseen
         coverable[sub.indices] = True
-        keep = sorted(greedy_cover(sub, int(coverable.sum()), seen))
-        kept = [self._left[i] for i in keep]
+        kept = [self._left[i] for i in sorted(greedy_cover(sub, int(coverable.sum()), ~unseen))]
         here = self._robot_cell(pose)
         dist, _ = distance_field(self._geo_cost, here)
-        chosen = self._best_route(
-            here, dist, [kept, self._order_from(here, dist, kept), self._left], unseen
-        )
+        routes = [kept, open_order_from(tour, dist, kept, self.params.tour.lkh_runs), self._left]
+        chosen = self._best_route(here, dist, routes, unseen)
         self.counters["skipped"] += len(self._left) - len(chosen)
         self._left = chosen
         self._kept_useless = useless & frozenset(chosen)
         self.counters["reorders"] += 1
-        if self._goal_kind == "tour" and (
-            not self._left or self._goal_rc != self._rc(self._left[0])
-        ):
+        if self._goal_kind == "tour" and (not chosen or self._goal_rc != self._rc(chosen[0])):
             self._goal_xy = self._goal_rc = None
             self._path = None
 
@@ -445,51 +441,12 @@ class OraclePolicy(Policy):
         return int(r), int(c)
 
     def _best_route(
-        self,
-        here: tuple[int, int],
-        dist: np.ndarray,
-        routes: list[list[int]],
-        unseen: np.ndarray,
+        self, here: tuple[int, int], dist: np.ndarray, routes: list[list[int]], unseen: np.ndarray
     ) -> list[int]:
-        """Of the candidate rests of the tour, the one the sensor model predicts to see what the
-        tour's target still needs after the shortest drive (the first on a tie; when none sees
-        it, the one that sees most). The tour's order was chosen with the scans along its legs
-        counted: an order re-solved on distances alone can lose what those legs saw."""
-        tour = self.tour
-        assert tour is not None and tour.legs is not None
-        need = math.ceil(self.params.tour.coverage_target * self._n_mask) - int((~unseen).sum())
-        best: tuple[Any, ...] | None = None
-        chosen = routes[0]
-        for route in routes:
-            cells = tour.viewpoints_rc[route].reshape(-1, 2)
-            lengths = np.concatenate(
-                [
-                    dist[cells[:1, 0], cells[:1, 1]],
-                    tour.distances_m[route[:-1], route[1:]],
-                ]
-            )
-            reached, drive_m, seen = predicted_drive_m(
-                tour.legs, np.vstack([np.array([here]), cells]), lengths, unseen, need
-            )
-            key = (0, drive_m, 0) if reached else (1, -seen, drive_m)
-            if best is None or key < best:
-                best, chosen = key, route
-        return list(chosen)
-
-    def _order_from(self, here: tuple[int, int], dist: np.ndarray, vps: list[int]) -> list[int]:
-        """``vps`` as an open LKH tour from the robot's cell ``here`` (``dist``: its geodesic
-        distance field)."""
+        """The rest of the tour to drive (:func:`~.oracle_goals.best_rest_of_tour`)."""
         assert self.tour is not None
-        if len(vps) <= 1:
-            return list(vps)
-        cells = self.tour.viewpoints_rc[vps]
-        d0 = dist[cells[:, 0], cells[:, 1]]
-        k = len(vps)
-        m = np.zeros((k + 1, k + 1))
-        m[0, 1:] = m[1:, 0] = d0
-        m[1:, 1:] = self.tour.distances_m[np.ix_(vps, vps)]
-        order = open_tour_order(m, self.params.tour.lkh_runs)
-        return [vps[i - 1] for i in order[1:]]
+        need = math.ceil(self.params.tour.coverage_target * self._n_mask) - int((~unseen).sum())
+        return best_rest_of_tour(self.tour, here, dist, routes, unseen, need)
 
     def _robot_cell(self, pose: tuple[float, float, float]) -> tuple[int, int]:
         assert self.tour is not None

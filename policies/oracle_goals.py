@@ -1,8 +1,9 @@
-"""The oracle's goals off its tour: a second look where a viewpoint's scan fell short, a
-shortcut to the coverage goal near the end, and what to see once the tour is done (see :class:`~semexplore_gym.policies.oracle.OraclePolicy`).
+"""The oracle's goals: which rest of its tour to drive once some viewpoints are no longer needed,
+a second look where a viewpoint's scan fell short, a shortcut to the coverage goal near the end,
+and what to see once the tour is done (see :class:`~semexplore_gym.policies.oracle.OraclePolicy`).
 
 All read only the oracle's privileged tour (:class:`~semexplore_gym.core.coverage_tour.CoverageTour`)
-and its live map's unseen cells; each returns a candidate cell or None.
+and its live map's unseen cells; each returns a candidate cell (or a route) or None.
 """
 
 from __future__ import annotations
@@ -12,10 +13,58 @@ from collections.abc import Callable
 
 import numpy as np
 
-from semexplore_gym.core.coverage_tour import CoverageTour
+from semexplore_gym.core.coverage_tour import CoverageTour, open_tour_order
+from semexplore_gym.core.coverage_tour.refine import predicted_drive_m
 from semexplore_gym.core.coverage_tour.tour import row_counts
 
 Cell = tuple[int, int]
+
+
+def best_rest_of_tour(
+    tour: CoverageTour,
+    here: Cell,
+    dist: np.ndarray,
+    routes: list[list[int]],
+    unseen: np.ndarray,
+    need: int,
+) -> list[int]:
+    """Of the candidate rests of the tour ``routes`` (viewpoint indices in driving order), the
+    one the sensor model predicts to see ``need`` of the ``unseen`` cells after the shortest
+    drive from the robot's cell ``here`` (``dist``: its geodesic distance field); the first on a
+    tie; when none sees that many, the one that sees most. The tour's order was chosen with the
+    scans along its legs counted: an order re-solved on distances alone can lose what those
+    legs saw (:func:`~semexplore_gym.core.coverage_tour.refine.predicted_drive_m`)."""
+    assert tour.legs is not None
+    best: tuple[float, float, float] | None = None
+    chosen = routes[0]
+    for route in routes:
+        cells = tour.viewpoints_rc[route].reshape(-1, 2)
+        lengths = np.concatenate(
+            [dist[cells[:1, 0], cells[:1, 1]], tour.distances_m[route[:-1], route[1:]]]
+        )
+        reached, drive_m, seen = predicted_drive_m(
+            tour.legs, np.vstack([np.array([here]), cells]), lengths, unseen, need
+        )
+        key = (0.0, drive_m, 0.0) if reached else (1.0, -float(seen), drive_m)
+        if best is None or key < best:
+            best, chosen = key, route
+    return list(chosen)
+
+
+def open_order_from(
+    tour: CoverageTour, dist: np.ndarray, vps: list[int], lkh_runs: int
+) -> list[int]:
+    """The viewpoints ``vps`` as an open LKH tour from the robot (``dist``: the geodesic
+    distance field from its cell)."""
+    if len(vps) <= 1:
+        return list(vps)
+    cells = tour.viewpoints_rc[vps]
+    k = len(vps)
+    m = np.zeros((k + 1, k + 1))
+    m[0, 1:] = m[1:, 0] = dist[cells[:, 0], cells[:, 1]]
+    m[1:, 1:] = tour.distances_m[np.ix_(vps, vps)]
+    order = open_tour_order(m, lkh_runs)
+    return [vps[i - 1] for i in order[1:]]
 
 
 def repair_cell(

@@ -192,7 +192,8 @@ def _fmt(x: float | None) -> str:
 
 
 def report_lines(missions: list[dict[str, Any]]) -> list[str]:
-    """Violations (must be none), the per-family table and median T99 / bound per policy."""
+    """Violations (must be none), the per-family table, the oracle's wins per folder (a suite or
+    a run: pairs are taken within one) and median T99 / bound per policy."""
     fams = family_report(missions)
     total = fams["all"]
     lines = [
@@ -215,6 +216,15 @@ def report_lines(missions: list[dict[str, Any]]) -> list[str]:
             f"{_fmt(f['median_best_known_over_bound'])} | "
             f"{_fmt(f['median_oracle_over_bound'])} ({f['oracle_missions']}) | {share} |"
         )
+    by_folder: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for m in missions:
+        by_folder[m["folder"]].append(m)
+    folder_wins = [(name, *_oracle_wins(ms)) for name, ms in by_folder.items()]
+    if any(pairs for _, _, pairs in folder_wins):
+        lines += ["", "| folder | oracle T99 ≤ other's |", "|---|---|"]
+        for name, wins, pairs in folder_wins:
+            if pairs:
+                lines.append(f"| {name} | {wins}/{pairs} ({100.0 * wins / pairs:.0f} %) |")
     ratios: dict[tuple[str, str], list[float]] = defaultdict(list)
     for m in missions:
         if m["T99_s"] is not None and 0 < m["bound_s"] < math.inf:

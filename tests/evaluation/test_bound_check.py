@@ -75,6 +75,9 @@ def test_report_prints_the_family_table_with_all_last(tmp_path: Path, capsys) ->
     assert "| maze | 2 | 5 | 1 | 3.50 | inf (2) | 1/2 (50 %) |" in out
     assert out.index("| office |") < out.index("| all |")
     assert "\n".join(report_lines(read_missions(tmp_path / "checked.csv"))) in out
+    # The oracle's wins per folder (a suite or a run): pairs only where it ran.
+    assert "| folder | oracle T99 ≤ other's |\n|---|---|\n| a | 1/2 (50 %) |\n\n" in out
+    assert "| b |" not in out
 
 
 def test_bad_checked_missions_are_one_line(tmp_path: Path, capsys) -> None:
