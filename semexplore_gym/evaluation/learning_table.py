@@ -253,29 +253,72 @@ def _collisions_cell(rows: list[dict[str, Any]]) -> str:
     return str(sum(counts)) if counts else "–"
 
 
-def paired_table_lines(rows: list[dict[str, Any]], reference: str = EXPERT) -> list[str]:
+def gap_closed(
+    rows: list[dict[str, Any]],
+    ref: dict[tuple[str, int], dict[str, Any]],
+    best_t99_s: dict[tuple[str, int], float],
+) -> tuple[float | None, int]:
+    """The share of the reference's gap to the best known that ``rows``' policy closes:
+    ``sum(T_ref - T) / sum(T_ref - T_best)`` over the (world, seed) pairs where all three reached
+    99 % (1: as fast as the best known; 0: as the reference; below 0: slower). A sum, not a median
+    of per-start shares: a start where the reference is already at the best known has no gap to
+    divide by. ``(None, n)`` when the reference has no gap on those pairs."""
+    gain = gap = 0.0
+    n = 0
+    for r in rows:
+        key = (r["world"], int(r["seed"]))
+        o, best = ref.get(key), best_t99_s.get(key)
+        if o is None or best is None:
+            continue
+        t, t_ref = _value(r, "T99_s"), _value(o, "T99_s")
+        if not (math.isfinite(t) and math.isfinite(t_ref) and math.isfinite(best)):
+            continue
+        gain += t_ref - t
+        gap += t_ref - best
+        n += 1
+    return (gain / gap if gap > 0 else None), n
+
+
+def paired_table_lines(
+    rows: list[dict[str, Any]],
+    reference: str = EXPERT,
+    best_t99_s: dict[tuple[str, int], float] | None = None,
+) -> list[str]:
     """Each policy's T99 against ``reference``'s on the same (world, seed), per family.
 
     One row per (family, policy), the reference first: missions, median T99, the median [IQR]
     over pairs of the policy's T99 over the reference's (a mission that never reached 99 %
     counts as ∞, as in the learning table), the Wilcoxon p of the pairs' log ratios, the pairs
     where the policy was faster, the missions it ended itself at coverage ≥
-    :data:`SELF_STOP_COVERAGE`, and its collisions. ``rows`` need the columns ``world``,
-    ``policy``, ``seed``, ``self_stopped``, ``coverage``, ``T99_s`` and ``collisions``.
+    :data:`SELF_STOP_COVERAGE`, and its collisions. With ``best_t99_s`` (the best-known T99 per
+    (world, seed) of these missions' starts) a last column gives the share of the reference's gap
+    to the best known the policy closes (:func:`gap_closed`). ``rows`` need the columns
+    ``world``, ``policy``, ``seed``, ``self_stopped``, ``coverage``, ``T99_s`` and
+    ``collisions``.
     """
     from semexplore_gym.evaluation.report import group_by_family
 
+    best = best_t99_s or {}
+    gap_col = bool(best) and any((r["world"], int(r["seed"])) in best for r in rows)
     lines = [
         f"Per family, each policy paired with `{reference}` by (world, seed). T99 ÷ "
         f"{reference} = median [IQR] over the pairs of the policy's T99 over {reference}'s "
         "(< 1: faster; a mission that never reached 99 % counts as ∞); p W = two-sided "
         "Wilcoxon signed-rank test on the pairs' log ratios; faster = pairs where the policy "
         f"reached 99 % sooner; self-stops = missions it ended itself at coverage ≥ "
-        f"{SELF_STOP_COVERAGE}.",
+        f"{SELF_STOP_COVERAGE}."
+        + (
+            f" Gap closed = the share of {reference}'s gap to the best-known T99 of the same "
+            f"starts that the policy closes, sum({reference} − policy) ÷ sum({reference} − best "
+            "known) over the pairs where all three reached 99 % (1: the best known; 0: as "
+            f"{reference}; n pairs)."
+            if gap_col
+            else ""
+        ),
         "",
         f"| family | policy | n | T99 (s) | T99 ÷ {reference} [IQR] | p W | faster | "
-        "self-stops | collisions |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "self-stops | collisions |" + (" gap closed (n) |" if gap_col else ""),
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|" + ("---:|" if gap_col else ""),
     ]
     for family, by_policy in group_by_family(rows).items():
         ref = {(r["world"], int(r["seed"])): r for r in by_policy.get(reference, [])}
@@ -289,6 +332,9 @@ def paired_table_lines(rows: list[dict[str, Any]], reference: str = EXPERT) -> l
             )
             cells = [str(len(rs)), _t99_cell(rs), _ratio_iqr_cell(logs)]
             cells += [_p_cell(logs), faster, f"{stops}/{len(rs)}", _collisions_cell(rs)]
+            if gap_col:
+                share, n = gap_closed(rs, ref, best) if policy != reference else (None, 0)
+                cells.append("–" if share is None else f"{share:.2f} ({n})")
             lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
     lines.append("")
     return lines

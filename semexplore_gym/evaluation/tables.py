@@ -360,7 +360,23 @@ def _paired_lines(source: Path, rows: list[dict[str, Any]], reference: str) -> l
             f"{source} has no {reference} missions to pair with (its policies: "
             f"{', '.join(policies)}; pick one with --reference)"
         )
-    return paired_table_lines(rows, reference)
+    return paired_table_lines(rows, reference, _best_known_t99(source))
+
+
+def _best_known_t99(source: Path) -> dict[tuple[str, int], float]:
+    """The shipped best-known T99 per (world, seed) of ``source``'s start poses, as the run's
+    ``benchmark.json`` (beside the CSV) gives them; none without one, or when its env config is
+    not the default one (the table's missions ran on the default env)."""
+    from semexplore_gym.evaluation.best_known import read_table, run_start
+
+    start = run_start(source if source.is_dir() else source.parent)
+    if start is None:
+        return {}
+    return {
+        (w, s): float(row["T99_s"])
+        for (w, s, st), row in read_table().items()
+        if st == start and row["T99_s"] is not None
+    }
 
 
 def markdown_tables(markdown: str) -> list[dict[str, Any]]:

@@ -103,3 +103,46 @@ def test_a_runs_csv_without_collisions_names_the_column(tmp_path: Path, capsys) 
     (run / "runs.csv").write_text("world,policy,seed,self_stopped,coverage,T99_s\n")
     assert main(["report", str(run), "--table", "paired"]) == 2
     assert "has no column collisions (the paired table reads" in capsys.readouterr().err
+
+
+def test_gap_closed_is_the_share_of_the_references_gap_to_the_best_known() -> None:
+    from semexplore_gym.evaluation.learning_table import gap_closed
+
+    ref = {("w", 0): {"T99_s": 100.0}, ("w", 1): {"T99_s": 200.0}, ("w", 2): {"T99_s": 50.0}}
+    best = {("w", 0): 60.0, ("w", 1): 100.0, ("w", 2): 50.0}
+    rows = [
+        {"world": "w", "seed": 0, "T99_s": 80.0},  # gains 20 of a 40 s gap
+        {"world": "w", "seed": 1, "T99_s": 220.0},  # loses 20 of a 100 s gap
+        {"world": "w", "seed": 2, "T99_s": 45.0},  # the reference is the best known: no gap
+    ]
+    share, n = gap_closed(rows, ref, best)
+    assert n == 3 and share == pytest.approx((20.0 - 20.0 + 5.0) / (40.0 + 100.0 + 0.0))
+    # A pair without a 99 % on one side, or without a best known, is left out.
+    rows.append({"world": "w", "seed": 3, "T99_s": 10.0})
+    rows.append({"world": "w", "seed": 0, "T99_s": None})
+    assert gap_closed(rows, ref, best)[1] == 3
+    # No gap at all: no share.
+    assert gap_closed(rows[2:3], ref, best) == (None, 1)
+
+
+def test_a_default_env_run_gets_the_gap_closed_column_from_the_shipped_best_known(
+    tmp_path: Path, capsys
+) -> None:
+    import json
+
+    from semexplore_gym.evaluation.best_known import read_table
+
+    run = _write(tmp_path / "run", _missions()[:8])
+    (run / "benchmark.json").write_text(json.dumps({"fixed_start": False, "env_overrides": []}))
+    best = {(w, s): row["T99_s"] for (w, s, st), row in read_table().items() if st == "random"}
+    assert all(k in best for k in EXPERT_T99)  # the paper suite's starts are in the table
+    assert main(["report", str(run), "--table", "paired"]) == 0
+    rows = _table_rows(capsys.readouterr().out)
+    gain = sum(t - t * LEARNER_FACTOR[k] for k, t in EXPERT_T99.items() if k != ("maze2", 1))
+    gap = sum(t - best[k] for k, t in EXPERT_T99.items() if k != ("maze2", 1))
+    assert rows[1].endswith(f" | {gain / gap:.2f} (3) |"), rows[1]
+    assert rows[0].endswith(" | – |")
+    # Another env config: not comparable with the table, no column.
+    (run / "benchmark.json").write_text(json.dumps({"config": "slam", "env_overrides": []}))
+    assert main(["report", str(run), "--table", "paired"]) == 0
+    assert "gap closed" not in capsys.readouterr().out
