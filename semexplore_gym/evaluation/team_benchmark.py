@@ -289,20 +289,24 @@ def run_team_task(task: TeamTask) -> dict[str, Any]:
 def team_tasks(config: TeamBenchmarkConfig) -> list[TeamTask]:
     """Every mission of ``config``, world-major, then team size, policy and seed."""
     c = config
-    overrides = list(MISSION_OVERRIDES)
-    overrides.append(f"episode.random_start={'false' if c.fixed_start else 'true'}")
-    if c.max_time_s is not None:
-        overrides.append(f"episode.max_time_s={c.max_time_s!r}")
-    overrides += list(c.env_overrides)
+    base = [*MISSION_OVERRIDES, f"episode.random_start={'false' if c.fixed_start else 'true'}"]
+
+    def overrides(limit_s: float | None) -> tuple[str, ...]:
+        # The env's own limit must not cut a mission short of its world's (a suite's limits
+        # exceed the env's default); the user's overrides win.
+        own = [f"episode.max_time_s={limit_s!r}"] if limit_s is not None else []
+        return (*base, *own, *c.env_overrides)
+
+    limits = {w: (c.time_limits or {}).get(w, c.max_time_s) for w in c.worlds}
     return [
         TeamTask(
             world=world.replace("seed=*", f"seed={seed}"),
             policy=spec,
             n_robots=int(n),
             seed=int(seed),
-            max_time_s=(c.time_limits or {}).get(world, c.max_time_s),
+            max_time_s=limits[world],
             env_config=c.env_config,
-            overrides=tuple(overrides),
+            overrides=overrides(limits[world]),
         )
         for world in c.worlds
         for n in c.robot_counts

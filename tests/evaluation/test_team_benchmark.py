@@ -325,3 +325,26 @@ def test_explore_robots_takes_a_team_variant(capsys: pytest.CaptureFixture[str])
     assert "team_greedy[claim_radius_m=1]" in capsys.readouterr().out
     assert main([*argv, "--policy", "greedy[claim_radius_m=x]"]) != 0
     assert "claim_radius_m: expected a number, got 'x'" in capsys.readouterr().err
+
+
+def test_a_worlds_own_time_limit_reaches_the_env(tmp_path: Path) -> None:
+    # A suite's limit above the env's default (1,200 s) must not be cut at the default: the
+    # env's own limit is set to each world's, and the user's --env-set still wins.
+    from semexplore_gym.evaluation.team_benchmark import TeamBenchmarkConfig, team_tasks
+
+    config = TeamBenchmarkConfig(
+        worlds=("maze1", "maze2"),
+        policies=("independent",),
+        robot_counts=(2,),
+        seeds=(0,),
+        out=tmp_path,
+        time_limits={"maze1": 4000.0},
+        env_overrides=("episode.max_time_s=50",),
+    )
+    by_world = {t.world: t for t in team_tasks(config)}
+    assert by_world["maze1"].max_time_s == 4000.0
+    maze1 = by_world["maze1"].overrides
+    assert "episode.max_time_s=4000.0" in maze1
+    assert maze1[-1] == "episode.max_time_s=50"  # the user's override comes last: it wins
+    assert by_world["maze2"].max_time_s is None
+    assert not any(o.startswith("episode.max_time_s=") for o in by_world["maze2"].overrides[:-1])
