@@ -108,9 +108,24 @@ def test_the_team_table_has_each_policy_and_team_size_of_its_runs(tmp_path: Path
         runs = list(csv.DictReader(f))
     assert {r["policy"] for r in runs} == {"team_independent", "team_oracle"}
     assert "| T_oracle(1) / T99 | regret | T99 / bound |" in text  # the team oracle's columns
-    for policy, robots in {(r["policy"], r["n_robots"]) for r in runs}:
-        n = sum(1 for r in runs if r["policy"] == policy and r["n_robots"] == robots)
-        assert f"| {policy} | {robots} | {n} | " in text, (policy, robots)
+    from semexplore_gym.evaluation.suites import world_family
+
+    sections = {}  # per family (the table's bold headings): its rows
+    for family in {world_family(r["world"]) for r in runs}:
+        start = text.index(f"**{family}**")
+        end = text.find("\n**", start + 1)
+        sections[family] = text[start : end if end >= 0 else len(text)]
+    for family, policy, robots in {
+        (world_family(r["world"]), r["policy"], r["n_robots"]) for r in runs
+    }:
+        n = sum(
+            1
+            for r in runs
+            if world_family(r["world"]) == family
+            and r["policy"] == policy
+            and r["n_robots"] == robots
+        )
+        assert f"| {policy} | {robots} | {n} | " in sections[family], (family, policy, robots)
     oracle_rows = [ln for ln in text.splitlines() if ln.startswith("| team_oracle |")]
     assert oracle_rows and all(ln.split(" | ")[-2] == "1.00" for ln in oracle_rows)  # regret
 
