@@ -37,7 +37,9 @@ def best_rest_of_tour(
     assert tour.legs is not None
     best: tuple[float, float, float] | None = None
     chosen = routes[0]
-    for route in routes:
+    for i, route in enumerate(routes):
+        if route in routes[:i]:
+            continue  # the same order again (LKH often keeps the tour's): same prediction
         cells = tour.viewpoints_rc[route].reshape(-1, 2)
         lengths = np.concatenate(
             [dist[cells[:1, 0], cells[:1, 1]], tour.distances_m[route[:-1], route[1:]]]
