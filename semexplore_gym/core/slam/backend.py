@@ -38,6 +38,11 @@ import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
+from semexplore_gym.core.slam.icp import (
+    line_map,
+    local_normals,
+    refine_point_to_line,
+)
 from semexplore_gym.core.slam.matcher import (
     MatchResult,
     build_likelihood_field,
@@ -51,10 +56,24 @@ from semexplore_gym.core.slam.pose_graph import Edge, optimise
 Pose = tuple[float, float, float]
 
 
+def _worst_sd_m(match: MatchResult) -> float:
+    """The position standard deviation of ``match`` along its worst-pinned direction."""
+    values = np.linalg.eigvalsh(np.asarray(match.covariance)[:2, :2])
+    return math.sqrt(max(float(values[-1]), 0.0))
+
+
 def compose(a: Pose, b: Pose) -> Pose:
     """``a (+) b``: the pose ``b``, given in the frame of ``a``, in the world frame."""
     c, s = math.cos(a[2]), math.sin(a[2])
     return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle_rad(a[2] + b[2]))
+
+
+def rotate(vectors: np.ndarray, yaw_rad: float) -> np.ndarray:
+    """``(n, 2)`` vectors turned by ``yaw_rad``."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    return np.stack(
+        [c * vectors[:, 0] - s * vectors[:, 1], s * vectors[:, 0] + c * vectors[:, 1]], 1
+    )
 
 
 def relative(a: Pose, b: Pose) -> Pose:
@@ -99,6 +118,7 @@ class ScanSlam:
         self.keyframe_poses: list[Pose] = []
         self._ranges: list[np.ndarray] = []
         self._points: list[np.ndarray] = []
+        self._normals: list[np.ndarray] = []
         self.edges: list[Edge] = []
         self.loop_closures = 0
         self.low_score_streak = 0
@@ -134,7 +154,9 @@ class ScanSlam:
         ranges = np.array(ranges_m, dtype=np.float32)
         self.keyframe_poses.append(pose)
         self._ranges.append(ranges)
-        self._points.append(scan_points(ranges, self._beams, self._max_range_m, self._mount))
+        points = scan_points(ranges, self._beams, self._max_range_m, self._mount)
+        self._points.append(points)
+        self._normals.append(local_normals(points))
 
     def _fuse(self, k: int) -> None:
         sx, sy, syaw = compose(self.keyframe_poses[k], (*self._mount, 0.0))
@@ -280,12 +302,23 @@ class ScanSlam:
     ) -> MatchResult:
         p = self.params
         world = [transform_points(self._points[k], self.keyframe_poses[k]) for k in keyframes]
-        field = build_likelihood_field(
-            np.concatenate(world) if world else np.zeros((0, 2)),
-            p.match_resolution_m,
-            p.likelihood_sigma_m,
+        cloud = np.concatenate(world) if world else np.zeros((0, 2))
+        field = build_likelihood_field(cloud, p.match_resolution_m, p.likelihood_sigma_m)
+        match = match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
+        if p.refine_max_pair_m <= 0 or len(cloud) < 3 or len(points) < 10:
+            return match
+        normals = np.concatenate(
+            [rotate(self._normals[k], self.keyframe_poses[k][2]) for k in keyframes]
         )
-        return match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
+        pose, pairs = refine_point_to_line(
+            line_map(cloud, normals), points, match.pose, max_pair_m=p.refine_max_pair_m
+        )
+        # The refinement polishes the correlative basin; a jump out of it is not trusted.
+        moved = math.hypot(pose[0] - match.pose[0], pose[1] - match.pose[1])
+        turned = abs(wrap_angle_rad(pose[2] - match.pose[2]))
+        if pairs == 0 or moved > 2 * p.match_resolution_m or turned > 2 * p.match_resolution_m:
+            return match
+        return MatchResult(pose, match.score, match.covariance)
 
     def _close_loop(self, points: np.ndarray) -> bool:
         """Try a loop closure from the newest keyframe; True when one re-rendered the map."""
@@ -308,6 +341,8 @@ class ScanSlam:
         match = self._match(sub, points, self.keyframe_poses[n], p.loop_search_xy_m)
         if match.score < p.loop_score_threshold:
             return False
+        if _worst_sd_m(match) > p.degenerate_sd_m:
+            return False  # a closure the scan pins only across one direction: not trusted
         delta = relative(self.keyframe_poses[i], match.pose)
         self.edges.append(Edge(i, n, delta, match.covariance, robust=True))
         self.loop_closures += 1

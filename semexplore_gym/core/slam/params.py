@@ -24,6 +24,7 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "score_collapse_ratio": (0.0, 1.0),
     "scan_jump_share": (0.05, 1.0),
     "scan_jump_range_m": (0.01, 10.0),
+    "refine_max_pair_m": (0.0, 1.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
 
@@ -67,6 +68,9 @@ class SlamParams:
             then means the robot was carried away (kidnapped): the back end reports itself
             lost at once. 1 turns the kidnap check off.
         scan_jump_range_m: A beam whose range changed by more than this has *changed*.
+        refine_max_pair_m: Each match (tracking and loop closure) is refined by point-to-line
+            ICP (:mod:`~semexplore_gym.core.slam.icp`), pairing a scan point with a submap
+            line no farther than this; 0 keeps the correlative match as it is.
     """
 
     enabled: bool = False
@@ -87,6 +91,7 @@ class SlamParams:
     score_collapse_ratio: float = 0.75
     scan_jump_share: float = 0.3
     scan_jump_range_m: float = 0.5
+    refine_max_pair_m: float = 0.08
 
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -81,9 +82,14 @@ def _run(params: SlamParams, seed: int):
     return slam, odom_err, ate_m
 
 
-#: A coarse front end (a blurred field, a short local map): its drift builds up around the
-#: ring, and only a loop closure takes it out.
-COARSE = {"match_resolution_m": 0.05, "likelihood_sigma_m": 0.1, "submap_keyframes": 4}
+#: A coarse front end (a blurred field, a short local map, no ICP refinement): its drift
+#: builds up around the ring, and only a loop closure takes it out.
+COARSE = {
+    "match_resolution_m": 0.05,
+    "likelihood_sigma_m": 0.1,
+    "submap_keyframes": 4,
+    "refine_max_pair_m": 0.0,
+}
 
 
 @pytest.mark.parametrize("seed", [1, 4])
@@ -103,6 +109,38 @@ def test_the_default_front_end_tracks_the_ring() -> None:
     slam, odom_err, ate_m = _run(SlamParams(enabled=True), seed=3)
     assert ate_m < 0.05 < odom_err
     assert slam.last_score > 0.8
+
+
+@pytest.mark.parametrize("seed", [3, 5])
+def test_icp_refinement_takes_out_the_correlative_lattice_error(seed: int) -> None:
+    # Loop closures off: the chain's own error is what is compared.
+    params = SlamParams(enabled=True, loop_search_radius_m=0.0)
+    _, _, refined_m = _run(params, seed)
+    _, _, lattice_m = _run(replace(params, refine_max_pair_m=0.0), seed)
+    assert refined_m < 0.5 * lattice_m
+    assert refined_m < 0.01
+
+
+def test_a_closure_the_scan_pins_only_across_a_corridor_is_not_taken() -> None:
+    # Up and down a bare corridor twice: every loop candidate's match slides along the axis.
+    index = SegmentIndex(np.array([[-1, 0, 13, 0], [-1, 1.4, 13, 1.4]], dtype=np.float64))
+    truth = _drive([(0.5, 0.7), (11.5, 0.7), (0.5, 0.7), (11.5, 0.7)])
+    geometry = GridGeometry.covering(-1.0, -1.0, 13.0, 2.5, 0.05, 0.5)
+    rng = np.random.default_rng(0)
+    odom = OdometryDrift(OdometryNoiseParams(0.02, 0.02, 0.02, 0.02))
+    odom.reset(truth[0])
+    slam = ScanSlam(SlamParams(enabled=True), geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+
+    def scan(p):
+        return np.minimum(cast_scan(index, p[0], p[1], p[2], BEAMS, MAX_RANGE_M), MAX_RANGE_M)
+
+    slam.reset(truth[0], scan(truth[0]))
+    for before, after in zip(truth[:-1], truth[1:], strict=True):
+        slam.update(tuple(odom.update(before, after, rng)), scan(after))
+    assert slam.degenerate_matches > 10  # the corridor is bare
+    for e in slam.edges:
+        if e.robust:  # any closure taken is pinned in both directions
+            assert np.sqrt(np.linalg.eigvalsh(e.cov[:2, :2])[-1]) <= slam.params.degenerate_sd_m
 
 
 def test_same_seed_same_map_bit_for_bit() -> None:

@@ -1,0 +1,71 @@
+"""Point-to-line ICP: the refinement of a correlative match on synthetic scans."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
+from semexplore_gym.core.slam.backend import rotate
+from semexplore_gym.core.slam.icp import line_map, local_normals, refine_point_to_line
+from semexplore_gym.core.slam.matcher import scan_points, transform_points
+
+BEAMS = np.arange(360) * (2 * math.pi / 360)
+MAX_RANGE_M = 3.5
+
+
+def _points(walls: list[list[float]], pose: tuple[float, float, float]) -> np.ndarray:
+    ranges = cast_scan(SegmentIndex(np.array(walls, dtype=np.float64)), *pose, BEAMS, MAX_RANGE_M)
+    return scan_points(np.minimum(ranges, MAX_RANGE_M), BEAMS, MAX_RANGE_M, (0.0, 0.0))
+
+
+ROOM = [[0, 0, 4, 0], [4, 0, 4, 3], [4, 3, 0, 3], [0, 3, 0, 0], [1, 1, 2.2, 1], [2.2, 1, 2.2, 2]]
+#: A corridor 1.4 m wide and 30 m long: from its middle no end is in range.
+CORRIDOR = [[-15, 0, 15, 0], [-15, 1.4, 15, 1.4]]
+
+
+def _lines(walls: list[list[float]], pose: tuple[float, float, float]):
+    pts = _points(walls, pose)
+    return line_map(transform_points(pts, pose), rotate(local_normals(pts), pose[2]))
+
+
+def test_normals_are_perpendicular_to_the_walls() -> None:
+    pts = _points(ROOM, (3.0, 2.0, 0.3))
+    normals = local_normals(pts)
+    world = transform_points(pts, (3.0, 2.0, 0.3))
+    on_bottom = (np.abs(world[:, 1]) < 1e-6) & (world[:, 0] > 2.5) & (world[:, 0] < 3.5)
+    n = rotate(normals[on_bottom], 0.3)
+    assert on_bottom.sum() >= 3
+    assert np.allclose(np.abs(n[:, 1]), 1.0, atol=1e-6)  # the bottom wall's normal is +-y
+    assert np.allclose(np.hypot(*normals[np.any(normals != 0, axis=1)].T), 1.0)
+
+
+def test_a_small_offset_is_taken_out_to_a_millimetre() -> None:
+    lines = _lines(ROOM, (3.0, 2.0, 0.3))
+    true = (2.8, 1.9, 0.25)
+    scan = _points(ROOM, true)
+    start = (true[0] + 0.015, true[1] - 0.012, true[2] + 0.008)  # a correlative step off
+    pose, pairs = refine_point_to_line(lines, scan, start)
+    assert pairs > 100
+    assert math.hypot(pose[0] - true[0], pose[1] - true[1]) < 1e-3
+    assert abs(pose[2] - true[2]) < 1e-3
+
+
+def test_along_a_bare_corridor_the_axis_stays_at_the_start() -> None:
+    lines = _lines(CORRIDOR, (0.0, 0.7, 0.0))
+    true = (0.3, 0.7, 0.0)
+    start = (0.35, 0.72, 0.01)  # 5 cm off along the axis, 2 cm across, 10 mrad
+    pose, pairs = refine_point_to_line(lines, _points(CORRIDOR, true), start)
+    assert pairs > 100
+    assert pose[1] == pytest.approx(true[1], abs=1e-3)  # across: pinned
+    assert pose[2] == pytest.approx(true[2], abs=1e-3)
+    assert pose[0] == pytest.approx(start[0], abs=1e-3)  # along: nothing pins it
+
+
+def test_too_few_pairs_give_the_start_back() -> None:
+    lines = _lines(ROOM, (3.0, 2.0, 0.3))
+    start = (3.0, 2.0, 0.3)
+    far = np.array([[10.0, 10.0], [11.0, 10.0]])  # nothing of the map near these
+    assert refine_point_to_line(lines, far, start) == (start, 0)
