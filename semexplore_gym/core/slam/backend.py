@@ -38,11 +38,7 @@ import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
-from semexplore_gym.core.slam.icp import (
-    line_map,
-    local_normals,
-    refine_point_to_line,
-)
+from semexplore_gym.core.slam.icp import local_normals, refine_point_to_line
 from semexplore_gym.core.slam.matcher import (
     MatchResult,
     build_likelihood_field,
@@ -119,6 +115,10 @@ class ScanSlam:
         self._ranges: list[np.ndarray] = []
         self._points: list[np.ndarray] = []
         self._normals: list[np.ndarray] = []
+        # Each keyframe's end points and normals in the world frame at its pose (kept in step
+        # with keyframe_poses: recomputed when an optimisation moves the poses).
+        self._world_points: list[np.ndarray] = []
+        self._world_normals: list[np.ndarray] = []
         self.edges: list[Edge] = []
         self.loop_closures = 0
         self.low_score_streak = 0
@@ -157,6 +157,8 @@ class ScanSlam:
         points = scan_points(ranges, self._beams, self._max_range_m, self._mount)
         self._points.append(points)
         self._normals.append(local_normals(points))
+        self._world_points.append(transform_points(points, pose))
+        self._world_normals.append(rotate(self._normals[-1], pose[2]))
 
     def _fuse(self, k: int) -> None:
         sx, sy, syaw = compose(self.keyframe_poses[k], (*self._mount, 0.0))
@@ -275,9 +277,8 @@ class ScanSlam:
         match to the recent keyframes, or the odometry prediction when it is not trusted."""
         p = self.params
         first = max(0, len(self.keyframe_poses) - p.submap_keyframes)
-        match = self._match(
-            range(first, len(self.keyframe_poses)), points, prediction, p.search_xy_m
-        )
+        keyframes = range(first, len(self.keyframe_poses))
+        match = self._match(keyframes, points, prediction, p.search_xy_m, p.match_score_threshold)
         self.last_score = match.score
         if len(points) >= 10 and match.score >= p.match_score_threshold:
             return self._unless_degenerate(match, prediction), match.covariance, True
@@ -298,20 +299,30 @@ class ScanSlam:
         return (float(xy[0]), float(xy[1]), match.pose[2])
 
     def _match(
-        self, keyframes: range, points: np.ndarray, prediction: Pose, search_xy_m: float
+        self,
+        keyframes: range,
+        points: np.ndarray,
+        prediction: Pose,
+        search_xy_m: float,
+        refine_from: float = math.inf,
     ) -> MatchResult:
+        """The scan ``points`` matched to the ``keyframes``' scans around ``prediction``; a
+        match scoring at least ``refine_from`` is refined by ICP (the others are not used
+        for a pose)."""
         p = self.params
-        world = [transform_points(self._points[k], self.keyframe_poses[k]) for k in keyframes]
+        world = [self._world_points[k] for k in keyframes]
         cloud = np.concatenate(world) if world else np.zeros((0, 2))
         field = build_likelihood_field(cloud, p.match_resolution_m, p.likelihood_sigma_m)
         match = match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
-        if p.refine_max_pair_m <= 0 or len(cloud) < 3 or len(points) < 10:
+        if (
+            p.refine_max_pair_m <= 0
+            or match.score < refine_from
+            or min(len(cloud), len(points)) < 10
+        ):
             return match
-        normals = np.concatenate(
-            [rotate(self._normals[k], self.keyframe_poses[k][2]) for k in keyframes]
-        )
+        normals = np.concatenate([self._world_normals[k] for k in keyframes])
         pose, pairs = refine_point_to_line(
-            line_map(cloud, normals), points, match.pose, max_pair_m=p.refine_max_pair_m
+            field, cloud, normals, points, match.pose, max_pair_m=p.refine_max_pair_m
         )
         # The refinement polishes the correlative basin; a jump out of it is not trusted.
         moved = math.hypot(pose[0] - match.pose[0], pose[1] - match.pose[1])
@@ -338,7 +349,9 @@ class ScanSlam:
             return False
         half = p.submap_keyframes // 2
         sub = range(max(0, i - half), min(last_old + 1, i + half + 1))
-        match = self._match(sub, points, self.keyframe_poses[n], p.loop_search_xy_m)
+        match = self._match(
+            sub, points, self.keyframe_poses[n], p.loop_search_xy_m, p.loop_score_threshold
+        )
         if match.score < p.loop_score_threshold:
             return False
         if _worst_sd_m(match) > p.degenerate_sd_m:
@@ -350,6 +363,13 @@ class ScanSlam:
         new = optimise(np.asarray(self.keyframe_poses), self.edges)
         moved = float(np.abs(new - np.asarray(self.keyframe_poses))[:, :2].max())
         self.keyframe_poses = [(float(x), float(y), wrap_angle_rad(float(t))) for x, y, t in new]
+        self._world_points = [
+            transform_points(pts, kp)
+            for pts, kp in zip(self._points, self.keyframe_poses, strict=True)
+        ]
+        self._world_normals = [
+            rotate(nrm, kp[2]) for nrm, kp in zip(self._normals, self.keyframe_poses, strict=True)
+        ]
         if moved < 0.25 * self.grid.geometry.resolution_m:
             return False
         self.grid.reset()

@@ -1,116 +1,184 @@
 """Point-to-line ICP in 2D: the sub-cell refinement of a correlative scan match.
 
 The correlative matcher (:mod:`.matcher`) finds the right basin robustly but only to its finest
-lattice step (a quarter of two field cells, and the field's cells quantise both point sets), so
-each keyframe's pose is off by a few millimetres and milliradians, and the errors add up along
-the chain. :func:`refine_point_to_line` starts from its pose and minimises the squared
-distances of the scan's end points to the local lines of the submap: for each scan point the
-nearest submap point within ``max_pair_m`` (scipy's KD-tree), the line through it along the
-principal direction of its neighbours in its own scan (:func:`local_normals`), Gauss-Newton steps on
-``(x, y, yaw)`` with Huber weights, damped towards the start so that a direction the lines do
-not pin (a bare corridor's axis) stays where the correlative match put it.
+lattice step, and its field's cells quantise both point sets, so each keyframe's pose is off by
+a few millimetres and milliradians, and the errors add up along the chain.
+:func:`refine_point_to_line` starts from its pose and minimises the squared distances of the
+scan's end points to the local lines of the submap: each scan point is paired with the submap
+point the likelihood field's ``nearest`` index gives for its cell (kept when within
+``max_pair_m``), the line through that point along its normal (:func:`local_normals`), and
+Gauss-Newton steps on ``(x, y, yaw)`` with Huber weights, damped towards the start so that a
+direction the lines do not pin (a bare corridor's axis) stays where the correlative match put
+it. Both kernels are compiled with numba.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
+from numba import njit
+
+from semexplore_gym.core.slam.matcher import LikelihoodField
 
 #: Huber threshold of the point-to-line residuals (m).
 _HUBER_M = 0.01
-#: Damping added to the normal equations (pulls an unpinned direction towards the start).
+#: Damping added to the normal equations, per pair (pulls an unpinned direction to the start).
 _DAMPING = 1e-6
-#: Neighbours (the point itself included) that fit a point's local line.
-_LINE_NEIGHBOURS = 6
-#: Neighbours farther than this do not take part in a point's line (m).
+#: A point's line is fitted to the points up to this many places either side of it in its
+#: scan (the beams' order) ...
+_LINE_SPAN = 3
+#: ... that lie within this distance of it (m); at least three points in all.
 _LINE_RADIUS_M = 0.12
-
-
-@dataclass(frozen=True)
-class LineMap:
-    """Submap points ``(n, 2)`` in the world frame with a unit normal per point (zero where the
-    point has too few neighbours for a line) and their KD-tree."""
-
-    points: np.ndarray
-    normals: np.ndarray
-    tree: cKDTree
+#: Steps smaller than this (m, and rad) end the iterations.
+_CONVERGED = 1e-4
 
 
 def local_normals(points_m: np.ndarray) -> np.ndarray:
-    """A unit normal ``(n, 2)`` per point of ``points_m``: the least principal direction of its
-    nearest neighbours within ``_LINE_RADIUS_M`` (zero with fewer than three of them). One
-    scan's end points sample its walls densely enough: the back end computes them once per
-    keyframe, in the robot frame, and rotates them with the keyframe."""
+    """A unit normal ``(n, 2)`` per end point of one scan (``points_m`` in the beams' order):
+    the least principal direction of its neighbours in the scan within ``_LINE_RADIUS_M``
+    (zero with fewer than three). The back end computes them once per keyframe, in the robot
+    frame, and turns them with the keyframe."""
     pts = np.ascontiguousarray(points_m, dtype=np.float64).reshape(-1, 2)
-    if len(pts) < 3:
-        return np.zeros_like(pts)
-    k = min(_LINE_NEIGHBOURS, len(pts))
-    dist, idx = cKDTree(pts).query(pts, k=k, distance_upper_bound=_LINE_RADIUS_M)
-    ok = np.isfinite(dist)
-    n_ok = ok.sum(axis=1)
-    nb = pts[np.where(ok, idx, np.arange(len(pts))[:, None])]  # missing: the point itself
-    w = ok.astype(np.float64)
-    mean = (nb * w[..., None]).sum(axis=1) / np.maximum(n_ok, 1)[:, None]
-    c = (nb - mean[:, None, :]) * w[..., None]
-    sxx = (c[..., 0] ** 2).sum(axis=1)
-    syy = (c[..., 1] ** 2).sum(axis=1)
-    sxy = (c[..., 0] * c[..., 1]).sum(axis=1)
-    theta = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # the principal (line) direction
-    normals = np.stack([-np.sin(theta), np.cos(theta)], axis=1)
-    normals[n_ok < 3] = 0.0
-    return normals
+    return _normals(pts, _LINE_SPAN, _LINE_RADIUS_M)
 
 
-def line_map(points_m: np.ndarray, normals: np.ndarray) -> LineMap:
-    """The :class:`LineMap` of world-frame ``points_m`` with their ``normals``."""
-    pts = np.ascontiguousarray(points_m, dtype=np.float64).reshape(-1, 2)
-    return LineMap(pts, np.asarray(normals, dtype=np.float64).reshape(-1, 2), cKDTree(pts))
+@njit(cache=True)
+def _normals(pts, span, radius):  # noqa: ANN001, ANN202
+    n = pts.shape[0]
+    out = np.zeros((n, 2))
+    for i in range(n):
+        sx = 0.0
+        sy = 0.0
+        k = 0
+        for j in range(max(0, i - span), min(n, i + span + 1)):
+            if (pts[j, 0] - pts[i, 0]) ** 2 + (pts[j, 1] - pts[i, 1]) ** 2 <= radius * radius:
+                sx += pts[j, 0]
+                sy += pts[j, 1]
+                k += 1
+        if k < 3:
+            continue
+        mx = sx / k
+        my = sy / k
+        sxx = 0.0
+        syy = 0.0
+        sxy = 0.0
+        for j in range(max(0, i - span), min(n, i + span + 1)):
+            dx = pts[j, 0] - pts[i, 0]
+            dy = pts[j, 1] - pts[i, 1]
+            if dx * dx + dy * dy <= radius * radius:
+                ex = pts[j, 0] - mx
+                ey = pts[j, 1] - my
+                sxx += ex * ex
+                syy += ey * ey
+                sxy += ex * ey
+        theta = 0.5 * math.atan2(2.0 * sxy, sxx - syy)  # the line's direction
+        out[i, 0] = -math.sin(theta)
+        out[i, 1] = math.cos(theta)
+    return out
 
 
 def refine_point_to_line(
-    lines: LineMap,
+    field: LikelihoodField,
+    cloud_m: np.ndarray,
+    normals: np.ndarray,
     points: np.ndarray,
     pose: tuple[float, float, float],
     max_pair_m: float = 0.08,
     iterations: int = 8,
     min_pairs: int = 20,
 ) -> tuple[tuple[float, float, float], int]:
-    """The pose near ``pose`` that best lays the robot-frame ``points`` on ``lines`` (see the
-    module docstring) and the pairs it used; ``pose`` itself with 0 when fewer than
-    ``min_pairs`` points find a line within ``max_pair_m``."""
-    pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
-    x, y, yaw = (float(v) for v in pose)
+    """The pose near ``pose`` that best lays the robot-frame ``points`` on the lines of the
+    submap (see the module docstring) and the pairs it used; ``pose`` itself with 0 when fewer
+    than ``min_pairs`` points find a line within ``max_pair_m``.
+
+    Args:
+        field: The likelihood field of ``cloud_m`` (its ``nearest`` index pairs the points).
+        cloud_m: ``(m, 2)`` the submap's end points, world frame.
+        normals: ``(m, 2)`` their unit normals (zero: no line there).
+        points: ``(n, 2)`` the scan's end points, robot frame.
+        pose: The start, ``(x_m, y_m, yaw_rad)``.
+    """
+    out = _refine(
+        field.nearest,
+        field.origin_x_m,
+        field.origin_y_m,
+        field.resolution_m,
+        np.ascontiguousarray(cloud_m, dtype=np.float64).reshape(-1, 2),
+        np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 2),
+        np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2),
+        float(pose[0]),
+        float(pose[1]),
+        float(pose[2]),
+        float(max_pair_m),
+        int(iterations),
+        int(min_pairs),
+    )
+    used = int(out[3])
+    if used == 0:
+        return (float(pose[0]), float(pose[1]), float(pose[2])), 0
+    yaw = float(out[2])
+    return (float(out[0]), float(out[1]), math.atan2(math.sin(yaw), math.cos(yaw))), used
+
+
+@njit(cache=True)
+def _refine(nearest, ox, oy, res, cloud, normals, pts, x, y, yaw, max_pair, iterations, min_pairs):  # noqa: ANN001, ANN202, E501
+    n_rows, n_cols = nearest.shape
     used = 0
     for _ in range(iterations):
-        c, s = math.cos(yaw), math.sin(yaw)
-        rx = c * pts[:, 0] - s * pts[:, 1]
-        ry = s * pts[:, 0] + c * pts[:, 1]
-        world = np.stack([rx + x, ry + y], axis=1)
-        dist, idx = lines.tree.query(world, k=1, distance_upper_bound=max_pair_m)
-        ok = np.isfinite(dist)
-        if np.any(ok):
-            normal = lines.normals[np.where(ok, idx, 0)]
-            ok &= np.any(normal != 0.0, axis=1)
-        n_pairs = int(np.count_nonzero(ok))
+        c = math.cos(yaw)
+        s = math.sin(yaw)
+        h = np.zeros((3, 3))
+        g = np.zeros(3)
+        n_pairs = 0
+        for i in range(pts.shape[0]):
+            rx = c * pts[i, 0] - s * pts[i, 1]
+            ry = s * pts[i, 0] + c * pts[i, 1]
+            wx = rx + x
+            wy = ry + y
+            col = int(math.floor((wx - ox) / res))
+            row = int(math.floor((wy - oy) / res))
+            if row < 0 or row >= n_rows or col < 0 or col >= n_cols:
+                continue
+            k = nearest[row, col]
+            if k < 0:
+                continue
+            nx = normals[k, 0]
+            ny = normals[k, 1]
+            if nx == 0.0 and ny == 0.0:
+                continue
+            dx = wx - cloud[k, 0]
+            dy = wy - cloud[k, 1]
+            if dx * dx + dy * dy > max_pair * max_pair:
+                continue
+            r = nx * dx + ny * dy
+            a = abs(r)
+            w = 1.0 if a <= _HUBER_M else _HUBER_M / a
+            j0 = nx
+            j1 = ny
+            j2 = -nx * ry + ny * rx  # d(world)/d(yaw) = (-ry, rx)
+            h[0, 0] += w * j0 * j0
+            h[0, 1] += w * j0 * j1
+            h[0, 2] += w * j0 * j2
+            h[1, 1] += w * j1 * j1
+            h[1, 2] += w * j1 * j2
+            h[2, 2] += w * j2 * j2
+            g[0] += w * j0 * r
+            g[1] += w * j1 * r
+            g[2] += w * j2 * r
+            n_pairs += 1
         if n_pairs < min_pairs:
             break
         used = n_pairs
-        n = lines.normals[idx[ok]]
-        q = lines.points[idx[ok]]
-        r = np.einsum("ij,ij->i", n, world[ok] - q)
-        # d(world)/d(yaw) = (-ry, rx)
-        jac = np.stack([n[:, 0], n[:, 1], -n[:, 0] * ry[ok] + n[:, 1] * rx[ok]], axis=1)
-        a = np.abs(r)
-        w = np.where(a <= _HUBER_M, 1.0, _HUBER_M / np.maximum(a, 1e-12))
-        h = (jac * w[:, None]).T @ jac + _DAMPING * n_pairs * np.eye(3)
-        g = (jac * w[:, None]).T @ r
-        step = -np.linalg.solve(h, g)
-        x, y, yaw = x + float(step[0]), y + float(step[1]), yaw + float(step[2])
-        if abs(step[0]) + abs(step[1]) < 1e-5 and abs(step[2]) < 1e-5:
+        h[1, 0] = h[0, 1]
+        h[2, 0] = h[0, 2]
+        h[2, 1] = h[1, 2]
+        for d in range(3):
+            h[d, d] += _DAMPING * n_pairs
+        step = np.linalg.solve(h, -g)
+        x += step[0]
+        y += step[1]
+        yaw += step[2]
+        if abs(step[0]) + abs(step[1]) < _CONVERGED and abs(step[2]) < _CONVERGED:
             break
-    if used == 0:
-        return (float(pose[0]), float(pose[1]), float(pose[2])), 0
-    return (x, y, math.atan2(math.sin(yaw), math.cos(yaw))), used
+    return np.array([x, y, yaw, float(used)])

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+#: The coarse lattice scores every this many end points of a scan (of 20 or more per step).
+_COARSE_EVERY = 4
 #: Score temperature of the covariance weights (score units, 0..1).
 _COV_TEMPERATURE = 0.02
 
@@ -26,12 +28,15 @@ _COV_TEMPERATURE = 0.02
 @dataclass(frozen=True)
 class LikelihoodField:
     """A likelihood field over a rectangle: ``values[row, col]`` at cell centre
-    ``(origin_x_m + (col + 0.5) * resolution_m, origin_y_m + (row + 0.5) * resolution_m)``."""
+    ``(origin_x_m + (col + 0.5) * resolution_m, origin_y_m + (row + 0.5) * resolution_m)``;
+    ``nearest[row, col]`` the index of the point whose kernel set the value there (the point
+    nearest the cell's centre within the field's reach; -1 where none reaches)."""
 
     values: np.ndarray
     origin_x_m: float
     origin_y_m: float
     resolution_m: float
+    nearest: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -51,7 +56,8 @@ def build_likelihood_field(
     field is taken as 0). With no points the field is one zero cell."""
     pts = np.ascontiguousarray(points_m, dtype=np.float64).reshape(-1, 2)
     if len(pts) == 0:
-        return LikelihoodField(np.zeros((1, 1), dtype=np.float32), 0.0, 0.0, resolution_m)
+        none = np.full((1, 1), -1, dtype=np.int32)
+        return LikelihoodField(np.zeros((1, 1), dtype=np.float32), 0.0, 0.0, resolution_m, none)
     reach = int(math.ceil(4.0 * sigma_m / resolution_m))
     lo = pts.min(axis=0) - margin_m - (reach + 1) * resolution_m
     hi = pts.max(axis=0) + margin_m + (reach + 1) * resolution_m
@@ -61,13 +67,15 @@ def build_likelihood_field(
     d2 = offsets[:, None] ** 2 + offsets[None, :] ** 2
     kernel = np.exp(-d2 / (2.0 * sigma_m**2)).astype(np.float32)
     values = np.zeros((n_rows, n_cols), dtype=np.float32)
-    _stamp(values, pts, float(lo[0]), float(lo[1]), float(resolution_m), kernel, reach)
-    return LikelihoodField(values, float(lo[0]), float(lo[1]), float(resolution_m))
+    nearest = np.full((n_rows, n_cols), -1, dtype=np.int32)
+    _stamp(values, nearest, pts, float(lo[0]), float(lo[1]), float(resolution_m), kernel, reach)
+    return LikelihoodField(values, float(lo[0]), float(lo[1]), float(resolution_m), nearest)
 
 
 @njit(cache=True)
-def _stamp(values, pts, origin_x, origin_y, res, kernel, reach):  # noqa: ANN001, ANN202
-    """The max of the kernel centred on the cell of each point (cell-centre distances)."""
+def _stamp(values, nearest, pts, origin_x, origin_y, res, kernel, reach):  # noqa: ANN001, ANN202
+    """The max of the kernel centred on the cell of each point (cell-centre distances), and
+    the point that set it (the first of equals)."""
     n_rows, n_cols = values.shape
     for i in range(pts.shape[0]):
         col = int(math.floor((pts[i, 0] - origin_x) / res))
@@ -82,6 +90,7 @@ def _stamp(values, pts, origin_x, origin_y, res, kernel, reach):  # noqa: ANN001
                     v = kernel[a + reach, b + reach]
                     if v > values[r, c]:
                         values[r, c] = v
+                        nearest[r, c] = i
 
 
 def scan_points(
@@ -180,8 +189,9 @@ def match_scan(
     x0, y0, yaw0 = prediction
     dxs, dys = _steps(search_xy_m, step_xy), _steps(search_xy_m, step_xy)
     dyaws = _steps(search_yaw_rad, step_yaw)
-    # The coarse lattice scores every other end point (neighbours overlap at its step).
-    coarse = (*args[:4], pts[::2] if len(pts) >= 40 else pts)
+    # The coarse lattice scores every fourth end point: it only has to find the basin (and
+    # spread its scores for the covariance); the fine steps and ICP use them all.
+    coarse = (*args[:4], pts[::_COARSE_EVERY] if len(pts) >= 20 * _COARSE_EVERY else pts)
     scores = _score_lattice(*coarse, x0, y0, yaw0, dxs, dys, dyaws)
     bx, by, byaw, best = _best(scores, dxs, dys, dyaws)
     floor = np.array([res**2, res**2, (step_yaw / 2.0) ** 2])

@@ -9,8 +9,8 @@ import pytest
 
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
 from semexplore_gym.core.slam.backend import rotate
-from semexplore_gym.core.slam.icp import line_map, local_normals, refine_point_to_line
-from semexplore_gym.core.slam.matcher import scan_points, transform_points
+from semexplore_gym.core.slam.icp import local_normals, refine_point_to_line
+from semexplore_gym.core.slam.matcher import build_likelihood_field, scan_points, transform_points
 
 BEAMS = np.arange(360) * (2 * math.pi / 360)
 MAX_RANGE_M = 3.5
@@ -26,9 +26,13 @@ ROOM = [[0, 0, 4, 0], [4, 0, 4, 3], [4, 3, 0, 3], [0, 3, 0, 0], [1, 1, 2.2, 1], 
 CORRIDOR = [[-15, 0, 15, 0], [-15, 1.4, 15, 1.4]]
 
 
-def _lines(walls: list[list[float]], pose: tuple[float, float, float]):
-    pts = _points(walls, pose)
-    return line_map(transform_points(pts, pose), rotate(local_normals(pts), pose[2]))
+def _refine(walls, map_pose, scan, start):  # noqa: ANN001, ANN202
+    """``scan`` refined from ``start`` against the scan taken at ``map_pose``."""
+    pts = _points(walls, map_pose)
+    cloud = transform_points(pts, map_pose)
+    field = build_likelihood_field(cloud, 0.025, 0.04)
+    normals = rotate(local_normals(pts), map_pose[2])
+    return refine_point_to_line(field, cloud, normals, scan, start)
 
 
 def test_normals_are_perpendicular_to_the_walls() -> None:
@@ -43,21 +47,18 @@ def test_normals_are_perpendicular_to_the_walls() -> None:
 
 
 def test_a_small_offset_is_taken_out_to_a_millimetre() -> None:
-    lines = _lines(ROOM, (3.0, 2.0, 0.3))
     true = (2.8, 1.9, 0.25)
-    scan = _points(ROOM, true)
     start = (true[0] + 0.015, true[1] - 0.012, true[2] + 0.008)  # a correlative step off
-    pose, pairs = refine_point_to_line(lines, scan, start)
+    pose, pairs = _refine(ROOM, (3.0, 2.0, 0.3), _points(ROOM, true), start)
     assert pairs > 100
     assert math.hypot(pose[0] - true[0], pose[1] - true[1]) < 1e-3
     assert abs(pose[2] - true[2]) < 1e-3
 
 
 def test_along_a_bare_corridor_the_axis_stays_at_the_start() -> None:
-    lines = _lines(CORRIDOR, (0.0, 0.7, 0.0))
     true = (0.3, 0.7, 0.0)
     start = (0.35, 0.72, 0.01)  # 5 cm off along the axis, 2 cm across, 10 mrad
-    pose, pairs = refine_point_to_line(lines, _points(CORRIDOR, true), start)
+    pose, pairs = _refine(CORRIDOR, (0.0, 0.7, 0.0), _points(CORRIDOR, true), start)
     assert pairs > 100
     assert pose[1] == pytest.approx(true[1], abs=1e-3)  # across: pinned
     assert pose[2] == pytest.approx(true[2], abs=1e-3)
@@ -65,7 +66,6 @@ def test_along_a_bare_corridor_the_axis_stays_at_the_start() -> None:
 
 
 def test_too_few_pairs_give_the_start_back() -> None:
-    lines = _lines(ROOM, (3.0, 2.0, 0.3))
     start = (3.0, 2.0, 0.3)
     far = np.array([[10.0, 10.0], [11.0, 10.0]])  # nothing of the map near these
-    assert refine_point_to_line(lines, far, start) == (start, 0)
+    assert _refine(ROOM, start, far, start) == (start, 0)

@@ -70,3 +70,16 @@ def test_matcher_scores_a_scan_of_another_place_low() -> None:
     truth = (3.0, 0.6, 1.1)
     points = scan_points(_scan(truth), BEAMS, MAX_RANGE_M, (0, 0))
     assert match_scan(field, points, truth, 0.2, 0.3).score < 0.35
+
+
+def test_the_field_names_the_point_nearest_each_cell() -> None:
+    pts = np.array([[0.0, 0.0], [1.0, 0.0]])
+    field = build_likelihood_field(pts, 0.05, 0.04)
+
+    def at(x: float, y: float) -> int:
+        col = int((x - field.origin_x_m) / field.resolution_m)
+        row = int((y - field.origin_y_m) / field.resolution_m)
+        return int(field.nearest[row, col])
+
+    assert at(0.06, 0.02) == 0 and at(0.94, -0.03) == 1
+    assert at(0.5, 0.0) == -1  # beyond the field's reach of both points
