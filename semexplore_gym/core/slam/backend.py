@@ -324,10 +324,14 @@ class ScanSlam:
         pose, pairs = refine_point_to_line(
             field, cloud, normals, points, match.pose, max_pair_m=p.refine_max_pair_m
         )
-        # The refinement polishes the correlative basin; a jump out of it is not trusted.
-        moved = math.hypot(pose[0] - match.pose[0], pose[1] - match.pose[1])
-        turned = abs(wrap_angle_rad(pose[2] - match.pose[2]))
-        if pairs == 0 or moved > 2 * p.match_resolution_m or turned > 2 * p.match_resolution_m:
+        # The refinement polishes the correlative basin; a jump out of it is not trusted: more
+        # than one coarse lattice step in x-y (2 cells) or two in yaw (the matcher's yaw step
+        # is one cell's edge in radians: it moves a point 2 m off by the x-y step).
+        moved_m = math.hypot(pose[0] - match.pose[0], pose[1] - match.pose[1])
+        turned_rad = abs(wrap_angle_rad(pose[2] - match.pose[2]))
+        step_xy_m = 2.0 * p.match_resolution_m
+        step_yaw_rad = step_xy_m / 2.0
+        if pairs == 0 or moved_m > step_xy_m or turned_rad > 2.0 * step_yaw_rad:
             return match
         return MatchResult(pose, match.score, match.covariance)
 
