@@ -64,14 +64,6 @@ def compose(a: Pose, b: Pose) -> Pose:
     return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle_rad(a[2] + b[2]))
 
 
-def rotate(vectors: np.ndarray, yaw_rad: float) -> np.ndarray:
-    """``(n, 2)`` vectors turned by ``yaw_rad``."""
-    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
-    return np.stack(
-        [c * vectors[:, 0] - s * vectors[:, 1], s * vectors[:, 0] + c * vectors[:, 1]], 1
-    )
-
-
 def relative(a: Pose, b: Pose) -> Pose:
     """``a^-1 (+) b``: the pose ``b`` in the frame of ``a``."""
     c, s = math.cos(a[2]), math.sin(a[2])
@@ -158,7 +150,7 @@ class ScanSlam:
         self._points.append(points)
         self._normals.append(local_normals(points))
         self._world_points.append(transform_points(points, pose))
-        self._world_normals.append(rotate(self._normals[-1], pose[2]))
+        self._world_normals.append(transform_points(self._normals[-1], (0.0, 0.0, pose[2])))
 
     def _fuse(self, k: int) -> None:
         sx, sy, syaw = compose(self.keyframe_poses[k], (*self._mount, 0.0))
@@ -372,7 +364,8 @@ class ScanSlam:
             for pts, kp in zip(self._points, self.keyframe_poses, strict=True)
         ]
         self._world_normals = [
-            rotate(nrm, kp[2]) for nrm, kp in zip(self._normals, self.keyframe_poses, strict=True)
+            transform_points(nrm, (0.0, 0.0, kp[2]))
+            for nrm, kp in zip(self._normals, self.keyframe_poses, strict=True)
         ]
         if moved < 0.25 * self.grid.geometry.resolution_m:
             return False

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
-from semexplore_gym.core.slam.backend import rotate
 from semexplore_gym.core.slam.icp import local_normals, refine_point_to_line
 from semexplore_gym.core.slam.matcher import build_likelihood_field, scan_points, transform_points
 
@@ -31,7 +30,7 @@ def _refine(walls, map_pose, scan, start):  # noqa: ANN001, ANN202
     pts = _points(walls, map_pose)
     cloud = transform_points(pts, map_pose)
     field = build_likelihood_field(cloud, 0.025, 0.04)
-    normals = rotate(local_normals(pts), map_pose[2])
+    normals = transform_points(local_normals(pts), (0.0, 0.0, map_pose[2]))
     return refine_point_to_line(field, cloud, normals, scan, start)
 
 
@@ -40,7 +39,7 @@ def test_normals_are_perpendicular_to_the_walls() -> None:
     normals = local_normals(pts)
     world = transform_points(pts, (3.0, 2.0, 0.3))
     on_bottom = (np.abs(world[:, 1]) < 1e-6) & (world[:, 0] > 2.5) & (world[:, 0] < 3.5)
-    n = rotate(normals[on_bottom], 0.3)
+    n = transform_points(normals[on_bottom], (0.0, 0.0, 0.3))
     assert on_bottom.sum() >= 3
     assert np.allclose(np.abs(n[:, 1]), 1.0, atol=1e-6)  # the bottom wall's normal is +-y
     assert np.allclose(np.hypot(*normals[np.any(normals != 0, axis=1)].T), 1.0)
