@@ -38,7 +38,7 @@ import numpy as np
 
 from semexplore_gym.core.grid import GridGeometry, wrap_angle_rad
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams, OccupancyGrid
-from semexplore_gym.core.slam.icp import local_normals, refine_point_to_line
+from semexplore_gym.core.slam.icp import local_normals, pair_residuals_m, refine_point_to_line
 from semexplore_gym.core.slam.matcher import (
     MatchResult,
     build_likelihood_field,
@@ -250,7 +250,7 @@ class ScanSlam:
                 self._freeze_reference(median, lost_now=True)
                 return False
             return trusted
-        match = self._match(self._reference, points, prediction, p.search_xy_m)
+        match, _ = self._match(self._reference, points, prediction, p.search_xy_m)
         if len(points) >= 10 and match.score >= self._reference_floor:
             self._reference = None
             return True
@@ -270,7 +270,9 @@ class ScanSlam:
         p = self.params
         first = max(0, len(self.keyframe_poses) - p.submap_keyframes)
         keyframes = range(first, len(self.keyframe_poses))
-        match = self._match(keyframes, points, prediction, p.search_xy_m, p.match_score_threshold)
+        match, _ = self._match(
+            keyframes, points, prediction, p.search_xy_m, p.match_score_threshold
+        )
         self.last_score = match.score
         if len(points) >= 10 and match.score >= p.match_score_threshold:
             return self._unless_degenerate(match, prediction), match.covariance, True
@@ -297,10 +299,13 @@ class ScanSlam:
         prediction: Pose,
         search_xy_m: float,
         refine_from: float = math.inf,
-    ) -> MatchResult:
+        fit: bool = False,
+    ) -> tuple[MatchResult, float]:
         """The scan ``points`` matched to the ``keyframes``' scans around ``prediction``; a
         match scoring at least ``refine_from`` is refined by ICP (the others are not used
-        for a pose)."""
+        for a pose). With it, when ``fit`` is asked for, the 90th percentile of the refined
+        scan's point-to-line distances (m); infinite when ICP did not refine the match (and
+        0 when it did and ``fit`` was not asked for)."""
         p = self.params
         world = [self._world_points[k] for k in keyframes]
         cloud = np.concatenate(world) if world else np.zeros((0, 2))
@@ -311,7 +316,7 @@ class ScanSlam:
             or match.score < refine_from
             or min(len(cloud), len(points)) < 10
         ):
-            return match
+            return match, math.inf
         normals = np.concatenate([self._world_normals[k] for k in keyframes])
         pose, pairs = refine_point_to_line(
             field, cloud, normals, points, match.pose, max_pair_m=p.refine_max_pair_m
@@ -324,8 +329,12 @@ class ScanSlam:
         step_xy_m = 2.0 * p.match_resolution_m
         step_yaw_rad = step_xy_m / 2.0
         if pairs == 0 or moved_m > step_xy_m or turned_rad > 2.0 * step_yaw_rad:
-            return match
-        return MatchResult(pose, match.score, match.covariance)
+            return match, math.inf
+        fit_m = 0.0
+        if fit:
+            residuals = pair_residuals_m(field, cloud, normals, points, pose, p.refine_max_pair_m)
+            fit_m = float(np.quantile(residuals, 0.9)) if len(residuals) else math.inf
+        return MatchResult(pose, match.score, match.covariance), fit_m
 
     def _close_loop(self, points: np.ndarray) -> bool:
         """Try a loop closure from the newest keyframe; True when one re-rendered the map."""
@@ -345,11 +354,18 @@ class ScanSlam:
             return False
         half = p.submap_keyframes // 2
         sub = range(max(0, i - half), min(last_old + 1, i + half + 1))
-        match = self._match(
-            sub, points, self.keyframe_poses[n], p.loop_search_xy_m, p.loop_score_threshold
+        match, fit_m = self._match(
+            sub,
+            points,
+            self.keyframe_poses[n],
+            p.loop_search_xy_m,
+            p.loop_score_threshold,
+            fit=True,
         )
         if match.score < p.loop_score_threshold:
             return False
+        if p.refine_max_pair_m > 0 and 0 < p.loop_max_residual_m < fit_m:
+            return False  # not refined, or the refined scan lies beside the old walls
         if _worst_sd_m(match) > p.degenerate_sd_m:
             return False  # a closure the scan pins only across one direction: not trusted
         delta = relative(self.keyframe_poses[i], match.pose)

@@ -25,6 +25,7 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "scan_jump_share": (0.05, 1.0),
     "scan_jump_range_m": (0.01, 10.0),
     "refine_max_pair_m": (0.0, 1.0),
+    "loop_max_residual_m": (0.0, 1.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
 
@@ -71,6 +72,11 @@ class SlamParams:
         refine_max_pair_m: Each match (tracking and loop closure) is refined by point-to-line
             ICP (:mod:`~semexplore_gym.core.slam.icp`), pairing a scan point with a submap
             line no farther than this; 0 keeps the correlative match as it is.
+        loop_max_residual_m: With the refinement on, a loop closure is taken only when ICP
+            refined its match and the 90th percentile of the scan points' distances to the
+            submap's lines is at most this (a match one yaw step off, which the refinement
+            did not pull back, lays its far points centimetres beside the walls and bends
+            everything it joins). 0 turns the check off.
     """
 
     enabled: bool = False
@@ -92,6 +98,7 @@ class SlamParams:
     scan_jump_share: float = 0.3
     scan_jump_range_m: float = 0.5
     refine_max_pair_m: float = 0.08
+    loop_max_residual_m: float = 0.02
 
     def __post_init__(self) -> None:
         for f in fields(self):

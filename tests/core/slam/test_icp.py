@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
-from semexplore_gym.core.slam.icp import local_normals, refine_point_to_line
+from semexplore_gym.core.slam.icp import local_normals, pair_residuals_m, refine_point_to_line
 from semexplore_gym.core.slam.matcher import build_likelihood_field, scan_points, transform_points
 
 BEAMS = np.arange(360) * (2 * math.pi / 360)
@@ -68,3 +68,18 @@ def test_too_few_pairs_give_the_start_back() -> None:
     start = (3.0, 2.0, 0.3)
     far = np.array([[10.0, 10.0], [11.0, 10.0]])  # nothing of the map near these
     assert _refine(ROOM, start, far, start) == (start, 0)
+
+
+def test_residuals_say_a_match_one_yaw_step_off_lies_beside_the_walls() -> None:
+    map_pose = (3.0, 2.0, 0.3)
+    pts = _points(ROOM, map_pose)
+    cloud = transform_points(pts, map_pose)
+    field = build_likelihood_field(cloud, 0.025, 0.04)
+    normals = transform_points(local_normals(pts), (0.0, 0.0, map_pose[2]))
+    true = (2.8, 1.9, 0.25)
+    scan = _points(ROOM, true)
+    right = pair_residuals_m(field, cloud, normals, scan, true)
+    off = pair_residuals_m(field, cloud, normals, scan, (true[0], true[1], true[2] + 0.025))
+    assert len(right) > 200 and np.quantile(right, 0.9) < 0.003
+    assert np.quantile(off, 0.9) > 0.02  # the far walls, 2-3 m off, miss by centimetres
+    assert len(pair_residuals_m(field, cloud, normals, scan, (true[0] + 2.0, *true[1:]))) < 50
