@@ -69,6 +69,7 @@ def test_same_seed_same_slam_map_bit_for_bit() -> None:
         ("slam.loop_score_threshold=2", "slam.loop_score_threshold"),
         ("slam.submap_keyframes=2.5", "slam.submap_keyframes"),
         ("slam.enabled=maybe", "slam.enabled"),
+        ("slam.loop_max_residual_m=-0.01", "slam.loop_max_residual_m"),
     ],
 )
 def test_a_bad_slam_value_is_one_line_naming_it(override: str, named: str, capsys) -> None:
