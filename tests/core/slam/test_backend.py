@@ -145,18 +145,19 @@ def test_a_closure_the_scan_pins_only_across_a_corridor_is_not_taken() -> None:
 
 def test_a_closure_whose_refined_scan_lies_beside_the_walls_is_not_taken(monkeypatch) -> None:
     # The loop search still finds its candidates; every fit is made to read 5 cm (a match a
-    # yaw step off): with the check none is taken, with it off (0) they are, as they are
-    # when ICP is off (nothing refined, nothing to check).
+    # yaw step off): with the check on none is taken, with it off (0, the default) they are,
+    # as they are when ICP is off (nothing refined, nothing to check).
     from semexplore_gym.core.slam import backend
 
-    taken, _, _ = _run(SlamParams(enabled=True), seed=1)
+    checked = SlamParams(enabled=True, loop_max_residual_m=0.02)
+    taken, _, _ = _run(checked, seed=1)
     assert taken.loop_closures >= 1
     monkeypatch.setattr(backend, "pair_residuals_m", lambda *a, **k: np.full(100, 0.05))
-    refused, _, _ = _run(SlamParams(enabled=True), seed=1)
-    unchecked, _, _ = _run(SlamParams(enabled=True, loop_max_residual_m=0.0), seed=1)
+    refused, _, _ = _run(checked, seed=1)
+    unchecked, _, _ = _run(SlamParams(enabled=True), seed=1)
     assert refused.loop_closures == 0
     assert unchecked.loop_closures == taken.loop_closures
-    lattice, _, _ = _run(SlamParams(enabled=True, **COARSE), seed=1)
+    lattice, _, _ = _run(replace(checked, **COARSE), seed=1)
     assert lattice.loop_closures >= 1
 
 
