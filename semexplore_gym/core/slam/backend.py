@@ -360,7 +360,7 @@ class ScanSlam:
             self.keyframe_poses[n],
             p.loop_search_xy_m,
             p.loop_score_threshold,
-            fit=True,
+            fit=p.loop_max_residual_m > 0,  # the residuals only when the check is on
         )
         if match.score < p.loop_score_threshold:
             return False
