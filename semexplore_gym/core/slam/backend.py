@@ -148,7 +148,11 @@ class ScanSlam:
         self._ranges.append(ranges)
         points = scan_points(ranges, self._beams, self._max_range_m, self._mount)
         self._points.append(points)
-        self._normals.append(local_normals(points))
+        normals = local_normals(points)
+        # Oriented towards the sensor that saw them: the side of the wall that faces it.
+        away = np.sum(normals * (np.asarray(self._mount) - points), axis=1) < 0
+        normals[away] *= -1.0
+        self._normals.append(normals)
         self._world_points.append(transform_points(points, pose))
         self._world_normals.append(transform_points(self._normals[-1], (0.0, 0.0, pose[2])))
 
@@ -307,8 +311,7 @@ class ScanSlam:
         scan's point-to-line distances (m); infinite when ICP did not refine the match (and
         0 when it did and ``fit`` was not asked for)."""
         p = self.params
-        world = [self._world_points[k] for k in keyframes]
-        cloud = np.concatenate(world) if world else np.zeros((0, 2))
+        cloud, normals = self._submap(keyframes, prediction)
         field = build_likelihood_field(cloud, p.match_resolution_m, p.likelihood_sigma_m)
         match = match_scan(field, points, prediction, search_xy_m, p.search_yaw_rad)
         if (
@@ -317,7 +320,6 @@ class ScanSlam:
             or min(len(cloud), len(points)) < 10
         ):
             return match, math.inf
-        normals = np.concatenate([self._world_normals[k] for k in keyframes])
         pose, pairs = refine_point_to_line(
             field, cloud, normals, points, match.pose, max_pair_m=p.refine_max_pair_m
         )
@@ -335,6 +337,23 @@ class ScanSlam:
             residuals = pair_residuals_m(field, cloud, normals, points, pose, p.refine_max_pair_m)
             fit_m = float(np.quantile(residuals, 0.9)) if len(residuals) else math.inf
         return MatchResult(pose, match.score, match.covariance), fit_m
+
+    def _submap(self, keyframes: range, prediction: Pose) -> tuple[np.ndarray, np.ndarray]:
+        """The ``keyframes``' end points and normals (world frame) a scan taken at
+        ``prediction`` is matched to: without the points on faces that look away from its
+        sensor (``SlamParams.backface_margin_m``)."""
+        if not keyframes:
+            return np.zeros((0, 2)), np.zeros((0, 2))
+        cloud = np.concatenate([self._world_points[k] for k in keyframes])
+        normals = np.concatenate([self._world_normals[k] for k in keyframes])
+        margin = self.params.backface_margin_m
+        if margin <= 0:
+            return cloud, normals
+        sensor = compose(prediction, (*self._mount, 0.0))
+        # A point without a line (zero normal) has facing 0 and stays.
+        facing = np.sum(normals * (np.asarray(sensor[:2]) - cloud), axis=1)
+        keep = facing >= -margin
+        return cloud[keep], normals[keep]
 
     def _close_loop(self, points: np.ndarray) -> bool:
         """Try a loop closure from the newest keyframe; True when one re-rendered the map."""

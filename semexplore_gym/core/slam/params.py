@@ -26,6 +26,7 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "scan_jump_range_m": (0.01, 10.0),
     "refine_max_pair_m": (0.0, 1.0),
     "loop_max_residual_m": (0.0, 1.0),
+    "backface_margin_m": (0.0, 1.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
 
@@ -78,6 +79,12 @@ class SlamParams:
             the refinement did not pull back, lays its far points centimetres beside the
             walls and bends everything it joins). Off (0) by default: on the suites it did
             not lower the offices' error and it let a warehouse map diverge (docs/slam.md).
+        backface_margin_m: When above 0, a match ignores the submap's points on wall faces
+            that look away from the sensor: a point is dropped when the sensor, at the
+            prediction, lies more than this behind the line of its face (each keyframe's
+            normals point towards the sensor that saw them). A LiDAR never sees a face from
+            behind; without this, a scan of a wall seen from a room can lie on the same wall's
+            corridor face seen earlier, one wall thickness off. 0 keeps every point.
     """
 
     enabled: bool = False
@@ -100,6 +107,7 @@ class SlamParams:
     scan_jump_range_m: float = 0.5
     refine_max_pair_m: float = 0.08
     loop_max_residual_m: float = 0.0
+    backface_margin_m: float = 0.05
 
     def __post_init__(self) -> None:
         for f in fields(self):
