@@ -70,6 +70,7 @@ def test_same_seed_same_slam_map_bit_for_bit() -> None:
         ("slam.submap_keyframes=2.5", "slam.submap_keyframes"),
         ("slam.enabled=maybe", "slam.enabled"),
         ("slam.loop_max_residual_m=-0.01", "slam.loop_max_residual_m"),
+        ("slam.backface_margin_m=-1", "slam.backface_margin_m"),
     ],
 )
 def test_a_bad_slam_value_is_one_line_naming_it(override: str, named: str, capsys) -> None:

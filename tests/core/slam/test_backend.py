@@ -219,3 +219,34 @@ def test_a_collapse_without_a_jump_is_no_kidnap() -> None:
     # on the way, none of them after a jump, and the back end never says it is lost.
     slam, _, ate_m = _run(SlamParams(enabled=True, score_collapse_ratio=1.0), seed=3)
     assert slam.lost_events == 0 and ate_m < 0.05
+
+
+def _thick_wall_scan(pose: tuple[float, float, float]) -> np.ndarray:
+    """A corridor (y 0 to 1.5) beside a room, parted by a 0.1 m thick wall with a 0.8 m door."""
+    walls = [
+        [-6, 0, 6, 0],
+        [-6, 1.5, -0.4, 1.5], [-0.4, 1.5, -0.4, 1.6], [-0.4, 1.6, -6, 1.6],
+        [0.4, 1.5, 6, 1.5], [0.4, 1.5, 0.4, 1.6], [0.4, 1.6, 6, 1.6],
+    ]  # fmt: skip
+    index = SegmentIndex(np.array(walls, dtype=np.float64))
+    ranges = cast_scan(index, pose[0], pose[1], pose[2], BEAMS, MAX_RANGE_M)
+    return np.minimum(ranges, MAX_RANGE_M)
+
+
+@pytest.mark.parametrize("room", [(1.0, 2.0, 0.3), (-1.0, 1.9, -0.2), (2.0, 2.1, 0.0)])
+def test_a_walls_room_face_is_not_laid_on_its_corridor_face(room) -> None:
+    # The first keyframe in the corridor saw the wall's corridor face; the next, in the room
+    # (through the door, one long step of exact odometry), sees the room face 0.1 m further.
+    # A LiDAR never sees a face from behind: culled, the corridor face cannot pull the scan.
+    geometry = GridGeometry.covering(-7.0, -1.0, 7.0, 6.0, 0.05, 0.5)
+    errors_m = {}
+    for margin_m in (0.05, 0.0):
+        params = SlamParams(enabled=True, backface_margin_m=margin_m)
+        slam = ScanSlam(params, geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+        corridor = (room[0], 0.9, room[2])
+        slam.reset(corridor, _thick_wall_scan(corridor))
+        estimate = slam.update(room, _thick_wall_scan(room))
+        errors_m[margin_m] = math.hypot(estimate[0] - room[0], estimate[1] - room[1])
+    assert SlamParams().backface_margin_m == 0.05  # on by default
+    assert errors_m[0.05] < 0.01
+    assert errors_m[0.0] > 0.05  # without it, one wall thickness off
