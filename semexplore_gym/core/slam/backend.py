@@ -3,7 +3,8 @@
 Each step :meth:`ScanSlam.update` takes the odometry pose and the scan. Between keyframes the
 estimate is the last keyframe's pose moved by the odometry since then. After
 ``keyframe_distance_m`` of travel or ``keyframe_angle_rad`` of turning the scan is matched to
-the local map of the recent keyframes (:mod:`.matcher`), the keyframe is linked to the last one
+the local map of the recent keyframes (:mod:`.matcher`; without the wall faces that look away
+from the scan's sensor, which no LiDAR sees from behind), the keyframe is linked to the last one
 by the match (or, when the match scores too low, by odometry alone), and an older keyframe
 within ``loop_search_radius_m`` and far back in the chain is tried as a loop closure against
 its own submap. A verified closure adds a robust edge and the pose graph is optimised
