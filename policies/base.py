@@ -111,6 +111,10 @@ class PolicyNotResetError(RuntimeError):
 #: The flag a policy instance carries once its ``reset`` has run to the end.
 RESET_DONE_ATTR = "_reset_done"
 
+#: How a stop reason starts when the observed pose lies off the map's grid (a SLAM back end
+#: that diverged): no frontier search and no path can start there.
+OFF_MAP_REASON = "pose estimate outside the map"
+
 
 def require_reset_before_act(cls: type) -> None:
     """Make ``cls``'s own ``act`` raise :class:`PolicyNotResetError` until ``reset`` has run.

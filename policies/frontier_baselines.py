@@ -55,7 +55,13 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, read_env_facts
+from semexplore_gym.policies.base import (
+    OFF_MAP_REASON,
+    DriveIntent,
+    Policy,
+    StepStats,
+    read_env_facts,
+)
 from semexplore_gym.policies.navigation import (
     GoalBlacklist,
     MoveBaseParams,
@@ -85,6 +91,7 @@ __all__ = [
     "FrontierExplorationPolicy",
     "NearestFrontierParams",
     "NearestFrontierPolicy",
+    "OFF_MAP_REASON",
 ]
 
 
@@ -165,6 +172,12 @@ class _FrontierBaseline(Policy):
         if self.done:
             return self._action(0.0, 0.0)
         grid, pose, scan = self._read(obs)
+        if not self._on_map(pose):
+            # A pose estimate off the map's grid (a SLAM back end that diverged): no frontier
+            # search can start there (explore_lite: "Robot out of costmap bounds, cannot
+            # search for frontiers"), nor a path. The robot stops and says why.
+            self._finish(f"{OFF_MAP_REASON} at ({pose[0]:.2f}, {pose[1]:.2f}) m")
+            return self._action(0.0, 0.0)
         self._update_goal(grid, pose, stats)
         if self.done:
             return self._action(0.0, 0.0)
@@ -174,6 +187,13 @@ class _FrontierBaseline(Policy):
         stats.extra = {"nav_status": self.nav.status, "n_frontiers": len(self.frontiers)}
         self.now_s += self.dt_s
         return self._action(v, w)
+
+    def _on_map(self, pose: np.ndarray) -> bool:
+        """Whether ``pose`` (the observed pose) lies on a cell of the map's grid."""
+        if not np.isfinite(pose[:2]).all():
+            return False
+        row, col = self.geometry.world_to_grid(float(pose[0]), float(pose[1]))
+        return bool(self.geometry.contains(int(row), int(col)))
 
     def _drive(
         self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats

@@ -42,6 +42,46 @@ def test_a_slam_benchmark_carries_the_slam_figures(tmp_path, capsys, source: str
     assert "| maze | nearest | 1 | " + f"{row['ate_m']:.3f}" in summary
 
 
+#: Every policy the package ships, torch-free ones first (the issue: every policy runs on the
+#: SLAM map unchanged; the oracle stays privileged and reads the true map).
+TORCH_FREE = (
+    "semantic",
+    "semantic-paper",
+    "frontier",
+    "nearest",
+    "frontier-student",
+    "pretrained:oracle_student",
+    "pretrained:frontier_value",
+    "oracle",
+)
+NEEDS_SB3 = ("pretrained:option_ppo", "pretrained:frontier_choice_maze", "pretrained:dagger_maze")
+
+
+@pytest.mark.slow
+def test_every_shipped_policy_runs_on_the_slam_map(tmp_path, capsys) -> None:
+    pytest.importorskip("gtsam")
+    specs = list(TORCH_FREE)
+    try:
+        import sb3_contrib  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        specs += NEEDS_SB3
+    out = tmp_path / "all"
+    argv = ["benchmark", "--worlds", WORLD, "--runs", "1", "--max-time-s", "12"]
+    argv += ["--policies", ",".join(specs), "--env-config", "slam"]
+    argv += ["--no-oracle", "--no-plots", "--no-progress", "--json", "--out", str(out)]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["ran"] == len(specs) and report["failed"] == 0
+    rows = {r["policy"]: r for r in read_runs(out / "runs.csv")}
+    assert sorted(rows) == sorted(specs)
+    for spec, row in rows.items():
+        assert row["steps"] > 0 and row["coverage"] > 0, spec
+        assert row["ate_m"] is not None and 0.0 <= row["ate_m"] < 0.5, spec
+        assert row["collisions"] == 0, spec
+
+
 def test_without_slam_the_columns_are_empty_and_the_section_absent(tmp_path, capsys) -> None:
     out = tmp_path / "plain"
     argv = ["benchmark", "--worlds", WORLD, "--runs", "1", "--max-time-s", "3"]
