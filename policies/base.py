@@ -116,6 +116,23 @@ RESET_DONE_ATTR = "_reset_done"
 OFF_MAP_REASON = "pose estimate outside the map"
 
 
+def on_map(geometry: GridGeometry, xy_m: Any) -> bool:
+    """Whether the position ``xy_m`` (an observed pose's x, y) lies on a cell of the grid."""
+    x, y = float(xy_m[0]), float(xy_m[1])
+    if not (np.isfinite(x) and np.isfinite(y)):
+        return False
+    row, col = geometry.world_to_grid(x, y)
+    return bool(geometry.contains(int(row), int(col)))
+
+
+def off_map_msg(geometry: GridGeometry, xy_m: Any, reason: str = "") -> str:
+    """``reason`` as it is on the map; off it, :data:`OFF_MAP_REASON` at ``xy_m`` first."""
+    if on_map(geometry, xy_m):
+        return reason
+    note = f"{OFF_MAP_REASON} at ({float(xy_m[0]):.2f}, {float(xy_m[1]):.2f}) m"
+    return f"{note}; {reason}" if reason else note
+
+
 def require_reset_before_act(cls: type) -> None:
     """Make ``cls``'s own ``act`` raise :class:`PolicyNotResetError` until ``reset`` has run.
 

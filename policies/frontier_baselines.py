@@ -55,13 +55,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from semexplore_gym.policies.base import (
-    OFF_MAP_REASON,
-    DriveIntent,
-    Policy,
-    StepStats,
-    read_env_facts,
-)
+from semexplore_gym.policies.base import DriveIntent, Policy, StepStats, off_map_msg, read_env_facts
 from semexplore_gym.policies.navigation import (
     GoalBlacklist,
     MoveBaseParams,
@@ -91,7 +85,6 @@ __all__ = [
     "FrontierExplorationPolicy",
     "NearestFrontierParams",
     "NearestFrontierPolicy",
-    "OFF_MAP_REASON",
 ]
 
 
@@ -172,13 +165,9 @@ class _FrontierBaseline(Policy):
         if self.done:
             return self._action(0.0, 0.0)
         grid, pose, scan = self._read(obs)
-        if not self._on_map(pose):
-            # A pose estimate off the map's grid (a SLAM back end that diverged): no frontier
-            # search can start there (explore_lite: "Robot out of costmap bounds, cannot
-            # search for frontiers"), nor a path. The robot stops and says why.
-            self._finish(f"{OFF_MAP_REASON} at ({pose[0]:.2f}, {pose[1]:.2f}) m")
-            return self._action(0.0, 0.0)
-        self._update_goal(grid, pose, stats)
+        # Off the map (a diverged SLAM) no search starts: stop, as explore_lite ("out of bounds").
+        note = off_map_msg(self.geometry, pose)
+        self._finish(note) if note else self._update_goal(grid, pose, stats)
         if self.done:
             return self._action(0.0, 0.0)
         v, w = self._drive(grid, pose, scan, stats)
@@ -187,13 +176,6 @@ class _FrontierBaseline(Policy):
         stats.extra = {"nav_status": self.nav.status, "n_frontiers": len(self.frontiers)}
         self.now_s += self.dt_s
         return self._action(v, w)
-
-    def _on_map(self, pose: np.ndarray) -> bool:
-        """Whether ``pose`` (the observed pose) lies on a cell of the map's grid."""
-        if not np.isfinite(pose[:2]).all():
-            return False
-        row, col = self.geometry.world_to_grid(float(pose[0]), float(pose[1]))
-        return bool(self.geometry.contains(int(row), int(col)))
 
     def _drive(
         self, grid: np.ndarray, pose: np.ndarray, scan: np.ndarray, stats: StepStats
@@ -387,8 +369,7 @@ class FrontierExplorationPolicy(_FrontierBaseline):
             nav.abort()
         v, w = super()._drive(grid, pose, scan, stats)
         if check and nav.last_plan_failed:
-            # The committed goal became unreachable on the updated map: drop it at once
-            # instead of waiting out planner patience and recoveries.
+            # The committed goal became unreachable on the updated map: drop it at once.
             nav.abort()
         return v, w
 
@@ -547,8 +528,7 @@ class NearestFrontierPolicy(_FrontierBaseline):
                 nav.set_goal(goal, self.now_s)
                 self.counters["goals_sent"] += 1
         elif due:
-            # The target is still a frontier: keep it (no goal switching), but keep the frontier
-            # list current for the overlay and the timing statistics.
+            # The target is still a frontier: keep it, and keep the frontier list current.
             self._last_search_s = self.now_s
             t0 = time.perf_counter()
             self.frontiers = self.detect(grid, pose)

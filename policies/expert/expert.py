@@ -75,7 +75,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from semexplore_gym.policies.base import OFF_MAP_REASON, Policy, StepStats, read_env_facts
+from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
 from semexplore_gym.policies.expert.counters import ExpertCounters
 from semexplore_gym.policies.expert.goal_memory import GoalMemory
 from semexplore_gym.policies.expert.params import SemanticExpertParams
@@ -232,13 +232,6 @@ class SemanticExpertPolicy(Policy):
                 self._goal_failed(grid, pose)
             if self._needs_replan(grid, pose):
                 self._replan(grid, pose, stats)
-                if self.done and not self.geometry.contains(
-                    *self.geometry.world_to_grid(pose[0], pose[1])
-                ):
-                    # Nothing found from a pose estimate off the map (a diverged SLAM): say so.
-                    self.stop_reason = (
-                        f"{OFF_MAP_REASON} at ({pose[0]:.2f}, {pose[1]:.2f}) m; {self.stop_reason}"
-                    )
             plan = self._plan
             if self.done:
                 v, w = 0.0, 0.0

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
+from semexplore_gym.policies.base import off_map_msg
 from semexplore_gym.policies.expert.counters import ExpertCounters
 from semexplore_gym.policies.expert.params import GoalMemoryParams
 from semexplore_gym.policies.expert.plan import Plan, PlanKind
@@ -150,6 +151,7 @@ class GoalMemory:
             self.params = params
         prm = self.params
         self.geometry = geometry
+        self.here_xy_m: tuple[float, float] | None = None  # the last place visited
         self.frontiers = FrontierMemory(
             prm.blacklist_radius_m,
             prm.revive_window_m,
@@ -249,6 +251,7 @@ class GoalMemory:
 
     def visit(self, xy_m: tuple[float, float]) -> None:
         """The robot is at ``xy_m`` (its trail)."""
+        self.here_xy_m = xy_m
         self.trail.add((int(xy_m[0] // TRAIL_CELL_M), int(xy_m[1] // TRAIL_CELL_M)))
 
     def adopt(self, goal_xy_m: tuple[float, float], known_cells: int) -> bool:
@@ -414,4 +417,8 @@ class GoalMemory:
             if n:
                 parts.append(f"{n} {text}")
         tail = f"; dropped: {', '.join(parts)}" if parts else ""
-        return f"no frontier left (grid check: none reachable{tail})"
+        reason = f"no frontier left (grid check: none reachable{tail})"
+        if self.geometry is None or self.here_xy_m is None:
+            return reason
+        # From a pose estimate off the map (a diverged SLAM) nothing is reachable: say so first.
+        return off_map_msg(self.geometry, self.here_xy_m, reason)
