@@ -165,9 +165,10 @@ class _FrontierBaseline(Policy):
         if self.done:
             return self._action(0.0, 0.0)
         grid, pose, scan = self._read(obs)
-        # Off the map (a diverged SLAM) no search starts: stop, as explore_lite ("out of bounds").
-        note = off_map_msg(self.geometry, pose)
-        self._finish(note) if note else self._update_goal(grid, pose, stats)
+        if note := off_map_msg(self.geometry, pose):  # a diverged SLAM: no search starts there
+            self._finish(note)  # (explore_lite: "Robot out of costmap bounds")
+        else:
+            self._update_goal(grid, pose, stats)
         if self.done:
             return self._action(0.0, 0.0)
         v, w = self._drive(grid, pose, scan, stats)
@@ -202,8 +203,7 @@ class _FrontierBaseline(Policy):
 
     def _finish(self, reason: str) -> None:
         """End the mission: the robot stops, ``stop_reason`` says why."""
-        self.done = True
-        self.stop_reason = reason
+        self.done, self.stop_reason = True, reason
         if self.nav is not None:
             self.nav.cancel()
 
