@@ -55,6 +55,27 @@ def test_the_slam_preset_gives_slams_map_pose_and_info() -> None:
     assert not set(SLAM_INFO_KEYS) & set(plain.reset(seed=0)[1])
 
 
+def test_known_when_seen_from_the_command_line_leaves_no_seen_cell_unknown(capsys) -> None:
+    """``--env-set slam.known_when_seen=true`` reaches the back end: after a mission no cell
+    with evidence either way is unknown in the SLAM map (by default some are, at walls seen
+    twice); only cells whose hits and misses cancel to within 1e-6 may be."""
+    counts = {}
+    for value in ("false", "true"):
+        ov = [f"slam.known_when_seen={value}"]
+        env = gym.make("SemanticExplore-v0", world=WORLD, config="slam", overrides=ov)
+        _drive(env, 150, seed=2)
+        grid = env.unwrapped.slam.grid
+        counts[value] = int(
+            np.count_nonzero((np.abs(grid.log_odds) > 1e-6) & (grid.encoded == 128))
+        )
+    assert counts["false"] > 0 and counts["true"] == 0
+    code = main(
+        ["explore", "--world", WORLD, "--env-config", "slam", "--env-set",
+         "slam.known_when_seen=true", "--max-time-s", "20", "--json", "--no-progress"]
+    )  # fmt: skip
+    assert code == 0 and "ate_m" in json.loads(capsys.readouterr().out)
+
+
 def test_same_seed_same_slam_map_bit_for_bit() -> None:
     a_maps, a_infos = _drive(gym.make("SemanticExplore-v0", world=WORLD, config="slam"), 120, 5)
     b_maps, b_infos = _drive(gym.make("SemanticExplore-v0", world=WORLD, config="slam"), 120, 5)
@@ -71,6 +92,7 @@ def test_same_seed_same_slam_map_bit_for_bit() -> None:
         ("slam.enabled=maybe", "slam.enabled"),
         ("slam.loop_max_residual_m=-0.01", "slam.loop_max_residual_m"),
         ("slam.backface_margin_m=-1", "slam.backface_margin_m"),
+        ("slam.known_when_seen=2", "slam.known_when_seen"),
     ],
 )
 def test_a_bad_slam_value_is_one_line_naming_it(override: str, named: str, capsys) -> None:

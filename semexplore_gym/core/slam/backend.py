@@ -33,6 +33,7 @@ judge: the estimate and the map are built as before.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -51,6 +52,10 @@ from semexplore_gym.core.slam.params import SlamParams
 from semexplore_gym.core.slam.pose_graph import Edge, optimise
 
 Pose = tuple[float, float, float]
+
+#: The thresholds of ``SlamParams.known_when_seen``: a log-odds this close to 0 (in float32; a
+#: cell no beam touched is exactly 0) is UNKNOWN, any other is FREE or OCCUPIED by its sign.
+_SEEN_LOG_ODDS = 1e-6
 
 
 def _worst_sd_m(match: MatchResult) -> float:
@@ -78,7 +83,8 @@ class ScanSlam:
     Args:
         params: The SLAM parameters.
         geometry: The map frame of the grid it builds.
-        mapping: The occupancy update parameters of that grid.
+        mapping: The occupancy update parameters of that grid (with
+            ``params.known_when_seen``, its thresholds are Gmapping's rule instead).
         beam_angles_rad: ``(n,)`` beam angles of the scans, relative to the heading.
         max_range_m: The LiDAR's maximum range (returns at it are "no return").
         mount_xy_m: The sensor's offset from the robot centre, in the robot frame.
@@ -94,6 +100,10 @@ class ScanSlam:
         mount_xy_m: tuple[float, float] = (0.0, 0.0),
     ) -> None:
         self.params = params
+        if params.known_when_seen:
+            mapping = dataclasses.replace(
+                mapping, free_threshold=-_SEEN_LOG_ODDS, occupied_threshold=_SEEN_LOG_ODDS
+            )
         self.grid = OccupancyGrid(geometry, mapping)
         self._beams = np.asarray(beam_angles_rad, dtype=np.float64)
         self._max_range_m = float(max_range_m)

@@ -29,6 +29,7 @@ _BOUNDS: dict[str, tuple[float, float]] = {
     "backface_margin_m": (0.0, 1.0),
 }
 _INTS = ("submap_keyframes", "loop_min_gap_keyframes", "lost_after_keyframes")
+_BOOLS = ("enabled", "known_when_seen")
 
 
 @dataclass(frozen=True)
@@ -85,6 +86,13 @@ class SlamParams:
             normals point towards the sensor that saw them). A LiDAR never sees a face from
             behind; without this, a scan of a wall seen from a room can lie on the same wall's
             corridor face seen earlier, one wall thickness off. 0 keeps every point.
+        known_when_seen: Gmapping's map rule for the map SLAM renders: every cell a beam
+            touched is known, OCCUPIED when its log-odds is above 0 (a hit share above about a
+            third of the beams that touched it), FREE below; only cells no beam touched (and
+            the rare cell whose hits and misses cancel out) stay UNKNOWN. Off: the mapping's thresholds (``mapping.free_threshold``,
+            ``mapping.occupied_threshold``) as in the perfect map, which leave a cell of
+            conflicting evidence UNKNOWN: a wall seen from two poses a cell apart then leaves
+            unknown cells beside free ones, frontiers no scan can clear.
     """
 
     enabled: bool = False
@@ -108,13 +116,14 @@ class SlamParams:
     refine_max_pair_m: float = 0.08
     loop_max_residual_m: float = 0.0
     backface_margin_m: float = 0.05
+    known_when_seen: bool = False
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name == "enabled":
+            if f.name in _BOOLS:
                 if not isinstance(v, bool):
-                    raise ValueError(f"slam.enabled must be true or false, got {v!r}")
+                    raise ValueError(f"slam.{f.name} must be true or false, got {v!r}")
                 continue
             ok_type = isinstance(v, int) if f.name in _INTS else isinstance(v, (int, float))
             lo, hi = _BOUNDS[f.name]

@@ -250,3 +250,36 @@ def test_a_walls_room_face_is_not_laid_on_its_corridor_face(room) -> None:
     assert SlamParams().backface_margin_m == 0.05  # on by default
     assert errors_m[0.05] < 0.01
     assert errors_m[0.0] > 0.05  # without it, one wall thickness off
+
+
+def _conflicting_map(params: SlamParams) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    """A back end's map after one scan sees a wall at 1.0 m and two see it at 1.1 m (a wall
+    mapped from two poses a cell or two apart): its encoded grid and log-odds, and the cell
+    of the first wall on the beam straight ahead."""
+    geometry = GridGeometry.covering(-2.0, -2.0, 2.0, 2.0, 0.05, 0.0)
+    slam = ScanSlam(params, geometry, MappingParams(), BEAMS, MAX_RANGE_M)
+    slam.reset((0.0, 0.0, 0.0), np.full(len(BEAMS), 1.02))
+    for _ in range(2):
+        slam.grid.integrate_scan(0.0, 0.0, 0.0, BEAMS, np.full(len(BEAMS), 1.12), MAX_RANGE_M)
+    row, col = (int(v) for v in geometry.world_to_grid(1.02, 0.01))
+    return slam.grid.encoded.copy(), slam.grid.log_odds.copy(), (row, col)
+
+
+def test_known_when_seen_leaves_no_touched_cell_unknown() -> None:
+    from semexplore_gym.core.grid import OCCUPIED, UNKNOWN
+
+    band, band_lo, cell = _conflicting_map(SlamParams(enabled=True))
+    seen, seen_lo, _ = _conflicting_map(SlamParams(enabled=True, known_when_seen=True))
+    np.testing.assert_array_equal(band_lo, seen_lo)  # the same evidence, another rule
+    # One hit and two misses: the perfect map's band leaves the wall's cell unknown (a
+    # frontier beside free cells); Gmapping's rule calls it occupied (hit share 1/3).
+    assert band[cell] == UNKNOWN and seen[cell] == OCCUPIED
+    touched = band_lo != 0
+    assert np.any(touched & (band == UNKNOWN))
+    assert not np.any(touched & (seen == UNKNOWN))
+    # Cells no beam reached (beyond the walls) stay unknown under both rules.
+    assert np.array_equal(band[~touched], seen[~touched])
+    assert np.all(seen[~touched] == UNKNOWN)
+    # Cells of one kind of evidence only are classified the same under both rules.
+    clear = touched & (band != UNKNOWN)
+    assert np.array_equal(band[clear], seen[clear])
