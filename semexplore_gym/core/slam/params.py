@@ -89,10 +89,11 @@ class SlamParams:
         known_when_seen: Gmapping's map rule for the map SLAM renders: every cell a beam
             touched is known, OCCUPIED when its log-odds is above 0 (a hit share above about a
             third of the beams that touched it), FREE below; only cells no beam touched (and
-            the rare cell whose hits and misses cancel out) stay UNKNOWN. Off: the mapping's thresholds (``mapping.free_threshold``,
-            ``mapping.occupied_threshold``) as in the perfect map, which leave a cell of
-            conflicting evidence UNKNOWN: a wall seen from two poses a cell apart then leaves
-            unknown cells beside free ones, frontiers no scan can clear.
+            the rare cell whose hits and misses cancel out) stay UNKNOWN. Off: the mapping's
+            thresholds (``mapping.free_threshold``, ``mapping.occupied_threshold``) as in the
+            perfect map, which leave a cell of conflicting evidence UNKNOWN: a wall seen from
+            two poses a cell apart then leaves unknown cells beside free ones, frontiers no
+            scan can clear.
     """
 
     enabled: bool = False
