@@ -53,9 +53,11 @@ from semexplore_gym.core.slam.pose_graph import Edge, optimise
 
 Pose = tuple[float, float, float]
 
-#: The thresholds of ``SlamParams.known_when_seen``: a log-odds this close to 0 (in float32; a
-#: cell no beam touched is exactly 0) is UNKNOWN, any other is FREE or OCCUPIED by its sign.
-_SEEN_LOG_ODDS = 1e-6
+#: The thresholds of ``SlamParams.known_when_seen``: a log-odds this close to 0 is UNKNOWN, any
+#: other is FREE or OCCUPIED by its sign. A cell no beam touched is exactly 0; a touched one is a
+#: sum of the two increments (multiples of 0.05 with the defaults), so one within this of 0 is a
+#: cell whose hits and misses cancel, up to float32 rounding.
+_SEEN_LOG_ODDS = 1e-4
 
 
 def _worst_sd_m(match: MatchResult) -> float:
