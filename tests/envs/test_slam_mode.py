@@ -14,6 +14,7 @@ import pytest
 import semexplore_gym  # noqa: F401  (registers the env ids)
 from semexplore_gym.cli import main
 from semexplore_gym.config.builder import ConfigError
+from semexplore_gym.core.grid import UNKNOWN
 from semexplore_gym.core.slam.pose_graph import GTSAM_HINT
 from semexplore_gym.envs.slam_mode import SLAM_INFO_KEYS
 
@@ -66,7 +67,7 @@ def test_known_when_seen_from_the_command_line_leaves_no_seen_cell_unknown(capsy
         _drive(env, 150, seed=2)
         grid = env.unwrapped.slam.grid
         counts[value] = int(
-            np.count_nonzero((np.abs(grid.log_odds) > 1e-4) & (grid.encoded == 128))
+            np.count_nonzero((np.abs(grid.log_odds) > 1e-4) & (grid.encoded == UNKNOWN))
         )
     assert counts["false"] > 0 and counts["true"] == 0
     code = main(

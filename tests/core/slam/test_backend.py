@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.grid import OCCUPIED, UNKNOWN, GridGeometry
 from semexplore_gym.core.mapping.occupancy_grid import MappingParams
 from semexplore_gym.core.mapping.odometry import OdometryDrift, OdometryNoiseParams
 from semexplore_gym.core.mapping.raycast import SegmentIndex, cast_scan
@@ -266,8 +266,6 @@ def _conflicting_map(params: SlamParams) -> tuple[np.ndarray, np.ndarray, tuple[
 
 
 def test_known_when_seen_leaves_no_touched_cell_unknown() -> None:
-    from semexplore_gym.core.grid import OCCUPIED, UNKNOWN
-
     band, band_lo, cell = _conflicting_map(SlamParams(enabled=True))
     seen, seen_lo, _ = _conflicting_map(SlamParams(enabled=True, known_when_seen=True))
     np.testing.assert_array_equal(band_lo, seen_lo)  # the same evidence, another rule
