@@ -35,7 +35,9 @@ def team_lower_bound_s(env: Any, key: tuple[str, int]) -> float | None:
             if any(k[0] != key[0] for k in _ONE_ROBOT):
                 _ONE_ROBOT.clear()  # one world at a time: tasks come world-major
             one = lower_bound(truth, params).distance_m
-            far = lower_bound(truth, replace(params, max_groups=1)).distance_m
+            # one forced region only (the branch bound is a whole walk, not one robot's share)
+            far_params = replace(params, max_groups=1, branch_block_m=0.0)
+            far = lower_bound(truth, far_params).distance_m
             _ONE_ROBOT[key] = (one, far)
         one, far = _ONE_ROBOT[key]
         allowed, _ = allowed_cells(truth, params.penetration_tolerance_m)

@@ -23,6 +23,8 @@ def test_oracle_json_prints_the_documented_keys(capsys):
     assert 0 < out["lower_bound_m"] <= out["tour_length_m"]
     assert out["lower_bound_s"] == pytest.approx(out["lower_bound_m"] / 0.22, rel=1e-3)
     assert out["lower_bound_groups"] >= 1 and out["bound_planning_s"] >= 0
+    # the bound is the larger of the route's and the branches'
+    assert 0 < out["lower_bound_branch_m"] <= out["lower_bound_m"]
 
 
 def test_no_bound_leaves_the_bound_keys_null(capsys):

@@ -36,7 +36,8 @@ optimum, so the result is below the path length of every explorer with this robo
    The bound is the least such route over every feasible S, every order and every choice of
    entry pieces (Held-Karp over subsets and last piece, exact), for any choice of groups.
 
-Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
+5. **Or the branch bound** (:mod:`.branch_bound`, on the same distances and visibility), the
+   larger of the two. Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
 LiDAR fused at the true pose (the env's default: no range noise, no odometry drift).
 """
 
@@ -44,11 +45,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
 
+from semexplore_gym.core.coverage_tour.bound_geometry import mask_groups, merge_walls
+from semexplore_gym.core.coverage_tour.branch_bound import BranchInputs, branch_bound_m
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
     held_karp_entries,
@@ -86,6 +89,9 @@ class LowerBoundParams:
             cell's view of each quarter (0: one wall for the whole group).
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
+        branch_block_m: Side of the branch bound's groups (0: no branch bound).
+        branch_max_walls: A branch group with more walls than this within reach is taken as
+            seen from every cell within reach, untested (rasterised maps: far quicker, looser).
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
     """
 
@@ -102,6 +108,8 @@ class LowerBoundParams:
     max_entries: int = 3
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
+    branch_block_m: float = 0.4
+    branch_max_walls: int = 400
     coverage_share: float | None = None
 
     def __post_init__(self) -> None:
@@ -113,6 +121,7 @@ class LowerBoundParams:
             ("sample_stride", 1, 16),
             ("visibility_splits", 0, 8),
             ("max_entries", 1, 16),
+            ("branch_max_walls", 0, 1_000_000),
         ):
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
@@ -125,6 +134,8 @@ class LowerBoundParams:
             v = getattr(self, name)
             if not (math.isfinite(v) and 0 <= v <= 0.5):
                 raise ValueError(f"{name} must be in [0, 0.5] m, got {v!r}")
+        if not (math.isfinite(self.branch_block_m) and 0 <= self.branch_block_m <= 10):
+            raise ValueError(f"branch_block_m must be in [0, 10] m, got {self.branch_block_m!r}")
         if not (math.isfinite(self.entry_tile_m) and 0.1 <= self.entry_tile_m <= 100):
             raise ValueError(f"entry_tile_m must be in [0.1, 100] m, got {self.entry_tile_m!r}")
         for name in ("keep_share", "leg_limit_share"):
@@ -141,7 +152,8 @@ class LowerBound:
     """A certified lower bound on the drive to the coverage goal, with what it is made of.
 
     Attributes:
-        distance_m: No explorer reaches the goal after a shorter drive (inf: none can).
+        distance_m: No explorer reaches the goal after a shorter drive (inf: none can): the
+            larger of the route's bound and ``branch_m``.
         time_s: ``distance_m`` at top speed.
         n_groups: Groups in the route's problem.
         group_cells: Coverage-mask cells of each group.
@@ -151,6 +163,7 @@ class LowerBound:
         budget_cells: Mask cells the goal lets an explorer leave unseen.
         block_cells: Side of the lattice blocks (map cells) of the groups.
         planning_s: Wall time spent.
+        branch_m: The branch bound (0 when not computed).
     """
 
     distance_m: float
@@ -163,6 +176,7 @@ class LowerBound:
     budget_cells: int
     block_cells: int
     planning_s: float
+    branch_m: float = 0.0
 
 
 def skip_budget_cells(n_cells: int, share: float) -> int:
@@ -204,68 +218,6 @@ def allowed_cells(facts: PrivilegedWorld, tolerance_m: float) -> tuple[np.ndarra
             "larger than the grid holds (or not closed by walls)"
         )
     return allowed, (row, col)
-
-
-def merge_walls(segments_m: np.ndarray, tol_m: float = 1e-9) -> np.ndarray:
-    """Collinear walls that touch or overlap, merged into maximal segments ``(M, 4)``."""
-    seg = np.asarray(segments_m, dtype=np.float64).reshape(-1, 4)
-    d = seg[:, 2:] - seg[:, :2]
-    length = np.hypot(d[:, 0], d[:, 1])
-    keep = length > 0
-    seg, d, length = seg[keep], d[keep], length[keep]
-    u = d / length[:, None]
-    flip = (u[:, 0] < -1e-12) | ((np.abs(u[:, 0]) <= 1e-12) & (u[:, 1] < 0))
-    u[flip] *= -1.0
-    offset = seg[:, 0] * -u[:, 1] + seg[:, 1] * u[:, 0]
-    key = np.round(np.column_stack([u[:, 0], u[:, 1], offset]) * 1e9).astype(np.int64)
-    out: list[np.ndarray] = []
-    _, inverse = np.unique(key, axis=0, return_inverse=True)
-    for g in np.unique(inverse):
-        idx = np.flatnonzero(inverse == g)
-        ug = u[idx[0]]
-        base = seg[idx[0], :2]
-        s0 = (seg[idx, :2] - base) @ ug
-        s1 = (seg[idx, 2:] - base) @ ug
-        lo, hi = np.minimum(s0, s1), np.maximum(s0, s1)
-        order = np.argsort(lo)
-        cur_lo, cur_hi = lo[order[0]], hi[order[0]]
-        for i in order[1:]:
-            if lo[i] <= cur_hi + tol_m:
-                cur_hi = max(cur_hi, hi[i])
-            else:
-                out.append(np.concatenate([base + cur_lo * ug, base + cur_hi * ug]))
-                cur_lo, cur_hi = lo[i], hi[i]
-        out.append(np.concatenate([base + cur_lo * ug, base + cur_hi * ug]))
-    return np.array(out, dtype=np.float64).reshape(-1, 4)
-
-
-def mask_groups(
-    mask: np.ndarray, geometry: GridGeometry, block_cells: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The mask cells of each ``block_cells`` lattice block: ``(rects, cells, centres)``:
-    the bounding rectangle ``x0, y0, x1, y1`` of each non-empty group, its cell count and the
-    centre of its block."""
-    b = max(1, int(block_cells))
-    rows, cols = np.nonzero(mask)
-    block = (rows // b) * (-(-mask.shape[1] // b)) + cols // b
-    ids, inverse, cells = np.unique(block, return_inverse=True, return_counts=True)
-    n = ids.size
-    rmin = np.full(n, np.iinfo(np.int64).max)
-    rmax = np.full(n, -1)
-    cmin = np.full(n, np.iinfo(np.int64).max)
-    cmax = np.full(n, -1)
-    np.minimum.at(rmin, inverse, rows)
-    np.maximum.at(rmax, inverse, rows)
-    np.minimum.at(cmin, inverse, cols)
-    np.maximum.at(cmax, inverse, cols)
-    h, x0, y0 = geometry.resolution_m, geometry.origin_x_m, geometry.origin_y_m
-    rects = np.column_stack(
-        [x0 + cmin * h, y0 + rmin * h, x0 + (cmax + 1) * h, y0 + (rmax + 1) * h]
-    )
-    nb = -(-mask.shape[1] // b)
-    br, bc = ids // nb, ids % nb
-    centres = np.column_stack([x0 + (bc + 0.5) * b * h, y0 + (br + 0.5) * b * h])
-    return rects.astype(np.float64), cells.astype(np.int64), centres
 
 
 @dataclass(frozen=True)
@@ -369,17 +321,17 @@ class _Problem:
 
 
 def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
-    """The moves between ``factor`` x ``factor`` blocks of ``allowed`` (uint8 bit masks, see
+    """The moves between ``factor`` x ``factor`` blocks of ``allowed`` (uint16 bit masks, see
     :func:`~.lower_bound_kernels.khop_distances`): block A passes to its neighbour B when an
     allowed cell of A is 8-adjacent to one of B (bit 4: A holds an allowed cell). A path's
     blocks thus step along moves, and blocks never join across a wall the cells do not."""
     f = int(factor)
     h, w = allowed.shape
     hc, wc = -(-h // f), -(-w // f)
-    out = np.zeros(hc * wc, dtype=np.uint8)
+    out = np.zeros(hc * wc, dtype=np.uint16)  # 9 bits: the move by (+1, +1) is bit 8
     rows, cols = np.nonzero(allowed)
     own = (rows // f) * wc + cols // f
-    np.bitwise_or.at(out, own, np.uint8(1 << 4))
+    np.bitwise_or.at(out, own, np.uint16(1 << 4))
     for dr in (-1, 0, 1):
         for dc in (-1, 0, 1):
             r2, c2 = rows + dr, cols + dc
@@ -388,8 +340,8 @@ def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
             br, bc = rows[ok] // f, cols[ok] // f
             sr, sc = r2[ok] // f - br, c2[ok] // f - bc
             step = (sr != 0) | (sc != 0)
-            bit = (3 * (sr[step] + 1) + sc[step] + 1).astype(np.uint8)
-            np.bitwise_or.at(out, br[step] * wc + bc[step], np.left_shift(np.uint8(1), bit))
+            bit = (3 * (sr[step] + 1) + sc[step] + 1).astype(np.uint16)
+            np.bitwise_or.at(out, br[step] * wc + bc[step], np.left_shift(np.uint16(1), bit))
     return out.reshape(hc, wc)
 
 
@@ -433,9 +385,21 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         if best is None or found.length_m > best.length_m:
             best = found
     assert best is not None
+    branch_m = 0.0
+    if p.branch_block_m > 0:
+        rects, cells, _ = mask_groups(mask, geo, max(1, round(p.branch_block_m / geo.resolution_m)))
+        frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
+        frame = np.append(frame, [prob.widen_m, _VISIBILITY_TOL_M, p.visibility_splits])
+        frame = np.append(frame, p.branch_max_walls)
+        fine = replace(prob, coarse=coarse_moves(allowed, 1), factor=1)
+        phi = fine.distances(np.array([sr * geo.width + sc]))
+        branch_m = branch_bound_m(
+            BranchInputs(allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget)
+        )
+    length_m = max(best.length_m, branch_m)
     return LowerBound(
-        distance_m=best.length_m,
-        time_s=best.length_m / facts.max_linear_speed_mps,
+        distance_m=length_m,
+        time_s=length_m / facts.max_linear_speed_mps,
         n_groups=len(best.cells),
         group_cells=best.cells,
         group_centres_m=best.centres_m,
@@ -444,6 +408,7 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         budget_cells=budget,
         block_cells=best.block_cells,
         planning_s=time.perf_counter() - t0,
+        branch_m=branch_m,
     )
 
 

@@ -210,7 +210,7 @@ def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma
 
 
 @njit(cache=True)
-def _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pragma: no cover
+def rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pragma: no cover
     """Whether every segment between ``rect`` and the square ``ux, uy`` (corners 0 and 2) no
     longer than ``reach_m`` meets a wall: one wall blocks all of them, the two are farther
     apart than ``reach_m``, or (up to ``depth`` times) each quarter of ``rect`` is blind in
@@ -265,10 +265,42 @@ def _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pr
 
 
 @njit(cache=True)
+def cells_within(rect, pad, gx0, gy0, res, h, w):  # pragma: no cover - numba
+    """Column and row ranges ``c_lo, c_hi, r_lo, r_hi`` of the ``res`` cells of an ``h`` x
+    ``w`` grid (origin ``gx0, gy0``) that may lie within ``pad`` of ``rect`` (one cell spare)."""
+    c_lo = max(0, int(math.floor((rect[0] - pad - gx0) / res)) - 1)
+    c_hi = min(w - 1, int(math.floor((rect[2] + pad - gx0) / res)) + 1)
+    r_lo = max(0, int(math.floor((rect[1] - pad - gy0) / res)) - 1)
+    r_hi = min(h - 1, int(math.floor((rect[3] + pad - gy0) / res)) + 1)
+    return c_lo, c_hi, r_lo, r_hi
+
+
+@njit(cache=True)
+def walls_near(walls, rect, pad):  # pragma: no cover - numba
+    """Indices of the walls whose bounding box meets ``rect`` grown by ``pad``, and their
+    count: ``(near, m)``, the first ``m`` entries of ``near``."""
+    near = np.empty(walls.shape[0], dtype=np.int64)
+    m = 0
+    bx0 = rect[0] - pad
+    bx1 = rect[2] + pad
+    by0 = rect[1] - pad
+    by1 = rect[3] + pad
+    for q in range(walls.shape[0]):
+        wx0 = min(walls[q, 0], walls[q, 2])
+        wx1 = max(walls[q, 0], walls[q, 2])
+        wy0 = min(walls[q, 1], walls[q, 3])
+        wy1 = max(walls[q, 1], walls[q, 3])
+        if wx1 >= bx0 and wx0 <= bx1 and wy1 >= by0 and wy0 <= by1:
+            near[m] = q
+            m += 1
+    return near, m
+
+
+@njit(cache=True)
 def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
-    rectangle and the walls do not meet every segment between the two (:func:`_blind`, quarters
+    rectangle and the walls do not meet every segment between the two (:func:`rect_blind`, quarters
     down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
     stride``; a ``stride`` above 1 tests only every stride-th row and column (a sample, for
     ranking groups, never for the bound)."""
@@ -281,24 +313,8 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     depth = int(frame[6])
     stride = int(frame[7])
     h, w = allowed.shape
-    c_lo = max(0, int(math.floor((rect[0] - reach_m - widen_m - gx0) / res)) - 1)
-    c_hi = min(w - 1, int(math.floor((rect[2] + reach_m + widen_m - gx0) / res)) + 1)
-    r_lo = max(0, int(math.floor((rect[1] - reach_m - widen_m - gy0) / res)) - 1)
-    r_hi = min(h - 1, int(math.floor((rect[3] + reach_m + widen_m - gy0) / res)) + 1)
-    near = np.empty(walls.shape[0], dtype=np.int64)
-    m = 0
-    bx0 = rect[0] - reach_m - widen_m
-    bx1 = rect[2] + reach_m + widen_m
-    by0 = rect[1] - reach_m - widen_m
-    by1 = rect[3] + reach_m + widen_m
-    for q in range(walls.shape[0]):
-        wx0 = min(walls[q, 0], walls[q, 2])
-        wx1 = max(walls[q, 0], walls[q, 2])
-        wy0 = min(walls[q, 1], walls[q, 3])
-        wy1 = max(walls[q, 1], walls[q, 3])
-        if wx1 >= bx0 and wx0 <= bx1 and wy1 >= by0 and wy0 <= by1:
-            near[m] = q
-            m += 1
+    c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
+    near, m = walls_near(walls, rect, reach_m + widen_m)
     ux = np.empty(4)
     uy = np.empty(4)
     work = np.empty((4, 4))
@@ -325,7 +341,7 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
             uy[1] = y0
             uy[2] = y1
             uy[3] = y1
-            blind, last = _blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work)
+            blind, last = rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work)
             if not blind:
                 out[count] = r * w + c
                 count += 1

@@ -365,3 +365,22 @@ def test_missions_never_reach_99_percent_sooner_or_shorter_than_the_bound(spec, 
         drive_m = float(np.hypot(steps[:, 0], steps[:, 1]).sum())
         assert drive_m >= bound.distance_m, (spec, policy, drive_m, bound.distance_m)
     assert reached >= 1
+
+
+@pytest.mark.parametrize("factor", [1, 2])
+def test_every_diagonal_move_is_kept_the_south_east_one_too(factor):
+    # Cells touching only at corners, in a chain going down and right: a path passes along it,
+    # so the K-hop search must reach its far end (the move by (+1, +1) is the mask's bit 8).
+    allowed = np.zeros((40, 40), dtype=bool)
+    for i in range(2, 38):
+        allowed[i, i] = True
+    moves = coarse_moves(allowed, factor)
+    rows, cols = np.nonzero(moves & (1 << 4))
+    for dr, dc in ((1, 1), (-1, -1)):
+        bit = 3 * (dr + 1) + dc + 1
+        inner = (rows + dr < moves.shape[0]) & (cols + dc < moves.shape[1])
+        joined = (moves[rows, cols] >> bit) & 1
+        assert joined[inner & (moves[rows + dr * inner, cols + dc * inner] & (1 << 4) > 0)].all()
+    start = (2 // factor) * moves.shape[1] + 2 // factor
+    d = _khop(moves, [start], 4, RES * factor)
+    assert np.isfinite(d[37 // factor, 37 // factor])

@@ -1,0 +1,340 @@
+"""Compiled parts of :mod:`.branch_bound`: the merge tree of the distance's superlevel sets and
+the level at which a set of cells first lies in one of its branches."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
+    cells_within,
+    rect_blind,
+    walls_near,
+)
+
+
+@njit(cache=True)
+def _find(parent, v):  # pragma: no cover - numba
+    root = v
+    while parent[root] != root:
+        root = parent[root]
+    while parent[v] != root:
+        nxt = parent[v]
+        parent[v] = root
+        v = nxt
+    return root
+
+
+@njit(cache=True)
+def merge_tree(moves, level):  # pragma: no cover - numba
+    """The merge tree of the superlevel sets ``{level >= t}`` over the cells of ``moves``.
+
+    ``moves``: the coarse grid's move bits (bit ``3 * (dr + 1) + dc + 1`` for a move by
+    ``(dr, dc)``, bit 4 for a cell that holds an allowed cell); ``level``: each cell's value
+    (flat; inf where unreachable, never part of the tree). Cells are added from the highest
+    value down; a cell joins the components of its neighbours already added. Leaves ``0..n-1``
+    are the cells in ``cells`` order; each join adds a node at the level of the cell that made
+    it. Returns ``(cells, node_of_cell, parent, node_level)``; a root's parent is itself.
+    """
+    hc, wc = moves.shape
+    flat_moves = moves.reshape(-1)
+    total = hc * wc
+    take = np.zeros(total, dtype=np.bool_)
+    n = 0
+    for i in range(total):
+        if (flat_moves[i] >> 4) & 1 and np.isfinite(level[i]):
+            take[i] = True
+            n += 1
+    cells = np.empty(n, dtype=np.int64)
+    k = 0
+    for i in range(total):
+        if take[i]:
+            cells[k] = i
+            k += 1
+    order = np.argsort(-level[cells], kind="mergesort")
+    node_of_cell = np.full(total, -1, dtype=np.int64)
+    for j in range(n):
+        node_of_cell[cells[j]] = j
+    size = max(1, 2 * n - 1)
+    parent = np.arange(size)
+    node_level = np.empty(size)
+    for j in range(n):
+        node_level[j] = level[cells[j]]
+    uf = np.arange(size)  # union-find over tree nodes: each set's representative is its top
+    added = np.zeros(total, dtype=np.bool_)
+    nxt = n
+    for oi in range(n):
+        j = order[oi]
+        v = cells[j]
+        lv = level[v]
+        added[v] = True
+        r, c = divmod(v, wc)
+        bits = flat_moves[v]
+        for dr in range(-1, 2):
+            for dc in range(-1, 2):
+                if dr == 0 and dc == 0:
+                    continue
+                if not (bits >> (3 * (dr + 1) + dc + 1)) & 1:
+                    continue
+                r2 = r + dr
+                c2 = c + dc
+                if r2 < 0 or r2 >= hc or c2 < 0 or c2 >= wc:
+                    continue
+                u = r2 * wc + c2
+                if not added[u]:
+                    continue
+                a = _find(uf, node_of_cell[u])
+                b = _find(uf, j)
+                if a == b:
+                    continue
+                parent[a] = nxt
+                parent[b] = nxt
+                node_level[nxt] = lv
+                uf[a] = nxt
+                uf[b] = nxt
+                nxt += 1
+    return cells, node_of_cell, parent[:nxt], node_level[:nxt]
+
+
+@njit(cache=True)
+def _depths(parent):  # pragma: no cover - numba
+    m = parent.size
+    depth = np.zeros(m, dtype=np.int64)
+    for v in range(m - 1, -1, -1):  # a parent's index is above its children's
+        if parent[v] != v:
+            depth[v] = depth[parent[v]] + 1
+    return depth
+
+
+@njit(cache=True)
+def set_levels(parent, node_level, region_nodes, region_start):  # pragma: no cover - numba
+    """For each set of leaves (``region_nodes[region_start[g]:region_start[g + 1]]``), the
+    lowest common ancestor of its leaves and that node's level: the highest ``t`` at which all of
+    them lie in one component of ``{level >= t}``; ``-1`` and ``-inf`` for an empty set or
+    leaves in different trees."""
+    m = parent.size
+    depth = _depths(parent)
+    levels = 1
+    while (1 << levels) < m + 1:
+        levels += 1
+    up = np.empty((levels, m), dtype=np.int64)
+    for v in range(m):
+        up[0, v] = parent[v]
+    for k in range(1, levels):
+        for v in range(m):
+            up[k, v] = up[k - 1, up[k - 1, v]]
+    n_sets = region_start.size - 1
+    lca = np.full(n_sets, -1, dtype=np.int64)
+    out = np.full(n_sets, -np.inf)
+    for g in range(n_sets):
+        a = -1
+        for i in range(region_start[g], region_start[g + 1]):
+            b = region_nodes[i]
+            if a < 0:
+                a = b
+                continue
+            x = a
+            y = b
+            if depth[x] < depth[y]:
+                x, y = y, x
+            diff = depth[x] - depth[y]
+            k = 0
+            while diff > 0:
+                if diff & 1:
+                    x = up[k, x]
+                diff >>= 1
+                k += 1
+            if x != y:
+                for k in range(levels - 1, -1, -1):
+                    if up[k, x] != up[k, y]:
+                        x = up[k, x]
+                        y = up[k, y]
+                x = parent[x]
+                y = parent[y]
+            if x != y:  # different trees
+                a = -2
+                break
+            a = x
+        if a >= 0:
+            lca[g] = a
+            out[g] = node_level[a]
+    return lca, out
+
+
+@njit(cache=True)
+def _segment_clear(walls, near, m, px, py, qx, qy, tol):  # pragma: no cover - numba
+    """Whether the segment ``p``-``q`` stays at least ``tol`` clear of every wall in
+    ``near[:m]`` (a segment a wall touches within ``tol`` counts as blocked)."""
+    dx = qx - px
+    dy = qy - py
+    for k in range(m):
+        q = near[k]
+        ax = walls[q, 0]
+        ay = walls[q, 1]
+        ex = walls[q, 2] - ax
+        ey = walls[q, 3] - ay
+        den = dx * ey - dy * ex
+        if abs(den) < 1e-15:
+            # parallel: blocked only if collinear and overlapping (count as blocked)
+            cross = (ax - px) * dy - (ay - py) * dx
+            if abs(cross) <= tol * math.sqrt(dx * dx + dy * dy) + 1e-12:
+                return False
+            continue
+        s = ((ax - px) * ey - (ay - py) * ex) / den
+        u = ((ax - px) * dy - (ay - py) * dx) / den
+        seg = math.sqrt(dx * dx + dy * dy)
+        wl = math.sqrt(ex * ex + ey * ey)
+        ms = tol / seg if seg > 0 else 1.0
+        mu = tol / wl if wl > 0 else 1.0
+        if s >= -ms and s <= 1.0 + ms and u >= -mu and u <= 1.0 + mu:
+            return False
+    return True
+
+
+@njit(cache=True)
+def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - numba
+    """Flat indices of the coarse cells (``factor`` x ``factor`` blocks of ``allowed``) not
+    certainly blind to ``rect`` (``x0, y0, x1, y1``): the bounding box of the block's allowed
+    map cells, widened by ``widen_m``, tested as :func:`.lower_bound_kernels.group_region`
+    tests one map cell's square (so a superset of the coarse cells of that region). A block
+    with one clear segment from its box's centre to ``rect`` within reach is in at once (then
+    no wall meets every segment). With more than ``max_walls`` walls near ``rect`` (a map
+    traced from a raster), every block within reach is in, untested (a superset; the tests
+    would cost walls x blocks). ``frame``: ``gx0, gy0, res (map), reach_m, widen_m, tol, depth,
+    max_walls``."""
+    gx0 = frame[0]
+    gy0 = frame[1]
+    res = frame[2]
+    reach_m = frame[3]
+    widen_m = frame[4]
+    tol = frame[5]
+    depth = int(frame[6])
+    max_walls = int(frame[7])
+    f = factor
+    hm, wm = allowed.shape
+    h = -(-hm // f)
+    w = -(-wm // f)
+    res = res * f
+    c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
+    near, m = walls_near(walls, rect, reach_m + widen_m)
+    ux = np.empty(4)
+    uy = np.empty(4)
+    work = np.empty((4, 4))
+    out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
+    count = 0
+    last = 0
+    cx_r = 0.5 * (rect[0] + rect[2])
+    cy_r = 0.5 * (rect[1] + rect[3])
+    for r in range(r_lo, r_hi + 1):
+        for c in range(c_lo, c_hi + 1):
+            r0 = r * f
+            c0 = c * f
+            lo_r = f
+            hi_r = -1
+            lo_c = f
+            hi_c = -1
+            for i in range(f):
+                for j in range(f):
+                    if r0 + i < hm and c0 + j < wm and allowed[r0 + i, c0 + j]:
+                        lo_r = min(lo_r, i)
+                        hi_r = max(hi_r, i)
+                        lo_c = min(lo_c, j)
+                        hi_c = max(hi_c, j)
+            if hi_r < 0:
+                continue
+            cell = res / f
+            y0 = gy0 + (r0 + lo_r) * cell - widen_m
+            y1 = gy0 + (r0 + hi_r + 1) * cell + widen_m
+            gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
+            x0 = gx0 + (c0 + lo_c) * cell - widen_m
+            x1 = gx0 + (c0 + hi_c + 1) * cell + widen_m
+            gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
+            if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
+                continue
+            px = 0.5 * (x0 + x1)
+            py = 0.5 * (y0 + y1)
+            # the rectangle's point nearest the centre, then its centre
+            qx = min(max(px, rect[0]), rect[2])
+            qy = min(max(py, rect[1]), rect[3])
+            seen = m > max_walls
+            for k in range(0 if seen else 2):
+                if k == 1:
+                    qx = cx_r
+                    qy = cy_r
+                if (qx - px) ** 2 + (qy - py) ** 2 <= reach_m * reach_m and _segment_clear(
+                    walls, near, m, px, py, qx, qy, tol
+                ):
+                    seen = True
+                    break
+            if not seen:
+                ux[0] = x0
+                ux[1] = x1
+                ux[2] = x1
+                ux[3] = x0
+                uy[0] = y0
+                uy[1] = y0
+                uy[2] = y1
+                uy[3] = y1
+                blind, last = rect_blind(
+                    walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work
+                )
+                seen = not blind
+            if seen:
+                out[count] = r * w + c
+                count += 1
+    return out[:count].copy()
+
+
+@njit(cache=True)
+def _merge_min_plus(f, g, out):  # pragma: no cover - numba
+    """``out[b] = min over b1 <= b of f[b1] + g[b - b1]`` (both non-increasing in ``b``)."""
+    n = f.size
+    for b in range(n):
+        best = np.inf
+        for b1 in range(b + 1):
+            v = f[b1] + g[b - b1]
+            if v < best:
+                best = v
+        out[b] = best
+
+
+@njit(cache=True)
+def branch_route(parent, edge_m, skip_weight, budget):  # pragma: no cover - numba
+    """The least ``2 * sum(edge_m[E]) - sum(edge_m[end path])`` over the node sets ``E`` a walk
+    from the root can enter (closed under parents, the root always in) whose skipped subtrees
+    (the nodes out of ``E`` whose parent is in it) weigh at most ``budget`` in all
+    (``skip_weight[w]``: the weight of ``w``'s subtree), the walk ending in one node of ``E``.
+
+    ``parent``: each node's parent, above its own index (the last node the root, its own
+    parent). Exact (a knapsack over the tree, min-plus merges of each child's table)."""
+    m = parent.size
+    nb = budget + 1
+    dp0 = np.zeros((m, nb))  # the walk ends outside this subtree
+    dp1 = np.full((m, nb), np.inf)  # it ends inside
+    x0 = np.zeros((m, nb))  # the children merged so far, all ending outside
+    x1 = np.full((m, nb), np.inf)  # ... one of them holding the end
+    t0 = np.empty(nb)
+    t1 = np.empty(nb)
+    t2 = np.empty(nb)
+    for w in range(m):
+        e = edge_m[w]
+        for b in range(nb):
+            enter0 = 2.0 * e + x0[w, b]
+            enter1 = e + min(x0[w, b], x1[w, b])
+            dp1[w, b] = enter1
+            dp0[w, b] = enter0
+            if parent[w] != w and b >= skip_weight[w]:
+                dp0[w, b] = 0.0
+        p = parent[w]
+        if p == w:
+            continue
+        _merge_min_plus(x0[p], dp0[w], t0)
+        _merge_min_plus(x1[p], dp0[w], t1)
+        _merge_min_plus(x0[p], dp1[w], t2)
+        for b in range(nb):
+            x0[p, b] = t0[b]
+            x1[p, b] = min(t1[b], t2[b])
+    root = m - 1
+    return min(dp0[root, budget], dp1[root, budget])

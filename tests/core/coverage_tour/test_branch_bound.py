@@ -1,0 +1,190 @@
+"""The branch bound (core/coverage_tour/branch_bound.py): its tree knapsack against brute force,
+its merge tree, its visibility superset, and the bound on hand-made worlds (never above a
+feasible drive; above the route bound where a world is a tree of many dead ends)."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+from semexplore_gym.core.coverage_tour.branch_kernels import (
+    branch_route,
+    coarse_region,
+    merge_tree,
+    set_levels,
+)
+from semexplore_gym.core.coverage_tour.lower_bound import (
+    _Problem,
+    allowed_cells,
+    coarse_moves,
+    mask_groups,
+    merge_walls,
+)
+from semexplore_gym.core.grid import GridGeometry
+from semexplore_gym.core.worlds.build import world_from_free_mask
+
+RES = 0.05
+RANGE_M = 1.0
+
+
+def _facts(privileged_world, rects, size_m, start):
+    """The privileged facts of a world whose free space is ``rects`` (a 1 m LiDAR)."""
+    h, w = int(round(size_m[1] / RES)), int(round(size_m[0] / RES))
+    free = np.zeros((h, w), dtype=bool)
+    for x0, y0, x1, y1 in rects:
+        rows = slice(int(round(y0 / RES)), int(round(y1 / RES)))
+        free[rows, int(round(x0 / RES)) : int(round(x1 / RES))] = True
+    world = world_from_free_mask("test", free, GridGeometry(RES, 0.0, 0.0, h, w), start_pose=start)
+    return privileged_world(world, start, 0.105, RANGE_M, RES)
+
+
+def _brute_force(parent, edge, weight, budget):
+    """The least drive over every parent-closed node set holding the root, by enumeration."""
+    m = parent.size
+    root = m - 1
+    best = np.inf
+    for bits in itertools.product((False, True), repeat=m - 1):
+        inside = np.array([*bits, True])
+        if any(inside[v] and not inside[parent[v]] for v in range(m)):
+            continue
+        skipped = sum(weight[v] for v in range(m) if not inside[v] and inside[parent[v]])
+        if skipped > budget:
+            continue
+        depth = np.zeros(m)
+        for v in range(m - 1, -1, -1):
+            depth[v] = edge[v] + (depth[parent[v]] if v != root else 0.0)
+        drive = 2 * edge[inside].sum() - max(depth[v] for v in range(m) if inside[v])
+        best = min(best, drive)
+    return best
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_tree_knapsack_equals_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(2, 9))
+    parent = np.array([int(rng.integers(v + 1, m)) for v in range(m - 1)] + [m - 1])
+    edge = np.append(rng.uniform(0.1, 3.0, m - 1), 0.0)
+    own = rng.integers(0, 6, m)
+    weight = own.copy()
+    for v in range(m - 1):  # a subtree's weight: its own and its children's
+        weight[parent[v]] += weight[v]
+    budget = int(rng.integers(0, 8))
+    got = branch_route(parent, edge, weight.astype(np.int64), budget)
+    assert got == pytest.approx(_brute_force(parent, edge, weight, budget))
+
+
+def _line_moves(n):
+    """Move bits of a 1 x n row of cells, each passing to its left and right neighbour."""
+    moves = np.full((1, n), 1 << 4, dtype=np.uint16)
+    moves[0, 1:] |= np.uint16(1 << 3)  # (0, -1)
+    moves[0, :-1] |= np.uint16(1 << 5)  # (0, +1)
+    return moves
+
+
+def test_the_merge_tree_joins_two_arms_at_the_level_of_their_meeting_cell():
+    # A row of 7 cells, the start in the middle: two arms whose levels rise away from it.
+    phi = np.array([3.0, 2.0, 1.0, 0.0, 1.5, 2.5, 3.5])
+    cells, node_of, parent, level = merge_tree(_line_moves(7), phi)
+    assert cells.size == 7 and int(np.sum(parent == np.arange(parent.size))) == 1
+    sets = [[0, 1], [0, 6], [5, 6], [2]]
+    flat = np.array([node_of[c] for s in sets for c in s], dtype=np.int64)
+    starts = np.cumsum([0] + [len(s) for s in sets]).astype(np.int64)
+    _, levels = set_levels(parent, level, flat, starts)
+    # The same arm: one branch until the lower cell's level; the two arms: only at the start.
+    assert levels.tolist() == [2.0, 0.0, 2.5, 1.0]
+
+
+def test_a_row_split_by_an_unreachable_cell_makes_two_trees():
+    phi = np.array([0.0, 1.0, np.inf, 1.0])
+    moves = _line_moves(4)
+    _, node_of, parent, level = merge_tree(moves, phi)
+    assert node_of[2] == -1 and int(np.sum(parent == np.arange(parent.size))) == 2
+    flat = np.array([node_of[0], node_of[3]], dtype=np.int64)
+    lca, levels = set_levels(parent, level, flat, np.array([0, 2], dtype=np.int64))
+    assert lca[0] == -1 and levels[0] == -np.inf
+
+
+@pytest.mark.parametrize("spec", ["maze:seed=1,size_m=5", "office:seed=2,size_m=10"])
+def test_a_distance_cells_region_holds_every_distance_cell_of_the_map_cell_region(spec):
+    """The branch bound tests distance cells, not map cells: it must keep every one that holds
+    a map cell of the route bound's (proven) region, so the same visibility proof carries."""
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    env = SemanticExploreEnv(spec, privileged=True, overrides=["episode.random_start=true"])
+    try:
+        facts = env.reset(seed=3)[1][PRIVILEGED_INFO_KEY]
+    finally:
+        env.close()
+    geo = facts.geometry
+    allowed, _ = allowed_cells(facts, 0.01)
+    prob = _Problem(
+        allowed=allowed,
+        coarse=coarse_moves(allowed, 2),
+        factor=2,
+        walls=merge_walls(facts.world.segments_m),
+        geometry=geo,
+        reach_m=facts.sensor.max_range_m + 1e-6,
+        widen_m=1e-6,
+        hop_cells=8,
+        split_depth=3,
+    )
+    frame = np.array(
+        [geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m, 1e-6, 1e-6, 3, 10**6]
+    )
+    rects, _, _ = mask_groups(facts.reachable_mask, geo, 8)
+    grew = 0
+    for g in range(0, rects.shape[0], 5):
+        proven = set(prob.region(rects[g]).tolist())
+        ours = set(coarse_region(allowed, 2, rects[g], prob.walls, frame).tolist())
+        assert proven <= ours
+        grew += len(ours - proven)
+        # Past the wall cap, every block within reach is in, untested: a superset again.
+        capped = frame.copy()
+        capped[7] = 0
+        assert ours <= set(coarse_region(allowed, 2, rects[g], prob.walls, capped).tolist())
+    # A distance cell's box is at most a map cell wider than its map cells: few extra cells.
+    assert grew <= 0.05 * sum(prob.region(rects[g]).size for g in range(0, rects.shape[0], 5))
+
+
+def _comb(privileged_world, n_teeth):
+    """A spine 0.6 m wide with ``n_teeth`` teeth 3 m deep every 2 m, the start at its left end;
+    and the drive that covers it: along the spine, into each tooth to the LiDAR's range of its
+    end and back, the last one not."""
+    teeth = [(2.0 * i, 0.0, 2.0 * i + 0.6, 3.6) for i in range(n_teeth)]
+    length = 2.0 * (n_teeth - 1) + 0.6
+    facts = _facts(
+        privileged_world, [(0.0, 0.0, length, 0.6), *teeth], (length, 3.6), (0.3, 0.3, 0.0)
+    )
+    depth = 3.3 - RANGE_M
+    return facts, length - 0.6 + 2 * depth * n_teeth - depth
+
+
+def test_on_a_comb_of_many_teeth_the_branch_bound_is_below_a_feasible_drive_and_above_the_route(
+    privileged_world,
+):
+    facts, feasible = _comb(privileged_world, 8)
+    b = lower_bound(facts)
+    route_only = lower_bound(facts, LowerBoundParams(branch_block_m=0.0))
+    assert route_only.branch_m == 0.0
+    assert b.branch_m <= feasible and b.distance_m <= feasible
+    assert b.branch_m > route_only.distance_m
+    assert b.distance_m == max(b.branch_m, route_only.distance_m)
+    # Every tooth is driven into and out of (the last not): about half the drive even with the
+    # K-hop metric's and the groups' slack; one tooth's worth of it is no longer enough.
+    assert b.branch_m >= 0.45 * feasible
+
+
+def test_on_a_ring_the_branch_bound_stays_below_driving_round_once(privileged_world):
+    rects = [(0.0, 0.0, 5.2, 0.6), (0.0, 4.6, 5.2, 5.2), (0.0, 0.0, 0.6, 5.2), (4.6, 0.0, 5.2, 5.2)]
+    facts = _facts(privileged_world, rects, (5.2, 5.2), (2.6, 0.3, 0.0))
+    b = lower_bound(facts)
+    assert 0.0 < b.branch_m <= 4 * 4.6 - 2 * RANGE_M
+
+
+def test_a_bad_branch_block_is_one_clear_error():
+    with pytest.raises(ValueError, match="branch_block_m"):
+        LowerBoundParams(branch_block_m=-0.1)
