@@ -322,3 +322,43 @@ def plan_context():
     """``plan_context(grid, geometry, params, pose, candidates=(), current=None)``: a
     :class:`PlanContext` for calling one plan source's ``propose`` by hand."""
     return _plan_context
+
+
+def _bound_problem(spec: str, seed: int, factor: int, hop_cells: int):
+    """``(facts, allowed, problem)``: the privileged facts of ``spec`` after a random-start
+    ``reset(seed=seed)``, the allowed map cells, and the lower bound's fixed parts on
+    ``factor``-cell distance cells with ``hop_cells`` hops (the env's LiDAR, no mount offset)."""
+    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+    from semexplore_gym.core.coverage_tour.lower_bound import (
+        _Problem,
+        allowed_cells,
+        coarse_moves,
+        merge_walls,
+    )
+    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
+
+    env = SemanticExploreEnv(spec, privileged=True, overrides=["episode.random_start=true"])
+    try:
+        facts = env.reset(seed=seed)[1][PRIVILEGED_INFO_KEY]
+    finally:
+        env.close()
+    allowed, _ = allowed_cells(facts, 0.01)
+    problem = _Problem(
+        allowed=allowed,
+        coarse=coarse_moves(allowed, factor),
+        factor=factor,
+        walls=merge_walls(facts.world.segments_m),
+        geometry=facts.geometry,
+        reach_m=facts.sensor.max_range_m + 1e-6,
+        widen_m=1e-6,
+        hop_cells=hop_cells,
+        split_depth=3,
+    )
+    return facts, allowed, problem
+
+
+@pytest.fixture
+def bound_problem():
+    """``bound_problem(spec, seed, factor, hop_cells)``: ``(facts, allowed, problem)`` of the
+    certified lower bound's proof steps on a world spelling (see :func:`_bound_problem`)."""
+    return _bound_problem

@@ -17,11 +17,7 @@ from semexplore_gym.core.coverage_tour.branch_kernels import (
     set_levels,
 )
 from semexplore_gym.core.coverage_tour.lower_bound import (
-    _Problem,
-    allowed_cells,
-    coarse_moves,
     mask_groups,
-    merge_walls,
 )
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.build import world_from_free_mask
@@ -108,30 +104,13 @@ def test_a_row_split_by_an_unreachable_cell_makes_two_trees():
 
 
 @pytest.mark.parametrize("spec", ["maze:seed=1,size_m=5", "office:seed=2,size_m=10"])
-def test_a_distance_cells_region_holds_every_distance_cell_of_the_map_cell_region(spec):
+def test_a_distance_cells_region_holds_every_distance_cell_of_the_map_cell_region(
+    spec, bound_problem
+):
     """The branch bound tests distance cells, not map cells: it must keep every one that holds
     a map cell of the route bound's (proven) region, so the same visibility proof carries."""
-    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
-    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
-
-    env = SemanticExploreEnv(spec, privileged=True, overrides=["episode.random_start=true"])
-    try:
-        facts = env.reset(seed=3)[1][PRIVILEGED_INFO_KEY]
-    finally:
-        env.close()
+    facts, allowed, prob = bound_problem(spec, 3, 2, 8)
     geo = facts.geometry
-    allowed, _ = allowed_cells(facts, 0.01)
-    prob = _Problem(
-        allowed=allowed,
-        coarse=coarse_moves(allowed, 2),
-        factor=2,
-        walls=merge_walls(facts.world.segments_m),
-        geometry=geo,
-        reach_m=facts.sensor.max_range_m + 1e-6,
-        widen_m=1e-6,
-        hop_cells=8,
-        split_depth=3,
-    )
     frame = np.array(
         [geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m, 1e-6, 1e-6, 3, 10**6]
     )

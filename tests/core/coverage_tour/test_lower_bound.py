@@ -256,29 +256,11 @@ def test_a_region_entered_at_the_start_has_the_start_as_its_one_entry():
         "forest:seed=4,size_m=6",
     ],
 )
-def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(spec):
-    from semexplore_gym.core.coverage_tour import PRIVILEGED_INFO_KEY
+def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(spec, bound_problem):
     from semexplore_gym.core.coverage_tour.viewpoints import visible_sets
-    from semexplore_gym.envs.semantic_explore import SemanticExploreEnv
 
-    env = SemanticExploreEnv(spec, privileged=True, overrides=["episode.random_start=true"])
-    try:
-        facts = env.reset(seed=4)[1][PRIVILEGED_INFO_KEY]
-    finally:
-        env.close()
+    facts, allowed, prob = bound_problem(spec, 4, 1, 4)
     geo = facts.geometry
-    allowed, _ = allowed_cells(facts, 0.01)
-    prob = _Problem(
-        allowed=allowed,
-        coarse=coarse_moves(allowed, 1),
-        factor=1,
-        walls=merge_walls(facts.world.segments_m),
-        geometry=geo,
-        reach_m=facts.sensor.max_range_m + 1e-6,
-        widen_m=1e-6,
-        hop_cells=4,
-        split_depth=3,
-    )
     block = 10
     rects, _, _ = mask_groups(facts.reachable_mask, geo, block)
     rows, cols = np.nonzero(facts.reachable_mask)
