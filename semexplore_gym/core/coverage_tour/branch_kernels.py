@@ -9,8 +9,8 @@ import numpy as np
 from numba import njit
 
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
+    box_blind,
     cells_within,
-    rect_blind,
     walls_near,
 )
 
@@ -219,9 +219,7 @@ def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - nu
     res = res * f
     c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
     near, m = walls_near(walls, rect, reach_m + widen_m)
-    ux = np.empty(4)
-    uy = np.empty(4)
-    work = np.empty((4, 4))
+    work = np.empty((6, 4))
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
     last = 0
@@ -269,17 +267,8 @@ def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - nu
                     seen = True
                     break
             if not seen:
-                ux[0] = x0
-                ux[1] = x1
-                ux[2] = x1
-                ux[3] = x0
-                uy[0] = y0
-                uy[1] = y0
-                uy[2] = y1
-                uy[3] = y1
-                blind, last = rect_blind(
-                    walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work
-                )
+                box = (x0, y0, x1, y1)
+                blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
                 seen = not blind
             if seen:
                 out[count] = r * w + c

@@ -265,6 +265,23 @@ def rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  
 
 
 @njit(cache=True)
+def box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work):  # pragma: no cover
+    """:func:`rect_blind` for the square ``box`` (``x0, y0, x1, y1``); ``work``: 6 x 4 scratch
+    (its last two rows take the box's corners). Returns ``(blind, last)``."""
+    ux = work[4]
+    uy = work[5]
+    ux[0] = box[0]
+    ux[1] = box[2]
+    ux[2] = box[2]
+    ux[3] = box[0]
+    uy[0] = box[1]
+    uy[1] = box[1]
+    uy[2] = box[3]
+    uy[3] = box[3]
+    return rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work[:4])
+
+
+@njit(cache=True)
 def cells_within(rect, pad, gx0, gy0, res, h, w):  # pragma: no cover - numba
     """Column and row ranges ``c_lo, c_hi, r_lo, r_hi`` of the ``res`` cells of an ``h`` x
     ``w`` grid (origin ``gx0, gy0``) that may lie within ``pad`` of ``rect`` (one cell spare)."""
@@ -315,9 +332,7 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     h, w = allowed.shape
     c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
     near, m = walls_near(walls, rect, reach_m + widen_m)
-    ux = np.empty(4)
-    uy = np.empty(4)
-    work = np.empty((4, 4))
+    work = np.empty((6, 4))
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
     last = 0
@@ -333,15 +348,8 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
             gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
             if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
                 continue
-            ux[0] = x0
-            ux[1] = x1
-            ux[2] = x1
-            ux[3] = x0
-            uy[0] = y0
-            uy[1] = y0
-            uy[2] = y1
-            uy[3] = y1
-            blind, last = rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work)
+            box = (x0, y0, x1, y1)
+            blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
             if not blind:
                 out[count] = r * w + c
                 count += 1
