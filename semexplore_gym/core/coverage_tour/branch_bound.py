@@ -1,24 +1,31 @@
 """The branch bound: every branch of the world that hides too much must be driven into and out.
 
 A second certified lower bound beside :func:`.lower_bound.lower_bound`'s route bound (the
-larger of the two is the bound). With ``phi`` the K-hop distance from the start (a metric never
-above a real path's length, so ``|phi(a) - phi(b)|`` never exceeds the drive between two
-cells), take for every level ``t > 0`` the branches at ``t``: the connected pieces of the cells
-with ``phi >= t`` (connected by the moves a path's cells make). They form a tree (the merge
-tree of ``phi``'s superlevel sets), and:
+larger of the two is the bound). With ``phi`` the K-hop distance from the start, take for every
+level ``t > 0`` the branches at ``t``: the connected pieces of the cells with ``phi >= t``
+(connected by the moves a path's cells make). They form a tree (the merge tree of ``phi``'s
+superlevel sets), and:
 
 1. **A branch hides the groups it holds.** A group of mask cells (a lattice block) can only be
    seen from its region (the visibility superset of :mod:`.lower_bound`, step 3, of each cell
    block's allowed map cells). If the region lies inside a branch that the explorer never
    enters, all of the group stays unseen.
-2. **Entering a branch at level t crosses level t; leaving it crosses it again.** A walk's
-   cells step along moves; a step into a branch comes from a cell with ``phi < t`` (a cell
-   with ``phi >= t`` next to it would belong to it). The walk starts outside every branch
-   (``phi`` = 0 at the start), so it crosses level ``t`` once into each branch it enters and
-   once out of each, but for the one it ends in. Since ``phi`` changes by at most the drive,
-   the drive is at least the integral over ``t`` of the crossings: twice the length (in
-   ``t``) of every branch entered, less the length of the chain the walk ends in.
-3. **The skip budget.** The branches never entered leave every group they hide unseen: their
+2. **How much phi can change along a drive.** ``phi(x) <= `` the drive from the start to x
+   (the drive's own checkpoints are a chain of hops). Between two points x, y of a drive,
+   ``phi(y) <= phi(x) + drive(x, y) + e`` with ``e = sqrt(2) h``: continue x's best chain along
+   the drive; x's last hop was measured to the near side of x's cell, the drive leaves from a
+   point of it up to a cell's diagonal farther (one splice).
+3. **Entering a branch crosses its level; leaving crosses it again.** Let the walk enter the
+   branches ``E`` (closed under parents) and take, for each leaf of ``E`` in order of first
+   entry, the point of entry, and between two consecutive ones the lowest point of ``phi``. At
+   every level ``t`` this sequence starts below ``t``, visits every branch of ``E`` at ``t`` and
+   drops below ``t`` between two of them (a walk between two pieces of ``{phi >= t}`` passes
+   below ``t``), so its variation is at least the integral over ``t`` of the crossings: twice
+   the length (in ``t``) of every branch of ``E``, less the chain the walk ends in. By step 2
+   the drive is at least that variation less ``2 e`` for each leaf of ``E`` but the first (the
+   first rise, from the start, is exact). Any ancestor-closed part of ``E`` gives the same
+   argument, so ``E`` is pruned of branches that hide nothing or are less than ``e`` deep.
+4. **The skip budget.** The branches never entered leave every group they hide unseen: their
    cells, and the cells no pose sees at all, may hold at most the goal's skip budget. The bound
    is the least such drive over every set of entered branches that keeps to the budget (a
    knapsack over the tree, exact, with cell counts rounded down to ``budget / units``: a
@@ -31,6 +38,7 @@ seen from its mouth (rooms behind doors).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -124,23 +132,38 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128) -> float:
     hidden = own.copy()
     for v in range(m - 1):  # children before parents: a parent's index is above its children's
         hidden[parent[v]] += hidden[v]
-    return _knapsack(parent, level, own, hidden, budget, units)
+    # phi's last hop measures from a cell's near side: between two points of a drive it may
+    # differ by the drive plus a cell's diagonal, once per splice (docs/oracle.md, step 5)
+    splice_m = math.sqrt(2.0) * float(frame[2])
+    return _knapsack(parent, level, (own, hidden), budget, units, 2.0 * splice_m)
 
 
 def _knapsack(
     parent: np.ndarray,
     level: np.ndarray,
-    own: np.ndarray,
-    hidden: np.ndarray,
+    cells: tuple[np.ndarray, np.ndarray],
     budget: int,
     units: int,
+    leaf_m: float,
 ) -> float:
-    """The tree knapsack of step 3 on the merge tree, its branches that hide nothing dropped
-    (never worth entering) and chains of one child merged (the same choices)."""
+    """The tree knapsack of step 3 on the merge tree, less ``leaf_m`` for each leaf of the
+    entered set but one. ``cells``: the mask cells each node hides itself and in its subtree.
+
+    The bound only needs a drive's entered set pruned to an ancestor-closed part of it: the
+    branches that hide nothing are left out (never worth entering), and so are those less than
+    ``leaf_m / 2`` deep (entering one would only lower the bound; their cells count as seen
+    from their parent); chains of one child that hide nothing themselves are merged (the same
+    choices)."""
+    own, hidden = (np.asarray(c, dtype=np.float64).copy() for c in cells)
     m = parent.size
     root = m - 1
     is_root = np.arange(m) == root
-    kept = (hidden > 0) | is_root
+    top = level.astype(np.float64).copy()
+    for v in range(m - 1):  # children before parents: a parent's index is above its children's
+        top[parent[v]] = max(top[parent[v]], top[v])
+    thin = ~is_root & (top - level[parent] < 0.5 * leaf_m)
+    np.add.at(own, parent[thin & ~thin[parent]], hidden[thin & ~thin[parent]])
+    kept = ((hidden > 0) & ~thin) | is_root
     children = np.bincount(parent[kept & ~is_root], minlength=m)
     chain = kept & ~is_root & (children == 1) & (own == 0)
     survive = kept & ~chain
@@ -155,4 +178,5 @@ def _knapsack(
     edge = np.where(is_root[idx], 0.0, np.maximum(level[idx] - level[above[idx]], 0.0))
     unit = max(1, -(-budget // max(1, int(units))))
     weight = np.floor(hidden[idx] / unit).astype(np.int64)
-    return float(branch_route(new_parent.astype(np.int64), edge, weight, budget // unit))
+    route = branch_route(new_parent.astype(np.int64), edge, weight, budget // unit, leaf_m)
+    return max(0.0, float(route))

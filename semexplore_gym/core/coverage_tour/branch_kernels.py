@@ -290,40 +290,48 @@ def _merge_min_plus(f, g, out):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def branch_route(parent, edge_m, skip_weight, budget):  # pragma: no cover - numba
-    """The least ``2 * sum(edge_m[E]) - sum(edge_m[end path])`` over the node sets ``E`` a walk
-    from the root can enter (closed under parents, the root always in) whose skipped subtrees
-    (the nodes out of ``E`` whose parent is in it) weigh at most ``budget`` in all
-    (``skip_weight[w]``: the weight of ``w``'s subtree), the walk ending in one node of ``E``.
+def branch_route(parent, edge_m, skip_weight, budget, leaf_m=0.0):  # pragma: no cover - numba
+    """The least ``2 * sum(edge_m[E]) - sum(edge_m[end path]) - leaf_m * (leaves(E) - 1)`` over
+    the node sets ``E`` a walk from the root can enter (closed under parents, the root always
+    in) whose skipped subtrees (the nodes out of ``E`` whose parent is in it) weigh at most
+    ``budget`` in all (``skip_weight[w]``: the weight of ``w``'s subtree), the walk ending in
+    one node of ``E``; ``leaves(E)``: the nodes of ``E`` but the root with no child in ``E``
+    (0 when ``E`` is the root alone: no allowance then).
 
     ``parent``: each node's parent, above its own index (the last node the root, its own
     parent). Exact (a knapsack over the tree, min-plus merges of each child's table)."""
     m = parent.size
     nb = budget + 1
-    dp0 = np.zeros((m, nb))  # the walk ends outside this subtree
-    dp1 = np.full((m, nb), np.inf)  # it ends inside
-    x0 = np.zeros((m, nb))  # the children merged so far, all ending outside
+    skip = np.full((m, nb), np.inf)  # this subtree skipped
+    dp0 = np.full((m, nb), np.inf)  # entered, the walk ends outside it
+    dp1 = np.full((m, nb), np.inf)  # entered, the walk ends inside it
+    a0 = np.zeros((m, nb))  # the children merged so far, all skipped
+    x0 = np.full((m, nb), np.inf)  # ... one entered at least, all ending outside
     x1 = np.full((m, nb), np.inf)  # ... one of them holding the end
-    t0 = np.empty(nb)
-    t1 = np.empty(nb)
-    t2 = np.empty(nb)
+    t = np.empty((5, nb))
     for w in range(m):
         e = edge_m[w]
         for b in range(nb):
-            enter0 = 2.0 * e + x0[w, b]
-            enter1 = e + min(x0[w, b], x1[w, b])
-            dp1[w, b] = enter1
-            dp0[w, b] = enter0
-            if parent[w] != w and b >= skip_weight[w]:
-                dp0[w, b] = 0.0
+            if a0[w, b] < np.inf:  # every child skipped: a leaf of E
+                leaf = a0[w, b] - leaf_m
+            else:
+                leaf = np.inf
+            dp0[w, b] = 2.0 * e + min(x0[w, b], leaf)
+            dp1[w, b] = e + min(x0[w, b], x1[w, b], leaf)
+            if b >= skip_weight[w]:
+                skip[w, b] = 0.0
         p = parent[w]
         if p == w:
             continue
-        _merge_min_plus(x0[p], dp0[w], t0)
-        _merge_min_plus(x1[p], dp0[w], t1)
-        _merge_min_plus(x0[p], dp1[w], t2)
+        _merge_min_plus(a0[p], skip[w], t[0])
+        _merge_min_plus(x0[p], np.minimum(skip[w], dp0[w]), t[1])
+        _merge_min_plus(a0[p], dp0[w], t[2])
+        _merge_min_plus(x1[p], np.minimum(skip[w], dp0[w]), t[3])
+        _merge_min_plus(np.minimum(a0[p], x0[p]), dp1[w], t[4])
         for b in range(nb):
-            x0[p, b] = t0[b]
-            x1[p, b] = min(t1[b], t2[b])
+            a0[p, b] = t[0, b]
+            x0[p, b] = min(t[1, b], t[2, b])
+            x1[p, b] = min(t[3, b], t[4, b])
     root = m - 1
-    return min(dp0[root, budget], dp1[root, budget])
+    # every set but the root alone has a leaf, whose allowance is given back (the first is free)
+    return min(a0[root, budget], min(x0[root, budget], x1[root, budget]) + leaf_m)

@@ -37,8 +37,9 @@ def _facts(privileged_world, rects, size_m, start):
     return privileged_world(world, start, 0.105, RANGE_M, RES)
 
 
-def _brute_force(parent, edge, weight, budget):
-    """The least drive over every parent-closed node set holding the root, by enumeration."""
+def _brute_force(parent, edge, weight, budget, leaf_m=0.0):
+    """The least drive over every parent-closed node set holding the root, by enumeration, less
+    ``leaf_m`` for each of its leaves but one."""
     m = parent.size
     root = m - 1
     best = np.inf
@@ -53,12 +54,16 @@ def _brute_force(parent, edge, weight, budget):
         for v in range(m - 1, -1, -1):
             depth[v] = edge[v] + (depth[parent[v]] if v != root else 0.0)
         drive = 2 * edge[inside].sum() - max(depth[v] for v in range(m) if inside[v])
-        best = min(best, drive)
+        has_child = np.zeros(m, dtype=bool)
+        has_child[parent[:-1][inside[:-1]]] = True
+        leaves = int(np.sum(inside[:-1] & ~has_child[:-1]))
+        best = min(best, drive - leaf_m * max(leaves - 1, 0))
     return best
 
 
+@pytest.mark.parametrize("leaf_m", [0.0, 0.7])
 @pytest.mark.parametrize("seed", range(12))
-def test_the_tree_knapsack_equals_brute_force(seed):
+def test_the_tree_knapsack_equals_brute_force(seed, leaf_m):
     rng = np.random.default_rng(seed)
     m = int(rng.integers(2, 9))
     parent = np.array([int(rng.integers(v + 1, m)) for v in range(m - 1)] + [m - 1])
@@ -68,8 +73,8 @@ def test_the_tree_knapsack_equals_brute_force(seed):
     for v in range(m - 1):  # a subtree's weight: its own and its children's
         weight[parent[v]] += weight[v]
     budget = int(rng.integers(0, 8))
-    got = branch_route(parent, edge, weight.astype(np.int64), budget)
-    assert got == pytest.approx(_brute_force(parent, edge, weight, budget))
+    got = branch_route(parent, edge, weight.astype(np.int64), budget, leaf_m)
+    assert got == pytest.approx(_brute_force(parent, edge, weight, budget, leaf_m))
 
 
 def _line_moves(n):
@@ -167,3 +172,22 @@ def test_on_a_ring_the_branch_bound_stays_below_driving_round_once(privileged_wo
 def test_a_bad_branch_block_is_one_clear_error():
     with pytest.raises(ValueError, match="branch_block_m"):
         LowerBoundParams(branch_block_m=-0.1)
+
+
+def test_phi_jumps_between_touching_cells_by_at_most_a_cells_diagonal(bound_problem):
+    """Step 2's splice: two cells that touch are a drive of length 0 apart, yet their K-hop
+    distances differ (each hop is measured to a cell's near side). The branch bound allows
+    sqrt(2) h per splice; more than that would break it, and none at all would be unsound."""
+    facts, allowed, prob = bound_problem("maze:seed=1,size_m=5", 3, 1, 8)
+    geo = facts.geometry
+    row, col = (int(v) for v in geo.world_to_grid(*facts.start_pose[:2]))
+    phi = prob.distances(np.array([row * geo.width + col])).reshape(allowed.shape)
+    h = geo.resolution_m
+    height, width = phi.shape
+    worst = 0.0
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):  # each touching pair once
+        a = phi[: height - dr, max(0, -dc) : width - max(0, dc)]
+        b = phi[dr:, max(0, dc) : width + min(0, dc)]
+        both = np.isfinite(a) & np.isfinite(b)
+        worst = max(worst, float(np.max(np.abs(a - b)[both])))
+    assert 0.5 * h < worst <= np.sqrt(2.0) * h + 1e-9, worst / h
