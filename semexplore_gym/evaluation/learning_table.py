@@ -279,10 +279,24 @@ def gap_closed(
     return (gain / gap if gap > 0 else None), n
 
 
+def _over_bound_cell(rows: list[dict[str, Any]], bound_s: dict[tuple[str, int], float]) -> str:
+    """Median of the missions' T99 over their start's bound (∞ short of 99 %), and how many."""
+    ratios = [
+        _value(r, "T99_s") / bound_s[(r["world"], int(r["seed"]))]
+        for r in rows
+        if (r["world"], int(r["seed"])) in bound_s
+    ]
+    if not ratios:
+        return "–"
+    med = float(np.median(ratios))
+    return f"{med:.2f} ({len(ratios)})" if math.isfinite(med) else f"∞ ({len(ratios)})"
+
+
 def paired_table_lines(
     rows: list[dict[str, Any]],
     reference: str = EXPERT,
     best_t99_s: dict[tuple[str, int], float] | None = None,
+    bound_s: dict[tuple[str, int], float] | None = None,
 ) -> list[str]:
     """Each policy's T99 against ``reference``'s on the same (world, seed), per family.
 
@@ -292,7 +306,9 @@ def paired_table_lines(
     where the policy was faster, the missions it ended itself at coverage ≥
     :data:`SELF_STOP_COVERAGE`, and its collisions. With ``best_t99_s`` (the best-known T99 per
     (world, seed) of these missions' starts) a last column gives the share of the reference's gap
-    to the best known the policy closes (:func:`gap_closed`). ``rows`` need the columns
+    to the best known the policy closes (:func:`gap_closed`); with ``bound_s`` (the certified
+    lower bound per (world, seed), seconds) one more the median of its T99 over the bound of
+    each mission's start (never below 1; ∞ for a mission short of 99 %). ``rows`` need the columns
     ``world``, ``policy``, ``seed``, ``self_stopped``, ``coverage``, ``T99_s`` and
     ``collisions``.
     """
@@ -300,6 +316,8 @@ def paired_table_lines(
 
     best = best_t99_s or {}
     gap_col = bool(best) and any((r["world"], int(r["seed"])) in best for r in rows)
+    bound = bound_s or {}
+    bound_col = bool(bound) and any((r["world"], int(r["seed"])) in bound for r in rows)
     lines = [
         f"Per family, each policy paired with `{reference}` by (world, seed). T99 ÷ "
         f"{reference} = median [IQR] over the pairs of the policy's T99 over {reference}'s "
@@ -314,11 +332,22 @@ def paired_table_lines(
             f"{reference}; n pairs)."
             if gap_col
             else ""
+        )
+        + (
+            " T99 ÷ bound = the median over the policy's missions of its T99 over the certified "
+            "lower bound of the mission's start (the best-known table's; ∞: short of 99 %; "
+            "n missions)."
+            if bound_col
+            else ""
         ),
         "",
         f"| family | policy | n | T99 (s) | T99 ÷ {reference} [IQR] | p W | faster | "
-        "self-stops | collisions |" + (" gap closed (n) |" if gap_col else ""),
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|" + ("---:|" if gap_col else ""),
+        "self-stops | collisions |"
+        + (" gap closed (n) |" if gap_col else "")
+        + (" T99 ÷ bound (n) |" if bound_col else ""),
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|"
+        + ("---:|" if gap_col else "")
+        + ("---:|" if bound_col else ""),
     ]
     for family, by_policy in group_by_family(rows).items():
         ref = {(r["world"], int(r["seed"])): r for r in by_policy.get(reference, [])}
@@ -335,6 +364,8 @@ def paired_table_lines(
             if gap_col:
                 share, n = gap_closed(rs, ref, best) if policy != reference else (None, 0)
                 cells.append("–" if share is None else f"{share:.2f} ({n})")
+            if bound_col:
+                cells.append(_over_bound_cell(rs, bound))
             lines.append(f"| {family} | {policy} | " + " | ".join(cells) + " |")
     lines.append("")
     return lines

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -360,23 +361,30 @@ def _paired_lines(source: Path, rows: list[dict[str, Any]], reference: str) -> l
             f"{source} has no {reference} missions to pair with (its policies: "
             f"{', '.join(policies)}; pick one with --reference)"
         )
-    return paired_table_lines(rows, reference, _best_known_t99(source))
+    best, bound = _best_known_columns(source)
+    return paired_table_lines(rows, reference, best, bound)
 
 
-def _best_known_t99(source: Path) -> dict[tuple[str, int], float]:
-    """The shipped best-known T99 per (world, seed) of ``source``'s start poses, as the run's
-    ``benchmark.json`` (beside the CSV) gives them; none without one, or when its env config is
-    not the default one (the table's missions ran on the default env)."""
+def _best_known_columns(
+    source: Path,
+) -> tuple[dict[tuple[str, int], float], dict[tuple[str, int], float]]:
+    """The shipped best-known T99 and certified lower bound (s) per (world, seed) of
+    ``source``'s start poses, as the run's ``benchmark.json`` (beside the CSV) gives them; none
+    without one, or when its env config is not the default one (the table's missions ran on the
+    default env)."""
     from semexplore_gym.evaluation.best_known import read_table, run_start
 
     start = run_start(source if source.is_dir() else source.parent)
     if start is None:
-        return {}
-    return {
-        (w, s): float(row["T99_s"])
-        for (w, s, st), row in read_table().items()
-        if st == start and row["T99_s"] is not None
+        return {}, {}
+    entries = {(w, s): row for (w, s, st), row in read_table().items() if st == start}
+    best = {k: float(r["T99_s"]) for k, r in entries.items() if r["T99_s"] is not None}
+    bound = {
+        k: float(r["lower_bound_s"])
+        for k, r in entries.items()
+        if r["lower_bound_s"] is not None and 0 < float(r["lower_bound_s"]) < math.inf
     }
+    return best, bound
 
 
 def markdown_tables(markdown: str) -> list[dict[str, Any]]:
