@@ -11,6 +11,7 @@ from numba import njit
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     box_blind,
     cells_within,
+    unpack_frame,
     walls_near,
 )
 
@@ -204,14 +205,7 @@ def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - nu
     traced from a raster), every block within reach is in, untested (a superset; the tests
     would cost walls x blocks). ``frame``: ``gx0, gy0, res (map), reach_m, widen_m, tol, depth,
     max_walls``."""
-    gx0 = frame[0]
-    gy0 = frame[1]
-    res = frame[2]
-    reach_m = frame[3]
-    widen_m = frame[4]
-    tol = frame[5]
-    depth = int(frame[6])
-    max_walls = int(frame[7])
+    gx0, gy0, res, reach_m, widen_m, tol, depth, max_walls = unpack_frame(frame)
     f = factor
     hm, wm = allowed.shape
     h = -(-hm // f)
@@ -323,10 +317,11 @@ def branch_route(parent, edge_m, skip_weight, budget, leaf_m=0.0):  # pragma: no
         p = parent[w]
         if p == w:
             continue
+        out0 = np.minimum(skip[w], dp0[w])  # the child skipped or entered, the end elsewhere
         _merge_min_plus(a0[p], skip[w], t[0])
-        _merge_min_plus(x0[p], np.minimum(skip[w], dp0[w]), t[1])
+        _merge_min_plus(x0[p], out0, t[1])
         _merge_min_plus(a0[p], dp0[w], t[2])
-        _merge_min_plus(x1[p], np.minimum(skip[w], dp0[w]), t[3])
+        _merge_min_plus(x1[p], out0, t[3])
         _merge_min_plus(np.minimum(a0[p], x0[p]), dp1[w], t[4])
         for b in range(nb):
             a0[p, b] = t[0, b]

@@ -164,6 +164,13 @@ def khop_distances(
 
 
 @njit(cache=True)
+def unpack_frame(frame):  # pragma: no cover - numba
+    """A visibility test's ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol`` (floats), then
+    the quartering depth and a last integer (the caller's: a stride, a wall cap)."""
+    return frame[0], frame[1], frame[2], frame[3], frame[4], frame[5], int(frame[6]), int(frame[7])
+
+
+@njit(cache=True)
 def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - numba
     """Whether ``wall`` meets every segment between the rectangles with corners ``(ax, ay)``
     and ``(ux, uy)``: its line separates them strictly and all 16 corner-pair segments cross
@@ -321,14 +328,7 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
     stride``; a ``stride`` above 1 tests only every stride-th row and column (a sample, for
     ranking groups, never for the bound)."""
-    gx0 = frame[0]
-    gy0 = frame[1]
-    res = frame[2]
-    reach_m = frame[3]
-    widen_m = frame[4]
-    tol = frame[5]
-    depth = int(frame[6])
-    stride = int(frame[7])
+    gx0, gy0, res, reach_m, widen_m, tol, depth, stride = unpack_frame(frame)
     h, w = allowed.shape
     c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
     near, m = walls_near(walls, rect, reach_m + widen_m)
