@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import time
 from typing import Any
 
@@ -170,19 +171,30 @@ def certified_bound(
     start_seed: int = 0,
     env_config: Any = None,
     env_overrides: list[str] | None = None,
+    threads: int | None = None,
 ) -> Any:
     """The certified :class:`~semexplore_gym.core.coverage_tour.LowerBound` of ``world`` from
-    the start of ``env.reset(seed=start_seed)``, with the env's LiDAR mount offset.
+    the start of ``env.reset(seed=start_seed)``, with the env's LiDAR mount offset, its
+    searches on ``threads`` threads (None: one per CPU this process may use).
 
     Raises:
         ValueError: as :func:`privileged_facts`, a noisy LiDAR or odometry, or a world where
             no bound can be computed.
     """
-    return _bound_of(*privileged_facts(world, start_seed, env_config, env_overrides))
+    facts, config = privileged_facts(world, start_seed, env_config, env_overrides)
+    return _bound_of(facts, config, threads)
 
 
-def _bound_of(facts: Any, config: Any) -> Any:
-    """The bound for the env's LiDAR, which it models noise-free and fused at the true pose."""
+def usable_cpus() -> int:
+    """The CPUs this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return max(1, os.cpu_count() or 1)
+
+
+def _bound_of(facts: Any, config: Any, threads: int | None = None) -> Any:
+    """The bound for the env's LiDAR, which it models noise-free and fused at the true pose;
+    its searches on ``threads`` threads (None: :func:`usable_cpus`)."""
     from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
 
     odo = config.odometry
@@ -193,7 +205,8 @@ def _bound_of(facts: Any, config: Any) -> Any:
             "no odometry noise); pass --no-bound"
         )
     mount_m = math.hypot(config.lidar.mount_x_m, config.lidar.mount_y_m)
-    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m))
+    n = usable_cpus() if threads is None else threads
+    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m, threads=n))
 
 
 def _finite_or_none(value: float, digits: int) -> float | None:

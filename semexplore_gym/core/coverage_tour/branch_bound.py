@@ -49,6 +49,7 @@ from semexplore_gym.core.coverage_tour.branch_kernels import (
     merge_tree,
     set_levels,
 )
+from semexplore_gym.core.coverage_tour.thread_map import thread_map
 
 
 @dataclass(frozen=True)
@@ -80,9 +81,10 @@ class BranchInputs:
     budget_cells: int
 
 
-def branch_bound_m(inputs: BranchInputs, units: int = 128) -> float:
+def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> float:
     """The branch bound (module docstring) in metres; ``units``: budget steps of the knapsack
-    (cell counts rounded down to ``budget / units``).
+    (cell counts rounded down to ``budget / units``); the groups' regions are found on up to
+    ``threads`` threads.
 
     Returns:
         The bound (inf when the cells no pose sees already exceed the budget; 0 when the
@@ -101,8 +103,12 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128) -> float:
     wide = -(-width // f)
     step = np.arange(f)
     regions = []
-    for g in range(group_rects.shape[0]):
-        blocks = coarse_region(allowed, f, group_rects[g], walls, frame)
+    found = thread_map(
+        lambda g: coarse_region(allowed, f, group_rects[g], walls, frame),
+        range(group_rects.shape[0]),
+        threads,
+    )
+    for blocks in found:
         br, bc = np.divmod(blocks, wide)
         rows = (br[:, None, None] * f + step[None, :, None]) + 0 * step[None, None, :]
         cols = (bc[:, None, None] * f + step[None, None, :]) + 0 * step[None, :, None]

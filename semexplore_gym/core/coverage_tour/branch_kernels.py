@@ -194,7 +194,7 @@ def _segment_clear(walls, near, m, px, py, qx, qy, tol):  # pragma: no cover - n
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the coarse cells (``factor`` x ``factor`` blocks of ``allowed``) not
     certainly blind to ``rect`` (``x0, y0, x1, y1``): the bounding box of the block's allowed

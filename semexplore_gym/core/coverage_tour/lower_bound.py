@@ -11,8 +11,11 @@ optimum, so the result is below the path length of every explorer with this robo
 2. **K-hop distances never exceed a real path.** Checkpoint a continuous path each time it first
    reaches Chebyshev distance K (cells) from the last checkpoint's cell: each piece stays in the
    previous checkpoint's ball, so a breadth-first search over allowed cells inside the ball
-   finds it, and the piece is at least as long as the distance between the two cells' squares.
-   The Dijkstra distance over such hops (the last hop may end inside a ball) is <= the length.
+   finds it. It reaches a checkpoint's cell from inside the last ball, so on the side of its
+   square facing that ball (a ring corner at its inner corner, on that side too), and the next
+   piece is at least the gap from that side to the next cell's square (the first: from anywhere
+   in the start's square). The Dijkstra distance over such hops, one state per (cell, side),
+   the last hop possibly ending inside a ball, is <= the length.
 3. **Where a group can be seen from (a superset).** A scan marks a cell FREE only along a beam
    from the sensor that reaches a point of the cell's square within the LiDAR's range and
    crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when
@@ -58,6 +61,7 @@ from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     khop_distances,
 )
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
+from semexplore_gym.core.coverage_tour.thread_map import thread_map
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.geometry import segment_distance_field
 
@@ -71,7 +75,8 @@ class LowerBoundParams:
     """Knobs of :func:`lower_bound` (any values give a valid bound; they trade speed for tightness).
 
     Attributes:
-        hop_cells: K of the K-hop metric (open space: about (K - 1) / K of the straight line).
+        hop_cells: K of the K-hop metric (open space: exact along a row, about 0.93 of a
+            diagonal at K = 8).
         distance_cell_factor: Distance cells are this many map cells on a side (one passes
             to a neighbour where their map cells do).
         group_scales: Group block sides to try, as multiples of the side whose square holds one
@@ -93,6 +98,8 @@ class LowerBoundParams:
         branch_max_walls: A branch group with more walls than this within reach is taken as
             seen from every cell within reach, untested (rasterised maps: far quicker, looser).
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
+        threads: Threads for the independent searches (the bound is the same for any
+            number; ``semexplore oracle`` uses one per CPU the process may use).
     """
 
     hop_cells: int = 8
@@ -111,6 +118,7 @@ class LowerBoundParams:
     branch_block_m: float = 0.4
     branch_max_walls: int = 400
     coverage_share: float | None = None
+    threads: int = 1
 
     def __post_init__(self) -> None:
         for name, lo, hi in (
@@ -122,6 +130,7 @@ class LowerBoundParams:
             ("visibility_splits", 0, 8),
             ("max_entries", 1, 16),
             ("branch_max_walls", 0, 1_000_000),
+            ("threads", 1, 256),
         ):
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
@@ -394,7 +403,8 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         fine = replace(prob, coarse=coarse_moves(allowed, 1), factor=1)
         phi = fine.distances(np.array([sr * geo.width + sc]))
         branch_m = branch_bound_m(
-            BranchInputs(allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget)
+            BranchInputs(allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget),
+            threads=p.threads,
         )
     length_m = max(best.length_m, branch_m)
     return LowerBound(
@@ -446,24 +456,25 @@ def _bound_for_blocks(
     score[cells < 0.5 * block * block] = 0.0
     live = np.flatnonzero(score > 0)
     if p.keep_share < 1 and live.size > p.pool_groups:
-        sample = np.array([prob.region(rects[g], p.sample_stride).size for g in live])
+        sample = np.array(
+            thread_map(lambda g: prob.region(rects[g], p.sample_stride).size, live, p.threads)
+        )
         cut = np.quantile(sample, p.keep_share)
         score[live[sample > cut]] = 0.0
     centres = 0.5 * (rects[:, :2] + rects[:, 2:])
     chosen: list[int] = []
-    regions: list[np.ndarray] = []
     while len(chosen) < min(p.pool_groups, rects.shape[0]):
         g = int(np.argmax(score))
         if not score[g] > 0:
             break
         chosen.append(g)
-        regions.append(prob.region(rects[g]))
         np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
+    regions = thread_map(lambda g: prob.region(rects[g]), chosen, p.threads)
     tile = max(1, int(round(p.entry_tile_m / (prob.geometry.resolution_m * prob.factor))))
     pieces = [prob.entry_pieces(r, start_cell, tile, p.max_entries) for r in regions]
     node_group = np.array([i for i, ps in enumerate(pieces) for _ in ps], dtype=np.int64)
     nodes = [q for ps in pieces for q in ps]
-    first, legs = _entry_legs(prob, nodes, node_group, from_start, p.leg_limit_share)
+    first, legs = _entry_legs(prob, nodes, node_group, from_start, p.leg_limit_share, p.threads)
     pick = _choose_groups(first, legs, node_group, cells[chosen].astype(np.int64), budget, p)
     length, order = _route(first, legs, node_group, cells[chosen].astype(np.int64), budget, pick)
     idx = np.array(chosen, dtype=np.int64)[pick]
@@ -537,9 +548,11 @@ def _entry_legs(
     node_group: np.ndarray,
     from_start: np.ndarray,
     share: float,
+    threads: int,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The start-to-node and node-to-node K-hop distances (the least over each piece's cells;
-    either direction of a leg bounds it, so the larger of the two)."""
+    either direction of a leg bounds it, so the larger of the two), one search a node, on up
+    to ``threads`` threads."""
     n = len(nodes)
     first = np.array([_least(from_start, q) for q in nodes], dtype=np.float64)
     # Legs longer than a share of the farthest node's distance from the start are lowered to
@@ -547,12 +560,15 @@ def _entry_legs(
     ok = np.isfinite(first)
     limit = share * float(first[ok].max()) if ok.any() and share < 1 else math.inf
     legs = np.zeros((n, n), dtype=np.float64)
-    for v in range(n):
+
+    def row(v: int) -> np.ndarray:
         others = [nodes[u] for u in range(n) if node_group[u] != node_group[v]]
         field = prob.distances(nodes[v], others, limit_m=limit)
-        for u in range(n):
-            if node_group[u] != node_group[v]:
-                legs[v, u] = _least(field, nodes[u])
+        return np.array([_least(field, q) if node_group[u] != node_group[v] else 0.0
+                         for u, q in enumerate(nodes)])  # fmt: skip
+
+    for v, leg in enumerate(thread_map(row, range(n), threads)):
+        legs[v] = leg
     return first, np.maximum(legs, legs.T)
 
 

@@ -57,17 +57,59 @@ def _heap_pop(keys, vals, n):  # pragma: no cover - numba
 
 
 @njit(cache=True)
+def _interval_gap(lo, hi, t0, t1):  # pragma: no cover - numba
+    """Gap between the intervals ``[lo, hi]`` and ``[t0, t1]`` (0 when they meet)."""
+    if t0 > hi:
+        return t0 - hi
+    if t1 < lo:
+        return lo - t1
+    return 0.0
+
+
+@njit(cache=True)
+def _face_costs(k, res):  # pragma: no cover - numba
+    """``cost[f, i * side + j]``: the distance from face ``f`` of a cell's square (0: the whole
+    square; 1, 2: its low and high row side; 3, 4: its low and high column side) to the square
+    of the cell at offset ``(i - k, j - k)``."""
+    side = 2 * k + 1
+    cost = np.empty((5, side * side), dtype=np.float64)
+    for f in range(5):
+        r0, r1, c0, c1 = -0.5, 0.5, -0.5, 0.5
+        if f == 1:
+            r1 = -0.5
+        elif f == 2:
+            r0 = 0.5
+        elif f == 3:
+            c1 = -0.5
+        elif f == 4:
+            c0 = 0.5
+        for i in range(side):
+            for j in range(side):
+                dr = _interval_gap(r0, r1, i - k - 0.5, i - k + 0.5)
+                dc = _interval_gap(c0, c1, j - k - 0.5, j - k + 0.5)
+                cost[f, i * side + j] = res * math.sqrt(dr * dr + dc * dc)
+    return cost
+
+
+@njit(cache=True, nogil=True)
 def khop_distances(
     moves, sources, k, res, target_of, n_targets, limit=np.inf
 ):  # pragma: no cover - numba
     """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
     ``moves[r, c]``: bit ``3 * (dr + 1) + (dc + 1)`` set when the robot can pass from cell
-    ``(r, c)`` to ``(r + dr, c + dc)`` (bit 4: the cell itself is allowed). A settled cell ``a``
-    (a checkpoint) reaches, by a breadth-first search along moves inside its Chebyshev ball of radius ``k`` that expands only cells strictly inside
-    the ball, every cell ``b`` a path can reach before first leaving the ball's interior; the
-    edge costs the distance between the squares of ``a`` and ``b``. Cells on the ball's rim are
-    the next checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop.
+    ``(r, c)`` to ``(r + dr, c + dc)`` (bit 4: the cell itself is allowed). A checkpoint is a
+    cell and the face of its square the path is on: a source anywhere in its square, a later
+    checkpoint on the side toward the one before (a path first reaches Chebyshev distance
+    ``k`` from a checkpoint by crossing that side; a ring corner at its inner corner, which
+    lies on its row side too). A settled checkpoint ``a`` reaches, by a breadth-first search
+    along moves inside its Chebyshev ball of radius ``k`` that expands only cells strictly
+    inside the ball, every cell ``b`` a path can reach before first leaving the ball's
+    interior; the edge costs the distance from ``a``'s face to ``b``'s square (a straight
+    chain of hops thus measures ``k`` cells a hop). Cells on the ball's rim are the next
+    checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop. A face
+    is not pushed when another face of the same cell is known at least one cell size lower
+    (its distances are never above this one's).
 
     With ``n_targets`` > 0 it stops once each target set (``target_of[cell]``, -1 for none)
     holds its final least distance: every later value is at least the popped one. It also stops
@@ -80,23 +122,18 @@ def khop_distances(
     h, w = moves.shape
     flat_moves = moves.reshape(h * w)
     side = 2 * k + 1
-    cost = np.empty(side * side, dtype=np.float64)
-    for i in range(side):
-        for j in range(side):
-            dr = max(abs(i - k) - 1, 0)
-            dc = max(abs(j - k) - 1, 0)
-            cost[i * side + j] = res * math.sqrt(dr * dr + dc * dc)
-    chain = np.full(h * w, np.inf)
+    cost = _face_costs(k, res)
+    chain = np.full(h * w * 5, np.inf)
     best = np.full(h * w, np.inf)
-    settled = np.zeros(h * w, dtype=np.bool_)
+    settled = np.zeros(h * w * 5, dtype=np.bool_)
     keys = np.empty(1024, dtype=np.float64)
     vals = np.empty(1024, dtype=np.int64)
     n = 0
     for s in sources:
-        if (flat_moves[s] >> 4) & 1 and chain[s] > 0.0:
-            chain[s] = 0.0
+        if (flat_moves[s] >> 4) & 1 and chain[5 * s] > 0.0:
+            chain[5 * s] = 0.0
             best[s] = 0.0
-            keys, vals, n = _heap_push(keys, vals, n, 0.0, s)
+            keys, vals, n = _heap_push(keys, vals, n, 0.0, 5 * s)
     stamp = np.zeros(side * side, dtype=np.int64)
     queue = np.empty(side * side, dtype=np.int64)
     sid = 0
@@ -106,14 +143,16 @@ def khop_distances(
         if flat_target[s] >= 0 and best[s] < tbest[flat_target[s]]:
             tbest[flat_target[s]] = best[s]
     while n > 0:
-        d, a, n = _heap_pop(keys, vals, n)
-        if settled[a] or d > chain[a]:
+        d, state, n = _heap_pop(keys, vals, n)
+        if settled[state] or d > chain[state]:
             continue
         if n_targets > 0 and d >= tbest.max():
             break
         if d >= limit:
             break
-        settled[a] = True
+        settled[state] = True
+        a = state // 5
+        face = state - 5 * a
         ar = a // w
         ac = a - ar * w
         sid += 1
@@ -128,16 +167,24 @@ def khop_distances(
             li = loc // side
             lj = loc - li * side
             g = (ar + li - k) * w + (ac + lj - k)
-            e = d + cost[loc]
+            e = d + cost[face, loc]
             if e < best[g]:
                 best[g] = e
                 t = flat_target[g]
                 if t >= 0 and e < tbest[t]:
                     tbest[t] = e
             if abs(li - k) == k or abs(lj - k) == k:
-                if e < chain[g] and not settled[g]:
-                    chain[g] = e
-                    keys, vals, n = _heap_push(keys, vals, n, e, g)
+                if abs(li - k) == k:
+                    nf = 1 if li > k else 2
+                else:
+                    nf = 3 if lj > k else 4
+                low = chain[5 * g]
+                for f2 in range(1, 5):
+                    if f2 != nf and chain[5 * g + f2] + res < low:
+                        low = chain[5 * g + f2] + res
+                if e < chain[5 * g + nf] and e < low and not settled[5 * g + nf]:
+                    chain[5 * g + nf] = e
+                    keys, vals, n = _heap_push(keys, vals, n, e, 5 * g + nf)
                 continue
             bits = flat_moves[g]
             for di in range(-1, 2):
@@ -320,7 +367,7 @@ def walls_near(walls, rect, pad):  # pragma: no cover - numba
     return near, m
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the

@@ -103,11 +103,21 @@ def test_khop_distance_never_exceeds_the_geodesic_on_an_l_corridor():
     corner = np.array([11.0, 108.0])
     path_cells = np.hypot(*(corner - a)) + np.hypot(*(np.array(b) - corner))
     assert 0.7 * path_cells * RES <= d[b] <= path_cells * RES
-    # open space: about (K - 1) / K of the straight line, never above it
-    open_moves = coarse_moves(np.ones((200, 200), dtype=bool), 1)
-    d_open = _khop(open_moves, np.array([100 * 200]), k, RES)
-    straight = 199 * RES
-    assert (k - 1) / k * straight - 2 * RES <= d_open[100, 199] <= straight
+
+
+def test_khop_distance_is_exact_along_a_row_and_never_above_the_squares_gap():
+    # Open space: every hop of a straight chain starts on the side of its checkpoint's square
+    # that the chain crossed, so along a row the K-hop distance is the gap between the two
+    # squares exactly (the square-to-square measure of every hop would lose a cell a hop);
+    # nowhere is it above the straight-line gap between the source's square and the cell's.
+    k = 8
+    n = 120
+    d = _khop(coarse_moves(np.ones((n, n), dtype=bool), 1), np.array([60 * n + 3]), k, RES)
+    assert d[60, n - 1] == pytest.approx((n - 1 - 3 - 1) * RES)
+    rows, cols = np.mgrid[0:n, 0:n]
+    gap = RES * np.hypot(np.maximum(np.abs(rows - 60) - 1, 0), np.maximum(np.abs(cols - 3) - 1, 0))
+    assert np.all(d <= gap + 1e-12)
+    assert np.median(d[gap > 20 * RES] / gap[gap > 20 * RES]) > 0.9
 
 
 def test_coarse_distance_cells_do_not_join_across_a_thin_wall():
@@ -316,7 +326,25 @@ def test_params_reject_bad_values():
         LowerBoundParams(hop_cells=0)
     with pytest.raises(ValueError, match="coverage_share"):
         LowerBoundParams(coverage_share=1.5)
+    with pytest.raises(ValueError, match="threads must be an integer in 1..256, got 0"):
+        LowerBoundParams(threads=0)
     assert math.isfinite(LowerBoundParams().group_scales[0])
+
+
+def test_the_bound_is_the_same_on_one_thread_or_several(privileged_world):
+    # The searches spread over threads are independent: the same route, groups and branches.
+    teeth = [(x, 0.0, x + 0.6, 3.6) for x in (0.0, 2.0, 4.0, 6.0)]
+    facts = _facts(privileged_world, [(0.0, 0.0, 6.6, 0.6), *teeth], (6.6, 3.6), (0.3, 0.3, 0.0))
+    one = lower_bound(facts, LowerBoundParams(threads=1))
+    three = lower_bound(facts, LowerBoundParams(threads=3))
+    assert one.distance_m > 0 and len(one.route) >= 2
+    assert (one.distance_m, one.branch_m, one.route, one.group_cells, one.region_cells) == (
+        three.distance_m,
+        three.branch_m,
+        three.route,
+        three.group_cells,
+        three.region_cells,
+    )
 
 
 @pytest.mark.slow
