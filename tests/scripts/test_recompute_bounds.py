@@ -3,30 +3,15 @@
 from __future__ import annotations
 
 import csv
-import importlib.util
-import sys
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from semexplore_gym.evaluation.best_known import read_table
 from semexplore_gym.evaluation.bound_check import MISSION_COLUMNS, read_missions
 
-REPO = Path(__file__).resolve().parents[2]
 WORLD = "maze:seed=3,size_m=4"
 PLACEHOLDER = "maze:seed=*,size_m=4"
-
-
-def _script() -> Any:
-    spec = importlib.util.spec_from_file_location(
-        "recompute_bounds", REPO / "scripts" / "recompute_bounds.py"
-    )
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["recompute_bounds"] = mod
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def _missions(path: Path, t99_s: float) -> Path:
@@ -61,12 +46,12 @@ def truth() -> dict:
     return {(WORLD, 0): (a.time_s, a.distance_m), (PLACEHOLDER, 5): (b.time_s, b.distance_m)}
 
 
-def test_both_tables_get_today_s_bound_and_keep_every_other_cell(tmp_path, truth, capsys):
+def test_both_tables_get_today_s_bound_and_keep_every_other_cell(tmp_path, truth, capsys, script):
     missions = _missions(tmp_path / "m.csv", 250.0)
     best = _best_known(tmp_path / "b.csv")
     cache = tmp_path / "cache.csv"
     args = [str(best), str(missions), "--cache", str(cache), "--no-progress"]
-    assert _script().main(args) == 0
+    assert script("recompute_bounds").main(args) == 0
     out = capsys.readouterr().out
     assert "2 starts, 0 in" in out and "0 violations" in out
     checked = read_missions(missions)
@@ -82,23 +67,23 @@ def test_both_tables_get_today_s_bound_and_keep_every_other_cell(tmp_path, truth
     assert entry["T99_policy"] == "nearest" and entry["D99_m"] == 30.0
     assert best.read_bytes().count(b"\r\n") == 2  # written as the table writer writes it
     # Rerun: every bound comes from the cache, nothing is computed again.
-    assert _script().main(args + ["--dry-run"]) == 0
+    assert script("recompute_bounds").main(args + ["--dry-run"]) == 0
     assert "2 starts, 2 in" in capsys.readouterr().out
 
 
-def test_a_mission_below_the_new_bound_writes_nothing(tmp_path, truth, capsys):
+def test_a_mission_below_the_new_bound_writes_nothing(tmp_path, truth, capsys, script):
     too_fast = truth[(WORLD, 0)][0] * 0.5
     missions = _missions(tmp_path / "m.csv", too_fast)
     before = missions.read_bytes()
     args = [str(missions), "--cache", str(tmp_path / "c.csv"), "--no-progress"]
-    assert _script().main(args) == 1
+    assert script("recompute_bounds").main(args) == 1
     captured = capsys.readouterr()
     assert "VIOLATION" in captured.out and "1 violations" in captured.out
     assert "no table written" in captured.err
     assert missions.read_bytes() == before
 
 
-def test_bad_input_is_one_clear_line(tmp_path, capsys):
+def test_bad_input_is_one_clear_line(tmp_path, capsys, script):
     other = tmp_path / "x.csv"
     other.write_text("a,b\n1,2\n", encoding="utf-8")
     for args, needle in (
@@ -106,6 +91,6 @@ def test_bad_input_is_one_clear_line(tmp_path, capsys):
         ([str(other)], "neither a best-known table nor a checked-missions CSV"),
         ([str(other), "--workers", "0"], "--workers must be at least 1, got 0"),
     ):
-        assert _script().main(args) == 2
+        assert script("recompute_bounds").main(args) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and needle in err[0]
