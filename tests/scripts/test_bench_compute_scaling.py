@@ -3,29 +3,18 @@
 from __future__ import annotations
 
 import csv
-import importlib.util
-import sys
 from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _bench() -> Any:
-    spec = importlib.util.spec_from_file_location(
-        "bench_compute_scaling", REPO / "scripts" / "bench_compute_scaling.py"
-    )
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["bench_compute_scaling"] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_small_maze_gives_a_row_per_world_and_a_figure(tmp_path: Path, capsys: Any) -> None:
+def test_small_maze_gives_a_row_per_world_and_a_figure(
+    tmp_path: Path, capsys: Any, script: Any
+) -> None:
     out, fig = tmp_path / "c.csv", tmp_path / "c.png"
     argv = ["--worlds", "maze:seed=0,size_m=5", "--repeats", "1", "--out", str(out)]
-    assert _bench().main([*argv, "--figure", str(fig), "--stat", "min"]) == 0
+    assert script("bench_compute_scaling").main([*argv, "--figure", str(fig), "--stat", "min"]) == 0
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 1 and rows[0]["world"] == "maze:seed=0,size_m=5"
     for stage in ("pm_map", "pm_plan", "fe_map", "fe_plan", "nearest_map", "nearest_plan"):

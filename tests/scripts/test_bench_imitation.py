@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import csv
-import importlib.util
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -12,17 +10,6 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-
-
-def _bench() -> Any:
-    spec = importlib.util.spec_from_file_location(
-        "bench_imitation", REPO / "scripts" / "bench_imitation.py"
-    )
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["bench_imitation"] = mod
-    spec.loader.exec_module(mod)
-    return mod
 
 
 class FakeRunner:
@@ -41,8 +28,8 @@ class FakeRunner:
         return {"mission_time_s": max_time_s, "coverage": cov, "collisions": 1, "wall_time_s": 1.0}
 
 
-def test_learners_run_for_the_expert_time_and_the_csv_resumes(tmp_path: Path) -> None:
-    bench = _bench()
+def test_learners_run_for_the_expert_time_and_the_csv_resumes(tmp_path: Path, script: Any) -> None:
+    bench = script("bench_imitation")
     runner = FakeRunner()
     out = tmp_path / "b.csv"
     rows = bench.run_imitation_benchmark(
@@ -76,15 +63,17 @@ def test_learners_run_for_the_expert_time_and_the_csv_resumes(tmp_path: Path) ->
     assert "**0.375**" not in table and "**0.38**" in table and "**0.75**" in table
 
 
-def test_seed_ranges() -> None:
-    bench = _bench()
+def test_seed_ranges(script: Any) -> None:
+    bench = script("bench_imitation")
     assert bench.parse_seed_range("100-103") == [100, 101, 102, 103]
     assert bench.parse_seed_range("1,5,7-8") == [1, 5, 7, 8]
     with pytest.raises(ValueError, match="seed list"):
         bench.parse_seed_range("a-b")
 
 
-def test_real_missions_with_a_tiny_budget(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+def test_real_missions_with_a_tiny_budget(
+    tmp_path: Path, capsys: pytest.CaptureFixture, script: Any
+) -> None:
     """Expert capped at 3 s, an untrained policy for the same 3 s (real env and harness)."""
     pytest.importorskip("torch")
     pytest.importorskip("stable_baselines3")
@@ -104,7 +93,7 @@ def test_real_missions_with_a_tiny_budget(tmp_path: Path, capsys: pytest.Capture
     )
     model = save_policy(policy, tmp_path / "m.zip", params)
     out = tmp_path / "bench.csv"
-    rc = _bench().main(
+    rc = script("bench_imitation").main(
         ["--models", str(model), "--seeds", "100", "--expert-max-time-s", "3", "--out", str(out)]
     )
     assert rc == 0
@@ -118,8 +107,8 @@ def test_real_missions_with_a_tiny_budget(tmp_path: Path, capsys: pytest.Capture
     assert "| maze:size_m=5,seed=* | 100 | 3.0 |" in text and "mean ratio" in text
 
 
-def test_summary_per_model_and_paired_comparison() -> None:
-    bench = _bench()
+def test_summary_per_model_and_paired_comparison(script: Any) -> None:
+    bench = script("bench_imitation")
     rows = [{"world": "m", "seed": s, "policy": "semantic", "ratio": 1.0} for s in range(12)]
     rows += [{"world": "m", "seed": s, "policy": "a", "ratio": 0.5 + 0.04 * s} for s in range(12)]
     rows += [{"world": "m", "seed": s, "policy": "b", "ratio": 0.4 + 0.04 * s} for s in range(12)]

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -12,26 +10,15 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _script() -> Any:
-    spec = importlib.util.spec_from_file_location(
-        "make_figures", REPO / "scripts" / "make_figures.py"
-    )
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["make_figures"] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_every_figure_is_committed_and_shown_by_a_page() -> None:
+def test_every_figure_is_committed_and_shown_by_a_page(script: Any) -> None:
     pages = " ".join(p.read_text(encoding="utf-8") for p in (REPO / "docs").glob("*.md"))
-    for name in _script().FIGURES:
+    for name in script("make_figures").FIGURES:
         assert (REPO / "docs" / "figures" / name).is_file(), name
         assert f"figures/{name}" in pages, name
 
 
-def test_list_prints_each_command_writing_into_the_out_dir(tmp_path, capsys) -> None:
-    mod = _script()
+def test_list_prints_each_command_writing_into_the_out_dir(tmp_path, capsys, script: Any) -> None:
+    mod = script("make_figures")
     assert mod.main(["--list", "--out-dir", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert [line.split(":", 1)[0] for line in lines] == list(mod.FIGURES)
@@ -41,16 +28,16 @@ def test_list_prints_each_command_writing_into_the_out_dir(tmp_path, capsys) -> 
     assert not list(tmp_path.iterdir())  # --list runs nothing
 
 
-def test_an_unknown_figure_is_one_error(capsys) -> None:
+def test_an_unknown_figure_is_one_error(capsys, script: Any) -> None:
     with pytest.raises(SystemExit) as info:
-        _script().main(["--only", "nope.gif"])
+        script("make_figures").main(["--only", "nope.gif"])
     assert info.value.code == 2
     assert "unknown figure(s) ['nope.gif']" in capsys.readouterr().err
 
 
-def test_the_team_figure_is_drawn_in_this_process(tmp_path, monkeypatch) -> None:
+def test_the_team_figure_is_drawn_in_this_process(tmp_path, monkeypatch, script: Any) -> None:
     pytest.importorskip("pettingzoo")
-    mod = _script()
+    mod = script("make_figures")
     calls: list[list[str]] = []
     import semexplore_gym.cli as cli
 

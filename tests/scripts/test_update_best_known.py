@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -14,17 +12,6 @@ from semexplore_gym.evaluation.best_known import read_table
 
 REPO = Path(__file__).resolve().parents[2]
 WORLD = "maze:seed=1,size_m=4"
-
-
-def _script() -> Any:
-    spec = importlib.util.spec_from_file_location(
-        "update_best_known", REPO / "scripts" / "update_best_known.py"
-    )
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["update_best_known"] = mod
-    spec.loader.exec_module(mod)
-    return mod
 
 
 @pytest.fixture(scope="module")
@@ -38,13 +25,15 @@ def run_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def test_a_run_is_merged_and_its_bounds_hold(run_folder: Path, tmp_path: Path, capsys: Any):
+def test_a_run_is_merged_and_its_bounds_hold(
+    run_folder: Path, tmp_path: Path, capsys: Any, script: Any
+):
     pytest.importorskip("elkai")
     from semexplore_gym.evaluation.run_row import read_runs
 
     table = tmp_path / "t.csv"
     assert (
-        _script().main(
+        script("update_best_known").main(
             [str(run_folder), "--table", str(table), "--bounds", "--json", "--no-progress"]
         )
         == 0
@@ -63,19 +52,28 @@ def test_a_run_is_merged_and_its_bounds_hold(run_folder: Path, tmp_path: Path, c
         assert 0 < e["lower_bound_s"] <= e["T99_s"]
         assert 0 < e["lower_bound_m"] <= e["D99_m"]
     # Run again: nothing new, no bound computed twice.
-    assert _script().main([str(run_folder), "--table", str(table), "--bounds", "--json"]) == 0
+    assert (
+        script("update_best_known").main(
+            [str(run_folder), "--table", str(table), "--bounds", "--json"]
+        )
+        == 0
+    )
     again = json.loads(capsys.readouterr().out)
     assert again["new_best_known"] == 0 and again["bounds_computed"] == 0
 
 
-def test_a_folder_without_runs_is_one_error_line(tmp_path: Path, capsys: Any):
-    assert _script().main([str(tmp_path), "--table", str(tmp_path / "t.csv")]) == 2
+def test_a_folder_without_runs_is_one_error_line(tmp_path: Path, capsys: Any, script: Any):
+    assert (
+        script("update_best_known").main([str(tmp_path), "--table", str(tmp_path / "t.csv")]) == 2
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no runs.csv" in err[0]
 
 
-def test_an_infinite_bound_is_kept_and_not_computed_again(tmp_path: Path, monkeypatch, capsys):
-    mod = _script()
+def test_an_infinite_bound_is_kept_and_not_computed_again(
+    tmp_path: Path, monkeypatch, capsys, script: Any
+):
+    mod = script("update_best_known")
     table = tmp_path / "t.csv"
     table.write_text(
         "world,seed,start,T99_s,T99_policy,D99_m,D99_policy,lower_bound_s,lower_bound_m\n"
@@ -98,11 +96,11 @@ def test_an_infinite_bound_is_kept_and_not_computed_again(tmp_path: Path, monkey
 
 
 def test_bounds_come_from_the_folder_s_check_before_any_is_computed(
-    run_folder: Path, tmp_path: Path, monkeypatch, capsys
+    run_folder: Path, tmp_path: Path, monkeypatch, capsys, script: Any
 ):
     import shutil
 
-    mod = _script()
+    mod = script("update_best_known")
     folder = tmp_path / "run"
     shutil.copytree(run_folder, folder)
     (folder / "lower_bounds.csv").write_text(

@@ -3,26 +3,16 @@
 from __future__ import annotations
 
 import csv
-import importlib.util
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _script():
-    spec = importlib.util.spec_from_file_location(
-        "update_team_bounds", REPO / "scripts/update_team_bounds.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.mark.slow
-def test_the_bounds_computed_again_are_the_benchmarks(tmp_path: Path, capsys) -> None:
+def test_the_bounds_computed_again_are_the_benchmarks(tmp_path: Path, capsys, script: Any) -> None:
     """The starts the script draws are the missions' own: with the same code, it gives back
     the bound each mission of a team benchmark recorded."""
     from semexplore_gym.cli import main
@@ -40,7 +30,7 @@ def test_the_bounds_computed_again_are_the_benchmarks(tmp_path: Path, capsys) ->
         w.writeheader()
         w.writerows({**r, "lower_bound_s": ""} for r in recorded)
     capsys.readouterr()
-    assert _script().main([str(blank)]) == 0
+    assert script("update_team_bounds").main([str(blank)]) == 0
     printed = capsys.readouterr().out
     assert printed.count(" -> ") == 4 and "wrote " in printed
     with blank.open(newline="") as f:
@@ -58,22 +48,24 @@ def test_the_bounds_computed_again_are_the_benchmarks(tmp_path: Path, capsys) ->
     ],
     ids=["not a team run", "bad seed", "empty"],
 )
-def test_bad_input_is_one_error_line(tmp_path: Path, capsys, text: str, says: str) -> None:
+def test_bad_input_is_one_error_line(
+    tmp_path: Path, capsys, text: str, says: str, script: Any
+) -> None:
     runs = tmp_path / "runs.csv"
     runs.write_text(text)
-    assert _script().main([str(runs)]) == 2
+    assert script("update_team_bounds").main([str(runs)]) == 2
     captured = capsys.readouterr()
     lines = captured.err.strip().splitlines()
     assert captured.out == "" and len(lines) == 1 and lines[0].startswith("error: ")
     assert says in lines[0]
     assert runs.read_text() == text  # left as it was
-    assert _script().main([str(tmp_path / "none")]) == 2
+    assert script("update_team_bounds").main([str(tmp_path / "none")]) == 2
     assert "does not exist" in capsys.readouterr().err
 
 
-def test_a_bad_env_override_is_one_error_line(tmp_path: Path, capsys) -> None:
+def test_a_bad_env_override_is_one_error_line(tmp_path: Path, capsys, script: Any) -> None:
     runs = tmp_path / "runs.csv"
     runs.write_text('world,seed,n_robots\n"maze:seed=1,size_m=4",0,2\n')
-    assert _script().main([str(runs), "--env-set", "team.no_such_key=1"]) == 2
+    assert script("update_team_bounds").main([str(runs), "--env-set", "team.no_such_key=1"]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and "no_such_key" in lines[0]
