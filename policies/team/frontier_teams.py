@@ -180,6 +180,7 @@ class FrontierTeam(TeamPolicy):
     """
 
     name = "frontier_team"
+    _poses: list[np.ndarray]  # each agent's last pose (TeamPolicy.reset_members)
 
     def __init__(self, params: FrontierTeamParams | None = None, **overrides: Any) -> None:
         super().__init__()

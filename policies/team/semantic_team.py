@@ -117,6 +117,8 @@ class _ExpertMember(SemanticExpertPolicy):
 class SemanticTeam(TeamPolicy):
     """The coordinated semantic expert (module docstring)."""
 
+    _poses: list[np.ndarray]  # each agent's last pose (TeamPolicy.reset_members)
+
     def __init__(self, params: SemanticTeamParams | None = None, **overrides: Any) -> None:
         super().__init__()
         p = params if params is not None else SemanticTeamParams()
