@@ -32,6 +32,8 @@ from semexplore_gym.config import build_params
 
 __all__ = ["OptionPPOConfig", "fit_bc", "load_option_ppo_config", "train_option_ppo"]
 
+VEC_ENVS = ("dummy", "subproc")
+
 
 @dataclass(frozen=True)
 class OptionPPOConfig:
@@ -49,6 +51,9 @@ class OptionPPOConfig:
         total_timesteps: PPO decisions (all envs together), BC's not counted.
         n_envs, n_steps, batch_size, n_epochs, learning_rate, gamma, ent_coef: MaskablePPO.
         torch_threads: ``torch.set_num_threads``.
+        vec_env: ``"dummy"``: the ``n_envs`` envs step in this process, one after another;
+            ``"subproc"``: each in its own process (SB3's ``SubprocVecEnv``), on as many cores.
+            The envs draw the same worlds and starts either way, so the run is the same.
         wall_budget_s: PPO stops (and saves) once the run has taken this much wall time,
             BC included (0: no limit; a resumed run counts from its restart).
     """
@@ -72,6 +77,7 @@ class OptionPPOConfig:
     gamma: float = 0.98
     ent_coef: float = 0.003
     torch_threads: int = 1
+    vec_env: str = "dummy"
     wall_budget_s: float = 0.0
 
     def __post_init__(self) -> None:
@@ -95,6 +101,8 @@ class OptionPPOConfig:
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         if not self.splits:
             raise ValueError("splits is empty: name at least one learning split")
+        if self.vec_env not in VEC_ENVS:
+            raise ValueError(f"vec_env must be one of {', '.join(VEC_ENVS)}, got {self.vec_env!r}")
 
 
 def load_option_ppo_config(path: str | None, overrides: list[str]) -> OptionPPOConfig:
@@ -327,7 +335,7 @@ def train_option_ppo(
     """BC then PPO (see the module); resumes from ``out/checkpoints/last.zip``."""
     import torch as th
     from sb3_contrib import MaskablePPO
-    from stable_baselines3.common.vec_env import DummyVecEnv
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
     from semexplore_gym.policies.option_ppo import load_option_model
 
@@ -337,7 +345,8 @@ def train_option_ppo(
     log(f"{len(worlds)} training worlds")
     curve = EpisodeLog(out / "curve.csv")
     metrics: dict[str, Any] = {}
-    vec = DummyVecEnv([partial(make_world_env, cfg, worlds, i) for i in range(cfg.n_envs)])
+    makers = [partial(make_world_env, cfg, worlds, i) for i in range(cfg.n_envs)]
+    vec = SubprocVecEnv(makers) if cfg.vec_env == "subproc" else DummyVecEnv(makers)
     last = out / "checkpoints" / "last.zip"
     t0 = time.perf_counter()
     if last.is_file():

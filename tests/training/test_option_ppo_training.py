@@ -32,6 +32,7 @@ TINY = [
         ("gamma", 1.5, "gamma must be in (0, 1], got 1.5"),
         ("splits", (), "splits is empty"),
         ("wall_budget_s", -1.0, "wall_budget_s must be a finite number >= 0, got -1.0"),
+        ("vec_env", "ray", "vec_env must be one of dummy, subproc, got 'ray'"),
     ],
 )
 def test_config_errors_name_the_value(key: str, value: object, message: str) -> None:
@@ -82,3 +83,29 @@ def test_tiny_run_writes_its_curve_and_resumes(tmp_path: Path, one_torch_thread:
     second = json.loads((out / "metrics.json").read_text())
     assert second["resumed_at"] >= 4 and second["timesteps"] >= 8
     assert "bc_decisions" not in second  # no second behaviour cloning
+
+
+def _curve_without_wall_time(out: Path) -> list[dict[str, str]]:
+    with (out / "curve.csv").open() as f:
+        return [{k: v for k, v in row.items() if k != "wall_s"} for row in csv.DictReader(f)]
+
+
+@pytest.mark.slow
+def test_envs_in_subprocesses_give_the_same_run(tmp_path: Path, one_torch_thread: None) -> None:
+    """Two envs in their own processes draw the same worlds and starts as in this process, so
+    the episodes, the curve and the trained weights are the same."""
+    pytest.importorskip("sb3_contrib")
+    import torch as th
+    from semexplore_gym.policies.option_ppo import load_option_model
+
+    runs = {}
+    for vec_env in ("dummy", "subproc"):
+        out = tmp_path / vec_env
+        assert _train(out, ["n_envs=2", "total_timesteps=8", f"vec_env={vec_env}"]) == 0
+        runs[vec_env] = out
+    curves = [_curve_without_wall_time(out) for out in runs.values()]
+    assert curves[0] and curves[0] == curves[1]
+    params = [load_option_model(out / "model.zip").policy.state_dict() for out in runs.values()]
+    assert params[0].keys() == params[1].keys()
+    for key, value in params[0].items():
+        assert th.equal(value, params[1][key]), key
