@@ -47,6 +47,8 @@ from semexplore_gym.core.coverage_tour.branch_kernels import (
     branch_route,
     coarse_region,
     merge_tree,
+    preorder,
+    region_extremes,
     set_levels,
 )
 from semexplore_gym.core.coverage_tour.thread_map import thread_map
@@ -99,38 +101,28 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> 
     if parent.size == 0 or int(np.sum(parent == np.arange(parent.size))) != 1:
         return 0.0
     f = int(region_factor)
-    height, width = allowed.shape
-    wide = -(-width // f)
-    step = np.arange(f)
-    regions = []
     found = thread_map(
         lambda g: coarse_region(allowed, f, group_rects[g], walls, frame),
         range(group_rects.shape[0]),
         threads,
     )
-    for blocks in found:
-        br, bc = np.divmod(blocks, wide)
-        rows = (br[:, None, None] * f + step[None, :, None]) + 0 * step[None, None, :]
-        cols = (bc[:, None, None] * f + step[None, None, :]) + 0 * step[None, :, None]
-        keep = (rows < height) & (cols < width)
-        rows, cols = rows[keep], cols[keep]
-        keep = allowed[rows, cols]  # the robot's centre is only ever in allowed cells
-        cells = rows[keep] * width + cols[keep]
-        regions.append(node_of[cells])
-    sizes = np.array([r.size for r in regions], dtype=np.int64)
+    block_start = np.zeros(len(found) + 1, dtype=np.int64)
+    block_start[1:] = np.cumsum([b.size for b in found])
+    blocks = np.concatenate(found) if found else np.zeros(0, dtype=np.int64)
+    # The robot's centre is only ever in allowed cells: a region is its blocks' allowed cells;
+    # the common branch of its cells is that of its first and last in the tree's preorder.
+    tin, _ = preorder(parent)
+    sizes, bad, ends = region_extremes(
+        blocks.astype(np.int64), block_start, f, allowed, node_of, tin
+    )
     unseeable = int(group_cells[sizes == 0].sum())
     budget = int(budget_cells) - unseeable
     if budget < 0:
         return float("inf")
-    starts = np.zeros(len(regions) + 1, dtype=np.int64)
-    starts[1:] = np.cumsum(sizes)
-    flat = np.concatenate(regions) if regions else np.zeros(0, dtype=np.int64)
-    lca, _ = set_levels(parent, level, flat, starts)
+    pairs = np.arange(0, ends.size + 1, 2, dtype=np.int64)
+    lca, _ = set_levels(parent, level, ends, pairs)
     # A region cell outside the tree cannot happen (the tree holds every reachable distance
     # cell); a group with one is left out (never counted as hidden: still a bound).
-    bad = np.zeros(len(regions), dtype=bool)
-    for g, r in enumerate(regions):
-        bad[g] = bool(np.any(r < 0))
     use = (lca >= 0) & ~bad
     m = parent.size
     own = np.zeros(m)

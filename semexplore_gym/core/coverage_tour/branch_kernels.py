@@ -100,23 +100,41 @@ def merge_tree(moves, level):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def _depths(parent):  # pragma: no cover - numba
+def preorder(parent):  # pragma: no cover - numba
+    """Each node's number in a depth-first preorder of the forest and its subtree's size: ``u``
+    is an ancestor of ``v`` (or ``v`` itself) iff ``tin[u] <= tin[v] < tin[u] + size[u]``.
+    A parent's index is above its children's (as :func:`merge_tree` builds them)."""
     m = parent.size
-    depth = np.zeros(m, dtype=np.int64)
-    for v in range(m - 1, -1, -1):  # a parent's index is above its children's
+    size = np.ones(m, dtype=np.int64)
+    for v in range(m):  # children before parents
         if parent[v] != v:
-            depth[v] = depth[parent[v]] + 1
-    return depth
+            size[parent[v]] += size[v]
+    tin = np.empty(m, dtype=np.int64)
+    nxt = np.empty(m, dtype=np.int64)
+    offset = 0
+    for v in range(m - 1, -1, -1):  # parents before children
+        p = parent[v]
+        if p == v:
+            tin[v] = offset
+            offset += size[v]
+        else:
+            tin[v] = nxt[p]
+            nxt[p] += size[v]
+        nxt[v] = tin[v] + 1
+    return tin, size
 
 
 @njit(cache=True)
 def set_levels(parent, node_level, region_nodes, region_start):  # pragma: no cover - numba
-    """For each set of leaves (``region_nodes[region_start[g]:region_start[g + 1]]``), the
-    lowest common ancestor of its leaves and that node's level: the highest ``t`` at which all of
-    them lie in one component of ``{level >= t}``; ``-1`` and ``-inf`` for an empty set or
-    leaves in different trees."""
+    """For each set of leaves (``region_nodes[region_start[g]:region_start[g + 1]]``; negative
+    entries, cells outside the tree, are passed over), the lowest common ancestor of its leaves
+    and that node's level: the highest ``t`` at which all of them lie in one component of
+    ``{level >= t}``; ``-1`` and ``-inf`` for an empty set or leaves in different trees.
+
+    The common ancestor of a set is that of its first and last leaf in preorder, found by
+    binary lifting; a set costs one pass over its leaves and one pair's ancestor search."""
     m = parent.size
-    depth = _depths(parent)
+    tin, size = preorder(parent)
     levels = 1
     while (1 << levels) < m + 1:
         levels += 1
@@ -130,38 +148,65 @@ def set_levels(parent, node_level, region_nodes, region_start):  # pragma: no co
     lca = np.full(n_sets, -1, dtype=np.int64)
     out = np.full(n_sets, -np.inf)
     for g in range(n_sets):
-        a = -1
+        lo = -1
+        hi = -1
         for i in range(region_start[g], region_start[g + 1]):
             b = region_nodes[i]
-            if a < 0:
-                a = b
+            if b < 0:
                 continue
-            x = a
-            y = b
-            if depth[x] < depth[y]:
-                x, y = y, x
-            diff = depth[x] - depth[y]
-            k = 0
-            while diff > 0:
-                if diff & 1:
-                    x = up[k, x]
-                diff >>= 1
-                k += 1
-            if x != y:
-                for k in range(levels - 1, -1, -1):
-                    if up[k, x] != up[k, y]:
-                        x = up[k, x]
-                        y = up[k, y]
-                x = parent[x]
-                y = parent[y]
-            if x != y:  # different trees
-                a = -2
-                break
-            a = x
-        if a >= 0:
-            lca[g] = a
-            out[g] = node_level[a]
+            if lo < 0 or tin[b] < tin[lo]:
+                lo = b
+            if hi < 0 or tin[b] > tin[hi]:
+                hi = b
+        if lo < 0:
+            continue
+        x = lo
+        if not (tin[x] <= tin[hi] < tin[x] + size[x]):
+            for k in range(levels - 1, -1, -1):
+                y = up[k, x]
+                if not (tin[y] <= tin[hi] < tin[y] + size[y]):
+                    x = y
+            x = parent[x]
+            if not (tin[x] <= tin[hi] < tin[x] + size[x]):  # different trees
+                continue
+        lca[g] = x
+        out[g] = node_level[x]
     return lca, out
+
+
+@njit(cache=True)
+def region_extremes(blocks, block_start, factor, allowed, node_of, tin):  # pragma: no cover
+    """Each region (the coarse blocks ``blocks[block_start[g]:block_start[g + 1]]``, each
+    ``factor`` x ``factor`` cells of ``allowed``) as the cells the robot's centre may be in:
+    their count, whether one lies outside the tree (``node_of`` negative), and its first and
+    last tree node in preorder (``tin``; -1 when it has none)."""
+    height, width = allowed.shape
+    wide = -(-width // factor)
+    n = block_start.size - 1
+    count = np.zeros(n, dtype=np.int64)
+    bad = np.zeros(n, dtype=np.bool_)
+    ends = np.full(2 * n, -1, dtype=np.int64)
+    for g in range(n):
+        lo = -1
+        hi = -1
+        for i in range(block_start[g], block_start[g + 1]):
+            br, bc = divmod(blocks[i], wide)
+            for r in range(br * factor, min(br * factor + factor, height)):
+                for c in range(bc * factor, min(bc * factor + factor, width)):
+                    if not allowed[r, c]:
+                        continue
+                    count[g] += 1
+                    v = node_of[r * width + c]
+                    if v < 0:
+                        bad[g] = True
+                        continue
+                    if lo < 0 or tin[v] < tin[lo]:
+                        lo = v
+                    if hi < 0 or tin[v] > tin[hi]:
+                        hi = v
+        ends[2 * g] = lo
+        ends[2 * g + 1] = hi
+    return count, bad, ends
 
 
 @njit(cache=True)

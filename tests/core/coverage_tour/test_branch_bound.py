@@ -14,6 +14,8 @@ from semexplore_gym.core.coverage_tour.branch_kernels import (
     branch_route,
     coarse_region,
     merge_tree,
+    preorder,
+    region_extremes,
     set_levels,
 )
 from semexplore_gym.core.coverage_tour.lower_bound import (
@@ -106,6 +108,63 @@ def test_a_row_split_by_an_unreachable_cell_makes_two_trees():
     flat = np.array([node_of[0], node_of[3]], dtype=np.int64)
     lca, levels = set_levels(parent, level, flat, np.array([0, 2], dtype=np.int64))
     assert lca[0] == -1 and levels[0] == -np.inf
+
+
+def _ancestors(parent, v):
+    out = [v]
+    while parent[out[-1]] != out[-1]:
+        out.append(int(parent[out[-1]]))
+    return out
+
+
+def test_common_branches_of_random_sets_are_the_brute_force_ones():
+    """Random levels on a 12 x 12 grid with two unreachable walls (a forest of merge trees):
+    each set's common ancestor (from its first and last leaf in preorder) is the deepest node
+    on every leaf's path to its root, or none when the leaves lie in different trees."""
+    rng = np.random.default_rng(7)
+    n = 12
+    moves = np.full((n, n), 1 << 4, dtype=np.uint16)
+    for dr, dc in itertools.product((-1, 0, 1), repeat=2):
+        if (dr, dc) != (0, 0):
+            moves |= np.uint16(1 << (3 * (dr + 1) + dc + 1))
+    phi = rng.random(n * n)
+    phi[5 * n : 6 * n] = np.inf  # a row nothing passes: two trees
+    _, node_of, parent, level = merge_tree(moves, phi)
+    tin, size = preorder(parent)
+    assert sorted(tin.tolist()) == list(range(parent.size))
+    cells = np.flatnonzero(node_of >= 0)
+    sets = [rng.choice(cells, size=k, replace=False) for k in (1, 2, 3, 5, 9, 20) * 5]
+    flat = np.concatenate([node_of[c] for c in sets]).astype(np.int64)
+    starts = np.cumsum([0] + [len(c) for c in sets]).astype(np.int64)
+    lca, levels = set_levels(parent, level, flat, starts)
+    split = 0
+    for g, c in enumerate(sets):
+        paths = [_ancestors(parent, int(node_of[x])) for x in c]
+        common = set(paths[0]).intersection(*paths[1:])
+        if not common:
+            split += 1
+            assert lca[g] == -1 and levels[g] == -np.inf
+            continue
+        deepest = next(v for v in paths[0] if v in common)
+        assert lca[g] == deepest and levels[g] == level[deepest]
+        for v in paths[0]:  # the preorder numbers an ancestor's subtree as one range
+            assert tin[v] <= tin[int(node_of[c[0]])] < tin[v] + size[v]
+    assert 0 < split < len(sets)
+
+
+def test_a_regions_blocks_give_its_cells_count_and_preorder_ends():
+    """Blocks of 2 x 2 cells of a 4 x 6 grid: the count holds only allowed cells, a cell
+    outside the tree marks the region, and the ends are its first and last tree node."""
+    allowed = np.ones((4, 6), dtype=bool)
+    allowed[0, 0] = False
+    node_of = np.arange(24, dtype=np.int64)
+    node_of[23] = -1  # (3, 5): not in the tree
+    tin = np.arange(24, dtype=np.int64)[::-1].copy()  # preorder: the reverse of the cell order
+    blocks = np.array([0, 2, 5], dtype=np.int64)  # (0,0), (0,4) | (1,4) in a 3-block-wide grid
+    count, bad, ends = region_extremes(blocks, np.array([0, 2, 3]), 2, allowed, node_of, tin)
+    assert count.tolist() == [7, 4]  # 3 of block (0,0) + 4 of block (0,4); block (1,4)
+    assert bad.tolist() == [False, True]
+    assert ends.tolist() == [11, 1, 22, 16]  # cell (0, 0) is not allowed
 
 
 @pytest.mark.parametrize("spec", ["maze:seed=1,size_m=5", "office:seed=2,size_m=10"])
