@@ -317,10 +317,14 @@ def plot_curve(csv_path: Path, png_path: Path) -> None:
     fig, ax = plt.subplots(1, 2, figsize=(9, 3.2))
     for phase, colour in (("bc", "tab:gray"), ("ppo", "tab:blue")):
         sel = [i for i, r in enumerate(rows) if r["phase"] == phase]
-        ax[0].plot([ep[i] for i in sel], [float(rows[i]["return"]) for i in sel], "o", c=colour,
-                   ms=3, label=phase)  # fmt: skip
-        ax[1].plot([ep[i] for i in sel], [float(rows[i]["coverage"]) for i in sel], "o", c=colour,
-                   ms=3)  # fmt: skip
+        x = np.array([ep[i] for i in sel])
+        for a, key in zip(ax, ("return", "coverage"), strict=True):
+            y = np.array([float(rows[i][key]) for i in sel])
+            a.plot(x, y, "o", c=colour, ms=2, alpha=0.3, label=phase if key == "return" else None)
+            k = len(y) // 20  # a running mean over a twentieth of the phase's episodes
+            if k >= 5:
+                a.plot(x[k - 1 :], np.convolve(y, np.ones(k) / k, mode="valid"), c="black", lw=1.5,
+                       label=f"mean of {k} episodes" if key == "return" else None)  # fmt: skip
     ax[0].set(xlabel="episode", ylabel="return")
     ax[1].set(xlabel="episode", ylabel="coverage at the end")
     ax[0].legend()
