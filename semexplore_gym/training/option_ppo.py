@@ -9,8 +9,9 @@
    its choice at each decision is the actor's label (cross-entropy over the valid rows) and the
    discounted return the critic's (``DIR/bc_data.npz``, read back when it exists).
 3. **PPO**: sb3-contrib MaskablePPO with :class:`~semexplore_gym.policies.option_ppo` networks,
-   ``n_envs`` envs in this process; ``DIR/checkpoints/last.zip`` after every update. Rerun the
-   same command and it resumes from there. ``DIR/curve.csv`` gets one row per finished episode
+   ``n_envs`` envs (``vec_env``: all in this process, or one process each);
+   ``DIR/checkpoints/last.zip`` after every update. Rerun the same command and it resumes from
+   there. ``DIR/curve.csv`` gets one row per finished episode
    (and ``curve.png`` at the end); the final model is ``DIR/model.zip``.
 """
 
