@@ -108,13 +108,11 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> 
     )
     block_start = np.zeros(len(found) + 1, dtype=np.int64)
     block_start[1:] = np.cumsum([b.size for b in found])
-    blocks = np.concatenate(found) if found else np.zeros(0, dtype=np.int64)
+    blocks = np.concatenate(found).astype(np.int64, copy=False) if found else np.zeros(0, np.int64)
     # The robot's centre is only ever in allowed cells: a region is its blocks' allowed cells;
     # the common branch of its cells is that of its first and last in the tree's preorder.
     tin, _ = preorder(parent)
-    sizes, bad, ends = region_extremes(
-        blocks.astype(np.int64), block_start, f, allowed, node_of, tin
-    )
+    sizes, bad, ends = region_extremes(blocks, block_start, f, allowed, node_of, tin)
     unseeable = int(group_cells[sizes == 0].sum())
     budget = int(budget_cells) - unseeable
     if budget < 0:
