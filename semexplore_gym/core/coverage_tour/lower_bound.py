@@ -14,8 +14,12 @@ optimum, so the result is below the path length of every explorer with this robo
    finds it. It reaches a checkpoint's cell from inside the last ball, so on the side of its
    square facing that ball (a ring corner at its inner corner, on that side too), and the next
    piece is at least the gap from that side to the next cell's square (the first: from anywhere
-   in the start's square). The Dijkstra distance over such hops, one state per (cell, side),
-   the last hop possibly ending inside a ball, is <= the length.
+   in the start's square). The piece also drives at least a map cell size between first
+   entering a cell of breadth-first depth ``m`` and one of ``m + 1`` (it enters the first from
+   a cell of depth ``m - 1``, which shares no move with, so does not touch, one of ``m + 1``):
+   a hop counts the larger of the gap and (depth - 1) cell sizes. The Dijkstra distance over
+   such hops, one state per (cell, side), the last hop possibly ending inside a ball, is <=
+   the length.
 3. **Where a group can be seen from (a superset).** A scan marks a cell FREE only along a beam
    from the sensor that reaches a point of the cell's square within the LiDAR's range and
    crosses no wall first. For a rectangle A of cells, a robot cell U is excluded only when
@@ -77,6 +81,8 @@ class LowerBoundParams:
     Attributes:
         hop_cells: K of the K-hop metric (open space: exact along a row, about 0.93 of a
             diagonal at K = 8).
+        hop_depth: A hop also counts a map cell size per breadth-first move beyond the first
+            (step 2; round corners, where the straight gap cuts through the wall).
         distance_cell_factor: Distance cells are this many map cells on a side (one passes
             to a neighbour where their map cells do).
         group_scales: Group block sides to try, as multiples of the side whose square holds one
@@ -103,6 +109,7 @@ class LowerBoundParams:
     """
 
     hop_cells: int = 8
+    hop_depth: bool = True
     distance_cell_factor: int = 2
     group_scales: tuple[float, ...] = (1.0, 1.4)
     max_groups: int = 13
@@ -135,6 +142,8 @@ class LowerBoundParams:
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
                 raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+        if not isinstance(self.hop_depth, bool):
+            raise ValueError(f"hop_depth must be true or false, got {self.hop_depth!r}")
         if not self.group_scales or not all(
             math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
         ):
@@ -242,6 +251,7 @@ class _Problem:
     widen_m: float
     hop_cells: int
     split_depth: int = 0
+    hop_depth: bool = True
 
     def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
         """The coarse cell of each map cell (flat indices)."""
@@ -323,8 +333,9 @@ class _Problem:
         sets = [t for t in (targets or []) if t.size]
         for j, t in enumerate(sets):
             flat[t] = j
+        step = self.geometry.resolution_m if self.hop_depth else 0.0
         d = khop_distances(
-            self.coarse, src, self.hop_cells, res, target_of, len(sets), float(limit_m)
+            self.coarse, src, self.hop_cells, res, target_of, len(sets), float(limit_m), step
         )
         return d.reshape(-1)
 
@@ -384,6 +395,7 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
         hop_cells=p.hop_cells,
         split_depth=p.visibility_splits,
+        hop_depth=p.hop_depth,
     )
     start = prob.to_coarse(np.array([sr * geo.width + sc]))
     from_start = prob.distances(start)

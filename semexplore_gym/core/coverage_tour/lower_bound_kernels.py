@@ -93,7 +93,7 @@ def _face_costs(k, res):  # pragma: no cover - numba
 
 @njit(cache=True, nogil=True)
 def khop_distances(
-    moves, sources, k, res, target_of, n_targets, limit=np.inf
+    moves, sources, k, res, target_of, n_targets, limit=np.inf, depth_step=0.0
 ):  # pragma: no cover - numba
     """K-hop lower-bound distances from ``sources`` (flat cell indices) over the cells' moves.
 
@@ -106,7 +106,14 @@ def khop_distances(
     along moves inside its Chebyshev ball of radius ``k`` that expands only cells strictly
     inside the ball, every cell ``b`` a path can reach before first leaving the ball's
     interior; the edge costs the distance from ``a``'s face to ``b``'s square (a straight
-    chain of hops thus measures ``k`` cells a hop). Cells on the ball's rim are the next
+    chain of hops thus measures ``k`` cells a hop), or ``(D - 1) * depth_step`` where that is
+    more, ``D`` the number of moves the search took from ``a`` to ``b`` (``depth_step``: the
+    least distance between two map cells whose cells share no move; 0: not used). A path
+    that first enters a cell of depth ``m`` does so from one of depth ``m - 1``, and a cell
+    of depth ``m - 1`` and one of depth ``m + 1`` share no move, so the path drives at least
+    ``depth_step`` between its first entries at depths ``m`` and ``m + 1``: round a corner
+    the breadth-first depth grows while the straight gap cuts through the wall. Cells on the
+    ball's rim are the next
     checkpoints (heap); every reached cell also records ``d(a) + cost`` as a last hop. A face
     is not pushed when another face of the same cell is known at least one cell size lower
     (its distances are never above this one's).
@@ -136,6 +143,7 @@ def khop_distances(
             keys, vals, n = _heap_push(keys, vals, n, 0.0, 5 * s)
     stamp = np.zeros(side * side, dtype=np.int64)
     queue = np.empty(side * side, dtype=np.int64)
+    depth = np.zeros(side * side, dtype=np.int64)
     sid = 0
     flat_target = target_of.reshape(h * w)
     tbest = np.full(max(n_targets, 1), np.inf)
@@ -159,6 +167,7 @@ def khop_distances(
         centre = k * side + k
         stamp[centre] = sid
         queue[0] = centre
+        depth[centre] = 0
         head = 0
         tail = 1
         while head < tail:
@@ -167,7 +176,7 @@ def khop_distances(
             li = loc // side
             lj = loc - li * side
             g = (ar + li - k) * w + (ac + lj - k)
-            e = d + cost[face, loc]
+            e = d + max(cost[face, loc], (depth[loc] - 1) * depth_step)
             if e < best[g]:
                 best[g] = e
                 t = flat_target[g]
@@ -202,6 +211,7 @@ def khop_distances(
                         continue
                     stamp[nl] = sid
                     queue[tail] = nl
+                    depth[nl] = depth[loc] + 1
                     tail += 1
     if limit < np.inf:
         for i in range(h * w):

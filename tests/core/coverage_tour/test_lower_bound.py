@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 import pytest
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 
 from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
 from semexplore_gym.core.coverage_tour.lower_bound import (
@@ -34,10 +36,30 @@ RADIUS = 0.105
 RANGE_M = 1.0
 
 
-def _khop(moves, sources, k, res):
+def _khop(moves, sources, k, res, depth_step=0.0):
     """The full K-hop field (no targets to stop at)."""
     none = np.full(moves.shape, -1, dtype=np.int64)
-    return khop_distances(moves, np.asarray(sources, dtype=np.int64), k, res, none, 0)
+    src = np.asarray(sources, dtype=np.int64)
+    return khop_distances(moves, src, k, res, none, 0, np.inf, depth_step)
+
+
+def _eight_connected_lengths(allowed, source, res):
+    """Shortest centre-to-centre polylines over touching allowed cells (a diagonal step passes
+    through the corner the two squares share): each is a drive the robot's centre could make."""
+    h, w = allowed.shape
+    idx = np.arange(h * w).reshape(h, w)
+    rows, cols, vals = [], [], []
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        a = idx[: h - dr, max(0, -dc) : w - max(0, dc)]
+        b = idx[dr:, max(0, dc) : w + min(0, dc)]
+        ok = allowed.reshape(-1)[a] & allowed.reshape(-1)[b]
+        rows.append(a[ok])
+        cols.append(b[ok])
+        vals.append(np.full(int(ok.sum()), res * math.hypot(dr, dc)))
+    graph = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))))
+    graph = graph.tocsr()
+    graph.resize(h * w, h * w)
+    return dijkstra(graph, directed=False, indices=source).reshape(h, w)
 
 
 def _world(rects, size_m, start):
@@ -103,6 +125,49 @@ def test_khop_distance_never_exceeds_the_geodesic_on_an_l_corridor():
     corner = np.array([11.0, 108.0])
     path_cells = np.hypot(*(corner - a)) + np.hypot(*(np.array(b) - corner))
     assert 0.7 * path_cells * RES <= d[b] <= path_cells * RES
+
+
+def test_a_hop_counts_its_breadth_first_depth_round_corners_and_stays_below_a_drive():
+    # A serpentine corridor 0.3 m wide, five runs of 3 m joined at alternate ends: a hop's
+    # straight gap round each of the eight corners cuts through the wall between two runs, the
+    # breadth-first depth of its far cell does not, so counting it raises the distance to the
+    # far end by metres; it stays below a drive there (centre polyline less a cell).
+    wd, runs, w = 6, 5, 60
+    allowed = np.zeros((runs * 2 * wd, w), dtype=bool)
+    for i in range(runs):
+        allowed[2 * i * wd : 2 * i * wd + wd, :] = True
+        if i < runs - 1:
+            cols = slice(w - wd, w) if i % 2 == 0 else slice(0, wd)
+            allowed[2 * i * wd + wd : 2 * i * wd + 2 * wd, cols] = True
+    src = (wd // 2) * w
+    end = (2 * (runs - 1) * wd + wd // 2, w - 1)
+    moves = coarse_moves(allowed, 1)
+    plain = _khop(moves, [src], 8, RES)
+    deep = _khop(moves, [src], 8, RES, depth_step=RES)
+    drive = _eight_connected_lengths(allowed, src, RES) - RES
+    assert plain[end] + 2.0 <= deep[end] <= drive[end]
+    assert np.all(deep[np.isfinite(plain)] >= plain[np.isfinite(plain)])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_depth_counting_khop_distance_is_never_above_a_drive_on_random_grids(seed):
+    # A drive from anywhere in the source's square to anywhere in a cell's square is at most
+    # the centre-to-centre polyline less half a cell at each end (h in all). Counting a cell
+    # size per breadth-first move beyond the first stays below it on cluttered grids with
+    # pinches; counting one per move (one more) would not, even along an open row.
+    rng = np.random.default_rng(seed)
+    allowed = rng.random((48, 48)) > 0.3 + 0.05 * seed
+    allowed[24, :] = True
+    src = 24 * 48 + int(rng.integers(0, 48))
+    moves = coarse_moves(allowed, 1)
+    drive = _eight_connected_lengths(allowed, src, RES) - RES
+    for k in (3, 8):
+        d = _khop(moves, [src], k, RES, depth_step=RES)
+        reached = np.isfinite(drive) & (drive > 0)
+        assert np.all(d[reached] <= drive[reached] + 1e-9)
+        assert np.array_equal(np.isfinite(d), np.isfinite(drive))
+    over = _khop(moves, [src], 8, RES, depth_step=RES * 8 / 7)  # as if D rather than D - 1
+    assert np.any(over[reached] > drive[reached] + 1e-9)
 
 
 def test_khop_distance_is_exact_along_a_row_and_never_above_the_squares_gap():
