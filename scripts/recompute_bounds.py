@@ -1,8 +1,8 @@
 """Recompute the certified lower bound of every start of best-known and checked-missions tables
 with today's bound, check it against every mission in them and write it into their columns.
 
-    python scripts/recompute_bounds.py configs/best_known/best_known.csv \\
-        docs/results/oracle/missions.csv --workers 2
+    SEMEXPLORE_MAPS_DIR=../shared/maps python scripts/recompute_bounds.py \\
+        configs/best_known/best_known.csv docs/results/oracle/missions.csv --workers 2
     python scripts/recompute_bounds.py my_missions.csv --dry-run   # report, write nothing
 
 After a change to the bound (``semexplore_gym.core.coverage_tour``), the tables that ship a
@@ -15,7 +15,9 @@ It then counts the rows whose T99 or drive to 99 % lies below the new bound; wit
 violation it writes nothing and exits 1 (the bound would be wrong). Otherwise it rewrites the
 bound columns (best known: 3 decimals, checked missions: 4), keeps every other cell, and
 prints per table the rows changed and the new bound over the old (least, median, largest).
-Team tables have their own bound: ``scripts/update_team_bounds.py``.
+Team tables have their own bound: ``scripts/update_team_bounds.py``. The shipped tables hold
+real maps (``map:NAME``): point ``SEMEXPLORE_MAPS_DIR`` at a folder that has them, or fetch
+them first (``semexplore maps get NAME``); a map not found stops the run with one line.
 """
 
 from __future__ import annotations
@@ -193,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{len(starts)} starts, {len(starts) - len(todo)} in {args.cache}, {len(todo)} to do")
     try:
         compute(todo, args.cache, args.workers, not args.no_progress)
-    except ValueError as e:  # a world or start the env refuses
+    except (ValueError, FileNotFoundError) as e:  # a world the env refuses, a map not here
         print(f"error: {e}", file=sys.stderr)
         return 2
     bounds = read_cache(args.cache)

@@ -94,3 +94,17 @@ def test_bad_input_is_one_clear_line(tmp_path, capsys, script):
         assert script("recompute_bounds").main(args) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and needle in err[0]
+
+
+def test_a_map_not_on_this_machine_is_one_clear_line(tmp_path, capsys, script, monkeypatch):
+    monkeypatch.setenv("SEMEXPLORE_MAPS_DIR", str(tmp_path / "no_maps"))
+    table = tmp_path / "best.csv"
+    table.write_text(
+        "world,seed,start,T99_s,T99_policy,D99_m,D99_policy,lower_bound_s,lower_bound_m\r\n"
+        '"map:brsu-c069",0,random,250.0,nearest,30.0,nearest,1.0,0.25\r\n',
+        encoding="utf-8",
+    )
+    args = [str(table), "--cache", str(tmp_path / "cache.csv"), "--no-progress"]
+    assert script("recompute_bounds").main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "brsu-c069" in err[0] and "semexplore maps get" in err[0]
