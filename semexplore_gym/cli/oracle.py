@@ -172,17 +172,20 @@ def certified_bound(
     env_config: Any = None,
     env_overrides: list[str] | None = None,
     threads: int | None = None,
+    params: dict[str, Any] | None = None,
 ) -> Any:
     """The certified :class:`~semexplore_gym.core.coverage_tour.LowerBound` of ``world`` from
     the start of ``env.reset(seed=start_seed)``, with the env's LiDAR mount offset, its
-    searches on ``threads`` threads (None: one per CPU this process may use).
+    searches on ``threads`` threads (None: one per CPU this process may use); ``params``:
+    other :class:`~semexplore_gym.core.coverage_tour.LowerBoundParams` fields (any values give
+    a valid bound).
 
     Raises:
-        ValueError: as :func:`privileged_facts`, a noisy LiDAR or odometry, or a world where
-            no bound can be computed.
+        ValueError: as :func:`privileged_facts`, a noisy LiDAR or odometry, a bad ``params``
+            field or value, or a world where no bound can be computed.
     """
     facts, config = privileged_facts(world, start_seed, env_config, env_overrides)
-    return _bound_of(facts, config, threads)
+    return _bound_of(facts, config, threads, params)
 
 
 def usable_cpus() -> int:
@@ -192,10 +195,21 @@ def usable_cpus() -> int:
     return max(1, os.cpu_count() or 1)
 
 
-def _bound_of(facts: Any, config: Any, threads: int | None = None) -> Any:
+def _bound_of(
+    facts: Any, config: Any, threads: int | None = None, params: dict[str, Any] | None = None
+) -> Any:
     """The bound for the env's LiDAR, which it models noise-free and fused at the true pose;
-    its searches on ``threads`` threads (None: :func:`usable_cpus`)."""
+    its searches on ``threads`` threads (None: :func:`usable_cpus`); ``params``: other
+    ``LowerBoundParams`` fields."""
+    from dataclasses import fields
+
     from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+
+    extra = dict(params or {})
+    known = {f.name for f in fields(LowerBoundParams)} - {"mount_offset_m", "threads"}
+    for key in extra:
+        if key not in known:
+            raise ValueError(f"unknown bound parameter {key!r}; known: {', '.join(sorted(known))}")
 
     odo = config.odometry
     drift = (odo.rot_from_rot, odo.rot_from_trans, odo.trans_from_trans, odo.trans_from_rot)
@@ -206,7 +220,7 @@ def _bound_of(facts: Any, config: Any, threads: int | None = None) -> Any:
         )
     mount_m = math.hypot(config.lidar.mount_x_m, config.lidar.mount_y_m)
     n = usable_cpus() if threads is None else threads
-    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m, threads=n))
+    return lower_bound(facts, LowerBoundParams(mount_offset_m=mount_m, threads=n, **extra))
 
 
 def _finite_or_none(value: float, digits: int) -> float | None:
