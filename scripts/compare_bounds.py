@@ -21,22 +21,18 @@ import sys
 import time
 from typing import Any
 
-import yaml
-
 
 def parse_sets(items: list[str]) -> dict[str, Any]:
-    """``KEY=VALUE`` strings as bound parameters (values read as YAML: ``false``, ``0.2``,
-    ``[1.0, 1.4]``; lists become tuples)."""
+    """``KEY=VALUE`` strings as bound parameters (values read as YAML, as every ``--*-set``
+    flag reads them: ``false``, ``0.2``, ``[1.0, 1.4]``; lists become tuples)."""
+    from semexplore_gym.config.builder import parse_override
+
     out: dict[str, Any] = {}
     for item in items:
-        key, sep, raw = item.partition("=")
-        if not sep or not key.strip():
+        if "=" not in item or not item.partition("=")[0].strip():
             raise ValueError(f"--set wants KEY=VALUE, got {item!r}")
-        try:
-            value = yaml.safe_load(raw)
-        except yaml.YAMLError:
-            raise ValueError(f"--set {key}: cannot read {raw!r}") from None
-        out[key.strip()] = tuple(value) if isinstance(value, list) else value
+        keys, value = parse_override(item)
+        out[".".join(keys)] = tuple(value) if isinstance(value, list) else value
     return out
 
 
