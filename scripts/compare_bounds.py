@@ -8,7 +8,7 @@ tightness). Prints per world the two bounds (m), their ratio and the median seco
 the bounds are deterministic, the seconds follow the machine's load.
 
     python scripts/compare_bounds.py --world 'maze:seed=5,size_m=10' --set hop_depth=false
-    python scripts/compare_bounds.py --world 'office:seed=1,size_m=20' --set branch_block_m=0.2 \\
+    python scripts/compare_bounds.py --world 'office:seed=1,size_m=20' --set branch_block_m=0.4 \\
         --rounds 2 --json
 """
 

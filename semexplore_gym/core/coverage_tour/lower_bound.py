@@ -122,7 +122,7 @@ class LowerBoundParams:
     max_entries: int = 3
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
-    branch_block_m: float = 0.4
+    branch_block_m: float = 0.2
     branch_max_walls: int = 400
     coverage_share: float | None = None
     threads: int = 1
