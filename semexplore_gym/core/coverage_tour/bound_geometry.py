@@ -68,3 +68,15 @@ def mask_groups(
     br, bc = ids // nb, ids % nb
     centres = np.column_stack([x0 + (bc + 0.5) * b * h, y0 + (br + 0.5) * b * h])
     return rects.astype(np.float64), cells.astype(np.int64), centres
+
+
+def group_parents(mask: np.ndarray, block_cells: int) -> np.ndarray:
+    """For each group of :func:`mask_groups` with ``block_cells``, the index of the group of
+    ``2 * block_cells`` blocks that holds it (the lattices nest: a block lies in one block of
+    twice the side, and so do its mask cells)."""
+    b = max(1, int(block_cells))
+    rows, cols = np.nonzero(mask)
+    small = (rows // b) * (-(-mask.shape[1] // b)) + cols // b
+    big = (rows // (2 * b)) * (-(-mask.shape[1] // (2 * b))) + cols // (2 * b)
+    _, first = np.unique(small, return_index=True)
+    return np.searchsorted(np.unique(big), big[first]).astype(np.int64)

@@ -46,6 +46,7 @@ import numpy as np
 from semexplore_gym.core.coverage_tour.branch_kernels import (
     branch_route,
     coarse_region,
+    coarse_region_among,
     merge_tree,
     preorder,
     region_extremes,
@@ -70,6 +71,11 @@ class BranchInputs:
         group_rects: Bounding rectangle ``x0, y0, x1, y1`` of each group's mask cells.
         group_cells: Mask cells of each group.
         budget_cells: Mask cells the goal lets an explorer leave unseen.
+        outer_rects: None, or the rectangles of larger groups, each group's region sought
+            only within that of its own (``outer_of``): every segment to a group is one to
+            a larger group that holds it, so the larger region holds the smaller (tighter
+            where the larger group's test proves a block blind that the smaller's does not).
+        outer_of: The larger group of each group (with ``outer_rects``).
     """
 
     allowed: np.ndarray
@@ -81,6 +87,8 @@ class BranchInputs:
     group_rects: np.ndarray
     group_cells: np.ndarray
     budget_cells: int
+    outer_rects: np.ndarray | None = None
+    outer_of: np.ndarray | None = None
 
 
 def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> float:
@@ -101,11 +109,26 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> 
     if parent.size == 0 or int(np.sum(parent == np.arange(parent.size))) != 1:
         return 0.0
     f = int(region_factor)
-    found = thread_map(
-        lambda g: coarse_region(allowed, f, group_rects[g], walls, frame),
-        range(group_rects.shape[0]),
-        threads,
-    )
+    if inputs.outer_rects is None:
+        found = thread_map(
+            lambda g: coarse_region(allowed, f, group_rects[g], walls, frame),
+            range(group_rects.shape[0]),
+            threads,
+        )
+    else:
+        outer_rects, outer_of = inputs.outer_rects, inputs.outer_of
+        outer = thread_map(
+            lambda g: coarse_region(allowed, f, outer_rects[g], walls, frame),
+            range(outer_rects.shape[0]),
+            threads,
+        )
+        found = thread_map(
+            lambda g: coarse_region_among(
+                allowed, f, group_rects[g], walls, frame, outer[outer_of[g]]
+            ),
+            range(group_rects.shape[0]),
+            threads,
+        )
     block_start = np.zeros(len(found) + 1, dtype=np.int64)
     block_start[1:] = np.cumsum([b.size for b in found])
     blocks = np.concatenate(found).astype(np.int64, copy=False) if found else np.zeros(0, np.int64)

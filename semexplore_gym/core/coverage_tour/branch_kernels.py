@@ -250,68 +250,84 @@ def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - nu
     traced from a raster), every block within reach is in, untested (a superset; the tests
     would cost walls x blocks). ``frame``: ``gx0, gy0, res (map), reach_m, widen_m, tol, depth,
     max_walls``."""
+    gx0, gy0, res, reach_m, widen_m, _, _, _ = unpack_frame(frame)
+    f = factor
+    h = -(-allowed.shape[0] // f)
+    w = -(-allowed.shape[1] // f)
+    c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res * f, h, w)
+    candidates = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
+    k = 0
+    for r in range(r_lo, r_hi + 1):
+        for c in range(c_lo, c_hi + 1):
+            candidates[k] = r * w + c
+            k += 1
+    return coarse_region_among(allowed, factor, rect, walls, frame, candidates[:k])
+
+
+@njit(cache=True, nogil=True)
+def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pragma: no cover
+    """:func:`coarse_region`'s test of the coarse cells ``candidates`` (flat indices) only: the
+    region within a known superset of it (a larger rectangle's region holds a smaller one's:
+    every segment to the smaller is one to the larger)."""
     gx0, gy0, res, reach_m, widen_m, tol, depth, max_walls = unpack_frame(frame)
     f = factor
     hm, wm = allowed.shape
-    h = -(-hm // f)
     w = -(-wm // f)
-    res = res * f
-    c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
     near, m = walls_near(walls, rect, reach_m + widen_m)
     work = np.empty((6, 4))
-    out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
+    out = np.empty(candidates.size, dtype=np.int64)
     count = 0
     last = 0
     cx_r = 0.5 * (rect[0] + rect[2])
     cy_r = 0.5 * (rect[1] + rect[3])
-    for r in range(r_lo, r_hi + 1):
-        for c in range(c_lo, c_hi + 1):
-            r0 = r * f
-            c0 = c * f
-            lo_r = f
-            hi_r = -1
-            lo_c = f
-            hi_c = -1
-            for i in range(f):
-                for j in range(f):
-                    if r0 + i < hm and c0 + j < wm and allowed[r0 + i, c0 + j]:
-                        lo_r = min(lo_r, i)
-                        hi_r = max(hi_r, i)
-                        lo_c = min(lo_c, j)
-                        hi_c = max(hi_c, j)
-            if hi_r < 0:
-                continue
-            cell = res / f
-            y0 = gy0 + (r0 + lo_r) * cell - widen_m
-            y1 = gy0 + (r0 + hi_r + 1) * cell + widen_m
-            gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
-            x0 = gx0 + (c0 + lo_c) * cell - widen_m
-            x1 = gx0 + (c0 + hi_c + 1) * cell + widen_m
-            gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
-            if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
-                continue
-            px = 0.5 * (x0 + x1)
-            py = 0.5 * (y0 + y1)
-            # the rectangle's point nearest the centre, then its centre
-            qx = min(max(px, rect[0]), rect[2])
-            qy = min(max(py, rect[1]), rect[3])
-            seen = m > max_walls
-            for k in range(0 if seen else 2):
-                if k == 1:
-                    qx = cx_r
-                    qy = cy_r
-                if (qx - px) ** 2 + (qy - py) ** 2 <= reach_m * reach_m and _segment_clear(
-                    walls, near, m, px, py, qx, qy, tol
-                ):
-                    seen = True
-                    break
-            if not seen:
-                box = (x0, y0, x1, y1)
-                blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
-                seen = not blind
-            if seen:
-                out[count] = r * w + c
-                count += 1
+    cell = (res * f) / f  # the map cell, rounded as the coarse side divided (as before)
+    for flat in candidates:
+        r, c = divmod(flat, w)
+        r0 = r * f
+        c0 = c * f
+        lo_r = f
+        hi_r = -1
+        lo_c = f
+        hi_c = -1
+        for i in range(f):
+            for j in range(f):
+                if r0 + i < hm and c0 + j < wm and allowed[r0 + i, c0 + j]:
+                    lo_r = min(lo_r, i)
+                    hi_r = max(hi_r, i)
+                    lo_c = min(lo_c, j)
+                    hi_c = max(hi_c, j)
+        if hi_r < 0:
+            continue
+        y0 = gy0 + (r0 + lo_r) * cell - widen_m
+        y1 = gy0 + (r0 + hi_r + 1) * cell + widen_m
+        gap_y = max(0.0, max(rect[1] - y1, y0 - rect[3]))
+        x0 = gx0 + (c0 + lo_c) * cell - widen_m
+        x1 = gx0 + (c0 + hi_c + 1) * cell + widen_m
+        gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
+        if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
+            continue
+        px = 0.5 * (x0 + x1)
+        py = 0.5 * (y0 + y1)
+        # the rectangle's point nearest the centre, then its centre
+        qx = min(max(px, rect[0]), rect[2])
+        qy = min(max(py, rect[1]), rect[3])
+        seen = m > max_walls
+        for k in range(0 if seen else 2):
+            if k == 1:
+                qx = cx_r
+                qy = cy_r
+            if (qx - px) ** 2 + (qy - py) ** 2 <= reach_m * reach_m and _segment_clear(
+                walls, near, m, px, py, qx, qy, tol
+            ):
+                seen = True
+                break
+        if not seen:
+            box = (x0, y0, x1, y1)
+            blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
+            seen = not blind
+        if seen:
+            out[count] = flat
+            count += 1
     return out[:count].copy()
 
 

@@ -57,7 +57,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import ndimage
 
-from semexplore_gym.core.coverage_tour.bound_geometry import mask_groups, merge_walls
+from semexplore_gym.core.coverage_tour.bound_geometry import group_parents, mask_groups, merge_walls
 from semexplore_gym.core.coverage_tour.branch_bound import BranchInputs, branch_bound_m
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
@@ -101,6 +101,8 @@ class LowerBoundParams:
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
         branch_block_m: Side of the branch bound's groups (0: no branch bound).
+        branch_nested: Seek each branch group's region within that of the block of twice
+            the side holding it (the same or a smaller region, quicker; off: tested alone).
         branch_max_walls: A branch group with more walls than this within reach is taken as
             seen from every cell within reach, untested (rasterised maps: far quicker, looser).
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
@@ -123,6 +125,7 @@ class LowerBoundParams:
     penetration_tolerance_m: float = 0.01
     mount_offset_m: float = 0.0
     branch_block_m: float = 0.2
+    branch_nested: bool = False
     branch_max_walls: int = 400
     coverage_share: float | None = None
     threads: int = 1
@@ -142,8 +145,9 @@ class LowerBoundParams:
             v = getattr(self, name)
             if not (isinstance(v, int) and lo <= v <= hi):
                 raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
-        if not isinstance(self.hop_depth, bool):
-            raise ValueError(f"hop_depth must be true or false, got {self.hop_depth!r}")
+        for name in ("hop_depth", "branch_nested"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} must be true or false, got {getattr(self, name)!r}")
         if not self.group_scales or not all(
             math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
         ):
@@ -408,14 +412,19 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
     assert best is not None
     branch_m = 0.0
     if p.branch_block_m > 0:
-        rects, cells, _ = mask_groups(mask, geo, max(1, round(p.branch_block_m / geo.resolution_m)))
+        side = max(1, round(p.branch_block_m / geo.resolution_m))
+        rects, cells, _ = mask_groups(mask, geo, side)
+        nest = p.branch_nested
+        outer = (mask_groups(mask, geo, 2 * side)[0], group_parents(mask, side)) if nest else ()
         frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
         frame = np.append(frame, [prob.widen_m, _VISIBILITY_TOL_M, p.visibility_splits])
         frame = np.append(frame, p.branch_max_walls)
         fine = replace(prob, coarse=coarse_moves(allowed, 1), factor=1)
         phi = fine.distances(np.array([sr * geo.width + sc]))
         branch_m = branch_bound_m(
-            BranchInputs(allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget),
+            BranchInputs(
+                allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget, *outer
+            ),
             threads=p.threads,
         )
     length_m = max(best.length_m, branch_m)

@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+from semexplore_gym.core.coverage_tour.bound_geometry import group_parents
 from semexplore_gym.core.coverage_tour.branch_kernels import (
     branch_route,
     coarse_region,
+    coarse_region_among,
     merge_tree,
     preorder,
     region_extremes,
@@ -193,6 +195,35 @@ def test_a_distance_cells_region_holds_every_distance_cell_of_the_map_cell_regio
     assert grew <= 0.05 * sum(prob.region(rects[g]).size for g in range(0, rects.shape[0], 5))
 
 
+@pytest.mark.parametrize("spec", ["maze:seed=1,size_m=5", "office:seed=2,size_m=10"])
+def test_a_region_sought_within_its_larger_groups_region_is_the_meet_of_both(spec, bound_problem):
+    """``branch_nested``: a group's region tested only among the blocks of the region of the
+    block of twice the side that holds it. Every segment to the group is one to the larger
+    group, so both regions are supersets of what sees the group, and so is their meet: the
+    nested search must give exactly the meet (no block lost to the order of the tests)."""
+    facts, allowed, prob = bound_problem(spec, 3, 2, 8)
+    geo, mask = facts.geometry, facts.reachable_mask
+    frame = np.array(
+        [geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m, 1e-6, 1e-6, 3, 10**6]
+    )
+    rects, _, _ = mask_groups(mask, geo, 4)
+    outer_rects, _, _ = mask_groups(mask, geo, 8)
+    parent = group_parents(mask, 4)
+    assert parent.shape == (rects.shape[0],) and np.unique(parent).size == outer_rects.shape[0]
+    # each group's mask cells lie in its parent's
+    inside = (rects[:, :2] >= outer_rects[parent, :2]) & (rects[:, 2:] <= outer_rects[parent, 2:])
+    assert inside.all()
+    every = np.arange(prob.coarse.size, dtype=np.int64)
+    for g in range(0, rects.shape[0], 7):
+        alone = coarse_region(allowed, 2, rects[g], prob.walls, frame)
+        outer = coarse_region(allowed, 2, outer_rects[parent[g]], prob.walls, frame)
+        nested = coarse_region_among(allowed, 2, rects[g], prob.walls, frame, outer)
+        assert np.array_equal(nested, np.intersect1d(alone, outer))
+        # among every block of the map, the test is coarse_region's own
+        among_all = coarse_region_among(allowed, 2, rects[g], prob.walls, frame, every)
+        assert np.array_equal(among_all, alone)
+
+
 def _comb(privileged_world, n_teeth):
     """A spine 0.6 m wide with ``n_teeth`` teeth 3 m deep every 2 m, the start at its left end;
     and the drive that covers it: along the spine, into each tooth to the LiDAR's range of its
@@ -231,6 +262,15 @@ def test_on_a_ring_the_branch_bound_stays_below_driving_round_once(privileged_wo
 def test_a_bad_branch_block_is_one_clear_error():
     with pytest.raises(ValueError, match="branch_block_m"):
         LowerBoundParams(branch_block_m=-0.1)
+    with pytest.raises(ValueError, match="branch_nested must be true or false, got 'yes'"):
+        LowerBoundParams(branch_nested="yes")
+
+
+def test_nested_regions_give_a_bound_as_high_and_still_below_a_feasible_drive(privileged_world):
+    facts, feasible = _comb(privileged_world, 4)
+    alone = lower_bound(facts)
+    nested = lower_bound(facts, LowerBoundParams(branch_nested=True))
+    assert alone.branch_m <= nested.branch_m <= feasible
 
 
 def test_phi_jumps_between_touching_cells_by_at_most_a_cells_diagonal(bound_problem):
