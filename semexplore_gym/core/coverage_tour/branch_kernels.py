@@ -12,7 +12,14 @@ from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     box_blind,
     cells_within,
     unpack_frame,
+    wall_blocks,
     walls_near,
+)
+from semexplore_gym.core.coverage_tour.sight_kernels import (
+    SIGHT_BUCKETS,
+    sees_clearly,
+    sight_table,
+    umbra_hints,
 )
 
 
@@ -209,47 +216,18 @@ def region_extremes(blocks, block_start, factor, allowed, node_of, tin):  # prag
     return count, bad, ends
 
 
-@njit(cache=True)
-def _segment_clear(walls, near, m, px, py, qx, qy, tol):  # pragma: no cover - numba
-    """Whether the segment ``p``-``q`` stays at least ``tol`` clear of every wall in
-    ``near[:m]`` (a segment a wall touches within ``tol`` counts as blocked)."""
-    dx = qx - px
-    dy = qy - py
-    for k in range(m):
-        q = near[k]
-        ax = walls[q, 0]
-        ay = walls[q, 1]
-        ex = walls[q, 2] - ax
-        ey = walls[q, 3] - ay
-        den = dx * ey - dy * ex
-        if abs(den) < 1e-15:
-            # parallel: blocked only if collinear and overlapping (count as blocked)
-            cross = (ax - px) * dy - (ay - py) * dx
-            if abs(cross) <= tol * math.sqrt(dx * dx + dy * dy) + 1e-12:
-                return False
-            continue
-        s = ((ax - px) * ey - (ay - py) * ex) / den
-        u = ((ax - px) * dy - (ay - py) * dx) / den
-        seg = math.sqrt(dx * dx + dy * dy)
-        wl = math.sqrt(ex * ex + ey * ey)
-        ms = tol / seg if seg > 0 else 1.0
-        mu = tol / wl if wl > 0 else 1.0
-        if s >= -ms and s <= 1.0 + ms and u >= -mu and u <= 1.0 + mu:
-            return False
-    return True
-
-
 @njit(cache=True, nogil=True)
 def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - numba
     """Flat indices of the coarse cells (``factor`` x ``factor`` blocks of ``allowed``) not
-    certainly blind to ``rect`` (``x0, y0, x1, y1``): the bounding box of the block's allowed
-    map cells, widened by ``widen_m``, tested as :func:`.lower_bound_kernels.group_region`
-    tests one map cell's square (so a superset of the coarse cells of that region). A block
-    with one clear segment from its box's centre to ``rect`` within reach is in at once (then
-    no wall meets every segment). With more than ``max_walls`` walls near ``rect`` (a map
-    traced from a raster), every block within reach is in, untested (a superset; the tests
-    would cost walls x blocks). ``frame``: ``gx0, gy0, res (map), reach_m, widen_m, tol, depth,
-    max_walls``."""
+    certainly blind to ``rect`` (``x0, y0, x1, y1``), in increasing order: the bounding box of
+    the block's allowed map cells, widened by ``widen_m``, tested as
+    :func:`.lower_bound_kernels.group_region` tests one map cell's square (so a superset of the
+    coarse cells of that region): within reach, and not proven blind by
+    :func:`.lower_bound_kernels.box_blind`. Umbras and sight tables
+    (:mod:`.sight_kernels`) decide most blocks sooner with the same answer. With more than
+    ``max_walls`` walls near ``rect`` (a map traced from a raster), every block within reach is
+    in, untested (a superset; the tests would cost walls x blocks). ``frame``: ``gx0, gy0, res
+    (map), reach_m, widen_m, tol, depth, max_walls``."""
     gx0, gy0, res, reach_m, widen_m, _, _, _ = unpack_frame(frame)
     f = factor
     h = -(-allowed.shape[0] // f)
@@ -272,17 +250,20 @@ def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pra
     gx0, gy0, res, reach_m, widen_m, tol, depth, max_walls = unpack_frame(frame)
     f = factor
     hm, wm = allowed.shape
+    h = -(-hm // f)
     w = -(-wm // f)
+    c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res * f, h, w)
+    rows = r_hi - r_lo + 1
+    cols = c_hi - c_lo + 1
     near, m = walls_near(walls, rect, reach_m + widen_m)
-    work = np.empty((6, 4))
-    out = np.empty(candidates.size, dtype=np.int64)
-    count = 0
-    last = 0
-    cx_r = 0.5 * (rect[0] + rect[2])
-    cy_r = 0.5 * (rect[1] + rect[3])
     cell = (res * f) / f  # the map cell, rounded as the coarse side divided (as before)
+    # the window's blocks: the candidates among them with allowed cells within reach
+    live = np.zeros((rows, cols), dtype=np.bool_)
+    boxes = np.empty((rows, cols, 4))
     for flat in candidates:
         r, c = divmod(flat, w)
+        if r < r_lo or r > r_hi or c < c_lo or c > c_hi:
+            continue  # beyond reach (the window holds every block within it)
         r0 = r * f
         c0 = c * f
         lo_r = f
@@ -306,28 +287,88 @@ def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pra
         gap_x = max(0.0, max(rect[0] - x1, x0 - rect[2]))
         if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
             continue
-        px = 0.5 * (x0 + x1)
-        py = 0.5 * (y0 + y1)
-        # the rectangle's point nearest the centre, then its centre
-        qx = min(max(px, rect[0]), rect[2])
-        qy = min(max(py, rect[1]), rect[3])
-        seen = m > max_walls
-        for k in range(0 if seen else 2):
-            if k == 1:
-                qx = cx_r
-                qy = cy_r
-            if (qx - px) ** 2 + (qy - py) ** 2 <= reach_m * reach_m and _segment_clear(
-                walls, near, m, px, py, qx, qy, tol
-            ):
-                seen = True
-                break
-        if not seen:
-            box = (x0, y0, x1, y1)
-            blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
-            seen = not blind
-        if seen:
-            out[count] = flat
-            count += 1
+        i = r - r_lo
+        j = c - c_lo
+        live[i, j] = True
+        boxes[i, j, 0] = x0
+        boxes[i, j, 1] = y0
+        boxes[i, j, 2] = x1
+        boxes[i, j, 3] = y1
+    out = np.empty(rows * cols, dtype=np.int64)
+    count = 0
+    if m > max_walls:
+        for i in range(rows):
+            for j in range(cols):
+                if live[i, j]:
+                    out[count] = (r_lo + i) * w + c_lo + j
+                    count += 1
+        return out[:count].copy()
+    hint = np.full((rows, cols), -1, dtype=np.int64)
+    window = np.array([gx0 + c_lo * res * f, gy0 + r_lo * res * f, res * f])
+    umbra_hints(walls, near, m, rect, tol, window, boxes, live, hint)
+    # sight tables from the rectangle's centre and (lazily) its corners, 2 mm in
+    inset = min(2e-3, 0.25 * min(rect[2] - rect[0], rect[3] - rect[1]))
+    sx = np.array([0.5 * (rect[0] + rect[2]), rect[0] + inset, rect[2] - inset])
+    sy = np.array([0.5 * (rect[1] + rect[3]), rect[1] + inset, rect[3] - inset])
+    tables = np.empty((5, SIGHT_BUCKETS))
+    built = np.zeros(5, dtype=np.bool_)
+    sight_table(walls, near, m, sx[0], sy[0], tables[0])
+    built[0] = True
+    margin = 4.0 * tol
+    work = np.empty((6, 4))
+    fa = np.empty(4)
+    fu = np.empty(4)
+    ux = np.empty(4)
+    uy = np.empty(4)
+    ax = np.array([rect[0], rect[2], rect[2], rect[0]])
+    ay = np.array([rect[1], rect[1], rect[3], rect[3]])
+    last = 0
+    for i in range(rows):
+        for j in range(cols):
+            if not live[i, j]:
+                continue
+            x0 = boxes[i, j, 0]
+            y0 = boxes[i, j, 1]
+            x1 = boxes[i, j, 2]
+            y1 = boxes[i, j, 3]
+            p = hint[i, j]
+            if p >= 0:  # box_blind's own first proof, with the wall it would find
+                ux[0] = x0
+                ux[1] = x1
+                ux[2] = x1
+                ux[3] = x0
+                uy[0] = y0
+                uy[1] = y0
+                uy[2] = y1
+                uy[3] = y1
+                if wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
+                    continue
+            px = 0.5 * (x0 + x1)
+            py = 0.5 * (y0 + y1)
+            seen = sees_clearly(tables[0], sx[0], sy[0], px, py, reach_m, margin)
+            for k in range(1, 5):  # the corners' tables, from the box's centre and corners
+                if seen:
+                    break
+                if not built[k]:
+                    kx = sx[1] if k == 1 or k == 4 else sx[2]
+                    ky = sy[1] if k <= 2 else sy[2]
+                    sight_table(walls, near, m, kx, ky, tables[k])
+                    built[k] = True
+                kx = sx[1] if k == 1 or k == 4 else sx[2]
+                ky = sy[1] if k <= 2 else sy[2]
+                for e in range(5):
+                    ex = px if e == 0 else (x0 + inset if e == 1 or e == 4 else x1 - inset)
+                    ey = py if e == 0 else (y0 + inset if e <= 2 else y1 - inset)
+                    if sees_clearly(tables[k], kx, ky, ex, ey, reach_m, margin):
+                        seen = True
+                        break
+            if not seen:
+                box = (x0, y0, x1, y1)
+                blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
+                seen = not blind
+            if seen:
+                out[count] = (r_lo + i) * w + c_lo + j
+                count += 1
     return out[:count].copy()
 
 

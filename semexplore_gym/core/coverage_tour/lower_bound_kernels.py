@@ -228,7 +228,7 @@ def unpack_frame(frame):  # pragma: no cover - numba
 
 
 @njit(cache=True)
-def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - numba
+def wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - numba
     """Whether ``wall`` meets every segment between the rectangles with corners ``(ax, ay)``
     and ``(ux, uy)``: its line separates them strictly and all 16 corner-pair segments cross
     the line inside the wall (the union of the segments is the convex hull of the two)."""
@@ -265,10 +265,10 @@ def _wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - n
 def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover
     """Position in ``near[:m]`` of a wall that meets every segment between the two rectangles
     (tried first: ``last``), or -1 for none."""
-    if m > 0 and _wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
+    if m > 0 and wall_blocks(walls, near[last], ax, ay, ux, uy, tol, fa, fu):
         return last
     for p in range(m):
-        if p != last and _wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
+        if p != last and wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
             return p
     return -1
 
