@@ -1,5 +1,5 @@
-"""Geometry the certified bounds share: walls merged into maximal segments, and the mask's
-cells grouped by the blocks of a lattice."""
+"""Geometry the certified bounds share: walls merged into maximal segments, the corners where
+two of them meet, and the mask's cells grouped by the blocks of a lattice."""
 
 from __future__ import annotations
 
@@ -39,6 +39,35 @@ def merge_walls(segments_m: np.ndarray, tol_m: float = 1e-9) -> np.ndarray:
                 cur_lo, cur_hi = lo[i], hi[i]
         out.append(np.concatenate([base + cur_lo * ug, base + cur_hi * ug]))
     return np.array(out, dtype=np.float64).reshape(-1, 4)
+
+
+def wall_corners(segments_m: np.ndarray, walls: np.ndarray, tol_m: float = 1e-9) -> np.ndarray:
+    """Where two merged ``walls`` (:func:`merge_walls` of ``segments_m``) that are not collinear
+    both end at one point that ends two of the env's own segments exactly (the same floats:
+    its ray cast then counts a beam through the point as a hit on one of them). One row per
+    pair: ``vx, vy``, then for each wall its unit direction from the point and its length
+    ``(K, 8)``."""
+    seg = np.asarray(segments_m, dtype=np.float64).reshape(-1, 4)
+    ends = np.concatenate([seg[:, :2], seg[:, 2:]])
+    points, counts = np.unique(ends, axis=0, return_counts=True)
+    shared = points[counts >= 2]
+    w = np.asarray(walls, dtype=np.float64).reshape(-1, 4)
+    rows: list[list[float]] = []
+    for vx, vy in shared:
+        legs = []
+        for a, b in ((w[:, :2], w[:, 2:]), (w[:, 2:], w[:, :2])):
+            at = np.flatnonzero(np.hypot(a[:, 0] - vx, a[:, 1] - vy) <= tol_m)
+            for i in at:
+                d = b[i] - (vx, vy)
+                length = float(np.hypot(*d))
+                if length > 0:
+                    legs.append((*(d / length), length))
+        for i in range(len(legs)):
+            for j in range(i + 1, len(legs)):
+                (ax, ay, la), (bx, by, lb) = legs[i], legs[j]
+                if abs(ax * by - ay * bx) > 1e-9:
+                    rows.append([vx, vy, ax, ay, la, bx, by, lb])
+    return np.array(rows, dtype=np.float64).reshape(-1, 8)
 
 
 def mask_groups(

@@ -39,7 +39,7 @@ seen from its mouth (rooms behind doors).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -76,6 +76,8 @@ class BranchInputs:
             a larger group that holds it, so the larger region holds the smaller (tighter
             where the larger group's test proves a block blind that the smaller's does not).
         outer_of: The larger group of each group (with ``outer_rects``).
+        corners: Pairs of walls that block a view together (:func:`.bound_geometry.wall_corners`;
+            none by default).
     """
 
     allowed: np.ndarray
@@ -89,6 +91,7 @@ class BranchInputs:
     budget_cells: int
     outer_rects: np.ndarray | None = None
     outer_of: np.ndarray | None = None
+    corners: np.ndarray = field(default_factory=lambda: np.zeros((0, 8)))
 
 
 def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> float:
@@ -104,6 +107,7 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> 
     group_rects, group_cells = inputs.group_rects, inputs.group_cells
     moves, from_start, budget_cells = inputs.moves, inputs.from_start, inputs.budget_cells
     region_factor = inputs.region_factor
+    corners = inputs.corners
     phi = np.asarray(from_start, dtype=np.float64)
     _, node_of, parent, level = merge_tree(moves, phi)
     if parent.size == 0 or int(np.sum(parent == np.arange(parent.size))) != 1:
@@ -111,20 +115,20 @@ def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> 
     f = int(region_factor)
     if inputs.outer_rects is None:
         found = thread_map(
-            lambda g: coarse_region(allowed, f, group_rects[g], walls, frame),
+            lambda g: coarse_region(allowed, f, group_rects[g], walls, frame, corners),
             range(group_rects.shape[0]),
             threads,
         )
     else:
         outer_rects, outer_of = inputs.outer_rects, inputs.outer_of
         outer = thread_map(
-            lambda g: coarse_region(allowed, f, outer_rects[g], walls, frame),
+            lambda g: coarse_region(allowed, f, outer_rects[g], walls, frame, corners),
             range(outer_rects.shape[0]),
             threads,
         )
         found = thread_map(
             lambda g: coarse_region_among(
-                allowed, f, group_rects[g], walls, frame, outer[outer_of[g]]
+                allowed, f, group_rects[g], walls, frame, outer[outer_of[g]], corners
             ),
             range(group_rects.shape[0]),
             threads,

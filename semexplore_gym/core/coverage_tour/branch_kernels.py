@@ -3,14 +3,13 @@ the level at which a set of cells first lies in one of its branches."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     box_blind,
     cells_within,
+    corners_near,
     unpack_frame,
     wall_blocks,
     walls_near,
@@ -217,7 +216,7 @@ def region_extremes(blocks, block_start, factor, allowed, node_of, tin):  # prag
 
 
 @njit(cache=True, nogil=True)
-def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - numba
+def coarse_region(allowed, factor, rect, walls, frame, corners):  # pragma: no cover - numba
     """Flat indices of the coarse cells (``factor`` x ``factor`` blocks of ``allowed``) not
     certainly blind to ``rect`` (``x0, y0, x1, y1``), in increasing order: the bounding box of
     the block's allowed map cells, widened by ``widen_m``, tested as
@@ -239,11 +238,13 @@ def coarse_region(allowed, factor, rect, walls, frame):  # pragma: no cover - nu
         for c in range(c_lo, c_hi + 1):
             candidates[k] = r * w + c
             k += 1
-    return coarse_region_among(allowed, factor, rect, walls, frame, candidates[:k])
+    return coarse_region_among(allowed, factor, rect, walls, frame, candidates[:k], corners)
 
 
 @njit(cache=True, nogil=True)
-def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pragma: no cover
+def coarse_region_among(
+    allowed, factor, rect, walls, frame, candidates, corners
+):  # pragma: no cover - numba
     """:func:`coarse_region`'s test of the coarse cells ``candidates`` (flat indices) only: the
     region within a known superset of it (a larger rectangle's region holds a smaller one's:
     every segment to the smaller is one to the larger)."""
@@ -256,6 +257,7 @@ def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pra
     rows = r_hi - r_lo + 1
     cols = c_hi - c_lo + 1
     near, m = walls_near(walls, rect, reach_m + widen_m)
+    close = corners_near(corners, rect, reach_m + widen_m)
     cell = (res * f) / f  # the map cell, rounded as the coarse side divided (as before)
     # the window's blocks: the candidates among them with allowed cells within reach
     live = np.zeros((rows, cols), dtype=np.bool_)
@@ -364,7 +366,9 @@ def coarse_region_among(allowed, factor, rect, walls, frame, candidates):  # pra
                         break
             if not seen:
                 box = (x0, y0, x1, y1)
-                blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
+                blind, last = box_blind(
+                    walls, near, m, last, rect, box, reach_m, depth, tol, work, close
+                )
                 seen = not blind
             if seen:
                 out[count] = (r_lo + i) * w + c_lo + j

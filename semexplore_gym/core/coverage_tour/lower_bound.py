@@ -52,12 +52,18 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import ndimage
 
-from semexplore_gym.core.coverage_tour.bound_geometry import group_parents, mask_groups, merge_walls
+from semexplore_gym.core.coverage_tour.bound_geometry import (
+    group_parents,
+    mask_groups,
+    merge_walls,
+    wall_corners,
+)
+from semexplore_gym.core.coverage_tour.bound_params import LowerBoundParams
 from semexplore_gym.core.coverage_tour.branch_bound import BranchInputs, branch_bound_m
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
@@ -72,101 +78,6 @@ from semexplore_gym.core.worlds.geometry import segment_distance_field
 _EIGHT = np.ones((3, 3), dtype=bool)
 _VISIBILITY_TOL_M = 1e-6
 _CLEARANCE_TOL_M = 1e-4
-
-
-@dataclass(frozen=True)
-class LowerBoundParams:
-    """Knobs of :func:`lower_bound` (any values give a valid bound; they trade speed for tightness).
-
-    Attributes:
-        hop_cells: K of the K-hop metric (open space: exact along a row, about 0.93 of a
-            diagonal at K = 8).
-        hop_depth: A hop also counts a map cell size per breadth-first move beyond the first
-            (step 2; round corners, where the straight gap cuts through the wall).
-        distance_cell_factor: Distance cells are this many map cells on a side (one passes
-            to a neighbour where their map cells do).
-        group_scales: Group block sides to try, as multiples of the side whose square holds one
-            more cell than the skip budget (the largest bound wins).
-        max_groups: Most groups in the exact route (Held-Karp is 2^n n^2).
-        pool_groups: Groups (farthest first) the route's groups are chosen from.
-        leg_limit_share: Legs are searched only up to this share of the farthest entry
-            piece's distance from the start (longer ones count as that much; 1: no limit).
-        keep_share: Share of the well-filled groups, those seen from the fewest cells (on a
-            sample every ``sample_stride`` cells), the pool is drawn from.
-        entry_tile_m: Side of the tiles that split where a route can first enter a region
-            into entry pieces (each piece a node of the route).
-        max_entries: Most entry pieces per group (more are merged into the nearest).
-        visibility_splits: Times a group's rectangle is quartered to find walls that block a
-            cell's view of each quarter (0: one wall for the whole group).
-        penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
-        mount_offset_m: LiDAR distance from the robot centre.
-        branch_block_m: Side of the branch bound's groups (0: no branch bound).
-        branch_nested: Seek each branch group's region within that of the block of twice
-            the side holding it (the same or a smaller region, quicker; off: tested alone).
-        branch_max_walls: A branch group with more walls than this within reach is taken as
-            seen from every cell within reach, untested (rasterised maps: far quicker, looser).
-        coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
-        threads: Threads for the independent searches (the bound is the same for any
-            number; ``semexplore oracle`` uses one per CPU the process may use).
-    """
-
-    hop_cells: int = 8
-    hop_depth: bool = True
-    distance_cell_factor: int = 2
-    group_scales: tuple[float, ...] = (1.0, 1.4)
-    max_groups: int = 13
-    pool_groups: int = 14
-    keep_share: float = 0.5
-    leg_limit_share: float = 0.6
-    sample_stride: int = 4
-    visibility_splits: int = 3
-    entry_tile_m: float = 1.0
-    max_entries: int = 3
-    penetration_tolerance_m: float = 0.01
-    mount_offset_m: float = 0.0
-    branch_block_m: float = 0.2
-    branch_nested: bool = False
-    branch_max_walls: int = 400
-    coverage_share: float | None = None
-    threads: int = 1
-
-    def __post_init__(self) -> None:
-        for name, lo, hi in (
-            ("hop_cells", 1, 64),
-            ("distance_cell_factor", 1, 8),
-            ("max_groups", 1, 18),
-            ("pool_groups", 1, 64),
-            ("sample_stride", 1, 16),
-            ("visibility_splits", 0, 8),
-            ("max_entries", 1, 16),
-            ("branch_max_walls", 0, 1_000_000),
-            ("threads", 1, 256),
-        ):
-            v = getattr(self, name)
-            if not (isinstance(v, int) and lo <= v <= hi):
-                raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
-        for name in ("hop_depth", "branch_nested"):
-            if not isinstance(getattr(self, name), bool):
-                raise ValueError(f"{name} must be true or false, got {getattr(self, name)!r}")
-        if not self.group_scales or not all(
-            math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
-        ):
-            raise ValueError(f"group_scales must be in [0.05, 20], got {self.group_scales!r}")
-        for name in ("penetration_tolerance_m", "mount_offset_m"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and 0 <= v <= 0.5):
-                raise ValueError(f"{name} must be in [0, 0.5] m, got {v!r}")
-        if not (math.isfinite(self.branch_block_m) and 0 <= self.branch_block_m <= 10):
-            raise ValueError(f"branch_block_m must be in [0, 10] m, got {self.branch_block_m!r}")
-        if not (math.isfinite(self.entry_tile_m) and 0.1 <= self.entry_tile_m <= 100):
-            raise ValueError(f"entry_tile_m must be in [0.1, 100] m, got {self.entry_tile_m!r}")
-        for name in ("keep_share", "leg_limit_share"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and 0 < v <= 1):
-                raise ValueError(f"{name} must be in (0, 1], got {v!r}")
-        share = self.coverage_share
-        if share is not None and not (0 < share <= 1):
-            raise ValueError(f"coverage_share must be in (0, 1], got {share!r}")
 
 
 @dataclass(frozen=True)
@@ -256,6 +167,7 @@ class _Problem:
     hop_cells: int
     split_depth: int = 0
     hop_depth: bool = True
+    corners: np.ndarray = field(default_factory=lambda: np.zeros((0, 8)))
 
     def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
         """The coarse cell of each map cell (flat indices)."""
@@ -267,7 +179,8 @@ class _Problem:
 
     def region(self, rect: np.ndarray, stride: int = 1) -> np.ndarray:
         """Coarse cells of the region of the group in ``rect`` (with ``stride`` > 1 a sample
-        of it, only to rank groups)."""
+        of it, only to rank groups: tested without corners, so that the groups a route is
+        chosen from are the same with them or without)."""
         g = self.geometry
         frame = np.array(
             [
@@ -282,7 +195,8 @@ class _Problem:
             ],
             dtype=np.float64,
         )
-        return self.to_coarse(group_region(self.allowed, rect, self.walls, frame))
+        corners = self.corners if stride == 1 else self.corners[:0]
+        return self.to_coarse(group_region(self.allowed, rect, self.walls, frame, corners))
 
     def entry_pieces(self, region: np.ndarray, start: int, tile: int, cap: int) -> list[np.ndarray]:
         """Where a route can first enter ``region`` (coarse cells): its cells with a move to a
@@ -389,17 +303,20 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
     share = facts.coverage_goal if p.coverage_share is None else p.coverage_share
     budget = skip_budget_cells(n_mask, share)
     f = p.distance_cell_factor
+    walls = merge_walls(facts.world.segments_m)
+    corners = wall_corners(facts.world.segments_m, walls) if p.wall_corners else np.zeros((0, 8))
     prob = _Problem(
         allowed=allowed,
         coarse=coarse_moves(allowed, f),
         factor=f,
-        walls=merge_walls(facts.world.segments_m),
+        walls=walls,
         geometry=geo,
         reach_m=facts.sensor.max_range_m + _VISIBILITY_TOL_M,
         widen_m=p.mount_offset_m + _VISIBILITY_TOL_M,
         hop_cells=p.hop_cells,
         split_depth=p.visibility_splits,
         hop_depth=p.hop_depth,
+        corners=corners,
     )
     start = prob.to_coarse(np.array([sr * geo.width + sc]))
     from_start = prob.distances(start)
@@ -410,23 +327,9 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         if best is None or found.length_m > best.length_m:
             best = found
     assert best is not None
-    branch_m = 0.0
-    if p.branch_block_m > 0:
-        side = max(1, round(p.branch_block_m / geo.resolution_m))
-        rects, cells, _ = mask_groups(mask, geo, side)
-        nest = p.branch_nested
-        outer = (mask_groups(mask, geo, 2 * side)[0], group_parents(mask, side)) if nest else ()
-        frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
-        frame = np.append(frame, [prob.widen_m, _VISIBILITY_TOL_M, p.visibility_splits])
-        frame = np.append(frame, p.branch_max_walls)
-        fine = replace(prob, coarse=coarse_moves(allowed, 1), factor=1)
-        phi = fine.distances(np.array([sr * geo.width + sc]))
-        branch_m = branch_bound_m(
-            BranchInputs(
-                allowed, f, prob.walls, frame, fine.coarse, phi, rects, cells, budget, *outer
-            ),
-            threads=p.threads,
-        )
+    branch_m = (
+        _branch_m(prob, mask, sr * geo.width + sc, budget, p) if p.branch_block_m > 0 else 0.0
+    )
     length_m = max(best.length_m, branch_m)
     return LowerBound(
         distance_m=length_m,
@@ -441,6 +344,37 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         planning_s=time.perf_counter() - t0,
         branch_m=branch_m,
     )
+
+
+def _branch_m(
+    prob: _Problem, mask: np.ndarray, start: int, budget: int, p: LowerBoundParams
+) -> float:
+    """The branch bound (step 5) on ``p.branch_block_m`` groups of ``mask``, from the map cell
+    ``start`` (flat)."""
+    geo = prob.geometry
+    side = max(1, round(p.branch_block_m / geo.resolution_m))
+    rects, cells, _ = mask_groups(mask, geo, side)
+    nest = p.branch_nested
+    outer = (mask_groups(mask, geo, 2 * side)[0], group_parents(mask, side)) if nest else ()
+    frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
+    frame = np.append(frame, [prob.widen_m, _VISIBILITY_TOL_M, p.visibility_splits])
+    frame = np.append(frame, p.branch_max_walls)
+    fine = replace(prob, coarse=coarse_moves(prob.allowed, 1), factor=1)
+    phi = fine.distances(np.array([start]))
+    inputs = BranchInputs(
+        prob.allowed,
+        prob.factor,
+        prob.walls,
+        frame,
+        fine.coarse,
+        phi,
+        rects,
+        cells,
+        budget,
+        *outer,
+        corners=prob.corners,
+    )
+    return branch_bound_m(inputs, threads=p.threads)
 
 
 @dataclass(frozen=True)

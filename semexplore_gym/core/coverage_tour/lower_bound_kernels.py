@@ -11,6 +11,9 @@ import math
 import numpy as np
 from numba import njit
 
+#: Most corners within reach that a visibility test tries (:func:`corners_near`).
+MAX_CORNERS = 64
+
 
 @njit(cache=True)
 def _heap_push(keys, vals, n, key, val):  # pragma: no cover - numba
@@ -262,6 +265,96 @@ def wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - nu
 
 
 @njit(cache=True)
+def _corner_reach(vx, vy, dx, dy, px, py):  # pragma: no cover - numba
+    """How far along the ray from ``v`` in unit direction ``d`` the convex hull of the 8 points
+    ``px, py`` reaches (its crossings of the ray's line, every pair of points on opposite sides;
+    -inf when it does not meet the line)."""
+    far = -np.inf
+    for i in range(8):
+        fi = (px[i] - vx) * -dy + (py[i] - vy) * dx
+        if fi == 0.0:
+            far = max(far, (px[i] - vx) * dx + (py[i] - vy) * dy)
+            continue
+        if fi < 0.0:
+            continue
+        for j in range(8):
+            fj = (px[j] - vx) * -dy + (py[j] - vy) * dx
+            if fj > 0.0:
+                continue
+            t = fi / (fi - fj)
+            x = px[i] + t * (px[j] - px[i])
+            y = py[i] + t * (py[j] - py[i])
+            far = max(far, (x - vx) * dx + (y - vy) * dy)
+    return far
+
+
+@njit(cache=True)
+def corner_blocks(corners, k, ax, ay, ux, uy, tol, px, py):  # pragma: no cover - numba
+    """Whether corner ``k`` (two walls that meet at an end: ``vx, vy``, then each wall's unit
+    direction from there and its length) meets every segment between the rectangles with
+    corners ``(ax, ay)`` and ``(ux, uy)``: one lies inside the sector between the two walls (the
+    one under half a turn) and the other beyond one of its two sides, each by more than
+    ``tol``, so every segment leaves the sector across one of the two rays; and where the convex
+    hull of both meets a ray it stays ``tol`` short of that wall's far end, so the crossing is on
+    a wall or at the corner, where the env's ray cast counts a hit (a beam through the shared
+    end has one wall's ends on either side). ``px, py``: 8 scratch floats."""
+    vx = corners[k, 0]
+    vy = corners[k, 1]
+    adx = corners[k, 2]
+    ady = corners[k, 3]
+    bdx = corners[k, 5]
+    bdy = corners[k, 6]
+    turn = adx * bdy - ady * bdx
+    if abs(turn) < 1e-9:
+        return False
+    sg = 1.0 if turn > 0.0 else -1.0
+    a_in = True
+    u_in = True
+    a_out_a = True
+    a_out_b = True
+    u_out_a = True
+    u_out_b = True
+    for i in range(4):
+        for side in range(2):
+            x = ax[i] if side == 0 else ux[i]
+            y = ay[i] if side == 0 else uy[i]
+            fa = sg * (adx * (y - vy) - ady * (x - vx))
+            fb = sg * ((x - vx) * bdy - (y - vy) * bdx)
+            inside = fa > tol and fb > tol
+            if side == 0:
+                a_in = a_in and inside
+                a_out_a = a_out_a and fa < -tol
+                a_out_b = a_out_b and fb < -tol
+            else:
+                u_in = u_in and inside
+                u_out_a = u_out_a and fa < -tol
+                u_out_b = u_out_b and fb < -tol
+            px[4 * side + i] = x
+            py[4 * side + i] = y
+    if not ((a_in and (u_out_a or u_out_b)) or (u_in and (a_out_a or a_out_b))):
+        return False
+    if _corner_reach(vx, vy, adx, ady, px, py) > corners[k, 4] - tol:
+        return False
+    return _corner_reach(vx, vy, bdx, bdy, px, py) <= corners[k, 7] - tol
+
+
+@njit(cache=True)
+def corners_near(corners, rect, pad):  # pragma: no cover - numba
+    """The corners (rows of ``corners``) within ``pad`` of ``rect`` in each axis; none when
+    there are more than ``MAX_CORNERS`` (a map traced from a raster: the proofs would cost
+    corners x blocks; without them a region is only larger)."""
+    keep = np.zeros(corners.shape[0], dtype=np.bool_)
+    for k in range(corners.shape[0]):
+        keep[k] = (
+            rect[0] - pad <= corners[k, 0] <= rect[2] + pad
+            and rect[1] - pad <= corners[k, 1] <= rect[3] + pad
+        )
+    if np.sum(keep) > MAX_CORNERS:
+        return corners[:0]
+    return corners[keep]
+
+
+@njit(cache=True)
 def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover
     """Position in ``near[:m]`` of a wall that meets every segment between the two rectangles
     (tried first: ``last``), or -1 for none."""
@@ -274,16 +367,20 @@ def _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu):  # pragma
 
 
 @njit(cache=True)
-def rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  # pragma: no cover
+def rect_blind(
+    walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work, corners
+):  # pragma: no cover - numba
     """Whether every segment between ``rect`` and the square ``ux, uy`` (corners 0 and 2) no
     longer than ``reach_m`` meets a wall: one wall blocks all of them, the two are farther
-    apart than ``reach_m``, or (up to ``depth`` times) each quarter of ``rect`` is blind in
-    turn (the segments from a rectangle are those from its quarters). Returns
-    ``(blind, last)``."""
+    apart than ``reach_m``, one of ``corners`` blocks all of them (:func:`corner_blocks`), or
+    (up to ``depth`` times) each quarter of ``rect`` is blind in turn (the segments from a
+    rectangle are those from its quarters). Returns ``(blind, last)``."""
     ax = work[0]
     ay = work[1]
     fa = work[2]
     fu = work[3]
+    px = np.empty(8)
+    py = np.empty(8)
     stack = np.empty((4 * depth + 1, 5))
     stack[0, 0] = rect[0]
     stack[0, 1] = rect[1]
@@ -314,6 +411,13 @@ def rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  
         if p >= 0:
             last = p
             continue
+        cornered = False
+        for k in range(corners.shape[0]):
+            if corner_blocks(corners, k, ax, ay, ux, uy, tol, px, py):
+                cornered = True
+                break
+        if cornered:
+            continue
         if d >= depth:
             return False, last
         xm = 0.5 * (x0 + x1)
@@ -329,7 +433,9 @@ def rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work):  
 
 
 @njit(cache=True)
-def box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work):  # pragma: no cover
+def box_blind(
+    walls, near, m, last, rect, box, reach_m, depth, tol, work, corners
+):  # pragma: no cover - numba
     """:func:`rect_blind` for the square ``box`` (``x0, y0, x1, y1``); ``work``: 6 x 4 scratch
     (its last two rows take the box's corners). Returns ``(blind, last)``."""
     ux = work[4]
@@ -342,7 +448,7 @@ def box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work):  # pr
     uy[1] = box[1]
     uy[2] = box[3]
     uy[3] = box[3]
-    return rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work[:4])
+    return rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work[:4], corners)
 
 
 @njit(cache=True)
@@ -378,17 +484,18 @@ def walls_near(walls, rect, pad):  # pragma: no cover - numba
 
 
 @njit(cache=True, nogil=True)
-def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
+def group_region(allowed, rect, walls, frame, corners):  # pragma: no cover - numba
     """Flat indices of the ``allowed`` cells not certainly blind to the rectangle ``rect``
     (``x0, y0, x1, y1``): the cell's square widened by ``widen_m`` is within ``reach_m`` of the
-    rectangle and the walls do not meet every segment between the two (:func:`rect_blind`, quarters
-    down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
+    rectangle and the walls (and ``corners``) do not meet every segment between the two
+    (:func:`rect_blind`, quarters down to ``depth`` levels). ``frame``: ``gx0, gy0, res, reach_m, widen_m, tol, depth,
     stride``; a ``stride`` above 1 tests only every stride-th row and column (a sample, for
     ranking groups, never for the bound)."""
     gx0, gy0, res, reach_m, widen_m, tol, depth, stride = unpack_frame(frame)
     h, w = allowed.shape
     c_lo, c_hi, r_lo, r_hi = cells_within(rect, reach_m + widen_m, gx0, gy0, res, h, w)
     near, m = walls_near(walls, rect, reach_m + widen_m)
+    close = corners_near(corners, rect, reach_m + widen_m)
     work = np.empty((6, 4))
     out = np.empty((r_hi - r_lo + 1) * (c_hi - c_lo + 1), dtype=np.int64)
     count = 0
@@ -406,7 +513,9 @@ def group_region(allowed, rect, walls, frame):  # pragma: no cover - numba
             if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
                 continue
             box = (x0, y0, x1, y1)
-            blind, last = box_blind(walls, near, m, last, rect, box, reach_m, depth, tol, work)
+            blind, last = box_blind(
+                walls, near, m, last, rect, box, reach_m, depth, tol, work, close
+            )
             if not blind:
                 out[count] = r * w + c
                 count += 1

@@ -206,7 +206,9 @@ def sight_table(walls, near, m, cx, cy, out):  # pragma: no cover - numba
         p2 = (math.atan2(y0 + dy - cy, x0 + dx - cx) - foot + math.pi) % two_pi - math.pi
         if p1 > p2:
             p1, p2 = p2, p1
-        for b in range(int(math.floor((foot + p1) / step)), int(math.floor((foot + p2) / step)) + 1):
+        for b in range(
+            int(math.floor((foot + p1) / step)), int(math.floor((foot + p2) / step)) + 1
+        ):
             lo = max(b * step - foot, p1)
             hi = min((b + 1) * step - foot, p2)
             if lo > hi:  # rounding at a bucket's edge: the nearer end

@@ -184,13 +184,15 @@ def test_a_distance_cells_region_holds_every_distance_cell_of_the_map_cell_regio
     grew = 0
     for g in range(0, rects.shape[0], 5):
         proven = set(prob.region(rects[g]).tolist())
-        ours = set(coarse_region(allowed, 2, rects[g], prob.walls, frame).tolist())
+        ours = set(coarse_region(allowed, 2, rects[g], prob.walls, frame, prob.corners).tolist())
         assert proven <= ours
         grew += len(ours - proven)
         # Past the wall cap, every block within reach is in, untested: a superset again.
         capped = frame.copy()
         capped[7] = 0
-        assert ours <= set(coarse_region(allowed, 2, rects[g], prob.walls, capped).tolist())
+        assert ours <= set(
+            coarse_region(allowed, 2, rects[g], prob.walls, capped, prob.corners).tolist()
+        )
     # A distance cell's box is at most a map cell wider than its map cells: few extra cells.
     assert grew <= 0.05 * sum(prob.region(rects[g]).size for g in range(0, rects.shape[0], 5))
 
@@ -215,12 +217,14 @@ def test_a_region_sought_within_its_larger_groups_region_is_the_meet_of_both(spe
     assert inside.all()
     every = np.arange(prob.coarse.size, dtype=np.int64)
     for g in range(0, rects.shape[0], 7):
-        alone = coarse_region(allowed, 2, rects[g], prob.walls, frame)
-        outer = coarse_region(allowed, 2, outer_rects[parent[g]], prob.walls, frame)
-        nested = coarse_region_among(allowed, 2, rects[g], prob.walls, frame, outer)
+        alone = coarse_region(allowed, 2, rects[g], prob.walls, frame, prob.corners)
+        outer = coarse_region(allowed, 2, outer_rects[parent[g]], prob.walls, frame, prob.corners)
+        nested = coarse_region_among(allowed, 2, rects[g], prob.walls, frame, outer, prob.corners)
         assert np.array_equal(nested, np.intersect1d(alone, outer))
         # among every block of the map, the test is coarse_region's own
-        among_all = coarse_region_among(allowed, 2, rects[g], prob.walls, frame, every)
+        among_all = coarse_region_among(
+            allowed, 2, rects[g], prob.walls, frame, every, prob.corners
+        )
         assert np.array_equal(among_all, alone)
 
 

@@ -331,10 +331,18 @@ def test_a_region_entered_at_the_start_has_the_start_as_its_one_entry():
         "forest:seed=4,size_m=6",
     ],
 )
-def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(spec, bound_problem):
+@pytest.mark.parametrize("corners", [False, True])
+def test_every_cell_a_scan_maps_free_lies_in_a_group_seen_from_the_scans_cell(
+    spec, corners, bound_problem
+):
+    from dataclasses import replace
+
+    from semexplore_gym.core.coverage_tour.bound_geometry import wall_corners
     from semexplore_gym.core.coverage_tour.viewpoints import visible_sets
 
     facts, allowed, prob = bound_problem(spec, 4, 1, 4)
+    if corners:  # two walls that meet block a view together (LowerBoundParams.wall_corners)
+        prob = replace(prob, corners=wall_corners(facts.world.segments_m, prob.walls))
     geo = facts.geometry
     block = 10
     rects, _, _ = mask_groups(facts.reachable_mask, geo, block)

@@ -141,11 +141,13 @@ def test_the_shortcuts_leave_the_region_exactly_what_box_blind_alone_gives(spec,
                 if gap_x**2 + gap_y**2 > reach**2:
                     continue
                 box = (x0, y0, x1, y1)
-                if box_blind(prob.walls, near, m, 0, rect, box, reach, 3, TOL, work)[0]:
+                if box_blind(prob.walls, near, m, 0, rect, box, reach, 3, TOL, work, prob.corners)[
+                    0
+                ]:
                     blind += 1
                 else:
                     expected.append(r * w + c)
-        ours = coarse_region(allowed, f, rect, prob.walls, frame)
+        ours = coarse_region(allowed, f, rect, prob.walls, frame, prob.corners)
         assert ours.tolist() == expected
         kept += len(expected)
     assert kept > 0 and blind > 0  # both answers occur: the comparison means something
