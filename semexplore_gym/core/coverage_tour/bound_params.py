@@ -31,9 +31,10 @@ class LowerBoundParams:
         max_entries: Most entry pieces per group (more are merged into the nearest).
         visibility_splits: Times a group's rectangle is quartered to find walls that block a
             cell's view of each quarter (0: one wall for the whole group).
-        wall_corners: Two walls that end at one shared point also block a view together:
-            every segment that leaves the sector between them crosses one of them or the
-            point, where the env's ray cast counts a hit (step 3).
+        wall_corners: In the branch bound's regions (step 5), two walls that end at one
+            shared point also block a view together: every segment that leaves the sector
+            between them crosses one of them or the point, where the env's ray cast counts a
+            hit (step 3).
         penetration_tolerance_m: How far the robot may press into a wall beyond its radius.
         mount_offset_m: LiDAR distance from the robot centre.
         branch_block_m: Side of the branch bound's groups (0: no branch bound).

@@ -179,8 +179,7 @@ class _Problem:
 
     def region(self, rect: np.ndarray, stride: int = 1) -> np.ndarray:
         """Coarse cells of the region of the group in ``rect`` (with ``stride`` > 1 a sample
-        of it, only to rank groups: tested without corners, so that the groups a route is
-        chosen from are the same with them or without)."""
+        of it, only to rank groups)."""
         g = self.geometry
         frame = np.array(
             [
@@ -195,8 +194,7 @@ class _Problem:
             ],
             dtype=np.float64,
         )
-        corners = self.corners if stride == 1 else self.corners[:0]
-        return self.to_coarse(group_region(self.allowed, rect, self.walls, frame, corners))
+        return self.to_coarse(group_region(self.allowed, rect, self.walls, frame, self.corners))
 
     def entry_pieces(self, region: np.ndarray, start: int, tile: int, cap: int) -> list[np.ndarray]:
         """Where a route can first enter ``region`` (coarse cells): its cells with a move to a
@@ -304,7 +302,6 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
     budget = skip_budget_cells(n_mask, share)
     f = p.distance_cell_factor
     walls = merge_walls(facts.world.segments_m)
-    corners = wall_corners(facts.world.segments_m, walls) if p.wall_corners else np.zeros((0, 8))
     prob = _Problem(
         allowed=allowed,
         coarse=coarse_moves(allowed, f),
@@ -316,7 +313,6 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         hop_cells=p.hop_cells,
         split_depth=p.visibility_splits,
         hop_depth=p.hop_depth,
-        corners=corners,
     )
     start = prob.to_coarse(np.array([sr * geo.width + sc]))
     from_start = prob.distances(start)
@@ -328,7 +324,9 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
             best = found
     assert best is not None
     branch_m = (
-        _branch_m(prob, mask, sr * geo.width + sc, budget, p) if p.branch_block_m > 0 else 0.0
+        _branch_m(prob, mask, (sr * geo.width + sc, budget), p, facts.world.segments_m)
+        if p.branch_block_m > 0
+        else 0.0
     )
     length_m = max(best.length_m, branch_m)
     return LowerBound(
@@ -347,10 +345,17 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
 
 
 def _branch_m(
-    prob: _Problem, mask: np.ndarray, start: int, budget: int, p: LowerBoundParams
+    prob: _Problem,
+    mask: np.ndarray,
+    start_budget: tuple[int, int],
+    p: LowerBoundParams,
+    segments_m: np.ndarray,
 ) -> float:
     """The branch bound (step 5) on ``p.branch_block_m`` groups of ``mask``, from the map cell
-    ``start`` (flat)."""
+    ``start`` (flat) with the skip ``budget`` (cells); with ``p.wall_corners``, the corners of
+    the world's ``segments_m`` block views too (only here: the route's relaxation is not
+    monotone in its regions, the branches are, so the bound is never lower with them)."""
+    start, budget = start_budget
     geo = prob.geometry
     side = max(1, round(p.branch_block_m / geo.resolution_m))
     rects, cells, _ = mask_groups(mask, geo, side)
@@ -372,7 +377,7 @@ def _branch_m(
         cells,
         budget,
         *outer,
-        corners=prob.corners,
+        corners=wall_corners(segments_m, prob.walls) if p.wall_corners else np.zeros((0, 8)),
     )
     return branch_bound_m(inputs, threads=p.threads)
 
