@@ -8,6 +8,7 @@ from numba import njit
 
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     box_blind,
+    box_corners,
     cells_within,
     corners_near,
     unpack_frame,
@@ -322,8 +323,9 @@ def coarse_region_among(
     fu = np.empty(4)
     ux = np.empty(4)
     uy = np.empty(4)
-    ax = np.array([rect[0], rect[2], rect[2], rect[0]])
-    ay = np.array([rect[1], rect[1], rect[3], rect[3]])
+    ax = np.empty(4)
+    ay = np.empty(4)
+    box_corners(rect[0], rect[1], rect[2], rect[3], ax, ay)
     last = 0
     for i in range(rows):
         for j in range(cols):
@@ -335,14 +337,7 @@ def coarse_region_among(
             y1 = boxes[i, j, 3]
             p = hint[i, j]
             if p >= 0:  # box_blind's own first proof, with the wall it would find
-                ux[0] = x0
-                ux[1] = x1
-                ux[2] = x1
-                ux[3] = x0
-                uy[0] = y0
-                uy[1] = y0
-                uy[2] = y1
-                uy[3] = y1
+                box_corners(x0, y0, x1, y1, ux, uy)
                 if wall_blocks(walls, near[p], ax, ay, ux, uy, tol, fa, fu):
                     continue
             px = 0.5 * (x0 + x1)
@@ -351,13 +346,11 @@ def coarse_region_among(
             for k in range(1, 5):  # the corners' tables, from the box's centre and corners
                 if seen:
                     break
-                if not built[k]:
-                    kx = sx[1] if k == 1 or k == 4 else sx[2]
-                    ky = sy[1] if k <= 2 else sy[2]
-                    sight_table(walls, near, m, kx, ky, tables[k])
-                    built[k] = True
                 kx = sx[1] if k == 1 or k == 4 else sx[2]
                 ky = sy[1] if k <= 2 else sy[2]
+                if not built[k]:
+                    sight_table(walls, near, m, kx, ky, tables[k])
+                    built[k] = True
                 for e in range(5):
                     ex = px if e == 0 else (x0 + inset if e == 1 or e == 4 else x1 - inset)
                     ey = py if e == 0 else (y0 + inset if e <= 2 else y1 - inset)

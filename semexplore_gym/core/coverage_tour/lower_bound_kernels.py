@@ -11,9 +11,6 @@ import math
 import numpy as np
 from numba import njit
 
-#: Most corners within reach that a visibility test tries (:func:`corners_near`).
-MAX_CORNERS = 64
-
 
 @njit(cache=True)
 def _heap_push(keys, vals, n, key, val):  # pragma: no cover - numba
@@ -230,6 +227,20 @@ def unpack_frame(frame):  # pragma: no cover - numba
     return frame[0], frame[1], frame[2], frame[3], frame[4], frame[5], int(frame[6]), int(frame[7])
 
 
+@njit(cache=True, inline="always")
+def box_corners(x0, y0, x1, y1, xs, ys):  # pragma: no cover - numba
+    """The corners of the box ``x0, y0, x1, y1`` into ``xs, ys`` (counter-clockwise from
+    ``x0, y0``), as the blocking tests take a rectangle."""
+    xs[0] = x0
+    xs[1] = x1
+    xs[2] = x1
+    xs[3] = x0
+    ys[0] = y0
+    ys[1] = y0
+    ys[2] = y1
+    ys[3] = y1
+
+
 @njit(cache=True)
 def wall_blocks(walls, q, ax, ay, ux, uy, tol, fa, fu):  # pragma: no cover - numba
     """Whether ``wall`` meets every segment between the rectangles with corners ``(ax, ay)``
@@ -340,17 +351,13 @@ def corner_blocks(corners, k, ax, ay, ux, uy, tol, px, py):  # pragma: no cover 
 
 @njit(cache=True)
 def corners_near(corners, rect, pad):  # pragma: no cover - numba
-    """The corners (rows of ``corners``) within ``pad`` of ``rect`` in each axis; none when
-    there are more than ``MAX_CORNERS`` (a map traced from a raster: the proofs would cost
-    corners x blocks; without them a region is only larger)."""
+    """The corners (rows of ``corners``) within ``pad`` of ``rect`` in each axis."""
     keep = np.zeros(corners.shape[0], dtype=np.bool_)
     for k in range(corners.shape[0]):
         keep[k] = (
             rect[0] - pad <= corners[k, 0] <= rect[2] + pad
             and rect[1] - pad <= corners[k, 1] <= rect[3] + pad
         )
-    if np.sum(keep) > MAX_CORNERS:
-        return corners[:0]
     return corners[keep]
 
 
@@ -399,14 +406,7 @@ def rect_blind(
         gap_y = max(0.0, max(y0 - uy[2], uy[0] - y1))
         if gap_x * gap_x + gap_y * gap_y > reach_m * reach_m:
             continue
-        ax[0] = x0
-        ax[1] = x1
-        ax[2] = x1
-        ax[3] = x0
-        ay[0] = y0
-        ay[1] = y0
-        ay[2] = y1
-        ay[3] = y1
+        box_corners(x0, y0, x1, y1, ax, ay)
         p = _blocking_wall(walls, near, m, last, ax, ay, ux, uy, tol, fa, fu)
         if p >= 0:
             last = p
@@ -440,14 +440,7 @@ def box_blind(
     (its last two rows take the box's corners). Returns ``(blind, last)``."""
     ux = work[4]
     uy = work[5]
-    ux[0] = box[0]
-    ux[1] = box[2]
-    ux[2] = box[2]
-    ux[3] = box[0]
-    uy[0] = box[1]
-    uy[1] = box[1]
-    uy[2] = box[3]
-    uy[3] = box[3]
+    box_corners(box[0], box[1], box[2], box[3], ux, uy)
     return rect_blind(walls, near, m, last, rect, ux, uy, reach_m, depth, tol, work[:4], corners)
 
 
