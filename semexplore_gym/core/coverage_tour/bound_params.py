@@ -40,6 +40,11 @@ class LowerBoundParams:
         branch_block_m: Side of the branch bound's groups (0: no branch bound).
         branch_nested: Seek each branch group's region within that of the block of twice
             the side holding it (the same or a smaller region, quicker; off: tested alone).
+        grown_shares: Also route over groups grown from the branch bound's blocks
+            (:mod:`.grown_groups`), each up to this share of the skip budget (one route per
+            share; empty: none; needs ``branch_block_m > 0``).
+        grown_growth: A grown group stops when the least a neighbouring block would widen
+            its region exceeds this share of the region.
         branch_max_walls: A branch group with more walls than this within reach is taken as
             seen from every cell within reach, untested (rasterised maps: far quicker, looser).
         coverage_share: Coverage to reach; None for the env's ``coverage_goal``.
@@ -65,6 +70,8 @@ class LowerBoundParams:
     branch_block_m: float = 0.2
     branch_nested: bool = False
     branch_max_walls: int = 400
+    grown_shares: tuple[float, ...] = (1.0,)
+    grown_growth: float = 0.3
     coverage_share: float | None = None
     threads: int = 1
 
@@ -90,6 +97,10 @@ class LowerBoundParams:
             math.isfinite(g) and 0.05 <= g <= 20 for g in self.group_scales
         ):
             raise ValueError(f"group_scales must be in [0.05, 20], got {self.group_scales!r}")
+        if not all(math.isfinite(g) and 0.05 <= g <= 20 for g in self.grown_shares):
+            raise ValueError(f"grown_shares must be in [0.05, 20], got {self.grown_shares!r}")
+        if not (math.isfinite(self.grown_growth) and 0 <= self.grown_growth <= 100):
+            raise ValueError(f"grown_growth must be in [0, 100], got {self.grown_growth!r}")
         for name in ("penetration_tolerance_m", "mount_offset_m"):
             v = getattr(self, name)
             if not (math.isfinite(v) and 0 <= v <= 0.5):

@@ -94,45 +94,57 @@ class BranchInputs:
     corners: np.ndarray = field(default_factory=lambda: np.zeros((0, 8)))
 
 
-def branch_bound_m(inputs: BranchInputs, units: int = 128, threads: int = 1) -> float:
+def branch_regions(inputs: BranchInputs, threads: int = 1) -> list[np.ndarray]:
+    """Each group's region (step 1): the coarse cells (``region_factor`` blocks, flat indices,
+    increasing) not proven blind to it, found on up to ``threads`` threads."""
+    allowed, walls, frame = inputs.allowed, inputs.walls, inputs.frame
+    group_rects, corners = inputs.group_rects, inputs.corners
+    f = int(inputs.region_factor)
+    if inputs.outer_rects is None:
+        return thread_map(
+            lambda g: coarse_region(allowed, f, group_rects[g], walls, frame, corners),
+            range(group_rects.shape[0]),
+            threads,
+        )
+    outer_rects, outer_of = inputs.outer_rects, inputs.outer_of
+    outer = thread_map(
+        lambda g: coarse_region(allowed, f, outer_rects[g], walls, frame, corners),
+        range(outer_rects.shape[0]),
+        threads,
+    )
+    return thread_map(
+        lambda g: coarse_region_among(
+            allowed, f, group_rects[g], walls, frame, outer[outer_of[g]], corners
+        ),
+        range(group_rects.shape[0]),
+        threads,
+    )
+
+
+def branch_bound_m(
+    inputs: BranchInputs,
+    units: int = 128,
+    threads: int = 1,
+    found: list[np.ndarray] | None = None,
+) -> float:
     """The branch bound (module docstring) in metres; ``units``: budget steps of the knapsack
     (cell counts rounded down to ``budget / units``); the groups' regions are found on up to
-    ``threads`` threads.
+    ``threads`` threads, or given as ``found`` (:func:`branch_regions`).
 
     Returns:
         The bound (inf when the cells no pose sees already exceed the budget; 0 when the
         map cells do not form one tree).
     """
-    allowed, walls, frame = inputs.allowed, inputs.walls, inputs.frame
-    group_rects, group_cells = inputs.group_rects, inputs.group_cells
+    allowed, frame = inputs.allowed, inputs.frame
+    group_cells = inputs.group_cells
     moves, from_start, budget_cells = inputs.moves, inputs.from_start, inputs.budget_cells
-    region_factor = inputs.region_factor
-    corners = inputs.corners
+    f = int(inputs.region_factor)
     phi = np.asarray(from_start, dtype=np.float64)
     _, node_of, parent, level = merge_tree(moves, phi)
     if parent.size == 0 or int(np.sum(parent == np.arange(parent.size))) != 1:
         return 0.0
-    f = int(region_factor)
-    if inputs.outer_rects is None:
-        found = thread_map(
-            lambda g: coarse_region(allowed, f, group_rects[g], walls, frame, corners),
-            range(group_rects.shape[0]),
-            threads,
-        )
-    else:
-        outer_rects, outer_of = inputs.outer_rects, inputs.outer_of
-        outer = thread_map(
-            lambda g: coarse_region(allowed, f, outer_rects[g], walls, frame, corners),
-            range(outer_rects.shape[0]),
-            threads,
-        )
-        found = thread_map(
-            lambda g: coarse_region_among(
-                allowed, f, group_rects[g], walls, frame, outer[outer_of[g]], corners
-            ),
-            range(group_rects.shape[0]),
-            threads,
-        )
+    if found is None:
+        found = branch_regions(inputs, threads)
     block_start = np.zeros(len(found) + 1, dtype=np.int64)
     block_start[1:] = np.cumsum([b.size for b in found])
     blocks = np.concatenate(found).astype(np.int64, copy=False) if found else np.zeros(0, np.int64)

@@ -41,7 +41,10 @@ optimum, so the result is below the path length of every explorer with this robo
    least the K-hop distance between the two pieces (either direction: a path reversed is a
    path; a value the search stopped short of counts as the limit it stopped at, below it).
    The bound is the least such route over every feasible S, every order and every choice of
-   entry pieces (Held-Karp over subsets and last piece, exact), for any choice of groups.
+   entry pieces (Held-Karp over subsets and last piece, exact), for any choice of groups:
+   lattice blocks of two sizes, and groups grown from the branch bound's small blocks around
+   the places seen from few cells (:mod:`.grown_groups`; a group's region is the union of its
+   blocks' regions). The largest route counts.
 
 5. **Or the branch bound** (:mod:`.branch_bound`, on the same distances and visibility), the
    larger of the two. Time at top speed is ``distance_m / max_linear_speed_mps``. The bound assumes a noise-free
@@ -64,7 +67,12 @@ from semexplore_gym.core.coverage_tour.bound_geometry import (
     wall_corners,
 )
 from semexplore_gym.core.coverage_tour.bound_params import LowerBoundParams
-from semexplore_gym.core.coverage_tour.branch_bound import BranchInputs, branch_bound_m
+from semexplore_gym.core.coverage_tour.branch_bound import (
+    BranchInputs,
+    branch_bound_m,
+    branch_regions,
+)
+from semexplore_gym.core.coverage_tour.grown_groups import grown_pool
 from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
     group_region,
     held_karp_entries,
@@ -94,7 +102,8 @@ class LowerBound:
         region_cells: Distance cells of each group's region.
         route: Group indices in the order of the bound's route (the groups it visits).
         budget_cells: Mask cells the goal lets an explorer leave unseen.
-        block_cells: Side of the lattice blocks (map cells) of the groups.
+        block_cells: Side of the lattice blocks (map cells) of the groups (grown groups: of
+            the blocks they were grown from).
         planning_s: Wall time spent.
         branch_m: The branch bound (0 when not computed).
     """
@@ -323,11 +332,14 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         if best is None or found.length_m > best.length_m:
             best = found
     assert best is not None
-    branch_m = (
-        _branch_m(prob, mask, (sr * geo.width + sc, budget), p, facts.world.segments_m)
-        if p.branch_block_m > 0
-        else 0.0
-    )
+    branch_m = 0.0
+    if p.branch_block_m > 0:
+        segments = facts.world.segments_m
+        branch_m, blocks = _branch_m(prob, mask, (sr * geo.width + sc, budget), p, segments)
+        for share in p.grown_shares:
+            found = _grown_route(prob, blocks, (int(start[0]), from_start), budget, share, p)
+            if found.length_m > best.length_m:
+                best = found
     length_m = max(best.length_m, branch_m)
     return LowerBound(
         distance_m=length_m,
@@ -350,15 +362,16 @@ def _branch_m(
     start_budget: tuple[int, int],
     p: LowerBoundParams,
     segments_m: np.ndarray,
-) -> float:
+) -> tuple[float, tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]]:
     """The branch bound (step 5) on ``p.branch_block_m`` groups of ``mask``, from the map cell
     ``start`` (flat) with the skip ``budget`` (cells); with ``p.wall_corners``, the corners of
-    the world's ``segments_m`` block views too (only here: the route's relaxation is not
-    monotone in its regions, the branches are, so the bound is never lower with them)."""
+    the world's ``segments_m`` block views too (only here and in the grown groups: the
+    route's relaxation is not monotone in its regions, the branches are, so the bound is never
+    lower with them). Also returns the groups' rectangles, cells, centres and regions."""
     start, budget = start_budget
     geo = prob.geometry
     side = max(1, round(p.branch_block_m / geo.resolution_m))
-    rects, cells, _ = mask_groups(mask, geo, side)
+    rects, cells, centres = mask_groups(mask, geo, side)
     nest = p.branch_nested
     outer = (mask_groups(mask, geo, 2 * side)[0], group_parents(mask, side)) if nest else ()
     frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
@@ -379,7 +392,31 @@ def _branch_m(
         *outer,
         corners=wall_corners(segments_m, prob.walls) if p.wall_corners else np.zeros((0, 8)),
     )
-    return branch_bound_m(inputs, threads=p.threads)
+    found = branch_regions(inputs, p.threads)
+    branch_m = branch_bound_m(inputs, threads=p.threads, found=found)
+    return branch_m, (rects, cells, centres, found)
+
+
+def _grown_route(
+    prob: _Problem,
+    blocks: tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]],
+    start: tuple[int, np.ndarray],
+    budget: int,
+    share: float,
+    p: LowerBoundParams,
+) -> _Route:
+    """The route (step 4) over groups grown from the branch bound's ``blocks`` (rectangles,
+    cells, centres, regions) to ``share`` of the budget (:func:`.grown_groups.grown_pool`)."""
+    geo = prob.geometry
+    side = max(1, round(p.branch_block_m / geo.resolution_m))
+    regions, cells, centres = grown_pool(
+        blocks[1:],
+        (geo.origin_x_m, geo.origin_y_m, side * geo.resolution_m),
+        (start[1], prob.coarse.size),
+        share * (budget + 1),
+        p,
+    )
+    return _route_over(prob, regions, cells, centres, start, budget, p, side)
 
 
 @dataclass(frozen=True)
@@ -430,18 +467,34 @@ def _bound_for_blocks(
         chosen.append(g)
         np.minimum(score, np.hypot(*(centres - centres[g]).T), out=score)
     regions = thread_map(lambda g: prob.region(rects[g]), chosen, p.threads)
+    return _route_over(prob, regions, cells[chosen], centres[chosen], start, budget, p, block)
+
+
+def _route_over(
+    prob: _Problem,
+    regions: list[np.ndarray],
+    cells: np.ndarray,
+    centres: np.ndarray,
+    start: tuple[int, np.ndarray],
+    budget: int,
+    p: LowerBoundParams,
+    block: int,
+) -> _Route:
+    """The exact route over the entry pieces of the groups with these ``regions`` (coarse
+    cells), ``cells`` and ``centres``, of the groups :func:`_choose_groups` keeps."""
+    start_cell, from_start = start
     tile = max(1, int(round(p.entry_tile_m / (prob.geometry.resolution_m * prob.factor))))
     pieces = [prob.entry_pieces(r, start_cell, tile, p.max_entries) for r in regions]
     node_group = np.array([i for i, ps in enumerate(pieces) for _ in ps], dtype=np.int64)
     nodes = [q for ps in pieces for q in ps]
     first, legs = _entry_legs(prob, nodes, node_group, from_start, p.leg_limit_share, p.threads)
-    pick = _choose_groups(first, legs, node_group, cells[chosen].astype(np.int64), budget, p)
-    length, order = _route(first, legs, node_group, cells[chosen].astype(np.int64), budget, pick)
-    idx = np.array(chosen, dtype=np.int64)[pick]
+    cells = np.asarray(cells, dtype=np.int64)
+    pick = _choose_groups(first, legs, node_group, cells, budget, p)
+    length, order = _route(first, legs, node_group, cells, budget, pick)
     return _Route(
         length_m=float(length),
-        cells=tuple(int(c) for c in cells[idx]),
-        centres_m=tuple((float(x), float(y)) for x, y in centres[idx]),
+        cells=tuple(int(c) for c in cells[pick]),
+        centres_m=tuple((float(x), float(y)) for x, y in centres[pick]),
         region_cells=tuple(int(regions[i].size) for i in pick),
         route=tuple(int(i) for i in order),
         block_cells=block,

@@ -19,7 +19,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from scipy import ndimage
-from skimage.measure import approximate_polygon, find_contours
 
 from semexplore_gym.core.worlds.build import world_from_segments
 from semexplore_gym.core.worlds.grid_maze import check_range
@@ -112,6 +111,9 @@ def carve_cave(params: CaveParams, rng: np.random.Generator) -> tuple[np.ndarray
 
 def contour_segments(free: np.ndarray, resolution_m: float, tolerance_m: float) -> np.ndarray:
     """Closed marching-squares contours of a bool raster (origin at its corner) as segments."""
+    # imported here: scikit-image pulls in scipy.signal (1.5 s), which only caves need
+    from skimage.measure import approximate_polygon, find_contours
+
     padded = np.pad(free.astype(np.float64), 1)
     segments = []
     for contour in find_contours(padded, 0.5):
