@@ -48,8 +48,10 @@ def grow_groups(
     n_region_cells: int,
     target_cells: float,
     growth: float,
-) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Partition the blocks into grown groups (module docstring).
+    values: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Partition the blocks into grown groups (module docstring); :func:`group_region` gives a
+    group's region.
 
     Args:
         neighbours: :func:`block_neighbours` of the blocks.
@@ -59,26 +61,12 @@ def grow_groups(
         target_cells: A group stops growing once it holds this many mask cells.
         growth: ... or when the least widening a neighbour adds exceeds this share of its
             region.
+        values: A value per region cell (none: zeros).
 
     Returns:
-        ``group_of`` (the group of each block) and each group's region (sorted, unique).
+        ``group_of`` (the group of each block), each group's region size, and the least of
+        ``values`` over each group's region.
     """
-    group_of, _, _ = _grown(neighbours, cells, regions, n_region_cells, target_cells, growth)
-    n_groups = int(group_of.max()) + 1 if group_of.size else 0
-    return group_of, [_union(group_of, regions, g) for g in range(n_groups)]
-
-
-def _grown(
-    neighbours: np.ndarray,
-    cells: np.ndarray,
-    regions: list[np.ndarray],
-    n_region_cells: int,
-    target_cells: float,
-    growth: float,
-    values: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`grow_groups`' partition, with each group's region size and the least of
-    ``values`` (per region cell; none: zeros) over its region."""
     n = len(regions)
     if n == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, np.int64), np.zeros(0)
@@ -101,7 +89,7 @@ def _grown(
     )
 
 
-def _union(group_of: np.ndarray, regions: list[np.ndarray], g: int) -> np.ndarray:
+def group_region(group_of: np.ndarray, regions: list[np.ndarray], g: int) -> np.ndarray:
     """Group ``g``'s region: the union of its blocks' regions (sorted, unique)."""
     members = np.flatnonzero(group_of == g)
     return np.unique(np.concatenate([regions[b] for b in members])).astype(np.int64)
@@ -136,7 +124,7 @@ def grown_pool(
     col = np.floor((centres[:, 0] - x0) / side_m).astype(np.int64)
     row = np.floor((centres[:, 1] - y0) / side_m).astype(np.int64)
     nb = block_neighbours(np.column_stack([row, col]))
-    group_of, sizes, least = _grown(
+    group_of, sizes, least = grow_groups(
         nb, cells, found, n_region_cells, target_cells, p.grown_growth, from_start
     )
     n = sizes.size
@@ -155,7 +143,7 @@ def grown_pool(
             break
         chosen.append(g)
         np.minimum(score, np.hypot(*(middle - middle[g]).T), out=score)
-    return [_union(group_of, found, g) for g in chosen], held[chosen], middle[chosen]
+    return [group_region(group_of, found, g) for g in chosen], held[chosen], middle[chosen]
 
 
 @njit(cache=True)

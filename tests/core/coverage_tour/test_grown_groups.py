@@ -8,8 +8,19 @@ import numpy as np
 import pytest
 
 from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound, plan_coverage_tour
-from semexplore_gym.core.coverage_tour.grown_groups import block_neighbours, grow_groups
+from semexplore_gym.core.coverage_tour.grown_groups import (
+    block_neighbours,
+    group_region,
+    grow_groups,
+)
 from tests.core.coverage_tour.test_lower_bound import _facts
+
+
+def _grown(nb, cells, regions, n_cells, target, growth):
+    """The partition and every group's region."""
+    group_of = grow_groups(nb, cells, regions, n_cells, target, growth)[0]
+    n = int(group_of.max()) + 1
+    return group_of, [group_region(group_of, regions, g) for g in range(n)]
 
 
 def test_block_neighbours_are_the_four_lattice_steps_and_minus_one_off_the_blocks():
@@ -40,7 +51,7 @@ def test_grown_groups_partition_the_blocks_and_hold_the_union_of_their_regions(s
     rc, cells, regions, n_cells = _random_blocks(seed)
     nb = block_neighbours(rc)
     target, growth = 40.0, 0.5
-    group_of, group_regions = grow_groups(nb, cells, regions, n_cells, target, growth)
+    group_of, group_regions = _grown(nb, cells, regions, n_cells, target, growth)
     assert group_of.shape == (len(rc),) and group_of.min() == 0
     assert set(group_of.tolist()) == set(range(len(group_regions)))
     for g, region in enumerate(group_regions):
@@ -76,16 +87,16 @@ def test_a_group_takes_the_neighbour_that_widens_its_region_least_within_the_gro
     cells = np.array([10, 10, 10, 10])
     nb = block_neighbours(rc)
     # growth 0.7: 3 of 5 and then 3 of 8 are within it; one group, the union of all four
-    group_of, group_regions = grow_groups(nb, cells, regions, 11, 35.0, 0.7)
+    group_of, group_regions = _grown(nb, cells, regions, 11, 35.0, 0.7)
     assert group_of.tolist() == [0, 0, 0, 0]
     assert group_regions[0].tolist() == list(range(11))
     # growth 0.5: block 2's 3 of 5 is too much; block 2 then seeds a group, and block 3's
     # 3 new cells of block 2's 5 are too much again
-    group_of, group_regions = grow_groups(nb, cells, regions, 11, 35.0, 0.5)
+    group_of, group_regions = _grown(nb, cells, regions, 11, 35.0, 0.5)
     assert group_of.tolist() == [0, 0, 1, 2]
     assert group_regions[0].tolist() == [0, 1, 2, 3, 4]
     # the target: a group stops once it holds 20 cells
-    group_of, _ = grow_groups(nb, cells, regions, 11, 20.0, 0.7)
+    group_of, _ = _grown(nb, cells, regions, 11, 20.0, 0.7)
     assert group_of.tolist() == [0, 0, 1, 1]
 
 
@@ -134,7 +145,7 @@ def test_every_cell_a_scan_maps_free_lies_in_a_grown_group_seen_from_the_scans_c
     rects, cells, centres = mask_groups(mask, geo, 4)
     found = [coarse_region(allowed, 2, r, prob.walls, frame, prob.corners) for r in rects]
     rc = np.floor((centres[:, ::-1] - (geo.origin_y_m, geo.origin_x_m)) / 0.2).astype(np.int64)
-    group_of, regions = grow_groups(block_neighbours(rc), cells, found, prob.coarse.size, 120, 0.3)
+    group_of, regions = _grown(block_neighbours(rc), cells, found, prob.coarse.size, 120, 0.3)
     assert 1 < len(regions) < len(found)  # groups of several blocks
     rows, cols = np.nonzero(mask)
     block_of = np.full(mask.shape, -1, dtype=np.int64)
