@@ -73,11 +73,8 @@ from semexplore_gym.core.coverage_tour.branch_bound import (
     branch_regions,
 )
 from semexplore_gym.core.coverage_tour.grown_groups import grown_pool
-from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
-    group_region,
-    held_karp_entries,
-    khop_distances,
-)
+from semexplore_gym.core.coverage_tour.khop_kernels import coarse_moves, khop_balls, khop_distances
+from semexplore_gym.core.coverage_tour.lower_bound_kernels import group_region, held_karp_entries
 from semexplore_gym.core.coverage_tour.problem import PrivilegedWorld
 from semexplore_gym.core.coverage_tour.thread_map import thread_map
 from semexplore_gym.core.grid import GridGeometry
@@ -86,6 +83,7 @@ from semexplore_gym.core.worlds.geometry import segment_distance_field
 _EIGHT = np.ones((3, 3), dtype=bool)
 _VISIBILITY_TOL_M = 1e-6
 _CLEARANCE_TOL_M = 1e-4
+_MAX_BALL_ENTRIES = 50_000_000  # 200 MB of cached breadth-first balls at most
 
 
 @dataclass(frozen=True)
@@ -177,6 +175,16 @@ class _Problem:
     split_depth: int = 0
     hop_depth: bool = True
     corners: np.ndarray = field(default_factory=lambda: np.zeros((0, 8)))
+    balls: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    def with_balls(self, max_entries: int = _MAX_BALL_ENTRIES) -> _Problem:
+        """The same problem with its searches' breadth-first balls computed once
+        (:func:`~.khop_kernels.khop_balls`: the same distances, quicker for many
+        searches), unless they could hold more than ``max_entries`` cells (memory)."""
+        n_cells = int(np.count_nonzero((self.coarse >> 4) & 1))
+        if n_cells * (2 * self.hop_cells + 1) ** 2 > max_entries:
+            return replace(self, balls=None)
+        return replace(self, balls=khop_balls(self.coarse, self.hop_cells))
 
     def to_coarse_each(self, flat: np.ndarray) -> np.ndarray:
         """The coarse cell of each map cell (flat indices)."""
@@ -260,34 +268,17 @@ class _Problem:
             flat[t] = j
         step = self.geometry.resolution_m if self.hop_depth else 0.0
         d = khop_distances(
-            self.coarse, src, self.hop_cells, res, target_of, len(sets), float(limit_m), step
+            self.coarse,
+            src,
+            self.hop_cells,
+            res,
+            target_of,
+            len(sets),
+            float(limit_m),
+            step,
+            self.balls,
         )
         return d.reshape(-1)
-
-
-def coarse_moves(allowed: np.ndarray, factor: int) -> np.ndarray:
-    """The moves between ``factor`` x ``factor`` blocks of ``allowed`` (uint16 bit masks, see
-    :func:`~.lower_bound_kernels.khop_distances`): block A passes to its neighbour B when an
-    allowed cell of A is 8-adjacent to one of B (bit 4: A holds an allowed cell). A path's
-    blocks thus step along moves, and blocks never join across a wall the cells do not."""
-    f = int(factor)
-    h, w = allowed.shape
-    hc, wc = -(-h // f), -(-w // f)
-    out = np.zeros(hc * wc, dtype=np.uint16)  # 9 bits: the move by (+1, +1) is bit 8
-    rows, cols = np.nonzero(allowed)
-    own = (rows // f) * wc + cols // f
-    np.bitwise_or.at(out, own, np.uint16(1 << 4))
-    for dr in (-1, 0, 1):
-        for dc in (-1, 0, 1):
-            r2, c2 = rows + dr, cols + dc
-            ok = (r2 >= 0) & (r2 < h) & (c2 >= 0) & (c2 < w)
-            ok[ok] &= allowed[r2[ok], c2[ok]]
-            br, bc = rows[ok] // f, cols[ok] // f
-            sr, sc = r2[ok] // f - br, c2[ok] // f - bc
-            step = (sr != 0) | (sc != 0)
-            bit = (3 * (sr[step] + 1) + sc[step] + 1).astype(np.uint16)
-            np.bitwise_or.at(out, br[step] * wc + bc[step], np.left_shift(np.uint16(1), bit))
-    return out.reshape(hc, wc)
 
 
 def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) -> LowerBound:
@@ -322,7 +313,7 @@ def lower_bound(facts: PrivilegedWorld, params: LowerBoundParams | None = None) 
         hop_cells=p.hop_cells,
         split_depth=p.visibility_splits,
         hop_depth=p.hop_depth,
-    )
+    ).with_balls()
     start = prob.to_coarse(np.array([sr * geo.width + sc]))
     from_start = prob.distances(start)
     best: _Route | None = None
@@ -377,7 +368,7 @@ def _branch_m(
     frame = np.array([geo.origin_x_m, geo.origin_y_m, geo.resolution_m, prob.reach_m])
     frame = np.append(frame, [prob.widen_m, _VISIBILITY_TOL_M, p.visibility_splits])
     frame = np.append(frame, p.branch_max_walls)
-    fine = replace(prob, coarse=coarse_moves(prob.allowed, 1), factor=1)
+    fine = replace(prob, coarse=coarse_moves(prob.allowed, 1), factor=1, balls=None)
     phi = fine.distances(np.array([start]))
     inputs = BranchInputs(
         prob.allowed,

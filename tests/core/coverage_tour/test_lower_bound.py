@@ -15,6 +15,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from semexplore_gym.core.coverage_tour import LowerBoundParams, lower_bound
+from semexplore_gym.core.coverage_tour.khop_kernels import khop_balls, khop_distances
 from semexplore_gym.core.coverage_tour.lower_bound import (
     _Problem,
     allowed_cells,
@@ -23,11 +24,7 @@ from semexplore_gym.core.coverage_tour.lower_bound import (
     merge_walls,
     skip_budget_cells,
 )
-from semexplore_gym.core.coverage_tour.lower_bound_kernels import (
-    held_karp_entries,
-    held_karp_route,
-    khop_distances,
-)
+from semexplore_gym.core.coverage_tour.lower_bound_kernels import held_karp_entries, held_karp_route
 from semexplore_gym.core.grid import GridGeometry
 from semexplore_gym.core.worlds.build import world_from_free_mask
 
@@ -212,6 +209,44 @@ def test_stopping_at_the_targets_keeps_their_least_distance_exact():
     early = khop_distances(moves, src, 5, RES, target_of, 2).reshape(-1)
     for t in targets:
         assert early[t].min() == full.reshape(-1)[t].min()
+
+
+def test_cached_balls_give_the_same_distances_bit_for_bit():
+    # A grid with walls, holes and a corridor: the searches of each kind (full field, several
+    # sources, a limit, targets, the depth step) give the same field with the balls computed
+    # once as with each search's own breadth-first search.
+    rng = np.random.default_rng(7)
+    allowed = rng.random((70, 64)) > 0.3
+    allowed[35, :] = True
+    allowed[:, 10] = False
+    allowed[5, 10] = True
+    moves = coarse_moves(allowed, 1)
+    k = 5
+    balls = khop_balls(moves, k)
+    assert balls[0].size == moves.size + 1 and balls[1].size == balls[2].size
+    inside = np.flatnonzero((moves.reshape(-1) >> 4) & 1)
+    assert np.all(np.diff(balls[0])[inside] > 0)  # every allowed cell's ball holds itself
+    none = np.full(moves.shape, -1, dtype=np.int64)
+    target_of = none.copy()
+    target_of.reshape(-1)[[35 * 64 + 63, 60 * 64 + 2]] = 0
+    for src, limit, step, targets in (
+        ([35 * 64], np.inf, 0.0, (none, 0)),
+        ([35 * 64, 3 * 64 + 3], np.inf, RES, (none, 0)),
+        ([35 * 64 + 30], 0.6, RES, (none, 0)),
+        ([35 * 64], np.inf, RES, (target_of, 1)),
+    ):
+        src = np.asarray(src, dtype=np.int64)
+        own = khop_distances(moves, src, k, RES, *targets, limit, step)
+        cached = khop_distances(moves, src, k, RES, *targets, limit, step, balls)
+        assert np.isfinite(own).sum() > 100
+        np.testing.assert_array_equal(cached, own)
+
+
+def test_balls_are_only_cached_within_the_memory_cap():
+    facts, prob, _ = _maze_problem(0)
+    assert prob.balls is None
+    assert prob.with_balls().balls is not None
+    assert prob.with_balls(max_entries=10).balls is None
 
 
 def test_skip_budget_matches_the_missions_coverage_rule():
