@@ -353,12 +353,12 @@ def _branch_m(
     start_budget: tuple[int, int],
     p: LowerBoundParams,
     segments_m: np.ndarray,
-) -> tuple[float, tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]]:
+) -> tuple[float, tuple[np.ndarray, np.ndarray, list[np.ndarray]]]:
     """The branch bound (step 5) on ``p.branch_block_m`` groups of ``mask``, from the map cell
     ``start`` (flat) with the skip ``budget`` (cells); with ``p.wall_corners``, the corners of
     the world's ``segments_m`` block views too (only here and in the grown groups: the
     route's relaxation is not monotone in its regions, the branches are, so the bound is never
-    lower with them). Also returns the groups' rectangles, cells, centres and regions."""
+    lower with them). Also returns the groups' cells, centres and regions."""
     start, budget = start_budget
     geo = prob.geometry
     side = max(1, round(p.branch_block_m / geo.resolution_m))
@@ -385,23 +385,23 @@ def _branch_m(
     )
     found = branch_regions(inputs, p.threads)
     branch_m = branch_bound_m(inputs, threads=p.threads, found=found)
-    return branch_m, (rects, cells, centres, found)
+    return branch_m, (cells, centres, found)
 
 
 def _grown_route(
     prob: _Problem,
-    blocks: tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]],
+    blocks: tuple[np.ndarray, np.ndarray, list[np.ndarray]],
     start: tuple[int, np.ndarray],
     budget: int,
     share: float,
     p: LowerBoundParams,
 ) -> _Route:
-    """The route (step 4) over groups grown from the branch bound's ``blocks`` (rectangles,
-    cells, centres, regions) to ``share`` of the budget (:func:`.grown_groups.grown_pool`)."""
+    """The route (step 4) over groups grown from the branch bound's ``blocks`` (cells,
+    centres, regions) to ``share`` of the budget (:func:`.grown_groups.grown_pool`)."""
     geo = prob.geometry
     side = max(1, round(p.branch_block_m / geo.resolution_m))
     regions, cells, centres = grown_pool(
-        blocks[1:],
+        blocks,
         (geo.origin_x_m, geo.origin_y_m, side * geo.resolution_m),
         (start[1], prob.coarse.size),
         share * (budget + 1),
