@@ -147,6 +147,19 @@ def grown_pool(
 
 
 @njit(cache=True)
+def _mark(ptr, idx, block, inside, marked, n_marked):  # pragma: no cover - numba
+    """Adds ``block``'s region cells not yet ``inside`` to ``marked`` (after ``n_marked``);
+    returns the new count."""
+    for k in range(ptr[block], ptr[block + 1]):
+        c = idx[k]
+        if not inside[c]:
+            inside[c] = True
+            marked[n_marked] = c
+            n_marked += 1
+    return n_marked
+
+
+@njit(cache=True)
 def _grow(neighbours, cells, ptr, idx, order, n_cells, target, growth, values):  # pragma: no cover
     n = order.shape[0]
     group_of = np.full(n, -1, dtype=np.int64)
@@ -164,13 +177,7 @@ def _grow(neighbours, cells, ptr, idx, order, n_cells, target, growth, values): 
         group_of[seed] = g
         members[0] = seed
         n_members = 1
-        n_marked = 0
-        for k in range(ptr[seed], ptr[seed + 1]):
-            c = idx[k]
-            if not inside[c]:
-                inside[c] = True
-                marked[n_marked] = c
-                n_marked += 1
+        n_marked = _mark(ptr, idx, seed, inside, marked, 0)
         held = cells[seed]
         while held < target:
             best = -1
@@ -193,12 +200,7 @@ def _grow(neighbours, cells, ptr, idx, order, n_cells, target, growth, values): 
             members[n_members] = best
             n_members += 1
             held += cells[best]
-            for k in range(ptr[best], ptr[best + 1]):
-                c = idx[k]
-                if not inside[c]:
-                    inside[c] = True
-                    marked[n_marked] = c
-                    n_marked += 1
+            n_marked = _mark(ptr, idx, best, inside, marked, n_marked)
         sizes[g] = n_marked
         for k in range(n_marked):
             inside[marked[k]] = False
