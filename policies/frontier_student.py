@@ -10,7 +10,10 @@ reached, mapped or no longer reachable (``keep_goal``), and only then chooses ag
 is not asked; everything else is the expert's: retries and views of goals reached without
 clearing them, the path follower, the collision guard, the blacklists, the pocket escape, the
 narrow tier and the stop rule (when no frontier is reachable, the expert's later sources run as
-usual).
+usual). A choice that would adopt again a goal it left without the map growing since (the
+goal memory's shuttle test) is passed to those sources too: at a narrow passage a goal can
+drop out of the options each time the robot nears it, and choosing again would send the robot
+back and forth between two such goals for the rest of the mission.
 
 The weights are learned from the oracle (:mod:`semexplore_gym.training.oracle_student`): at
 states the student itself reaches, the privileged teacher prices every option by the length of
@@ -185,12 +188,14 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         super().__init__(self.student_params.expert, segmenter=segmenter, recipe=recipe)
         self.chooser = chooser
         self.decisions = 0
+        self.shuttles_passed = 0
 
     def reset(
         self, obs: dict[str, np.ndarray], info: dict[str, Any], seed: int | None = None
     ) -> None:
         super().reset(obs, info, seed=seed)
         self.decisions = 0
+        self.shuttles_passed = 0
 
     def _decide(self, ctx: PlanContext) -> Plan | None:
         options = ctx.grid_frontier_options()
@@ -204,6 +209,15 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         else:
             choice = self._choose(ctx, options, current, kept)
         goal = options.goal_xy_m[choice]
+        if choice != kept and ctx.memory.would_shuttle(
+            (float(goal[0]), float(goal[1])), self._known_cells
+        ):
+            # Back to a goal it left without the map growing since: a shuttle between goals
+            # that drop out of the options as the robot nears them (a wall cell that flickers
+            # at a narrow passage). Pass: the expert's own sources choose this time, with the
+            # goal memory's retries and drops.
+            self.shuttles_passed += 1
+            return None
         return Plan(
             PlanKind.LEARNED,
             (float(goal[0]), float(goal[1])),
@@ -237,4 +251,8 @@ class FrontierStudentPolicy(SemanticExpertPolicy):
         return choice
 
     def mission_metrics(self) -> dict[str, Any]:
-        return {**super().mission_metrics(), "student_decisions": self.decisions}
+        return {
+            **super().mission_metrics(),
+            "student_decisions": self.decisions,
+            "student_shuttles_passed": self.shuttles_passed,
+        }

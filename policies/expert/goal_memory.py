@@ -258,15 +258,9 @@ class GoalMemory:
         """A new goal was adopted with ``known_cells`` known; with the shuttle guard on, True
         (and :attr:`shuttle_xy_m` set) when it is a goal adopted within the last
         ``shuttle_switches`` goals and the map gained less than ``shuttle_min_new_m2`` since."""
-        prm = self.params
         if not self.rules.shuttle_guard:
             return False
-        assert self.geometry is not None
-        min_new = prm.shuttle_min_new_m2 / self.geometry.resolution_m**2
-        again = any(
-            math.dist(goal_xy_m, xy) <= prm.shuttle_radius_m and known_cells - k < min_new
-            for xy, k in self.recent_goals
-        )
+        again = self.would_shuttle(goal_xy_m, known_cells)
         self.recent_goals.append((goal_xy_m, known_cells))
         if not again:
             if self.shuttle_xy_m is not None and not self.is_shuttle_goal(goal_xy_m):
@@ -276,6 +270,20 @@ class GoalMemory:
         self.counts.shuttles += 1
         self.log("shuttle", f"goal adopted again without progress, kept: {goal_xy_m}")
         return True
+
+    def would_shuttle(self, goal_xy_m: tuple[float, float], known_cells: int) -> bool:
+        """With the shuttle guard on: whether adopting ``goal_xy_m`` now, with ``known_cells``
+        known, would be adopting again a goal of the last ``shuttle_switches`` without the map
+        gaining ``shuttle_min_new_m2`` since (what :meth:`adopt` reports)."""
+        if not self.rules.shuttle_guard:
+            return False
+        assert self.geometry is not None
+        prm = self.params
+        min_new = prm.shuttle_min_new_m2 / self.geometry.resolution_m**2
+        return any(
+            math.dist(goal_xy_m, xy) <= prm.shuttle_radius_m and known_cells - k < min_new
+            for xy, k in self.recent_goals
+        )
 
     def is_shuttle_goal(self, xy_m: tuple[float, float]) -> bool:
         """Whether the shuttle guard committed to a goal near ``xy_m``."""

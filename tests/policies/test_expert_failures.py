@@ -132,6 +132,24 @@ def test_goals_adopted_again_after_the_map_grew_are_no_shuttle() -> None:
     off = GoalMemory(prm.goal_memory, ExpertCounters(), print, GoalRules(shuttle_guard=False))
     off.reset(GEOM)
     assert not any(off.adopt(xy, 0) for xy in [(1.0, 1.0), (4.0, 1.0), (1.0, 1.0)])
+    assert not off.would_shuttle((4.0, 1.0), 0)
+
+
+def test_would_shuttle_tells_what_adopt_would_report_without_recording() -> None:
+    from semexplore_gym.policies.expert.counters import ExpertCounters
+    from semexplore_gym.policies.expert.goal_memory import GoalMemory
+
+    counts = ExpertCounters()
+    mem = GoalMemory(SemanticExpertParams().goal_memory, counts, lambda *_: None)
+    mem.reset(GEOM)
+    mem.adopt((1.0, 1.0), 1000)
+    mem.adopt((4.0, 1.0), 1100)
+    assert mem.would_shuttle((1.1, 1.0), 1200)  # back, less than 1 m² more known
+    assert not mem.would_shuttle((1.1, 1.0), 1500)  # back after the map grew
+    assert not mem.would_shuttle((2.5, 1.0), 1200)  # a goal not adopted lately
+    assert mem.would_shuttle((1.1, 1.0), 1200)  # asking recorded nothing
+    assert counts.shuttles == 0 and mem.shuttle_xy_m is None
+    assert mem.adopt((1.1, 1.0), 1200)  # what adopt then reports
 
 
 # ---------------------------------------------------------------------- the view pose

@@ -91,6 +91,36 @@ def test_without_keep_goal_it_switches_past_the_margin() -> None:
         assert d.scores[d.choice] == best  # with margin 0 only a best-scoring goal is kept
 
 
+def test_a_chooser_that_flips_between_far_goals_cannot_livelock_the_student() -> None:
+    # Choosing at every replan the option farthest from its last pick, the chooser sends the
+    # robot back and forth between two ends without mapping anything on the way (the shuttle
+    # of goals that drop out of the options as the robot nears them, forced). The student
+    # passes a choice that would adopt again a goal it left without the map growing, and the
+    # expert's own sources choose then: the mission still ends.
+    policy = make_policy("frontier-student", keep_goal=False)
+    picks: list[np.ndarray] = []
+
+    def flip(d: StudentDecision) -> int | None:
+        if len(d.options) < 2:
+            return None
+        ref = picks[-1] if picks else np.asarray(d.pose[:2])
+        j = int(np.argmax(np.hypot(*(d.options.goal_xy_m - ref).T)))
+        picks.append(d.options.goal_xy_m[j].copy())
+        return j
+
+    policy.chooser = flip
+    res = _mission(policy, world="maze:seed=1,size_m=6", max_time_s=900.0)
+    assert policy.shuttles_passed > 0
+    assert policy.mission_metrics()["student_shuttles_passed"] == policy.shuttles_passed
+    assert policy.done and res.coverage >= 0.95
+    # The goal memory flags a goal adopted again without the map growing; the student's own
+    # plans never are one (without the pass: 156 of them in this mission).
+    events = policy.events
+    flagged = [t for t, e, _d in events if e == "shuttle"]
+    adopted = {t: d for t, e, d in events if e == "goal"}
+    assert not any(adopted.get(t, "").startswith("learned") for t in flagged)
+
+
 def test_the_pretrained_student_loads_without_torch_and_runs() -> None:
     from semexplore_gym.policies.pretrained import get_pretrained
 
