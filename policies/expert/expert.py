@@ -53,7 +53,7 @@ argument ``plan_sources``; ``recipe.with_source`` places one by name)::
             return None if path is None else Plan(PlanKind.COMMANDED, goal, ctx.resampled(path))
 
     class TeamExpert(SemanticExpertPolicy):
-        recipe = SEMANTIC_V3.with_source(TeamGoal(), before="semantic")
+        recipe = SEMANTIC_V4.with_source(TeamGoal(), before="semantic")
 
 *Drive to this goal*: :meth:`~SemanticExpertPolicy.drive_to` commands a point in world
 coordinates; the expert's navigation drives there over a clearance-aware grid route (with its
@@ -77,7 +77,9 @@ from typing import Any
 import numpy as np
 from semexplore_gym.policies.base import Policy, StepStats, read_env_facts
 from semexplore_gym.policies.expert.counters import ExpertCounters
+from semexplore_gym.policies.expert.drawing import area_type_raster
 from semexplore_gym.policies.expert.goal_memory import GoalMemory
+from semexplore_gym.policies.expert.map_reading import MapReader
 from semexplore_gym.policies.expert.params import SemanticExpertParams
 from semexplore_gym.policies.expert.path_following import PathFollower
 from semexplore_gym.policies.expert.plan import ExpertMode, Plan, PlanKind
@@ -88,7 +90,7 @@ from semexplore_gym.policies.expert.plan_sources import (
     goal_open,
     insert_plan_source,
 )
-from semexplore_gym.policies.expert.recipes import SEMANTIC_V3, ExpertRecipe
+from semexplore_gym.policies.expert.recipes import SEMANTIC_V4, ExpertRecipe
 
 from semexplore_gym.core.planning.graph_search import (
     FrontierCandidate,
@@ -146,7 +148,7 @@ class SemanticExpertPolicy(Policy):
     name = "semantic"
     reads_map_in_step_only = True  # tested: missions identical with a copied or a shared map
     #: What the expert is made of: its plan sources and goal rules (see the module docstring).
-    recipe: ExpertRecipe = SEMANTIC_V3
+    recipe: ExpertRecipe = SEMANTIC_V4
     plan_sources: tuple[PlanSource, ...]
 
     def __init__(
@@ -198,12 +200,18 @@ class SemanticExpertPolicy(Policy):
             self._segmenter = TopometricSegmenter()
         self.clearance_m = self.limits.radius_m + self.params.clearance_margin_m
         self.tmap, self.candidates, self.mode, self.events = None, [], ExpertMode.IDLE, []
+        part = self.recipe.map_reading
+        self._map_reader = (
+            MapReader(self.params.sliver_max_width_m, self.geometry.resolution_m)
+            if part is not None and part.applies(info, self.params.sliver_maps)
+            else None
+        )
         self.counts.clear()
         self._time_s, self._next_replan_s, self._plan = 0.0, 0.0, None
         self._last_reason, self._min_range_m = "", facts.min_range_m
         self._seg_known_cells = self._empty_replans = 0
         self._area_types: np.ndarray | None = None
-        self._known_cells = known_cell_count(obs["map"])
+        self._known_cells = known_cell_count(self.read_map(obs))
         self.goal_memory.reset(self.geometry, self.params.goal_memory)
         xy_m = (float(obs["pose"][0]), float(obs["pose"][1]))
         where = (self.geometry, self.limits, self.dt_s, xy_m, self._known_cells)
@@ -216,7 +224,7 @@ class SemanticExpertPolicy(Policy):
         if self.done:
             self.last_stats = stats
             return np.zeros(2, dtype=np.float32)
-        grid = obs["map"]
+        grid = self.read_map(obs)
         p = obs["pose"]
         pose = (float(p[0]), float(p[1]), float(p[2]))
         scan = np.asarray(obs["scan"], dtype=np.float64)
@@ -299,6 +307,12 @@ class SemanticExpertPolicy(Policy):
         ):
             return "goal_vanished"
         return ""
+
+    def read_map(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        """``obs["map"]`` as the expert reads it: with its wall slivers read as wall where the
+        recipe's ``map_reading`` applies (:mod:`.map_reading`)."""
+        reader = getattr(self, "_map_reader", None)
+        return obs["map"] if reader is None else reader(obs["map"])
 
     # ------------------------------------------------------------------ read-outs
     @property
@@ -434,7 +448,7 @@ class SemanticExpertPolicy(Policy):
         if self._segmenter is None:
             raise ValueError("frontier_candidates needs reset() first")
         prm = self.params
-        grid = obs["map"]
+        grid = self.read_map(obs)
         x_m, y_m, yaw_rad = (float(v) for v in obs["pose"][:3])
         tmap = self._segmenter(
             grid, self.geometry, self.clearance_m, params=prm.segmentation, previous=self.tmap
@@ -584,17 +598,3 @@ class SemanticExpertPolicy(Policy):
         out["text"] = text
         return out
 
-
-def area_type_raster(tmap: TopometricMap) -> np.ndarray:
-    """``(H, W)`` int16 raster of :class:`AreaType` values of the map's areas; -1 elsewhere."""
-    ids = tmap.area_ids
-    out = np.full(ids.shape, -1, dtype=np.int16)
-    inside = ids >= 0
-    if not inside.any() or not tmap.areas:
-        return out
-    uniq, inv = np.unique(ids[inside], return_inverse=True)
-    lut = np.array(
-        [int(tmap.areas[int(a)].type) if int(a) in tmap.areas else -1 for a in uniq], dtype=np.int16
-    )
-    out[inside] = lut[inv]
-    return out

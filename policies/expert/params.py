@@ -33,6 +33,11 @@ What the paper leaves open, and how the expert handles it (parameters in
   (:mod:`semexplore_gym.core.frontiers.reachable`), and keeps that goal while it lasts. Tiny
   frontier groups (leaks through rasterised walls) and unknown slivers no scan can fill (the
   inside of walls, pockets along them) are ignored.
+* **Wall slivers of a SLAM map** (recipe part ``map_reading``, ``sliver_max_width_m``,
+  ``sliver_maps``; in ``semantic-v4``, on SLAM maps unless ``sliver_maps="all"``): UNKNOWN strips narrower than ``sliver_max_width_m``
+  along walls (the inside of walls and their junctions, which a SLAM map rendered from
+  keyframes shows through gaps in wall faces) read as OCCUPIED: no scan clears them, and where
+  one meets the outside of the building it looks like a frontier with deep unknown space behind.
 * **Stop confirmation** (``stop_confirmations``): the mission ends after this many consecutive
   replans found no frontier from either source.
 * **Potential-field local minima** (in :class:`PotentialFieldParams`): the lookahead point
@@ -359,6 +364,12 @@ class SemanticExpertParams:
             speed (at least ``min_goal_time_s``) counts as a failed approach (part of
             ``stuck_recovery``): the robot may be moving but not getting there.
         min_goal_time_s: See ``goal_time_factor``.
+        sliver_max_width_m: With a recipe that reads a SLAM map's wall slivers as wall
+            (``semantic-v4``: :mod:`~semexplore_gym.policies.expert.map_reading`), UNKNOWN
+            strips narrower than this along walls are read as OCCUPIED (the inside of walls,
+            and the corners where they meet, that a SLAM map shows through gaps in their faces).
+        sliver_maps: On which maps: ``"slam"``, a map the env's SLAM back end builds (the
+            perfect map is read as observed); ``"all"``, every map.
     """
 
     removed_config_keys: ClassVar[dict[str, str]] = REMOVED_SWITCHES
@@ -426,8 +437,12 @@ class SemanticExpertParams:
     stuck_recovery: bool = True
     goal_time_factor: float = 4.0
     min_goal_time_s: float = 90.0
+    sliver_max_width_m: float = 0.25
+    sliver_maps: str = "slam"
 
     def __post_init__(self) -> None:
+        if self.sliver_maps not in ("slam", "all"):
+            raise ValueError(f"sliver_maps must be 'slam' or 'all', got {self.sliver_maps!r}")
         if self.prune_by not in ("opening", "area"):
             raise ValueError(f"prune_by must be 'opening' or 'area', got {self.prune_by!r}")
         positive = (
@@ -438,6 +453,7 @@ class SemanticExpertParams:
             "stuck_radius_m",
             "progress_timeout_s",
             "local_min_timeout_s",
+            "sliver_max_width_m",
         )
         require_finite(self, positive, positive=True)
         nonneg = (

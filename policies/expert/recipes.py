@@ -1,16 +1,19 @@
 """Recipes: what a semantic expert is made of.
 
 An expert is a composition, not a set of switches: the plan sources it asks, in order (and the
-variant of each), the rules its goal memory follows, and the parameter values it starts from.
-:class:`ExpertRecipe` holds the three; every named version of the expert
+variant of each), the rules its goal memory follows, the parameter values it starts from, and
+how it reads the observed map. :class:`ExpertRecipe` holds the four; every named version of the expert
 (:mod:`~semexplore_gym.policies.expert.versions`) and the paper's method alone are recipes:
 
 ==================  =========================================================================
 recipe              what it holds
 ==================  =========================================================================
-``semantic-v3``     today's expert (``semantic``): every plan source (:data:`DEFAULT_PLAN_
-                    SOURCES`), Algorithm 1's goal over the grid's route with the grid's
-                    nearest frontier as a candidate, every goal rule (:class:`GoalRules`)
+``semantic-v4``     today's expert (``semantic``): ``semantic-v3`` reading the wall slivers of
+                    a SLAM map as wall (:class:`~semexplore_gym.policies.expert.map_reading.
+                    WallSliverFill`); on the perfect map it is ``semantic-v3``
+``semantic-v3``     the 0.3.0 expert: every plan source (:data:`DEFAULT_PLAN_SOURCES`),
+                    Algorithm 1's goal over the grid's route with the grid's nearest frontier
+                    as a candidate, every goal rule (:class:`GoalRules`), the map as observed
 ``semantic-v2``     the 0.2.0 expert: no ``view`` nor ``room_beyond_gap`` source, Algorithm 1's
                     goal along the map's path (with the entry detour) and no grid candidate;
                     no shuttle guard, a dropped goal beside another keeps no point of its own,
@@ -24,9 +27,10 @@ A recipe's parameter values are a layer below the user's (``semantic-paper[cost.
 the user's own switches (``narrow_passages``, ...) stay in
 :class:`~semexplore_gym.policies.expert.params.SemanticExpertParams`. The experts whose goals
 an outside choice makes (the learning agents' driver, the frontier student, the learned
-frontier value, the teams) run :data:`OUTSIDE_CHOICE`: today's recipe with the semantic source
-along the map's paths and without the grid candidate (:func:`for_outside_choice` refuses a
-recipe they cannot honour).
+frontier value, the teams) run :data:`OUTSIDE_CHOICE`: ``semantic-v3``'s recipe with the
+semantic source along the map's paths and without the grid candidate (:func:`for_outside_choice`
+refuses a recipe they cannot honour); they read the map as observed, as they were trained and
+measured.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 from semexplore_gym.policies.expert.goal_memory import GoalRules
+from semexplore_gym.policies.expert.map_reading import WallSliverFill
 from semexplore_gym.policies.expert.narrow_sources import NarrowFallback
 from semexplore_gym.policies.expert.plan_context import PlanSource
 from semexplore_gym.policies.expert.plan_sources import (
@@ -55,6 +60,7 @@ __all__ = [
     "PAPER_PARAMS",
     "SEMANTIC_V2",
     "SEMANTIC_V3",
+    "SEMANTIC_V4",
     "ExpertRecipe",
     "GoalRules",
     "for_outside_choice",
@@ -72,12 +78,17 @@ class ExpertRecipe:
         params: Parameter values (flat or nested keys of ``SemanticExpertParams``) the recipe
             starts from, below the user's overrides (a plain dict, so that an expert pickles;
             treat it as read-only).
+        map_reading: How it reads the observed map
+            (:mod:`~semexplore_gym.policies.expert.map_reading`): None, as observed; a
+            :class:`~semexplore_gym.policies.expert.map_reading.WallSliverFill`, with the wall
+            slivers of a SLAM map read as wall.
     """
 
     name: str
     plan_sources: tuple[PlanSource, ...]
     goal_rules: GoalRules = field(default_factory=GoalRules)
     params: Mapping[str, object] = field(default_factory=dict)
+    map_reading: WallSliverFill | None = None
 
     def __post_init__(self) -> None:
         names = self.source_names
@@ -118,6 +129,12 @@ class ExpertRecipe:
         kept = tuple(s for s in self.plan_sources if s.name not in names)
         return replace(self, name=name or self.name, plan_sources=kept)
 
+    def with_map_reading(
+        self, part: WallSliverFill | None, name: str | None = None
+    ) -> ExpertRecipe:
+        """This recipe reading the map through ``part`` (None: as observed; a variant)."""
+        return replace(self, name=name or self.name, map_reading=part)
+
     def with_rules(self, name: str | None = None, **rules: bool) -> ExpertRecipe:
         """This recipe with goal rules changed (``shuttle_guard=False``; a variant)."""
         return replace(self, name=name or self.name, goal_rules=replace(self.goal_rules, **rules))
@@ -137,8 +154,12 @@ class ExpertRecipe:
         return replace(self, name=name or self.name, plan_sources=sources)
 
 
-#: Today's expert (``semantic``): every plan source, every goal rule.
+#: The expert of the 0.3.0 release: every plan source, every goal rule, the map as observed.
 SEMANTIC_V3 = ExpertRecipe("semantic-v3", DEFAULT_PLAN_SOURCES)
+
+#: Today's expert (``semantic``): ``semantic-v3`` reading the wall slivers of a SLAM map as
+#: wall (on the perfect map it is ``semantic-v3``, mission for mission).
+SEMANTIC_V4 = SEMANTIC_V3.with_map_reading(WallSliverFill(), name="semantic-v4")
 
 #: The expert of the 0.2.0 release, mission for mission.
 SEMANTIC_V2 = ExpertRecipe(
@@ -199,7 +220,8 @@ PAPER_METHOD = ExpertRecipe(
     PAPER_PARAMS,
 )
 
-#: Today's recipe for an expert whose goals an outside choice makes: the grid's nearest frontier
+#: The recipe of an expert whose goals an outside choice makes (``semantic-v3``'s, the map as
+#: observed): the grid's nearest frontier
 #: would overrule that choice, and the learned agents were trained and measured driving the
 #: map's paths.
 OUTSIDE_CHOICE = SEMANTIC_V3.with_semantic("outside-choice", grid_candidate=False, grid_route=False)

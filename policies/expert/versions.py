@@ -1,4 +1,5 @@
-"""Named versions of the semantic expert: ``semantic-v2``, ``semantic-v3``; ``semantic`` is the newest.
+"""Named versions of the semantic expert: ``semantic-v2``, ``semantic-v3``, ``semantic-v4``;
+``semantic`` is the newest.
 
 As with Gymnasium's env ids (``CartPole-v0``, ``CartPole-v1``), a version name never changes
 meaning: a table measured with ``semantic-v2`` is measured again with ``semantic-v2`` in any
@@ -13,7 +14,8 @@ expert with another weight. Every run record (the mission JSON of ``semexplore e
 A release that changes the expert's behaviour adds a version here with a new recipe, and each
 older version keeps its recipe, so its missions stay as they were: an old behaviour lives in the
 parts an old recipe lists, not in a switch of today's expert. ``tests/policies/test_expert_versions.py`` holds ``semantic-v2`` to
-the 0.2.0 release's own mission on a small office and ``semantic`` to ``semantic-v3``.
+the 0.2.0 release's own mission on a small office, ``semantic`` to ``semantic-v4``, and
+``semantic-v4`` to ``semantic-v3`` on the perfect map, mission for mission.
 """
 
 from __future__ import annotations
@@ -22,7 +24,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from semexplore_gym.policies.expert.recipes import SEMANTIC_V2, SEMANTIC_V3, ExpertRecipe
+from semexplore_gym.policies.expert.recipes import (
+    SEMANTIC_V2,
+    SEMANTIC_V3,
+    SEMANTIC_V4,
+    ExpertRecipe,
+)
 from semexplore_gym.policies.specs import parse_spec
 
 
@@ -60,18 +67,25 @@ EXPERT_VERSIONS: Mapping[str, ExpertVersion] = MappingProxyType(
                 "gaps, a point of its own per dropped goal, Algorithm 1's goal over the grid's "
                 "route",
             ),
+            ExpertVersion(
+                "semantic-v4",
+                "0.4.0",
+                SEMANTIC_V4,
+                "on a SLAM map, the wall slivers (UNKNOWN strips narrower than "
+                "sliver_max_width_m along walls) read as wall; on the perfect map semantic-v3",
+            ),
         )
     }
 )
 #: The version the plain ``semantic`` spec runs.
-LATEST_EXPERT = "semantic-v3"
+LATEST_EXPERT = "semantic-v4"
 #: The name that always means the newest version.
 NEWEST_ALIAS = "semantic"
 
 
 def expert_version(spec: str) -> str:
-    """The expert version a policy spec runs: ``"semantic-v3"`` for ``semantic``,
-    ``semantic[cost.w_v=2]`` or ``semantic-v3``, ``"semantic-v2"`` for ``semantic-v2[...]``, and
+    """The expert version a policy spec runs: ``"semantic-v4"`` for ``semantic``,
+    ``semantic[cost.w_v=2]`` or ``semantic-v4``, ``"semantic-v2"`` for ``semantic-v2[...]``, and
     ``""`` for every other policy (a baseline, a learned agent, the paper-pure preset).
 
     Raises:

@@ -1,4 +1,5 @@
-"""Named expert versions: ``semantic-v2`` is the 0.2.0 expert, ``semantic-v3`` today's, and
+"""Named expert versions: ``semantic-v2`` is the 0.2.0 expert, ``semantic-v3`` the 0.3.0 one,
+``semantic-v4`` today's (``semantic-v3`` on the perfect map, mission for mission), and
 ``semantic`` the newest; every run record states the version a spec ran."""
 
 from __future__ import annotations
@@ -27,20 +28,28 @@ RELEASE_0_2_0 = {"mission_time_s": 117.2, "path_length_m": 24.989, "coverage": 1
 
 
 def test_the_names_resolve_to_versions() -> None:
-    assert list(EXPERT_VERSIONS) == ["semantic-v2", "semantic-v3"]
-    assert LATEST_EXPERT == "semantic-v3"
-    assert expert_version("semantic") == "semantic-v3"
-    assert expert_version("semantic[cost.w_v=2]") == "semantic-v3"
-    assert expert_version("semantic[tuned]") == "semantic-v3"
+    assert list(EXPERT_VERSIONS) == ["semantic-v2", "semantic-v3", "semantic-v4"]
+    assert LATEST_EXPERT == "semantic-v4"
+    assert expert_version("semantic") == "semantic-v4"
+    assert expert_version("semantic[cost.w_v=2]") == "semantic-v4"
+    assert expert_version("semantic[tuned]") == "semantic-v4"
     assert expert_version("semantic-v2[cost.w_v=2]") == "semantic-v2"
     assert expert_version("semantic-v3") == "semantic-v3"
+    assert expert_version("semantic-v4") == "semantic-v4"
     for other in ("semantic-paper", "nearest", "frontier-student", "pretrained:frontier_value"):
         assert expert_version(other) == ""
 
 
 def test_semantic_is_the_newest_version_and_todays_defaults() -> None:
-    newest = make_policy("semantic").params
-    assert make_policy("semantic-v3").params == newest == SemanticExpertParams()
+    newest = make_policy("semantic")
+    assert make_policy("semantic-v4").params == newest.params == SemanticExpertParams()
+    assert make_policy("semantic-v3").params == newest.params
+    assert newest.recipe is EXPERT_VERSIONS["semantic-v4"].recipe
+    # v4 is v3 with the wall slivers of a SLAM map read as wall
+    v3 = EXPERT_VERSIONS["semantic-v3"].recipe
+    assert v3.map_reading is None and newest.recipe.map_reading is not None
+    assert newest.recipe.plan_sources == v3.plan_sources
+    assert newest.recipe.goal_rules == v3.goal_rules
 
 
 def test_semantic_v2_is_its_recipe_on_todays_values_and_takes_overrides() -> None:
@@ -100,11 +109,15 @@ def test_semantic_v2_runs_maze2_as_the_0_2_0_release_did(
 
 
 @pytest.mark.slow
-def test_semantic_runs_semantic_v3_by_name(capsys: pytest.CaptureFixture[str]) -> None:
-    newest_run, v3 = _explore("semantic", capsys), _explore("semantic-v3", capsys)
-    assert newest_run["policy_version"] == v3["policy_version"] == "semantic-v3"
+def test_semantic_runs_semantic_v4_by_name_which_is_v3_on_the_perfect_map(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    newest_run, v4 = _explore("semantic", capsys), _explore("semantic-v4", capsys)
+    v3 = _explore("semantic-v3", capsys)
+    assert newest_run["policy_version"] == v4["policy_version"] == "semantic-v4"
+    assert v3["policy_version"] == "semantic-v3"
     keys = ("mission_time_s", "path_length_m", "coverage", "stop_reason")
-    assert {k: newest_run[k] for k in keys} == {k: v3[k] for k in keys}
+    assert {k: newest_run[k] for k in keys} == {k: v4[k] for k in keys} == {k: v3[k] for k in keys}
     assert v3["mission_time_s"] != RELEASE_0_2_0["mission_time_s"]  # the versions differ here
 
 
@@ -117,13 +130,13 @@ def test_benchmark_rows_and_summary_state_the_version(tmp_path: Path) -> None:
     with (out / "runs.csv").open(newline="") as f:
         rows = {r["policy"]: r["policy_version"] for r in csv.DictReader(f)}
     assert rows == {
-        "semantic": "semantic-v3",
+        "semantic": "semantic-v4",
         "semantic-v2[cost.w_v=2]": "semantic-v2",
         "nearest": "",
     }
     summary = (out / "summary.md").read_text()
     assert (
-        "Expert versions: `semantic` = semantic-v3, `semantic-v2[cost.w_v=2]` = semantic-v2."
+        "Expert versions: `semantic` = semantic-v4, `semantic-v2[cost.w_v=2]` = semantic-v2."
         in (summary)
     )
 
@@ -153,7 +166,7 @@ def test_a_version_takes_its_parameter_values_from_a_file(tmp_path: Path) -> Non
     """``semantic:FILE.yaml`` is a short spec for many values (the docs' Optuna weights)."""
     pol = make_policy("semantic:configs/expert/optuna_weights.yaml")
     assert (pol.params.cost.w_v, pol.params.cost.w_p, pol.params.cost.w_i) == (0.62, 0.051, 0.004)
-    assert expert_version("semantic:configs/expert/optuna_weights.yaml") == "semantic-v3"
+    assert expert_version("semantic:configs/expert/optuna_weights.yaml") == "semantic-v4"
     own = tmp_path / "w.yaml"
     own.write_text("cost: {w_v: 2.0}\n")
     v2 = make_policy(f"semantic-v2:{own}[cost.w_p=0.5]")

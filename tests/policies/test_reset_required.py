@@ -32,6 +32,7 @@ SPECS = {
     "semantic-paper": "semantic-paper",
     "semantic-v2": "semantic-v2",
     "semantic-v3": "semantic-v3",
+    "semantic-v4": "semantic-v4",
     "frontier-value": "frontier-value",
     "frontier-student": "frontier-student",
     "frontier": "frontier",

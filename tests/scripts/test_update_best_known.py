@@ -47,7 +47,7 @@ def test_a_run_is_merged_and_its_bounds_hold(
         assert (world, start) == (WORLD, "random")
         mine = [r for r in rows if r["seed"] == seed and r["T99_s"] is not None]
         assert e["T99_s"] == pytest.approx(min(r["T99_s"] for r in mine), abs=1e-3)
-        assert e["T99_policy"] in ("nearest", "semantic-v3")  # semantic named by its version
+        assert e["T99_policy"] in ("nearest", "semantic-v4")  # semantic named by its version
         # The certified bound never lies above what a policy did.
         assert 0 < e["lower_bound_s"] <= e["T99_s"]
         assert 0 < e["lower_bound_m"] <= e["D99_m"]
