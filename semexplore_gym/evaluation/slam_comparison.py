@@ -7,7 +7,7 @@ perfect map (``--env-config default``; its ``ate_m`` cells are empty) and the sa
 (``semexplore report PERFECT SLAM --table slam-vs-perfect``):
 
 - per family and policy: pairs; self-stops at true coverage >= :data:`GOOD_COVERAGE` on each
-  map; collisions; the median SLAM / perfect mission-time ratio with the Wilcoxon signed-rank p
+  map; the median true coverage at the end on each map; collisions; the median SLAM / perfect mission-time ratio with the Wilcoxon signed-rank p
   on the log ratios; the SLAM figures (median ATE, median odometry ATE / ATE, map error, loop
   closures); false stops; the median SLAM / perfect wall-time ratio;
 - per family and map: the reference policy's mission time over each other policy's on the same
@@ -96,6 +96,9 @@ def _pair_cells(a: list[Row], b: list[Row]) -> list[str]:
     return [
         str(n),
         f"{sum(map(_finished, a))}/{n} / {sum(map(_finished, b))}/{n}",
+        _median([r["coverage"] for r in a], "{:.3f}")
+        + " / "
+        + _median([r["coverage"] for r in b], "{:.3f}"),
         f"{sum(int(r['collisions']) for r in a)} / {sum(int(r['collisions']) for r in b)}",
         median_p(_ratios(a, b, "mission_time_s")),
         _median([s.get("ate_m") for s in b], "{:.3f}"),
@@ -111,10 +114,10 @@ def paired_table(perfect: dict[Key, Row], slam: dict[Key, Row], family: Family) 
     """The per family and policy table (see the module docstring), families and policies in
     the perfect-map rows' order; ``family`` maps a world to its family."""
     lines = [
-        "| family | policy | pairs | self-stops ≥ 0.97 perfect / SLAM | collisions perfect / "
-        "SLAM | SLAM ÷ perfect time | ATE (m) | odometry ÷ SLAM ATE | map error | loop "
+        "| family | policy | pairs | self-stops ≥ 0.97 perfect / SLAM | coverage perfect / SLAM "
+        "| collisions perfect / SLAM | SLAM ÷ perfect time | ATE (m) | odometry ÷ SLAM ATE | map error | loop "
         "closures | false stops | SLAM ÷ perfect wall time |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     groups: dict[tuple[str, str], list[Key]] = {}
     for key in perfect:
@@ -180,7 +183,7 @@ def slam_vs_perfect_lines(rows: list[Row], reference: str) -> list[str]:
     lines = [
         "Each mission on the perfect map paired with the same (world, policy, seed) in the SLAM "
         f"mode. Self-stops: missions that stopped themselves at true coverage ≥ {GOOD_COVERAGE}; "
-        "time ratios: median over the pairs of the SLAM mission's time divided by the "
+        "coverage: median true coverage at the mission's end; time ratios: median over the pairs of the SLAM mission's time divided by the "
         "perfect-map mission's, p = two-sided Wilcoxon signed-rank test on the log ratios; ATE, "
         "odometry ÷ SLAM ATE (per mission), map error and loop closures: medians over the SLAM "
         "missions; false stops: SLAM missions the policy ended short on a SLAM artefact.",

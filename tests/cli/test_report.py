@@ -205,8 +205,8 @@ def test_report_reads_several_runs_as_one_for_the_slam_pairs(tmp_path: Path, cap
     slam = _write_slam_pair(tmp_path / "slam", slam=True, seeds=range(2))
     assert main(["report", str(perfect), str(slam / "runs.csv"), "--table", "slam-vs-perfect"]) == 0
     out = capsys.readouterr().out
-    assert "| paper mazes | semantic | 2 | 2/2 / 2/2 | 0 / 0 | 1.10 (p = " in out
-    assert "| paper mazes | nearest | 2 | 2/2 / 2/2 | 0 / 0 | 1.10 (p = " in out
+    assert "| paper mazes | semantic | 2 | 2/2 / 2/2 | 0.990 / 0.990 | 0 / 0 | 1.10 (p = " in out
+    assert "| paper mazes | nearest | 2 | 2/2 / 2/2 | 0.990 / 0.990 | 0 / 0 | 1.10 (p = " in out
     assert "| family | map | semantic ÷ nearest |" in out
     assert "| paper mazes | SLAM | 0.50 (p = " in out
     # Several runs read as one for any benchmark table, and --json names every file read.

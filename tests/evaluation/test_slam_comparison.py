@@ -38,19 +38,29 @@ def test_missions_pair_by_world_policy_and_seed() -> None:
     perfect = [_row("semantic", s, 100.0 + s, 1.0) for s in range(4)]
     perfect += [_row("nearest", s, 200.0, 1.0) for s in range(4)]
     slam = [
-        _row("semantic", s, 110.0, 2.0, slam_false_stop=s == 0, **SLAM_FIGURES) for s in range(3)
+        _row(
+            "semantic",
+            s,
+            110.0,
+            2.0,
+            slam_false_stop=s == 0,
+            **SLAM_FIGURES,
+            coverage=0.96 + s / 100,
+        )
+        for s in range(3)
     ]
     slam += [_row("nearest", s, 150.0, 2.0, **SLAM_FIGURES) for s in range(4)]
     slam.append(_row("frontier", 0, 90.0, 1.0, **SLAM_FIGURES))  # no perfect-map twin
     lines = slam_vs_perfect_lines(perfect + slam, "semantic")
     cells = _cells(lines, "| paper mazes | semantic |")
     assert cells[2] == "3"  # seed 3 has no SLAM twin
-    assert cells[3] == "3/3 / 3/3"
+    assert cells[3] == "3/3 / 2/3"  # seed 0's SLAM mission ended at 0.96
+    assert cells[4] == "0.990 / 0.970"  # median true coverage on each map
     ratios = [110.0 / (100.0 + s) for s in range(3)]
-    assert cells[5] == median_p(ratios)
-    assert cells[5].startswith("1.09 (p = ")
-    assert cells[6:10] == ["0.020", "20.0", "0.050", "3"]
-    assert cells[10] == "1/3" and cells[11] == "2.00×"
+    assert cells[6] == median_p(ratios)
+    assert cells[6].startswith("1.09 (p = ")
+    assert cells[7:11] == ["0.020", "20.0", "0.050", "3"]
+    assert cells[11] == "1/3" and cells[12] == "2.00×"
     assert not [ln for ln in lines if ln.startswith("| paper mazes | frontier |")]
     # The second table: semantic's time over the others' on each map; frontier ran on SLAM only.
     head = next(ln for ln in lines if ln.startswith("| family | map |"))
