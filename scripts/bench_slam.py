@@ -10,6 +10,10 @@ median wall time of each mode and the median of the paired ratios; at the end th
 over all worlds' rounds, with the load average (the machine is shared: quote the ratios, which
 alternation keeps fair, more than the seconds).
 
+A benchmark check as well: the SLAM issue (#54) keeps the SLAM mission's wall time at most 3x
+the perfect map's, so the script exits with status 1, and a line saying so, when the median
+ratio over all pairs is above ``--max-ratio`` (3.0).
+
     python scripts/bench_slam.py --worlds 'maze1;maze2' --rounds 3
     python scripts/bench_slam.py --worlds 'office:seed=300,size_m=12' --rounds 3 --json
 """
@@ -51,9 +55,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0, help="the missions' start seed")
     ap.add_argument("--rounds", type=int, default=3, help="alternated pairs per world (>= 1)")
     ap.add_argument("--json", action="store_true", help="print the results as JSON")
+    ap.add_argument(
+        "--max-ratio",
+        type=float,
+        default=3.0,
+        help="exit 1 when the median SLAM / perfect wall-time ratio is above this (default 3.0)",
+    )
     args = ap.parse_args(argv)
     if args.rounds < 1:
         ap.error(f"--rounds must be >= 1, got {args.rounds}")
+    if not args.max_ratio > 0:
+        ap.error(f"--max-ratio must be > 0, got {args.max_ratio}")
     worlds = [w.strip() for w in args.worlds.split(";") if w.strip()]
     if not worlds:
         ap.error(f"--worlds names no world: {args.worlds!r}")
@@ -87,14 +99,27 @@ def main(argv: list[str] | None = None) -> int:
                 f"{out[world]['ratio']:.2f} (median of {args.rounds})",
                 flush=True,
             )
-    summary = {"median_ratio": statistics.median(ratios_all), "load_avg_1min": os.getloadavg()[0]}
+    median = statistics.median(ratios_all)
+    summary = {
+        "median_ratio": median,
+        "load_avg_1min": os.getloadavg()[0],
+        "max_ratio": args.max_ratio,
+        "within_max_ratio": median <= args.max_ratio,
+    }
     if args.json:
         print(json.dumps({"worlds": out, **summary}, indent=2))
     else:
         print(
-            f"all: SLAM / perfect wall time, median {summary['median_ratio']:.2f} over "
+            f"all: SLAM / perfect wall time, median {median:.2f} over "
             f"{len(ratios_all)} pairs (load average {summary['load_avg_1min']:.2f})"
         )
+    if median > args.max_ratio:
+        print(
+            f"check failed: the median SLAM / perfect wall-time ratio {median:.2f} is above "
+            f"--max-ratio {args.max_ratio:g}",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 
