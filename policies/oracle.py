@@ -150,6 +150,13 @@ class OracleParams:
             fewer than this share of the reachable mask ...
         finish_slack: ... at a candidate whose scan would see this many times the cells needed
             (a single scan's view is fragile: see :class:`~semexplore_gym.core.coverage_tour.refine.LegVisibility`).
+        drive_planned_legs: Drive to the next viewpoint along the leg the tour counted (from
+            the viewpoint just reached, or from where the rest of the tour was re-chosen), not
+            the least-cost path from the robot's cell: the robot stops up to
+            ``goal_reached_radius_m`` short of a viewpoint, and where two ways round a block
+            cost about the same, a search from there can take the other way, which does not
+            see what the planned leg would (on a DungeonMap this left a room unseen until a
+            15 m detour at the end). False: the least-cost path from the robot (before).
     """
 
     tour: TourParams = field(default_factory=TourParams)
@@ -175,6 +182,7 @@ class OracleParams:
     repair_min_cells: int = 10
     repair_radius_m: float = 1.0
     finish_slack: float = 1.5
+    drive_planned_legs: bool = True
 
 
 class OraclePolicy(Policy):
@@ -244,6 +252,10 @@ class OraclePolicy(Policy):
         self._goal_xy: tuple[float, float] | None = None
         self._goal_rc: tuple[int, int] | None = None
         self._goal_kind = ""
+        # The cell the tour's prediction drives the next tour leg from (None: from the robot).
+        self._leg_from: tuple[int, int] | None = self._robot_cell(
+            (float(obs["pose"][0]), float(obs["pose"][1]), float(obs["pose"][2]))
+        )
         self._path: np.ndarray | None = None
         self._progress = 0
         self._time_s = 0.0
@@ -350,11 +362,13 @@ class OraclePolicy(Policy):
             if d <= prm.goal_reached_radius_m:
                 self.counters["reached"] += 1
                 passed = self._left[0] if self._goal_kind == "tour" and self._left else None
+                self._leg_from = self._goal_rc if passed is not None else None
                 self._drop_goal()
                 if passed is not None:
                     self._repair(grid, pose, passed)
             elif self._time_s - self._goal_since_s > self._goal_budget_s:
                 self.counters["timeouts"] += 1
+                self._leg_from = None
                 self._drop_goal()
         if self._goal_xy is None or self._time_s >= self._next_check_s - 1e-9:
             self._next_check_s = self._time_s + prm.check_period_s
@@ -397,6 +411,8 @@ class OraclePolicy(Policy):
         if self._goal_kind == "tour" and (not chosen or self._goal_rc != self._rc(chosen[0])):
             self._goal_xy = self._goal_rc = None
             self._path = None
+        if self._goal_xy is None:
+            self._leg_from = here  # the chosen rest was judged from here
 
     def _repair(self, grid: np.ndarray, pose: tuple[float, float, float], vp: int) -> None:
         """At a viewpoint just reached: look again from nearby where its scan fell short."""
@@ -494,7 +510,12 @@ class OraclePolicy(Policy):
         return rc
 
     def _set_goal(self, rc: tuple[int, int], kind: str, pose: tuple[float, float, float]) -> bool:
-        path = self._plan_path(rc, pose)
+        leg_from, self._leg_from = self._leg_from, None
+        path = None
+        if kind == "tour" and leg_from is not None and self.params.drive_planned_legs:
+            path = self._planned_leg(leg_from, rc, pose)
+        if path is None:
+            path = self._plan_path(rc, pose)
         if path is None:
             return False
         x, y = self.geometry.grid_to_world(rc[0], rc[1])
@@ -506,6 +527,26 @@ class OraclePolicy(Policy):
             self.params.goal_time_factor * length / self.limits.max_linear_speed_mps,
         )
         return True
+
+    def _planned_leg(
+        self, leg_from: tuple[int, int], rc: tuple[int, int], pose: tuple[float, float, float]
+    ) -> np.ndarray | None:
+        """The tour's leg from ``leg_from`` to ``rc`` (the cells its scans were counted on),
+        from the robot's pose; None when the robot is not at ``leg_from``'s cell or beside it."""
+        tour = self.tour
+        assert tour is not None and tour.legs is not None
+        here = self._robot_cell(pose)
+        reach = self.params.goal_reached_radius_m / self.geometry.resolution_m + 1.0
+        if math.hypot(here[0] - leg_from[0], here[1] - leg_from[1]) > reach:
+            return None
+        cells = tour.legs.path(leg_from, rc)
+        if cells is None:
+            return None
+        xs, ys = self.geometry.grid_to_world(cells[:, 0], cells[:, 1])
+        pts = np.vstack([[pose[0], pose[1]], np.column_stack([xs, ys])])
+        self._path = resample_polyline(pts, self.geometry.resolution_m)
+        self._progress = 0
+        return self._path
 
     def _plan_path(
         self, rc: tuple[int, int], pose: tuple[float, float, float]

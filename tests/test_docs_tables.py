@@ -81,9 +81,9 @@ def test_the_best_known_table_has_each_family_of_the_shipped_table(tmp_path: Pat
     text = ext.write_tables(DOCS, tmp_path)["best_known"].read_text(encoding="utf-8")
     with (DOCS / ext.TABLES["best_known"][0]).open(newline="") as f:
         rows = list(csv.DictReader(f))
-    for family in {world_family(r["world"]) for r in rows}:
-        n = sum(1 for r in rows if world_family(r["world"]) == family and r["start"] == "random")
-        assert f"| {family} | random | {n} | " in text, family
+    for family, start in {(world_family(r["world"]), r["start"]) for r in rows}:
+        n = sum(1 for r in rows if world_family(r["world"]) == family and r["start"] == start)
+        assert f"| {family} | {start} | {n} | " in text, (family, start)
 
 
 def test_the_slam_table_pairs_each_family_and_policy_of_its_runs(tmp_path: Path) -> None:
@@ -163,3 +163,20 @@ def test_the_oracle_tables_have_each_family_of_their_runs(tmp_path: Path) -> Non
         n = sum(1 for r in missions if world_family(r["world"]) == family)
         assert re.search(rf"^\| {family} \| \d+ \| {n} \| 0 \|", check, re.M), family
     assert f"missions: {len(missions)};" in check
+
+
+def test_the_dungeon_learners_table_pairs_fixed_starts_with_the_best_known(tmp_path: Path) -> None:
+    """The DungeonMaps start on their markers: the table's missions pair with the best-known
+    table's fixed starts (its gap-closed and bound columns filled for every learner)."""
+    ext = _extension()
+    text = ext.write_tables(DOCS, tmp_path)["learners_vs_expert_dungeon"].read_text("utf-8")
+    with (DOCS / ext.TABLES["learners_vs_expert_dungeon"][0]).open(newline="") as f:
+        runs = list(csv.DictReader(f))
+    for policy in {r["policy"] for r in runs}:
+        n = sum(1 for r in runs if r["policy"] == policy)
+        row = next(line for line in text.splitlines() if line.startswith(f"| dungeon | {policy} |"))
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[2] == str(n), policy
+        assert cells[-1] == f"{cells[-1].split()[0]} ({n})" and cells[-1] != "–", policy
+        if policy != "semantic":
+            assert re.fullmatch(r"-?\d+\.\d\d \(\d+\)", cells[-2]), (policy, cells[-2])

@@ -21,6 +21,7 @@ TABLES: dict[str, tuple[str, str | None]] = {
     "lower_bound_check": ("results/oracle/missions.csv", None),
     "slam_vs_perfect": ("results/slam/runs.csv", "slam-vs-perfect"),
     "learners_vs_expert": ("results/learning/runs.csv", "paired"),
+    "learners_vs_expert_dungeon": ("results/learning_dungeon/runs.csv", "paired"),
     "teams_mazes": ("results/teams/runs.csv", None),
 }
 GENERATED_DIR = "_generated"

@@ -143,6 +143,14 @@ def run_start(out_dir: str | os.PathLike) -> str | None:
         return None  # another env config, or a team
     if meta.get("env_overrides", [None]):
         return None  # overrides, or unknown ones (an older manifest)
+    # A suite's or split's own ``random_start: false`` (the DungeonMaps' start markers) fixes
+    # the starts as ``--fixed-start`` does; the manifest records it per suite.
+    suites = meta.get("suites") or []
+    starts = {s.get("random_start") for s in suites if isinstance(s, dict)} - {None}
+    if starts == {False}:
+        return "fixed"
+    if len(starts) > 1:
+        return None  # random and fixed starts in one run
     return "fixed" if meta.get("fixed_start") else "random"
 
 

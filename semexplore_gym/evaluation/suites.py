@@ -290,7 +290,8 @@ def suite_tasks(
         env_overrides: ``SECTION.KEY=VALUE`` env overrides (win over the suite's).
 
     Returns:
-        (tasks, ``[{"name", "version", "source"}]`` per suite, every world in order).
+        (tasks, ``[{"name", "version", "source", "random_start"}]`` per suite, every world in
+        order).
 
     Raises:
         ParameterError: an unknown or repeated suite, a world in two suites, a world that
@@ -313,9 +314,16 @@ def suite_tasks(
         if any(r["name"] == suite.name for r in records):
             raise ParameterError("names", f"{PARAM} lists suite {suite.name!r} twice")
         source = suite.source if isinstance(name, Suite) else str(name)
-        records.append({"name": suite.name, "version": suite.version, "source": source})
         seeds = seeds_for(suite.runs)
         random_start = suite.random_start and not fixed_start
+        records.append(
+            {
+                "name": suite.name,
+                "version": suite.version,
+                "source": source,
+                "random_start": random_start,
+            }
+        )
         repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
         if not random_start and len(seeds) > 1 and repeated:
             _warn_repeated_missions(suite.name, len(repeated))

@@ -259,7 +259,7 @@ def test_suite_time_limits_per_world(tmp_path, capsys) -> None:
     for t in tasks:
         assert t.env_config.episode.max_time_s == t.max_time_s
         assert t.env_config.episode.random_start is True
-    assert records == [{"name": "tiny", "version": 2, "source": str(suite)}]
+    assert records == [{"name": "tiny", "version": 2, "source": str(suite), "random_start": True}]
 
 
 @pytest.mark.parametrize(

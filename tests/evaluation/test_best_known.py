@@ -170,6 +170,26 @@ def test_only_runs_with_the_default_env_are_compared(tmp_path):
     assert manifest(env_overrides=["lidar.max_range_m=5"]) is None
     (tmp_path / "benchmark.json").write_text(json.dumps({"fixed_start": False, "config": None}))
     assert run_start(tmp_path) is None  # an older manifest: overrides unknown
+    # A suite or split whose own starts are fixed (the DungeonMaps' markers).
+    dungeon = {"name": "dungeon-test", "version": 1, "source": "s", "random_start": False}
+    assert manifest(suites=[dungeon]) == "fixed"
+    assert manifest(suites=[{**dungeon, "random_start": True}]) == "random"
+    assert manifest(suites=[dungeon, {**dungeon, "random_start": True}]) is None  # both kinds
+    # A manifest written before suites recorded their starts reads as before.
+    assert manifest(suites=[{"name": "paper", "version": 1, "source": "s"}]) == "random"
+
+
+def test_a_split_with_fixed_starts_records_them_in_the_manifest(tmp_path):
+    from semexplore_gym.evaluation.suites import Suite, SuiteWorld, suite_tasks
+
+    worlds = (SuiteWorld("maze1"),)
+    fixed = Suite(name="fixed", version=1, worlds=worlds, random_start=False)
+    _, records, _ = suite_tasks([fixed], ["nearest"], lambda runs: [0])
+    assert records[0]["random_start"] is False
+    _, records, _ = suite_tasks([Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0])
+    assert records[0]["random_start"] is True
+    _, records, _ = suite_tasks([Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0], fixed_start=True)
+    assert records[0]["random_start"] is False
 
 
 def test_benchmark_compares_with_a_table_and_writes_the_updated_one(tmp_path, capsys):

@@ -164,3 +164,44 @@ def test_the_oracle_drives_through_a_passage_just_wider_than_the_robot(ros_map_f
     # Without the tight mode (the field everywhere) the robot never gets to the far room.
     stalled, _ = mission(tight_margin_m=0.0)
     assert not stalled.self_stopped and stalled.coverage < 0.8
+
+
+def _ring_pixels() -> np.ndarray:
+    """Map pixels (0.05 m): a 5 m square room round a 2.5 m block, symmetric about its middle
+    row, so that the ways north and south of the block between the middles of the west and
+    east corridors cost the same."""
+    img = np.zeros((105, 105), dtype=np.uint8)
+    img[2:103, 2:103] = 254
+    img[27:78, 27:78] = 0
+    return img
+
+
+def test_the_oracle_drives_the_leg_its_tour_counted(ros_map_file):
+    world = ros_map_file(_ring_pixels(), "ring")
+    env = gym.make("SemanticExplore-v0", world=world, privileged=True)
+    obs, info = env.reset(seed=0)
+    policy = OraclePolicy()
+    policy.reset(obs, info, seed=0)
+    geo, legs = policy.geometry, policy.tour.legs
+    west = tuple(int(v) for v in geo.world_to_grid(0.1 + 0.625, 2.625))
+    east = tuple(int(v) for v in geo.world_to_grid(5.25 - 0.1 - 0.625, 2.625))
+    leg = legs.path(west, east)
+    side = int(np.sign(leg[:, 0].mean() - west[0]))
+    assert side != 0
+    # The robot stopped two cells short of the viewpoint, towards the other side of the block.
+    x, y = geo.grid_to_world(west[0] - 2 * side, west[1])
+    pose = (float(x), float(y), 0.0)
+
+    def driven_side(path: np.ndarray) -> int:
+        rows, _ = geo.world_to_grid(path[:, 0], path[:, 1])
+        return int(np.sign(np.mean(rows) - west[0]))
+
+    for drive_planned_legs, expected in ((True, side), (False, -side)):
+        policy.params = OracleParams(drive_planned_legs=drive_planned_legs)
+        policy._leg_from = west
+        assert policy._set_goal(east, "tour", pose)
+        assert driven_side(policy._path) == expected
+        assert policy._leg_from is None  # a leg is driven once; replans start from the robot
+    # Too far from where the leg starts (a timeout, a detour): the least-cost path from the robot.
+    x, y = geo.grid_to_world(west[0] - 10 * side, west[1])
+    assert policy._planned_leg(west, east, (float(x), float(y), 0.0)) is None

@@ -19,11 +19,19 @@ _TIE = (
     "tour, gets there 2 s later"
 )
 
+_PRUNED = (
+    "a 5 m maze: the live map makes a viewpoint unnecessary just short of it, and the leg from "
+    "there to the next, predicted from single scans, leaves two wedges behind a corner unseen "
+    "that the dropped viewpoint's leg would have seen: a detour at the end, T99 139 s against "
+    "the expert's 109 s (99 s driving the least-cost paths, drive_planned_legs=false, which "
+    "loses elsewhere: docs/oracle.md)"
+)
+
 #: (world, seed of the random start): small worlds of each procedural family. Marked: where
 #: the oracle still loses (strict: the mark must go when it stops losing).
 WORLDS = [
     ("maze:seed=1,size_m=5", 0),
-    ("maze:seed=2,size_m=5", 0),
+    pytest.param("maze:seed=2,size_m=5", 0, marks=pytest.mark.xfail(strict=True, reason=_PRUNED)),
     ("maze:seed=3,size_m=5", 2),
     ("office:seed=2,size_m=8", 0),
     ("office:seed=3,size_m=8", 1),

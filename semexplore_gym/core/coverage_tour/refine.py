@@ -81,6 +81,7 @@ class LegVisibility:
         self._scans: dict[tuple[int, int], np.ndarray] = {}
         self._cells: dict[tuple[int, int], np.ndarray] = {}
         self._legs: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
+        self._paths: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray | None] = {}
 
     def cells(self, cells_rc: np.ndarray) -> list[np.ndarray]:
         """Per cell, the sorted columns its pose sees (see ``robust_cells``)."""
@@ -125,17 +126,32 @@ class LegVisibility:
             cols = vis.indices[vis.indptr[i] : vis.indptr[i + 1]]
             self._scans[k] = np.sort(cols).astype(np.int64)
 
+    def path(self, a_rc: tuple[int, int], b_rc: tuple[int, int]) -> np.ndarray | None:
+        """The cells of the leg from ``a_rc`` to ``b_rc`` in driving order: the least-cost path
+        whose scans :meth:`leg` counts (one path per pair of ends, whichever way it is driven:
+        where two ways cost about the same, a search from a cell beside ``a_rc`` may take the
+        other, which sees other cells), or None when ``b_rc`` is unreachable."""
+        a_rc, b_rc = (int(a_rc[0]), int(a_rc[1])), (int(b_rc[0]), int(b_rc[1]))
+        key = (a_rc, b_rc) if a_rc <= b_rc else (b_rc, a_rc)
+        if key not in self._paths:
+            found = shortest_path_cells(self._cost, key[0], key[1])
+            self._paths[key] = None if found is None else found[0]
+        cells = self._paths[key]
+        if cells is None or key[0] == a_rc:
+            return cells
+        return cells[::-1]
+
     def leg(self, a_rc: tuple[int, int], b_rc: tuple[int, int]) -> np.ndarray:
         """Sorted columns seen by the scans along the driven path from ``a_rc`` to ``b_rc``."""
         key = (a_rc, b_rc) if a_rc <= b_rc else (b_rc, a_rc)
         got = self._legs.get(key)
         if got is not None:
             return got
-        found = shortest_path_cells(self._cost, key[0], key[1])
-        if found is None or found[0].shape[0] <= 2:
+        cells = self.path(key[0], key[1])
+        if cells is None or cells.shape[0] <= 2:
             seen = _EMPTY
         else:
-            inner = found[0][1:-1]
+            inner = cells[1:-1]
             samples = inner[self._step_cells // 2 :: self._step_cells]
             keys = [(int(r), int(c)) for r, c in samples]
             self._scan(keys)

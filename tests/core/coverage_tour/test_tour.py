@@ -201,3 +201,38 @@ def test_the_predicted_drive_counts_leg_scans_and_stops_at_the_leg_that_complete
     assert len(route) > 2 and later.sum() > 0
     r1, d1, s1 = predicted_drive_m(tour.legs, route, legs_m, later, 1)
     assert r1 and s1 >= 1 and d1 > legs_m[0]
+
+
+def _ring(privileged_world):
+    """A 5.05 m square room round a 2.55 m block, symmetric about the row through its middle:
+    from the middle of the west corridor to the middle of the east one, the ways north and
+    south of the block cost the same."""
+    s, w = 5.05, 1.25
+    rects = [(0.0, 0.0, s, w), (0.0, s - w, s, s), (0.0, 0.0, w, s), (s - w, 0.0, s, s)]
+    facts = _facts(privileged_world, rects, (s, s), (0.625, 2.525, 0.0))
+    geo = facts.geometry
+    west = tuple(int(v) for v in geo.world_to_grid(0.625, 2.525))
+    east = tuple(int(v) for v in geo.world_to_grid(s - 0.625, 2.525))
+    return facts, west, east
+
+
+def test_a_leg_is_one_path_whichever_way_it_is_driven(privileged_world):
+    from semexplore_gym.core.planning.grid_search import shortest_path_cells
+
+    facts, west, east = _ring(privileged_world)
+    tour = plan_coverage_tour(facts, TourParams(robust_cells=0))
+    legs = tour.legs
+    assert legs is not None
+    there, back = legs.path(west, east), legs.path(east, west)
+    assert there is not None and back is not None
+    assert tuple(there[0]) == west and tuple(there[-1]) == east
+    np.testing.assert_array_equal(there, back[::-1])
+    np.testing.assert_array_equal(legs.leg(west, east), legs.leg(east, west))
+    # The two ways tie: the leg takes one; a search from two cells towards the other side of
+    # the block takes the other, which is why the oracle drives the leg itself.
+    side = np.sign(there[:, 0].mean() - west[0])
+    assert side != 0
+    beside = (west[0] - int(side) * 2, west[1])
+    other = shortest_path_cells(legs._cost, beside, east)
+    assert other is not None
+    assert np.sign(other[0][:, 0].mean() - west[0]) == -side
