@@ -186,9 +186,13 @@ def test_a_split_with_fixed_starts_records_them_in_the_manifest(tmp_path):
     fixed = Suite(name="fixed", version=1, worlds=worlds, random_start=False)
     _, records, _ = suite_tasks([fixed], ["nearest"], lambda runs: [0])
     assert records[0]["random_start"] is False
-    _, records, _ = suite_tasks([Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0])
+    _, records, _ = suite_tasks(
+        [Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0]
+    )
     assert records[0]["random_start"] is True
-    _, records, _ = suite_tasks([Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0], fixed_start=True)
+    _, records, _ = suite_tasks(
+        [Suite(name="r", version=1, worlds=worlds)], ["nearest"], lambda runs: [0], fixed_start=True
+    )
     assert records[0]["random_start"] is False
 
 

@@ -21,6 +21,7 @@ the grid :func:`wall_sliver_mask_box` computes the mask again over the changed b
 from __future__ import annotations
 
 import math
+
 import numpy as np
 import numpy.typing as npt
 from scipy import ndimage
