@@ -27,11 +27,17 @@ import csv
 import math
 import sys
 import time
-from multiprocessing import Pool
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from semexplore_gym.evaluation.table_refresh import (
+    BEST_KNOWN,
+    add_refresh_arguments,
+    run_into_cache,
+    table_kind,
+)
 
 #: One start: (world spelling, seed, random start).
 Start = tuple[str, int, bool]
@@ -57,30 +63,25 @@ class Table:
     """One table's rows as ``(start, T99_s, drive_m, bound_s, bound_m)`` and how to write it."""
 
     def __init__(self, path: Path) -> None:
-        from semexplore_gym.evaluation.best_known import COLUMNS, read_table
-        from semexplore_gym.evaluation.bound_check import MISSION_COLUMNS, read_missions
+        from semexplore_gym.evaluation.best_known import read_table
+        from semexplore_gym.evaluation.bound_check import read_missions
 
-        if not path.is_file():
-            raise ValueError(f"{path} does not exist")
-        with path.open(newline="", encoding="utf-8", errors="replace") as fh:
-            header = next(csv.reader(fh), [])
         self.path = path
-        if all(c in header for c in COLUMNS):
-            self.kind, self.digits = "best-known", 3
+        self.kind = table_kind(path)
+        if self.kind == BEST_KNOWN:
+            self.digits = 3
             self.entries: Any = read_table(path)
             self.rows = [
                 ((w, s, st == "random"), e["T99_s"], e["D99_m"], e["lower_bound_s"], e["lower_bound_m"])
                 for (w, s, st), e in self.entries.items()
             ]  # fmt: skip
-        elif all(c in header for c in MISSION_COLUMNS):
-            self.kind, self.digits = "checked missions", 4
+        else:
+            self.digits = 4
             self.entries = read_missions(path)
             self.rows = [
                 (m["start"], m["T99_s"], m["drive_m"], m["bound_s"], m["bound_m"])
                 for m in self.entries
             ]
-        else:
-            raise ValueError(f"{path} is neither a best-known table nor a checked-missions CSV")
 
     def write(self, bounds: dict[Start, tuple[float, float]]) -> None:
         """Write the table with ``bounds`` in its bound columns (rounded to its digits)."""
@@ -90,7 +91,7 @@ class Table:
         def cell(x: float) -> float:
             return round(x, self.digits) if math.isfinite(x) else math.inf
 
-        if self.kind == "best-known":
+        if self.kind == BEST_KNOWN:
             for (w, s, st), e in self.entries.items():
                 bound_s, bound_m = bounds[(w, s, st == "random")]
                 e["lower_bound_s"], e["lower_bound_m"] = cell(bound_s), cell(bound_m)
@@ -115,25 +116,20 @@ def read_cache(path: Path) -> dict[Start, tuple[float, float]]:
         }
 
 
+def start_bound_row(task: tuple[Start, int | None]) -> list[str]:
+    """A cache row (:data:`CACHE_COLUMNS`) of one start's bound (a worker's task)."""
+    start, bound_s, bound_m, seconds = start_bound(task)
+    return [start[0], str(start[1]), str(start[2]), repr(bound_s), repr(bound_m), f"{seconds:.1f}"]
+
+
 def compute(todo: list[Start], cache: Path, workers: int, progress: bool) -> None:
     """Each start's bound appended to ``cache`` as it comes (largest worlds first)."""
-    from tqdm import tqdm
-
     todo = sorted(todo, key=lambda s: (not s[0].startswith("map:"), s))
-    new = not cache.is_file()
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    with cache.open("a", newline="", encoding="utf-8") as fh, Pool(workers) as pool:
-        w = csv.writer(fh)
-        if new:
-            w.writerow(CACHE_COLUMNS)
-        bar = tqdm(total=len(todo), desc="bounds", unit="start", disable=not progress)
-        threads = None if workers == 1 else 1  # one worker: its searches on every CPU
-        tasks = [(start, threads) for start in todo]
-        for start, bound_s, bound_m, seconds in pool.imap_unordered(start_bound, tasks):
-            w.writerow([*start[:2], str(start[2]), repr(bound_s), repr(bound_m), f"{seconds:.1f}"])
-            fh.flush()
-            bar.update()
-        bar.close()
+    threads = None if workers == 1 else 1  # one worker: its searches on every CPU
+    tasks = [(start, threads) for start in todo]
+    run_into_cache(
+        start_bound_row, tasks, cache, CACHE_COLUMNS, workers, progress=progress, desc="bounds"
+    )
 
 
 def report(table: Table, bounds: dict[Start, tuple[float, float]]) -> tuple[list[str], int]:
@@ -168,16 +164,7 @@ def report(table: Table, bounds: dict[Start, tuple[float, float]]) -> tuple[list
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("tables", nargs="+", type=Path, help="best-known or checked-missions CSVs")
-    ap.add_argument("--workers", type=int, default=1, help="processes (default 1)")
-    ap.add_argument(
-        "--cache",
-        type=Path,
-        default=Path("runs/recomputed_bounds.csv"),
-        help="each start's new bound, as it comes (default runs/recomputed_bounds.csv)",
-    )
-    ap.add_argument("--fresh", action="store_true", help="discard the cache first")
-    ap.add_argument("--dry-run", action="store_true", help="report only; write no table")
-    ap.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_refresh_arguments(ap, "runs/recomputed_bounds.csv", "new bound")
     args = ap.parse_args(argv)
     if args.workers < 1:
         print(f"error: --workers must be at least 1, got {args.workers}", file=sys.stderr)

@@ -30,11 +30,19 @@ import io
 import math
 import sys
 import time
-from multiprocessing import Pool
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from semexplore_gym.evaluation.table_refresh import (
+    BEST_KNOWN,
+    CHECKED_MISSIONS,
+    RUNS,
+    add_refresh_arguments,
+    run_into_cache,
+    table_kind,
+)
 
 #: One start: (world spelling, seed, random start).
 Start = tuple[str, int, bool]
@@ -123,40 +131,30 @@ class Table:
     """A table's oracle starts and how to write today's missions into it."""
 
     def __init__(self, path: Path) -> None:
-        from semexplore_gym.evaluation.best_known import COLUMNS, read_table
-        from semexplore_gym.evaluation.bound_check import MISSION_COLUMNS, read_missions
+        from semexplore_gym.evaluation.best_known import read_table
+        from semexplore_gym.evaluation.bound_check import read_missions
 
-        if not path.is_file():
-            raise ValueError(f"{path} does not exist")
-        with path.open(newline="", encoding="utf-8", errors="replace") as fh:
-            header = next(csv.reader(fh), [])
         self.path = path
+        self.kind = table_kind(path, RUNS_COLUMNS)
         self.starts: dict[tuple[str, int], bool] = {}  # (world, seed) -> random start
-        if all(c in header for c in COLUMNS):
-            self.kind = "best-known"
+        if self.kind == BEST_KNOWN:
             self.entries: Any = read_table(path)
             self.starts = {(w, s): st == "random" for (w, s, st) in self.entries}
-        elif all(c in header for c in MISSION_COLUMNS):
-            self.kind = "checked missions"
+        elif self.kind == CHECKED_MISSIONS:
             self.entries = read_missions(path)
             for m in self.entries:
                 if m["policy"] == ORACLE:
                     w, s, random_start = m["start"]
                     self.starts[(w, s)] = random_start
-        elif all(c in header for c in RUNS_COLUMNS):
-            self.kind = "runs"
+        else:
             text = path.read_bytes().decode("utf-8")
             self.newline = "\r\n" if "\r\n" in text else "\n"
-            self.header = header
             self.entries = list(csv.DictReader(io.StringIO(text, newline="")))
-        else:
-            raise ValueError(
-                f"{path} is neither a best-known table, a checked-missions CSV nor a runs.csv"
-            )
+            self.header = list(self.entries[0]) if self.entries else list(RUNS_COLUMNS)
 
     def oracle_keys(self) -> list[tuple[str, int]]:
         """(world, seed) of the rows today's oracle is run for."""
-        if self.kind == "runs":
+        if self.kind == RUNS:
             return [(r["world"], int(r["seed"])) for r in self.entries if r["policy"] == ORACLE]
         return list(self.starts)
 
@@ -178,7 +176,7 @@ class Table:
             ):
                 below.append(f"  BELOW THE BOUND {where}: T99 {t99} s, drive {drive} m")
 
-        if self.kind == "checked missions":
+        if self.kind == CHECKED_MISSIONS:
             for m in self.entries:
                 if m["policy"] != ORACLE:
                     continue
@@ -193,7 +191,7 @@ class Table:
                     pairs.append((t99, m["T99_s"]))
                 changed += (t99, drive) != (m["T99_s"], m["drive_m"])
                 m["T99_s"], m["drive_m"] = t99, drive
-        elif self.kind == "runs":
+        elif self.kind == RUNS:
             for row in self.entries:
                 if row["policy"] != ORACLE:
                     continue
@@ -242,9 +240,9 @@ class Table:
         from semexplore_gym.evaluation.best_known import write_table
         from semexplore_gym.evaluation.bound_check import write_missions
 
-        if self.kind == "best-known":
+        if self.kind == BEST_KNOWN:
             write_table(self.path, self.entries)
-        elif self.kind == "checked missions":
+        elif self.kind == CHECKED_MISSIONS:
             write_missions(self.path, self.entries)
         else:
             buf = io.StringIO(newline="")
@@ -270,23 +268,26 @@ def starts_of(tables: list[Table]) -> dict[tuple[str, int], bool]:
     return starts
 
 
+def oracle_mission_row(task: tuple[Start, float]) -> list[Any]:
+    """A cache row (:data:`CACHE_COLUMNS`) of one start's mission (a worker's task)."""
+    row = oracle_mission(task)
+    return [row[c] for c in CACHE_COLUMNS]
+
+
 def run_all(todo: list[Start], cache: Path, workers: int, limit_s: float, progress: bool) -> None:
     """Each start's mission appended to ``cache`` as it comes (real maps first)."""
-    from tqdm import tqdm
-
     todo = sorted(todo, key=lambda s: (not s[0].startswith("map:"), s))
-    new = not cache.is_file()
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    with cache.open("a", newline="", encoding="utf-8") as fh, Pool(workers) as pool:
-        w = csv.DictWriter(fh, CACHE_COLUMNS)
-        if new:
-            w.writeheader()
-        bar = tqdm(total=len(todo), desc="oracle", unit="mission", disable=not progress)
-        for row in pool.imap_unordered(oracle_mission, [(s, limit_s) for s in todo]):
-            w.writerow(row)
-            fh.flush()
-            bar.update()
-        bar.close()
+    tasks = [(s, limit_s) for s in todo]
+    run_into_cache(
+        oracle_mission_row,
+        tasks,
+        cache,
+        CACHE_COLUMNS,
+        workers,
+        progress=progress,
+        desc="oracle",
+        unit="mission",
+    )
 
 
 def summary(table: Table, pairs: list[tuple[float, float]], changed: int) -> str:
@@ -306,13 +307,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "tables", nargs="+", type=Path, help="checked-missions, runs or best-known CSVs"
     )
-    ap.add_argument("--workers", type=int, default=1, help="processes (default 1)")
-    ap.add_argument(
-        "--cache",
-        type=Path,
-        default=Path("runs/oracle_rerun.csv"),
-        help="each start's mission, as it comes (default runs/oracle_rerun.csv)",
-    )
+    add_refresh_arguments(ap, "runs/oracle_rerun.csv", "mission")
     ap.add_argument(
         "--old-spec",
         default="",
@@ -326,9 +321,6 @@ def main(argv: list[str] | None = None) -> int:
         help="stop a mission after this simulated time (default 20000; the oracle stops "
         "itself at the coverage goal)",
     )
-    ap.add_argument("--fresh", action="store_true", help="discard the cache first")
-    ap.add_argument("--dry-run", action="store_true", help="report only; write no table")
-    ap.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     if args.workers < 1:
         print(f"error: --workers must be at least 1, got {args.workers}", file=sys.stderr)
