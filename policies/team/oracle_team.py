@@ -59,7 +59,9 @@ class TeamOracleParams:
 
     Attributes:
         member: Each robot's driving (the one-robot oracle's parameters; its ``tour`` is the
-            tour the team splits).
+            tour the team splits). A member drives the least-cost path from where it is
+            (``drive_planned_legs`` does not apply): its route is re-solved on distances
+            alone, so no leg was counted for it to follow.
         routing: The split's solver settings.
         coverage_goal: The team stops at this team coverage (the benchmark's T99 level; the
             env's own goal is ignored, as the team benchmark sets it to 1).
@@ -101,6 +103,11 @@ class _RouteOracle(OraclePolicy):
 
     def plan_tour(self, facts: PrivilegedWorld, tour_params: TourParams) -> CoverageTour:
         return self._route
+
+    def _planned_leg(
+        self, leg_from: tuple[int, int], rc: tuple[int, int], pose: tuple[float, float, float]
+    ) -> np.ndarray | None:
+        return None  # no leg of a route was counted: the least-cost path from the robot
 
     def _best_route(
         self, here: tuple[int, int], dist: np.ndarray, routes: list[list[int]], unseen: np.ndarray

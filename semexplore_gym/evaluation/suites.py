@@ -316,14 +316,8 @@ def suite_tasks(
         source = suite.source if isinstance(name, Suite) else str(name)
         seeds = seeds_for(suite.runs)
         random_start = suite.random_start and not fixed_start
-        records.append(
-            {
-                "name": suite.name,
-                "version": suite.version,
-                "source": source,
-                "random_start": random_start,
-            }
-        )
+        record = {"name": suite.name, "version": suite.version, "source": source}
+        records.append({**record, "random_start": random_start})
         repeated = [w.world for w in suite.worlds if "seed=*" not in w.world]
         if not random_start and len(seeds) > 1 and repeated:
             _warn_repeated_missions(suite.name, len(repeated))

@@ -66,3 +66,20 @@ def test_more_robots_than_viewpoints_is_one_clear_line(capsys: pytest.CaptureFix
     err = capsys.readouterr().err.strip()
     assert err.endswith("8 robots, but the coverage tour of this world has 1")
     assert "Traceback" not in err and len(err.splitlines()) == 1
+
+
+def test_team_members_drive_the_least_cost_path_whatever_drive_planned_legs_says():
+    """A member's route is re-solved on distances alone: no leg of it was counted, so the
+    one-robot oracle's ``drive_planned_legs`` leaves a team mission as it was."""
+    from semexplore_gym.evaluation.team_benchmark import run_team_mission
+
+    runs = []
+    for flag in ("true", "false"):
+        env = make_multi(
+            world="maze:seed=1,size_m=5", n_robots=2, overrides=OVERRIDES, privileged=True
+        )
+        team = make_team_policy(f"oracle[member.drive_planned_legs={flag}]")
+        res = run_team_mission(env, team, seed=0, max_time_s=600)
+        assert team.done and res.T99_s is not None
+        runs.append((res.T99_s, res.mission_time_s, tuple(res.path_per_robot_m)))
+    assert runs[0] == runs[1]
