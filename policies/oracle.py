@@ -464,11 +464,7 @@ class OraclePolicy(Policy):
         cells = tour.legs.path(leg_from, rc)
         if cells is None:
             return None
-        xs, ys = self.geometry.grid_to_world(cells[:, 0], cells[:, 1])
-        pts = np.vstack([[pose[0], pose[1]], np.column_stack([xs, ys])])
-        self._path = resample_polyline(pts, self.geometry.resolution_m)
-        self._progress = 0
-        return self._path
+        return self._drive_along(cells, pose)
 
     def _plan_path(
         self, rc: tuple[int, int], pose: tuple[float, float, float]
@@ -478,6 +474,10 @@ class OraclePolicy(Policy):
         if found is None:
             return None
         cells, _ = found
+        return self._drive_along(cells, pose)
+
+    def _drive_along(self, cells: np.ndarray, pose: tuple[float, float, float]) -> np.ndarray:
+        """Follow the path through ``cells`` from the robot's pose, from its start."""
         xs, ys = self.geometry.grid_to_world(cells[:, 0], cells[:, 1])
         pts = np.vstack([[pose[0], pose[1]], np.column_stack([xs, ys])])
         self._path = resample_polyline(pts, self.geometry.resolution_m)
